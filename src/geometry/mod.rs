@@ -1,0 +1,33 @@
+//! Geometry: exact NURBS primitives (lines, circular arcs), analytic curves and their spline fits,
+//! rotation-minimising section frames, and tube surfaces swept along centrelines (vertices and triangles only;
+//! writing files is the `io` layer's job).
+
+pub mod analytic;
+pub mod fit;
+pub mod frame;
+pub mod primitives;
+pub mod tube;
+
+use crate::math::{MathError, Real};
+
+/// Errors raised when geometric data cannot produce a valid curve, frame or surface.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum GeometryError {
+    /// A NURBS operation failed.
+    #[error(transparent)]
+    Math(#[from] MathError),
+    /// A parameter of a primitive or analytic curve is out of range.
+    #[error("invalid {what}: {reason}")]
+    InvalidParameter {
+        /// Which parameter.
+        what: &'static str,
+        /// What is wrong, with the value.
+        reason: String,
+    },
+    /// A curve is degenerate where a frame is needed (zero tangent).
+    #[error("degenerate curve: zero tangent at u = {u}")]
+    ZeroTangent {
+        /// Curve parameter.
+        u: Real,
+    },
+}

@@ -1,0 +1,1 @@
+//! Closed tube surfaces swept along centrelines: vertices and outward-oriented triangles.

@@ -1,0 +1,1 @@
+//! Files: YAML design files, STL and OBJ meshes.

@@ -1,0 +1,40 @@
+//! # stentkit
+//!
+//! Design, simulate and export 4D-printed shape-memory-polymer (SMP) devices made of slender rods —
+//! cardiovascular stents first — following Ferri & Marino, *Simulating programmable morphing of shape memory
+//! polymer beam systems with complex geometry and topology* (equation labels in the docs refer to that paper).
+//!
+//! ## Layers
+//!
+//! Dependencies point one way, left to right never imported from the right:
+//! `math → geometry → material → model → solver → io → cli`.
+//! `math`, `geometry`, `material`, `model` and `solver` are pure: no files, no printing, no serde.
+//!
+//! | module | owns |
+//! |---|---|
+//! | [`math`] | vocabulary types, knot vectors, B-spline/NURBS basis, curves, SO(3) maps |
+//! | [`geometry`] | exact NURBS primitives, analytic curves and their spline fits, rotation-minimising frames, tube surfaces |
+//! | [`material`] | Prony series, WLF shift, section stiffness |
+//! | [`model`] | the continuous problem: patches, nodes, conditions, loads, schedules |
+//! | [`solver`] | collocation, residual and tangent, Newton, time stepping |
+//! | [`io`] | YAML design files, STL/OBJ writers |
+//! | [`cli`] | the `stentkit` command line |
+//!
+//! ## Conventions (stated once, here and in [`math::so3`])
+//!
+//! * Units: any consistent system, declared by the design (`SI` = m, N, Pa, s; `mm-N-MPa` = mm, N, MPa, s).
+//!   Temperature is always °C.
+//! * Rotations: the columns of a rotation `R` are the directors `d1, d2, d3` in global coordinates. `d1` is the
+//!   rod axis (the tangent in the reference configuration), `d2, d3` span the cross-section.
+//! * Material (body) quantities are capitalised in the paper (`Γ, K, N, M`), spatial ones lower-case.
+//!   Rotation increments are material: `R ← R exp(δΘ̃)`.
+//! * Strains: `Γ = Rᵀ c,s`, `K = axial(Rᵀ R,s)`, measured from the reference as `Γ_N = Γ − Γ0`, `K_M = K − K0`.
+//! * `s` is the arc length of the *reference* centreline; curve parameters `u` live in `[0, 1]`.
+
+pub mod cli;
+pub mod geometry;
+pub mod io;
+pub mod material;
+pub mod math;
+pub mod model;
+pub mod solver;

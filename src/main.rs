@@ -1,0 +1,5 @@
+//! The `stentkit` command line; see [`stentkit::cli`].
+
+fn main() -> std::process::ExitCode {
+    stentkit::cli::main()
+}

@@ -1,0 +1,58 @@
+//! Mathematical vocabulary and kernels: the crate's small types, knot vectors, B-spline and NURBS basis
+//! functions with derivatives, curves (evaluation, knot insertion, degree elevation, interpolation) and the SO(3)
+//! maps the rod kinematics needs.
+//!
+//! Everything here is pure and allocation-light; algorithms cite their source (Piegl & Tiller, *The NURBS
+//! Book*, 2nd ed., algorithm numbers A2.1 …).
+
+pub mod basis;
+pub mod curve;
+pub mod interp;
+pub mod knots;
+pub mod so3;
+
+pub use basis::BasisTable;
+pub use curve::NurbsCurve;
+pub use knots::KnotVector;
+
+/// The floating-point type of every computation.
+pub type Real = f64;
+/// A vector (position, displacement, force, rotation vector …) in 3-D.
+pub type Vec3 = nalgebra::Vector3<Real>;
+/// A 3×3 matrix (stiffness block, skew matrix, rotation stored as its matrix).
+pub type Mat3 = nalgebra::Matrix3<Real>;
+/// A rotation; its matrix columns are the directors `d1, d2, d3` in global coordinates.
+pub type Rot3 = nalgebra::Rotation3<Real>;
+
+/// Errors raised by the math layer when data (not the programmer) is wrong.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum MathError {
+    /// A knot vector failed validation.
+    #[error("invalid knot vector: {reason}")]
+    InvalidKnots {
+        /// What is wrong, with the offending values.
+        reason: String,
+    },
+    /// A curve's data are inconsistent (counts, weights, degree).
+    #[error("invalid curve: {reason}")]
+    InvalidCurve {
+        /// What is wrong, with the offending values.
+        reason: String,
+    },
+    /// A parameter lies outside the knot vector's domain.
+    #[error("parameter {u} lies outside the domain [{lo}, {hi}]")]
+    OutOfDomain {
+        /// The parameter asked for.
+        u: Real,
+        /// Lower end of the domain.
+        lo: Real,
+        /// Upper end of the domain.
+        hi: Real,
+    },
+    /// A linear system (interpolation) was singular.
+    #[error("singular system in {context}")]
+    Singular {
+        /// Which computation.
+        context: String,
+    },
+}

@@ -1,0 +1,1 @@
+//! The continuous problem: patches, sections, materials, nodes, boundary conditions, loads and schedules.

@@ -1,0 +1,1 @@
+//! The quasi-static IGA-collocation solver (paper §3).
