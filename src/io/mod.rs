@@ -1,1 +1,4 @@
 //! Files: YAML design files, STL and OBJ meshes.
+
+pub mod obj;
+pub mod stl;

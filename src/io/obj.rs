@@ -1,0 +1,1 @@
+//! Wavefront OBJ export of triangle meshes (plain text, written by hand).

@@ -1,0 +1,1 @@
+//! Binary STL export of triangle meshes (stl_io).
