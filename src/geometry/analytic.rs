@@ -1,1 +1,363 @@
-//! Analytic curves that are not NURBS (helix, the sinusoidal crown wire, placed curves, point lists).
+//! Analytic curves that are not NURBS: the helix, the sinusoidal crown wire of the paper's appendix, point
+//! lists (through their cubic interpolant) and any of them mapped by a placement
+//! `P = c(s) + R(s) P_local` along a centreline. [`super::fit`] turns them into analysis splines.
+
+use super::GeometryError;
+use super::frame::{FrameField, FrameSettings};
+use crate::math::{KnotVector, Mat3, NurbsCurve, Real, Vec3, interp};
+
+/// A smooth parametric curve `t ∈ [t0, t1] ↦ c(t)`.
+pub trait ParametricCurve {
+    /// The parameter interval `(t0, t1)`, `t0 < t1`.
+    fn domain(&self) -> (Real, Real);
+
+    /// The point `c(t)`.
+    fn point(&self, t: Real) -> Vec3;
+
+    /// The derivative `c'(t)`; by default a fourth-order central difference of [`Self::point`]
+    /// (step `1e-3` of the domain length, error `O(1e-12)` relative for curves smooth on that scale).
+    fn derivative(&self, t: Real) -> Vec3 {
+        let (t0, t1) = self.domain();
+        let h = 1e-3 * (t1 - t0);
+        (self.point(t - 2.0 * h) - self.point(t + 2.0 * h)
+            + (self.point(t + h) - self.point(t - h)) * 8.0)
+            / (12.0 * h)
+    }
+}
+
+/// An orthonormal frame from an axis (local z) and an optional reference direction for local x.
+pub fn frame_from_axis(axis: &Vec3, x_hint: Option<Vec3>) -> Result<Mat3, GeometryError> {
+    let n = axis.norm();
+    if !(n > 0.0) || !n.is_finite() {
+        return Err(GeometryError::InvalidParameter {
+            what: "axis",
+            reason: format!("must be a non-zero finite vector, got {axis:?}"),
+        });
+    }
+    let z = axis / n;
+    let x = super::frame::normal_to(&z, x_hint);
+    let y = z.cross(&x);
+    Ok(Mat3::from_columns(&[x, y, z]))
+}
+
+/// A rigid placement `P = origin + rotation · P_local`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct RigidPlacement {
+    /// Where the local origin goes.
+    pub origin: Vec3,
+    /// Columns: the local x, y, z axes in global coordinates.
+    pub rotation: Mat3,
+}
+
+impl RigidPlacement {
+    /// The identity placement.
+    pub fn identity() -> Self {
+        Self {
+            origin: Vec3::zeros(),
+            rotation: Mat3::identity(),
+        }
+    }
+
+    /// Maps a local point.
+    pub fn apply(&self, p: &Vec3) -> Vec3 {
+        self.origin + self.rotation * p
+    }
+}
+
+/// A circular helix about the local z axis: `c(t) = (r cos(φ0 + t), r sin(φ0 + t), pitch t / 2π)`,
+/// `t ∈ [0, 2π turns]`, placed rigidly.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Helix {
+    /// Radius [length], > 0.
+    pub radius: Real,
+    /// Rise per turn [length] (negative for a left-handed helix).
+    pub pitch: Real,
+    /// Number of turns, > 0.
+    pub turns: Real,
+    /// Start angle φ0 [rad].
+    pub start_angle: Real,
+    /// Placement of the local frame.
+    pub placement: RigidPlacement,
+}
+
+impl ParametricCurve for Helix {
+    fn domain(&self) -> (Real, Real) {
+        (0.0, std::f64::consts::TAU * self.turns)
+    }
+
+    fn point(&self, t: Real) -> Vec3 {
+        let a = self.start_angle + t;
+        let local = Vec3::new(
+            self.radius * a.cos(),
+            self.radius * a.sin(),
+            self.pitch * t / std::f64::consts::TAU,
+        );
+        self.placement.apply(&local)
+    }
+
+    fn derivative(&self, t: Real) -> Vec3 {
+        let a = self.start_angle + t;
+        let local = Vec3::new(
+            -self.radius * a.sin(),
+            self.radius * a.cos(),
+            self.pitch / std::f64::consts::TAU,
+        );
+        self.placement.rotation * local
+    }
+}
+
+/// The sinusoidal crown wire of the paper's appendix, on the cylinder of radius `R` about the local z axis:
+/// `c(ϑ) = (R cos ϑ, R sin ϑ, h sin(m ϑ + φ))`, `ϑ ∈ [ϑ0, ϑ1]`, where `m` is the number of waves (crests) per
+/// full turn (the appendix's `n_w/2`). Placed rigidly.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SineWire {
+    /// Cylinder radius `R` [length], > 0.
+    pub radius: Real,
+    /// Amplitude `h` (half the crown height) [length].
+    pub amplitude: Real,
+    /// Waves per full turn `m`, > 0.
+    pub waves: Real,
+    /// Phase φ [rad].
+    pub phase: Real,
+    /// Start angle ϑ0 [rad].
+    pub from: Real,
+    /// End angle ϑ1 [rad], ≠ ϑ0.
+    pub to: Real,
+    /// Placement of the local frame.
+    pub placement: RigidPlacement,
+}
+
+impl ParametricCurve for SineWire {
+    fn domain(&self) -> (Real, Real) {
+        (0.0, 1.0)
+    }
+
+    fn point(&self, t: Real) -> Vec3 {
+        let a = self.from + (self.to - self.from) * t;
+        let local = Vec3::new(
+            self.radius * a.cos(),
+            self.radius * a.sin(),
+            self.amplitude * (self.waves * a + self.phase).sin(),
+        );
+        self.placement.apply(&local)
+    }
+
+    fn derivative(&self, t: Real) -> Vec3 {
+        let da = self.to - self.from;
+        let a = self.from + da * t;
+        let local = Vec3::new(
+            -self.radius * a.sin(),
+            self.radius * a.cos(),
+            self.amplitude * self.waves * (self.waves * a + self.phase).cos(),
+        ) * da;
+        self.placement.rotation * local
+    }
+}
+
+/// A spline curve viewed as a parametric curve on its own domain.
+impl ParametricCurve for NurbsCurve {
+    fn domain(&self) -> (Real, Real) {
+        self.knots().domain()
+    }
+
+    fn point(&self, t: Real) -> Vec3 {
+        NurbsCurve::point(self, t)
+    }
+
+    fn derivative(&self, t: Real) -> Vec3 {
+        self.derivatives(t, 1)[1]
+    }
+}
+
+/// The curve through a list of points: the cubic (or lower, for fewer than four points) spline that
+/// interpolates them at chord-length parameters with averaged knots (Piegl–Tiller Eq. 9.5 and 9.8).
+pub fn point_list_curve(points: &[Vec3]) -> Result<NurbsCurve, GeometryError> {
+    if points.len() < 2 {
+        return Err(GeometryError::InvalidParameter {
+            what: "points",
+            reason: format!("need at least 2 points, got {}", points.len()),
+        });
+    }
+    let mut params = Vec::with_capacity(points.len());
+    params.push(0.0);
+    for (k, w) in points.windows(2).enumerate() {
+        let d = (w[1] - w[0]).norm();
+        if !(d > 0.0) || !d.is_finite() {
+            return Err(GeometryError::InvalidParameter {
+                what: "points",
+                reason: format!("points {k} and {} coincide or are not finite", k + 1),
+            });
+        }
+        params.push(params[k] + d);
+    }
+    let total = params[params.len() - 1];
+    params.iter_mut().for_each(|t| *t /= total);
+    let n = points.len();
+    let p = 3.min(n - 1);
+    // Knots by averaging (Piegl–Tiller Eq. 9.8): u_{j+p} = (1/p) Σ_{i=j}^{j+p−1} t_i, j = 1 … n−p−1.
+    let interior: Vec<Real> = (1..n - p)
+        .map(|j| params[j..j + p].iter().sum::<Real>() / p as Real)
+        .collect();
+    let knots = KnotVector::clamped_with_interior(p, &interior)?;
+    Ok(interp::interpolate(knots, &params, points)?)
+}
+
+/// The arc length `s(t) = ∫_{t0}^{t} |c'|` of a parametric curve, tabulated on uniform panels (5-point
+/// Gauss–Legendre each, exact for degree-9 integrands, so round-off accurate for smooth speeds) and inverted by
+/// Newton's method.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ArcLengthTable {
+    t0: Real,
+    t1: Real,
+    /// Arc length at `t_k = t0 + k (t1 − t0) / panels`.
+    lengths: Vec<Real>,
+}
+
+impl ArcLengthTable {
+    /// Tabulates the arc length of `curve` on `panels` uniform panels.
+    pub fn new(curve: &dyn ParametricCurve, panels: usize) -> Self {
+        let (t0, t1) = curve.domain();
+        let panels = panels.max(1);
+        let mut lengths = vec![0.0; panels + 1];
+        for k in 0..panels {
+            let a = t0 + (t1 - t0) * k as Real / panels as Real;
+            let b = t0 + (t1 - t0) * (k + 1) as Real / panels as Real;
+            lengths[k + 1] = lengths[k] + gauss_legendre_5(a, b, |t| curve.derivative(t).norm());
+        }
+        Self { t0, t1, lengths }
+    }
+
+    /// Total length.
+    pub fn length(&self) -> Real {
+        self.lengths[self.lengths.len() - 1]
+    }
+
+    /// The parameter `t` at arc length `s` (clamped to `[0, L]`): linear guess in the panel, then Newton on
+    /// `s(t) − s = 0`, which reaches round-off in a few iterations.
+    pub fn parameter_at(&self, curve: &dyn ParametricCurve, s: Real) -> Real {
+        // Newton iterations allowed; convergence is quadratic from the in-panel linear guess.
+        const MAX_NEWTON: usize = 8;
+        let panels = self.lengths.len() - 1;
+        let s = s.clamp(0.0, self.length());
+        let k = self.lengths.partition_point(|&l| l <= s).clamp(1, panels);
+        let (la, lb) = (self.lengths[k - 1], self.lengths[k]);
+        let dt = (self.t1 - self.t0) / panels as Real;
+        let ta = self.t0 + dt * (k - 1) as Real;
+        let mut t = ta + dt * if lb > la { (s - la) / (lb - la) } else { 0.0 };
+        for _ in 0..MAX_NEWTON {
+            let speed = curve.derivative(t).norm();
+            if !(speed > 0.0) {
+                break;
+            }
+            let f = la + gauss_legendre_5(ta, t, |v| curve.derivative(v).norm()) - s;
+            let step = f / speed;
+            t = (t - step).clamp(self.t0, self.t1);
+            if step.abs() <= 4.0 * Real::EPSILON * (self.t1 - self.t0) {
+                break;
+            }
+        }
+        t
+    }
+}
+
+/// A centreline with a rotation-minimising frame, evaluated by reference arc length: the carrier of
+/// placements `P = c(s) + R(s) P_local` (paper §4.3).
+#[derive(Debug, Clone)]
+pub struct Centreline {
+    curve: NurbsCurve,
+    frames: FrameField,
+    arc: ArcLengthTable,
+}
+
+/// Panels of a centreline's arc-length table (see [`ArcLengthTable`]).
+const CENTRELINE_PANELS: usize = 256;
+
+impl Centreline {
+    /// A centreline along `curve` with the section axis at its start closest to `normal_hint`.
+    pub fn new(curve: NurbsCurve, normal_hint: Option<Vec3>) -> Result<Self, GeometryError> {
+        let frames =
+            FrameField::rotation_minimising(&curve, normal_hint, &FrameSettings::default())?;
+        let arc = ArcLengthTable::new(&curve, CENTRELINE_PANELS);
+        Ok(Self { curve, frames, arc })
+    }
+
+    /// Total length.
+    pub fn length(&self) -> Real {
+        self.arc.length()
+    }
+
+    /// Position `c(s)` and rotation `R(s)` (columns: tangent, d2, d3) at arc length `s`.
+    pub fn at(&self, s: Real) -> Result<(Vec3, Mat3), GeometryError> {
+        let u = self.arc.parameter_at(&self.curve, s);
+        let f = self.frames.at(&self.curve, u)?;
+        Ok((f.position, f.rotation))
+    }
+
+    /// The underlying curve.
+    pub fn curve(&self) -> &NurbsCurve {
+        &self.curve
+    }
+}
+
+/// 5-point Gauss–Legendre quadrature of `f` over `[a, b]`.
+pub fn gauss_legendre_5(a: Real, b: Real, f: impl Fn(Real) -> Real) -> Real {
+    const X: [Real; 5] = [
+        -0.906_179_845_938_664,
+        -0.538_469_310_105_683,
+        0.0,
+        0.538_469_310_105_683,
+        0.906_179_845_938_664,
+    ];
+    const W: [Real; 5] = [
+        0.236_926_885_056_189_08,
+        0.478_628_670_499_366_47,
+        0.568_888_888_888_888_9,
+        0.478_628_670_499_366_47,
+        0.236_926_885_056_189_08,
+    ];
+    let (m, r) = (0.5 * (a + b), 0.5 * (b - a));
+    X.iter()
+        .zip(&W)
+        .map(|(x, w)| w * f(m + r * x))
+        .sum::<Real>()
+        * r
+}
+
+/// How a local curve is carried by a [`Centreline`].
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Station {
+    /// Rigidly at arc length `s0`: `P = c(s0) + R(s0) P_local` (the paper's crowns).
+    Rigid(Real),
+    /// Bent along the centreline: the local x coordinate is arc length from `s0`,
+    /// `P = c(s0 + x) + R(s0 + x) (0, y, z)` (the local x axis follows the centreline tangent).
+    Follow(Real),
+}
+
+/// A local curve mapped onto a centreline, `P = c(s) + R(s) P_local` (paper §4.3).
+pub struct PlacedCurve<'a> {
+    /// The curve in local coordinates (x along the centreline tangent, y and z across).
+    pub local: &'a dyn ParametricCurve,
+    /// The carrier.
+    pub centreline: &'a Centreline,
+    /// Where along the carrier.
+    pub station: Station,
+}
+
+impl ParametricCurve for PlacedCurve<'_> {
+    fn domain(&self) -> (Real, Real) {
+        self.local.domain()
+    }
+
+    fn point(&self, t: Real) -> Vec3 {
+        let p = self.local.point(t);
+        let (s, local) = match self.station {
+            Station::Rigid(s0) => (s0, p),
+            Station::Follow(s0) => (s0 + p.x, Vec3::new(0.0, p.y, p.z)),
+        };
+        // A frame failure can only come from a degenerate centreline, which `Centreline::new` rejected.
+        match self.centreline.at(s) {
+            Ok((c, r)) => c + r * local,
+            Err(_) => Vec3::repeat(Real::NAN),
+        }
+    }
+}

@@ -1,4 +1,5 @@
 //! Files: YAML design files, STL and OBJ meshes.
 
+pub mod design;
 pub mod obj;
 pub mod stl;

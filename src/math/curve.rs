@@ -15,7 +15,11 @@ pub struct NurbsCurve {
 
 impl NurbsCurve {
     /// A NURBS curve; fails unless there is one point and one positive finite weight per basis function.
-    pub fn try_new(knots: KnotVector, points: Vec<Vec3>, weights: Vec<Real>) -> Result<Self, MathError> {
+    pub fn try_new(
+        knots: KnotVector,
+        points: Vec<Vec3>,
+        weights: Vec<Real>,
+    ) -> Result<Self, MathError> {
         todo!("{knots:?} {points:?} {weights:?}")
     }
 

@@ -1,1 +1,346 @@
-//! The continuous problem: patches, sections, materials, nodes, boundary conditions, loads and schedules.
+//! The continuous problem: patches (reference centrelines), cross-sections and material, nodes that join
+//! patch ends, boundary conditions and loads per node in a local basis, distributed loads, the temperature
+//! schedule, time and solver settings, and named probes.
+//!
+//! A [`Model`] is built and validated by the `io` layer from a design file (or by hand in tests); it holds no
+//! file names or YAML positions. Every physical field is in the design's consistent unit system
+//! ([`Units`]); temperatures are in °C.
+
+pub mod schedule;
+
+pub use schedule::{ScheduleError, TimeFunction};
+
+use crate::material::{Integrator, Material, Section};
+use crate::math::{Mat3, NurbsCurve, Real, Vec3};
+
+/// The consistent unit system a design declares; every length, force, stress and time in the model is in it.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Units {
+    /// m, N, Pa, s.
+    Si,
+    /// mm, N, MPa, s.
+    MmNMpa,
+}
+
+impl Units {
+    /// The design-file spelling (`SI`, `mm-N-MPa`).
+    pub fn name(self) -> &'static str {
+        match self {
+            Units::Si => "SI",
+            Units::MmNMpa => "mm-N-MPa",
+        }
+    }
+
+    /// Unit of length.
+    pub fn length(self) -> &'static str {
+        match self {
+            Units::Si => "m",
+            Units::MmNMpa => "mm",
+        }
+    }
+
+    /// Unit of force.
+    pub fn force(self) -> &'static str {
+        "N"
+    }
+
+    /// Unit of stress.
+    pub fn stress(self) -> &'static str {
+        match self {
+            Units::Si => "Pa",
+            Units::MmNMpa => "MPa",
+        }
+    }
+
+    /// Unit of moment.
+    pub fn moment(self) -> &'static str {
+        match self {
+            Units::Si => "N·m",
+            Units::MmNMpa => "N·mm",
+        }
+    }
+}
+
+/// One rod patch: a reference centreline with its discretisation, cross-section and material.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Patch {
+    /// Unique name (design files refer to its ends as `name.start`, `name.end`).
+    pub name: String,
+    /// Reference centreline, already at the analysis degree `p` and number of control points `n`.
+    pub curve: NurbsCurve,
+    /// Optional hint for the first section axis `d2` at `u = 0` (projected normal to the tangent);
+    /// `None` lets the frame pick one. Irrelevant to the mechanics of circular sections.
+    pub normal_hint: Option<Vec3>,
+    /// Index into [`Model::sections`].
+    pub section: usize,
+    /// Largest deviation of `curve` from the analytic curve it was fitted to [length]; `None` when exact.
+    pub fit_error: Option<Real>,
+}
+
+/// Which end of a patch.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub enum End {
+    /// `u = 0`; outward sign σ = −1.
+    Start,
+    /// `u = 1`; outward sign σ = +1.
+    End,
+}
+
+impl End {
+    /// The outward sign σ of the end (DESIGN §4 "Joints").
+    pub fn sign(self) -> Real {
+        match self {
+            End::Start => -1.0,
+            End::End => 1.0,
+        }
+    }
+
+    /// The curve parameter of the end.
+    pub fn parameter(self) -> Real {
+        match self {
+            End::Start => 0.0,
+            End::End => 1.0,
+        }
+    }
+
+    /// `start` or `end`.
+    pub fn name(self) -> &'static str {
+        match self {
+            End::Start => "start",
+            End::End => "end",
+        }
+    }
+}
+
+/// One end of one patch.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub struct PatchEnd {
+    /// Index into [`Model::patches`].
+    pub patch: usize,
+    /// Which end.
+    pub end: End,
+}
+
+/// What is known at one of a node's six components (three translations, three rotations, in the node's
+/// local basis).
+#[derive(Debug, Clone, PartialEq)]
+pub enum Component {
+    /// Neumann: the component is free and loaded by the given force/moment component (dead load, fixed in
+    /// space) as a function of time.
+    Load(TimeFunction),
+    /// Dirichlet: the displacement component [length] or rotation component [rad] is prescribed as a
+    /// function of time; after `release` (if any) it becomes free with the given load.
+    Prescribed {
+        /// The prescribed value.
+        value: TimeFunction,
+        /// Time from which the component is free (the paper's release step); `None` = never.
+        release: Option<Real>,
+        /// Load on the component once released.
+        load_after_release: TimeFunction,
+    },
+}
+
+impl Component {
+    /// A free, unloaded component.
+    pub fn free() -> Self {
+        Component::Load(TimeFunction::zero())
+    }
+
+    /// A component held at zero for all time.
+    pub fn fixed() -> Self {
+        Component::Prescribed {
+            value: TimeFunction::zero(),
+            release: None,
+            load_after_release: TimeFunction::zero(),
+        }
+    }
+
+    /// True when the component is prescribed at time `t`.
+    pub fn is_prescribed_at(&self, t: Real) -> bool {
+        match self {
+            Component::Load(_) => false,
+            Component::Prescribed { release, .. } => release.is_none_or(|r| t < r),
+        }
+    }
+}
+
+/// The conditions at a node: six components in a local orthonormal basis fixed in space.
+#[derive(Debug, Clone, PartialEq)]
+pub struct NodeConditions {
+    /// Local basis: columns are the unit axes `e1, e2, e3` in global coordinates (identity by default).
+    pub basis: Mat3,
+    /// Components `[u1, u2, u3, θ1, θ2, θ3]`: translations along and rotations about `e1, e2, e3`
+    /// (loads: forces along and moments about them).
+    pub components: [Component; 6],
+}
+
+impl Default for NodeConditions {
+    fn default() -> Self {
+        Self {
+            basis: Mat3::identity(),
+            components: std::array::from_fn(|_| Component::free()),
+        }
+    }
+}
+
+/// A point where patch ends meet (a joint), or a single free end.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Node {
+    /// Unique name; an end that no declared node names gets the node `patch.start` / `patch.end`.
+    pub name: String,
+    /// The patch ends joined here (at least one).
+    pub ends: Vec<PatchEnd>,
+    /// Reference position [length].
+    pub position: Vec3,
+    /// Boundary conditions and concentrated loads.
+    pub conditions: NodeConditions,
+}
+
+/// A distributed load on a patch: force and couple per unit reference length, fixed in space (dead), each
+/// global component a function of time.
+#[derive(Debug, Clone, PartialEq)]
+pub struct DistributedLoad {
+    /// Index into [`Model::patches`].
+    pub patch: usize,
+    /// Force per unit length `n̄` [force/length], global components.
+    pub force: [TimeFunction; 3],
+    /// Couple per unit length `m̄` [force], global components.
+    pub couple: [TimeFunction; 3],
+}
+
+/// Where a probe reads the displacement.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum ProbeLocation {
+    /// At a node.
+    Node(usize),
+    /// On a patch at the curve parameter `u ∈ [0, 1]`.
+    Patch {
+        /// Index into [`Model::patches`].
+        patch: usize,
+        /// Curve parameter.
+        u: Real,
+    },
+}
+
+/// A named point whose displacement is recorded (`P.ux`, `P.uy`, `P.uz` in `history.csv`).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Probe {
+    /// Name used in the output columns.
+    pub name: String,
+    /// Where.
+    pub location: ProbeLocation,
+}
+
+/// Time stepping settings.
+#[derive(Debug, Clone, PartialEq)]
+pub struct TimeSettings {
+    /// End time [time] (the run starts at 0).
+    pub end: Real,
+    /// Nominal time step `h` [time]; steps are shortened to land on schedule breakpoints.
+    pub step: Real,
+    /// Smallest step that automatic step cutting may reach before giving up [time].
+    pub min_step: Real,
+}
+
+/// Newton settings.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SolverSettings {
+    /// Convergence tolerance on the normalised per-field residual and increment norms (DESIGN §4).
+    pub tolerance: Real,
+    /// Newton iterations allowed per step before the step is cut.
+    pub max_iterations: usize,
+}
+
+impl Default for SolverSettings {
+    /// Tolerance 1e-10 relative (below the 1e-8 accuracy floor the paper reports for its convergence study)
+    /// and 25 iterations (quadratic convergence needs fewer than 10 when the step is reasonable).
+    fn default() -> Self {
+        Self {
+            tolerance: 1e-10,
+            max_iterations: 25,
+        }
+    }
+}
+
+/// The whole continuous problem.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Model {
+    /// Design name.
+    pub name: String,
+    /// Unit system of every number.
+    pub units: Units,
+    /// The thermo-viscoelastic material (one per design).
+    pub material: Material,
+    /// Internal-variable update of the Maxwell branches.
+    pub integrator: Integrator,
+    /// Cross-sections, referred to by [`Patch::section`].
+    pub sections: Vec<Section>,
+    /// Rod patches.
+    pub patches: Vec<Patch>,
+    /// Nodes: every patch end belongs to exactly one.
+    pub nodes: Vec<Node>,
+    /// Distributed loads.
+    pub distributed_loads: Vec<DistributedLoad>,
+    /// Temperature [°C] as a function of time, uniform over the device.
+    pub temperature: TimeFunction,
+    /// Time stepping.
+    pub time: TimeSettings,
+    /// Newton settings.
+    pub solver: SolverSettings,
+    /// Recorded points.
+    pub probes: Vec<Probe>,
+}
+
+impl Model {
+    /// Total number of collocation points (one per control point of every patch).
+    pub fn num_collocation_points(&self) -> usize {
+        self.patches.iter().map(|p| p.curve.num_points()).sum()
+    }
+
+    /// Number of unknowns of the global system: 3 translations and 3 rotations per control point.
+    pub fn num_unknowns(&self) -> usize {
+        6 * self.num_collocation_points()
+    }
+
+    /// Number of nominal time steps `⌈end / step⌉`.
+    pub fn num_time_steps(&self) -> usize {
+        (self.time.end / self.time.step - 1e-9).ceil().max(0.0) as usize
+    }
+
+    /// The node that holds the given patch end.
+    pub fn node_of(&self, end: PatchEnd) -> Option<usize> {
+        self.nodes.iter().position(|n| n.ends.contains(&end))
+    }
+
+    /// Every time at which a schedule changes slope or a condition switches, within `(0, end]`, sorted and
+    /// deduplicated: time stepping lands on each.
+    pub fn schedule_breakpoints(&self) -> Vec<Real> {
+        let mut times: Vec<Real> = self.temperature.breakpoints().collect();
+        for node in &self.nodes {
+            for c in &node.conditions.components {
+                match c {
+                    Component::Load(f) => times.extend(f.breakpoints()),
+                    Component::Prescribed {
+                        value,
+                        release,
+                        load_after_release,
+                    } => {
+                        times.extend(value.breakpoints());
+                        times.extend(*release);
+                        times.extend(load_after_release.breakpoints());
+                    }
+                }
+            }
+        }
+        for load in &self.distributed_loads {
+            for f in load.force.iter().chain(&load.couple) {
+                times.extend(f.breakpoints());
+            }
+        }
+        let end = self.time.end;
+        times.retain(|&t| t > 0.0 && t <= end);
+        times.sort_by(Real::total_cmp);
+        times.dedup_by(|a, b| (*a - *b).abs() <= 1e-12 * end);
+        times
+    }
+}

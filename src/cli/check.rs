@@ -1,0 +1,152 @@
+//! `stentkit check`: validate a design and describe what a run would solve.
+
+use crate::io::design::load_design;
+use crate::model::{Component, Model};
+use std::fmt::Write as _;
+use std::path::Path;
+
+/// Loads the design and prints its description.
+pub fn run(path: &Path) -> anyhow::Result<()> {
+    let design = load_design(path)?;
+    print!(
+        "{}",
+        describe(&design.model, &path.display().to_string(), &design.warnings)
+    );
+    Ok(())
+}
+
+/// The human-readable description printed by `check`.
+pub fn describe(model: &Model, file: &str, warnings: &[String]) -> String {
+    let mut s = String::new();
+    let u = model.units;
+    let _ = writeln!(s, "design      {} ({file}), units {}", model.name, u.name());
+    let m = &model.material;
+    let _ = write!(
+        s,
+        "material    E_inf = {} {}, {} Maxwell branches, nu = {}",
+        m.prony.e_inf,
+        u.stress(),
+        m.prony.branches.len(),
+        m.poisson
+    );
+    match &m.wlf {
+        Some(w) => {
+            let _ = writeln!(
+                s,
+                ", WLF C1 = {}, C2 = {} K, Tg = {} °C (frozen at and below {} °C), integrator {:?}",
+                w.c1,
+                w.c2,
+                w.tg,
+                w.tg - w.c2,
+                model.integrator
+            );
+        }
+        None => {
+            let _ = writeln!(
+                s,
+                ", no WLF shift (temperature-independent), integrator {:?}",
+                model.integrator
+            );
+        }
+    }
+    for (k, sec) in model.sections.iter().enumerate() {
+        let _ = writeln!(
+            s,
+            "section {k}   circular, d = {} {}, shear factor {:.4}",
+            sec.diameter,
+            u.length(),
+            sec.shear_factor
+        );
+    }
+    let _ = writeln!(s, "patches     {}", model.patches.len());
+    let width = model
+        .patches
+        .iter()
+        .map(|p| p.name.len())
+        .max()
+        .unwrap_or(0);
+    for p in &model.patches {
+        let fit = match p.fit_error {
+            None => "exact".to_string(),
+            Some(e) => format!("fit error {e:.3e} {}", u.length()),
+        };
+        let _ = writeln!(
+            s,
+            "  {:width$}  p = {}, n = {:3}, section {}, {fit}",
+            p.name,
+            p.curve.degree(),
+            p.curve.num_points(),
+            p.section
+        );
+    }
+    let _ = writeln!(s, "nodes       {}", model.nodes.len());
+    let width = model.nodes.iter().map(|n| n.name.len()).max().unwrap_or(0);
+    for n in &model.nodes {
+        let prescribed = n
+            .conditions
+            .components
+            .iter()
+            .filter(|c| matches!(c, Component::Prescribed { .. }))
+            .count();
+        let loaded = n
+            .conditions
+            .components
+            .iter()
+            .filter(|c| matches!(c, Component::Load(f) if !f.is_zero()))
+            .count();
+        let released = n.conditions.components.iter().find_map(|c| match c {
+            Component::Prescribed {
+                release: Some(r), ..
+            } => Some(*r),
+            _ => None,
+        });
+        let mut what = format!(
+            "{} end{}, {prescribed} prescribed, {loaded} loaded",
+            n.ends.len(),
+            if n.ends.len() == 1 { "" } else { "s" }
+        );
+        if let Some(r) = released {
+            let _ = write!(what, ", released at t = {r}");
+        }
+        let _ = writeln!(s, "  {:width$}  {what}", n.name);
+    }
+    let _ = writeln!(s, "collocation points  {}", model.num_collocation_points());
+    let _ = writeln!(s, "unknowns            {}", model.num_unknowns());
+    let _ = writeln!(
+        s,
+        "time steps          {} (h = {} s, end {} s)",
+        model.num_time_steps(),
+        model.time.step,
+        model.time.end
+    );
+    let worst = model
+        .patches
+        .iter()
+        .filter_map(|p| p.fit_error.map(|e| (e, &p.name)))
+        .max_by(|a, b| a.0.total_cmp(&b.0));
+    match worst {
+        Some((e, name)) => {
+            let _ = writeln!(
+                s,
+                "geometry fit error  {e:.3e} {} (patch {name})",
+                u.length()
+            );
+        }
+        None => {
+            let _ = writeln!(s, "geometry fit error  0 (all patches exact)");
+        }
+    }
+    if !model.probes.is_empty() {
+        let names: Vec<_> = model.probes.iter().map(|p| p.name.as_str()).collect();
+        let _ = writeln!(s, "probes              {}", names.join(", "));
+    }
+    if warnings.is_empty() {
+        let _ = writeln!(s, "warnings            none");
+    } else {
+        let _ = writeln!(s, "warnings            {}", warnings.len());
+        for w in warnings {
+            let _ = writeln!(s, "  - {w}");
+        }
+    }
+    s
+}

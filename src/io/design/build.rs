@@ -1,0 +1,884 @@
+//! From the deserialised design ([`super::dto`]) to a validated [`Model`]: geometry is generated, names are
+//! resolved, and every check that involves more than one value is made here. A failed check is an [`Issue`]
+//! naming the field path; [`super`] turns it into a line and column.
+
+use super::dto::*;
+use crate::geometry::analytic::{
+    Helix, ParametricCurve, RigidPlacement, SineWire, frame_from_axis, point_list_curve,
+};
+use crate::geometry::fit::{FitSettings, fit_curve};
+use crate::geometry::{GeometryError, primitives};
+use crate::material::{Integrator, Material, Prony, PronyBranch, Section, Wlf};
+use crate::math::{Mat3, NurbsCurve, Real, Vec3};
+use crate::model::*;
+use std::collections::HashMap;
+
+/// A problem found while building the model, at a field path.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Issue {
+    /// Field path, e.g. `patches[2].arc.angle_deg`.
+    pub path: String,
+    /// What is wrong and what is allowed.
+    pub message: String,
+}
+
+fn issue(path: impl Into<String>, message: impl Into<String>) -> Issue {
+    Issue {
+        path: path.into(),
+        message: message.into(),
+    }
+}
+
+type Result<T> = std::result::Result<T, Issue>;
+
+/// Relative size of the default joint tolerance: ends closer than this fraction of the model's bounding-box
+/// diagonal are the same point. Fits and exact primitives place shared ends to ~1e-14 relative, so 1e-8
+/// separates coincident ends from distinct ones with a wide margin on both sides.
+const DEFAULT_JOINT_TOLERANCE: Real = 1e-8;
+
+/// Fit deviation, as a fraction of the wire diameter, above which the design gets a warning.
+const FIT_WARNING_FRACTION: Real = 0.01;
+
+/// Default smallest step, as a fraction of the nominal step: ten halvings.
+const DEFAULT_MIN_STEP_FRACTION: Real = 1.0 / 1024.0;
+
+fn vec3(v: &Vector) -> Vec3 {
+    Vec3::new(v[0].0, v[1].0, v[2].0)
+}
+
+fn time_function(f: &TimeFn, path: &str) -> Result<TimeFunction> {
+    match f {
+        TimeFn::Constant(v) => Ok(TimeFunction::constant(*v)),
+        TimeFn::Table(points) => {
+            TimeFunction::try_table(points.clone()).map_err(|e| issue(path, e.to_string()))
+        }
+    }
+}
+
+/// Cowper's shear correction factor of a solid circular section, `6(1+ν)/(7+6ν)` (G. R. Cowper, *The shear
+/// coefficient in Timoshenko's beam theory*, J. Appl. Mech. 33 (1966) 335–340).
+pub fn cowper_shear_factor(nu: Real) -> Real {
+    6.0 * (1.0 + nu) / (7.0 + 6.0 * nu)
+}
+
+/// Builds and validates the model; returns it with the warnings found.
+pub fn build(dto: &DesignDto, default_name: &str) -> Result<(Model, Vec<String>)> {
+    let mut warnings = Vec::new();
+    if let Some(v) = dto.version
+        && v != 1
+    {
+        return Err(issue(
+            "version",
+            format!("version {v} is not supported; allowed: 1"),
+        ));
+    }
+    let units = match dto.units {
+        UnitsDto::Si => Units::Si,
+        UnitsDto::MmNMpa => Units::MmNMpa,
+    };
+    let (material, integrator) = material(&dto.material)?;
+    let shear_factor = dto
+        .section
+        .shear_factor
+        .map(|Positive(k)| k)
+        .unwrap_or_else(|| cowper_shear_factor(material.poisson));
+    let mut sections = vec![Section {
+        diameter: dto.section.diameter.0,
+        shear_factor,
+    }];
+    let patches = patches(dto, &mut sections, shear_factor, &mut warnings)?;
+    let tolerance = joint_tolerance(dto, &patches);
+    let mut nodes = nodes(dto, &patches, tolerance)?;
+    conditions(dto, &patches, &mut nodes)?;
+    let distributed_loads = distributed_loads(dto, &patches)?;
+    let temperature = match (&dto.temperature, &material.wlf) {
+        (Some(f), _) => time_function(f, "temperature")?,
+        (None, None) => TimeFunction::constant(20.0),
+        (None, Some(_)) => {
+            return Err(issue(
+                "temperature",
+                "missing: a material with `wlf` needs a temperature schedule (a number or [[t, T], …] in °C)",
+            ));
+        }
+    };
+    if let Some(w) = &material.wlf {
+        let freeze = w.tg - w.c2;
+        let (lo, _) = temperature.range();
+        if lo <= freeze {
+            warnings.push(format!(
+                "temperature reaches {lo} °C, at or below the WLF singularity Tg − C2 = {freeze} °C: relaxation freezes there (instantaneous moduli)"
+            ));
+        }
+    }
+    let time = time_settings(&dto.time)?;
+    let solver = solver_settings(dto.solver.as_ref())?;
+    let probes = probes(dto, &patches, &nodes)?;
+    let any_prescribed = nodes.iter().any(|n| {
+        n.conditions
+            .components
+            .iter()
+            .any(|c| matches!(c, Component::Prescribed { .. }))
+    });
+    if !any_prescribed {
+        warnings.push("no component of any node is prescribed: rigid-body motion is unconstrained and the tangent will be singular".to_string());
+    }
+    let model = Model {
+        name: dto.name.clone().unwrap_or_else(|| default_name.to_string()),
+        units,
+        material,
+        integrator,
+        sections,
+        patches,
+        nodes,
+        distributed_loads,
+        temperature,
+        time,
+        solver,
+        probes,
+    };
+    Ok((model, warnings))
+}
+
+fn material(m: &MaterialDto) -> Result<(Material, Integrator)> {
+    let mut branches = Vec::with_capacity(m.prony.len());
+    for (k, [Finite(e), Finite(tau)]) in m.prony.iter().enumerate() {
+        if !(*e > 0.0) {
+            return Err(issue(
+                format!("material.prony[{k}][0]"),
+                format!("branch modulus E = {e} must be > 0"),
+            ));
+        }
+        if !(*tau > 0.0) {
+            return Err(issue(
+                format!("material.prony[{k}][1]"),
+                format!("relaxation time τ = {tau} must be > 0"),
+            ));
+        }
+        branches.push(PronyBranch {
+            modulus: *e,
+            tau_g: *tau,
+        });
+    }
+    let e0 = m.e_inf.0 + branches.iter().map(|b| b.modulus).sum::<Real>();
+    if !(e0 > 0.0) {
+        return Err(issue(
+            "material.E_inf",
+            "the instantaneous modulus E_inf + Σ E_α must be > 0",
+        ));
+    }
+    let nu = m.nu.0;
+    if !(nu > -1.0 && nu < 0.5) {
+        return Err(issue(
+            "material.nu",
+            format!("Poisson's ratio {nu} must lie in (−1, 0.5)"),
+        ));
+    }
+    let wlf = match &m.wlf {
+        None => None,
+        Some(w) => {
+            if !(w.c1.0 > 0.0) {
+                return Err(issue(
+                    "material.wlf.C1",
+                    format!("C1 = {} must be > 0", w.c1.0),
+                ));
+            }
+            if !(w.c2.0 > 0.0) {
+                return Err(issue(
+                    "material.wlf.C2",
+                    format!("C2 = {} must be > 0", w.c2.0),
+                ));
+            }
+            Some(Wlf {
+                c1: w.c1.0,
+                c2: w.c2.0,
+                tg: w.tg.0,
+            })
+        }
+    };
+    let integrator = match m.integrator {
+        None | Some(IntegratorDto::Trapezoidal) => Integrator::Trapezoidal,
+        Some(IntegratorDto::BackwardEuler) => Integrator::BackwardEuler,
+        Some(IntegratorDto::Exponential) => Integrator::Exponential,
+    };
+    let material = Material {
+        prony: Prony {
+            e_inf: m.e_inf.0,
+            branches,
+        },
+        poisson: nu,
+        wlf,
+    };
+    Ok((material, integrator))
+}
+
+fn geometry_issue(path: &str, e: GeometryError) -> Issue {
+    issue(path, e.to_string())
+}
+
+/// Checks a discretisation: `p ≥ 2`, `n ≥ p + 1`.
+fn discretisation(dto: &DesignDto, k: usize, patch: &PatchDto) -> Result<(usize, usize)> {
+    let base = format!("patches[{k}]");
+    let mesh = dto.mesh.as_ref();
+    let (p, p_path) = match (patch.p, mesh.and_then(|m| m.p)) {
+        (Some(p), _) => (p, format!("{base}.p")),
+        (None, Some(p)) => (p, "mesh.p".to_string()),
+        (None, None) => return Err(issue(&base, "no degree: give `p` here or `mesh.p` (p ≥ 2)")),
+    };
+    let (n, n_path) = match (patch.n, mesh.and_then(|m| m.n)) {
+        (Some(n), _) => (n, format!("{base}.n")),
+        (None, Some(n)) => (n, "mesh.n".to_string()),
+        (None, None) => {
+            return Err(issue(
+                &base,
+                "no number of control points: give `n` here or `mesh.n` (n > p)",
+            ));
+        }
+    };
+    if p < 2 {
+        return Err(issue(
+            p_path,
+            format!(
+                "degree p = {p} is too low: collocation of the strong form needs second derivatives, so p ≥ 2"
+            ),
+        ));
+    }
+    if n <= p {
+        return Err(issue(
+            n_path,
+            format!("n = {n} control points cannot carry degree p = {p}: need n > p"),
+        ));
+    }
+    Ok((p, n))
+}
+
+fn placement(
+    origin: &Option<Vector>,
+    axis: &Option<Vector>,
+    x_axis: &Option<Vector>,
+) -> std::result::Result<RigidPlacement, GeometryError> {
+    let axis = axis.as_ref().map(vec3).unwrap_or(Vec3::z());
+    Ok(RigidPlacement {
+        origin: origin.as_ref().map(vec3).unwrap_or_else(Vec3::zeros),
+        rotation: frame_from_axis(&axis, x_axis.as_ref().map(vec3))?,
+    })
+}
+
+fn fitted(
+    curve: &dyn ParametricCurve,
+    p: usize,
+    n: usize,
+    path: &str,
+) -> Result<(NurbsCurve, Option<Real>)> {
+    let fit =
+        fit_curve(curve, p, n, &FitSettings::default()).map_err(|e| geometry_issue(path, e))?;
+    Ok((fit.curve, Some(fit.max_deviation)))
+}
+
+fn patches(
+    dto: &DesignDto,
+    sections: &mut Vec<Section>,
+    shear_factor: Real,
+    warnings: &mut Vec<String>,
+) -> Result<Vec<Patch>> {
+    if dto.patches.is_empty() {
+        return Err(issue("patches", "a design needs at least one patch"));
+    }
+    let mut names: HashMap<&str, usize> = HashMap::new();
+    let mut out = Vec::with_capacity(dto.patches.len());
+    for (k, pd) in dto.patches.iter().enumerate() {
+        let base = format!("patches[{k}]");
+        if pd.name.is_empty() || pd.name.contains('.') || pd.name.contains(char::is_whitespace) {
+            return Err(issue(
+                format!("{base}.name"),
+                format!(
+                    "`{}` is not a valid patch name: use a non-empty name without dots or spaces",
+                    pd.name
+                ),
+            ));
+        }
+        if let Some(first) = names.insert(&pd.name, k) {
+            return Err(issue(
+                format!("{base}.name"),
+                format!(
+                    "patch name `{}` is already used by patches[{first}]",
+                    pd.name
+                ),
+            ));
+        }
+        let given = [
+            pd.line.is_some(),
+            pd.arc.is_some(),
+            pd.helix.is_some(),
+            pd.sine_wire.is_some(),
+            pd.points.is_some(),
+        ];
+        let count = given.iter().filter(|&&g| g).count();
+        if count != 1 {
+            return Err(issue(
+                &base,
+                format!(
+                    "give exactly one geometry (line, arc, helix, sine_wire or points); found {count}"
+                ),
+            ));
+        }
+        let (p, n) = discretisation(dto, k, pd)?;
+        let (curve, fit_error) = if let Some(l) = &pd.line {
+            let path = format!("{base}.line");
+            let c = primitives::line(vec3(&l.from), vec3(&l.to), p, n)
+                .map_err(|e| geometry_issue(&path, e))?;
+            (c, None)
+        } else if let Some(a) = &pd.arc {
+            let path = format!("{base}.arc");
+            let c = primitives::arc(
+                vec3(&a.center),
+                vec3(&a.start),
+                vec3(&a.axis),
+                a.angle_deg.0.to_radians(),
+                p,
+                n,
+            )
+            .map_err(|e| geometry_issue(&path, e))?;
+            (c, None)
+        } else if let Some(h) = &pd.helix {
+            let path = format!("{base}.helix");
+            let helix = Helix {
+                radius: h.radius.0,
+                pitch: h.pitch.0,
+                turns: h.turns.0,
+                start_angle: h.start_deg.map_or(0.0, |a| a.0.to_radians()),
+                placement: placement(&h.origin, &h.axis, &h.x_axis)
+                    .map_err(|e| geometry_issue(&path, e))?,
+            };
+            fitted(&helix, p, n, &path)?
+        } else if let Some(w) = &pd.sine_wire {
+            let path = format!("{base}.sine_wire");
+            if w.from_deg.0 == w.to_deg.0 {
+                return Err(issue(
+                    format!("{path}.to_deg"),
+                    "the wire must span a non-zero angle: to_deg ≠ from_deg",
+                ));
+            }
+            let wire = SineWire {
+                radius: w.radius.0,
+                amplitude: w.amplitude.0,
+                waves: w.waves.0,
+                phase: w.phase_deg.map_or(0.0, |a| a.0.to_radians()),
+                from: w.from_deg.0.to_radians(),
+                to: w.to_deg.0.to_radians(),
+                placement: placement(&w.origin, &w.axis, &w.x_axis)
+                    .map_err(|e| geometry_issue(&path, e))?,
+            };
+            fitted(&wire, p, n, &path)?
+        } else if let Some(pts) = &pd.points {
+            let path = format!("{base}.points");
+            let points: Vec<Vec3> = pts.iter().map(vec3).collect();
+            let through = point_list_curve(&points).map_err(|e| geometry_issue(&path, e))?;
+            fitted(&through, p, n, &path)?
+        } else {
+            unreachable!("exactly one geometry was checked above")
+        };
+        let section = match pd.diameter {
+            None => 0,
+            Some(Positive(d)) => {
+                sections.push(Section {
+                    diameter: d,
+                    shear_factor,
+                });
+                sections.len() - 1
+            }
+        };
+        if let Some(dev) = fit_error {
+            let d = sections[section].diameter;
+            if dev > FIT_WARNING_FRACTION * d {
+                warnings.push(format!(
+                    "patch `{}`: the spline fit deviates up to {dev:.3e} from the curve, {:.1}% of the wire diameter; raise n",
+                    pd.name,
+                    100.0 * dev / d
+                ));
+            }
+        }
+        out.push(Patch {
+            name: pd.name.clone(),
+            curve,
+            normal_hint: pd.normal.as_ref().map(vec3),
+            section,
+            fit_error,
+        });
+    }
+    Ok(out)
+}
+
+fn end_position(patches: &[Patch], e: PatchEnd) -> Vec3 {
+    patches[e.patch].curve.point(e.end.parameter())
+}
+
+fn all_ends(patches: &[Patch]) -> impl Iterator<Item = PatchEnd> + '_ {
+    (0..patches.len()).flat_map(|patch| [End::Start, End::End].map(|end| PatchEnd { patch, end }))
+}
+
+fn joint_tolerance(dto: &DesignDto, patches: &[Patch]) -> Real {
+    if let Some(j) = &dto.joints {
+        return j.tolerance.0;
+    }
+    let (mut lo, mut hi) = (
+        Vec3::repeat(Real::INFINITY),
+        Vec3::repeat(Real::NEG_INFINITY),
+    );
+    for p in patches {
+        for q in p.curve.points() {
+            lo = lo.inf(q);
+            hi = hi.sup(q);
+        }
+    }
+    DEFAULT_JOINT_TOLERANCE * (hi - lo).norm()
+}
+
+/// Parses `patch.start` / `patch.end`.
+fn parse_end(name: &str, patches: &[Patch]) -> Option<PatchEnd> {
+    let (patch, end) = name.rsplit_once('.')?;
+    let end = match end {
+        "start" => End::Start,
+        "end" => End::End,
+        _ => return None,
+    };
+    let patch = patches.iter().position(|p| p.name == patch)?;
+    Some(PatchEnd { patch, end })
+}
+
+fn nodes(dto: &DesignDto, patches: &[Patch], tolerance: Real) -> Result<Vec<Node>> {
+    let mut owner: HashMap<PatchEnd, usize> = HashMap::new();
+    let mut nodes: Vec<Node> = Vec::new();
+    let mut names: HashMap<String, usize> = HashMap::new();
+    for (k, nd) in dto.nodes.iter().enumerate() {
+        let base = format!("nodes[{k}]");
+        if nd.name.is_empty() {
+            return Err(issue(
+                format!("{base}.name"),
+                "a node needs a non-empty name",
+            ));
+        }
+        if let Some(first) = names.insert(nd.name.clone(), k) {
+            return Err(issue(
+                format!("{base}.name"),
+                format!("node name `{}` is already used by nodes[{first}]", nd.name),
+            ));
+        }
+        let mut ends = Vec::new();
+        match (&nd.ends, &nd.at) {
+            (Some(list), None) => {
+                if list.is_empty() {
+                    return Err(issue(
+                        format!("{base}.ends"),
+                        "list at least one patch end (`patch.start` or `patch.end`)",
+                    ));
+                }
+                for (j, name) in list.iter().enumerate() {
+                    let e = parse_end(name, patches).ok_or_else(|| {
+                        issue(
+                            format!("{base}.ends[{j}]"),
+                            format!("`{name}` is not a patch end; write `<patch>.start` or `<patch>.end` with a patch named in `patches`"),
+                        )
+                    })?;
+                    ends.push(e);
+                }
+            }
+            (None, Some(at)) => {
+                let x = vec3(at);
+                ends.extend(
+                    all_ends(patches)
+                        .filter(|&e| (end_position(patches, e) - x).norm() <= tolerance),
+                );
+                if ends.is_empty() {
+                    return Err(issue(
+                        format!("{base}.at"),
+                        format!(
+                            "no patch end lies within {tolerance:.3e} of [{}, {}, {}]",
+                            x.x, x.y, x.z
+                        ),
+                    ));
+                }
+            }
+            _ => return Err(issue(&base, "give exactly one of `ends` or `at`")),
+        }
+        let x0 = end_position(patches, ends[0]);
+        for (j, &e) in ends.iter().enumerate() {
+            if let Some(&other) = owner.get(&e) {
+                return Err(issue(
+                    format!("{base}.ends[{j}]"),
+                    format!(
+                        "`{}.{}` already belongs to node `{}`",
+                        patches[e.patch].name,
+                        e.end.name(),
+                        nodes[other].name
+                    ),
+                ));
+            }
+            let gap = (end_position(patches, e) - x0).norm();
+            if gap > tolerance {
+                return Err(issue(
+                    format!("{base}.ends[{j}]"),
+                    format!(
+                        "`{}.{}` is {gap:.3e} away from `{}.{}`: joined ends must coincide (tolerance {tolerance:.3e}; set `joints.tolerance` to change it)",
+                        patches[e.patch].name,
+                        e.end.name(),
+                        patches[ends[0].patch].name,
+                        ends[0].end.name()
+                    ),
+                ));
+            }
+            owner.insert(e, nodes.len());
+        }
+        nodes.push(new_node(nd.name.clone(), ends, patches));
+    }
+    // Remaining ends: joined automatically when `joints` is given, otherwise free ends.
+    let auto = dto.joints.is_some();
+    let free: Vec<PatchEnd> = all_ends(patches)
+        .filter(|e| !owner.contains_key(e))
+        .collect();
+    let mut used = vec![false; free.len()];
+    for i in 0..free.len() {
+        if used[i] {
+            continue;
+        }
+        used[i] = true;
+        let mut ends = vec![free[i]];
+        if auto {
+            let x = end_position(patches, free[i]);
+            for j in i + 1..free.len() {
+                if !used[j] && (end_position(patches, free[j]) - x).norm() <= tolerance {
+                    used[j] = true;
+                    ends.push(free[j]);
+                }
+            }
+        }
+        let e = ends[0];
+        let name = format!("{}.{}", patches[e.patch].name, e.end.name());
+        nodes.push(new_node(name, ends, patches));
+    }
+    Ok(nodes)
+}
+
+fn new_node(name: String, ends: Vec<PatchEnd>, patches: &[Patch]) -> Node {
+    let position =
+        ends.iter().map(|&e| end_position(patches, e)).sum::<Vec3>() / ends.len() as Real;
+    Node {
+        name,
+        ends,
+        position,
+        conditions: NodeConditions::default(),
+    }
+}
+
+/// Resolves a node reference: a node name, or `patch.start` / `patch.end` of any end the node holds.
+fn find_node(name: &str, patches: &[Patch], nodes: &[Node]) -> Option<usize> {
+    nodes.iter().position(|n| n.name == name).or_else(|| {
+        let e = parse_end(name, patches)?;
+        nodes.iter().position(|n| n.ends.contains(&e))
+    })
+}
+
+/// Completes an orthonormal right-handed basis whose first axis is `n`.
+fn basis_from_normal(n: &Vec3) -> Mat3 {
+    let e1 = n.normalize();
+    let e2 = crate::geometry::frame::normal_to(&e1, None);
+    Mat3::from_columns(&[e1, e2, e1.cross(&e2)])
+}
+
+/// Orthonormality tolerance of a user-given basis: rows typed with about seven significant digits pass.
+const BASIS_TOLERANCE: Real = 1e-6;
+
+fn conditions(dto: &DesignDto, patches: &[Patch], nodes: &mut [Node]) -> Result<()> {
+    // Which entry set each node's basis and each component, to report contradictions.
+    let mut basis_from: HashMap<usize, usize> = HashMap::new();
+    let mut set_by: HashMap<(usize, usize), usize> = HashMap::new();
+    for (k, c) in dto.conditions.iter().enumerate() {
+        let base = format!("conditions[{k}]");
+        let node = find_node(&c.node, patches, nodes).ok_or_else(|| {
+            issue(
+                format!("{base}.node"),
+                format!("no node `{}`: name a node from `nodes` or a patch end `<patch>.start` / `<patch>.end`", c.node),
+            )
+        })?;
+        let basis = match (&c.basis, &c.symmetry_plane) {
+            (Some(_), Some(_)) => {
+                return Err(issue(
+                    &base,
+                    "give `basis` or `symmetry_plane`, not both: the plane defines the basis",
+                ));
+            }
+            (Some(rows), None) => {
+                let m = Mat3::from_columns(&[vec3(&rows[0]), vec3(&rows[1]), vec3(&rows[2])]);
+                let err = (m.transpose() * m - Mat3::identity()).abs().max();
+                if err > BASIS_TOLERANCE || m.determinant() < 0.0 {
+                    return Err(issue(
+                        format!("{base}.basis"),
+                        format!(
+                            "the rows must be orthonormal and right-handed (|BᵀB − I| = {err:.2e}, det = {:.3})",
+                            m.determinant()
+                        ),
+                    ));
+                }
+                Some(m)
+            }
+            (None, Some(n)) => {
+                let n = vec3(n);
+                if !(n.norm() > 0.0) {
+                    return Err(issue(
+                        format!("{base}.symmetry_plane"),
+                        "the plane normal must be non-zero",
+                    ));
+                }
+                Some(basis_from_normal(&n))
+            }
+            (None, None) => None,
+        };
+        if let Some(b) = basis {
+            match basis_from.get(&node) {
+                Some(&first)
+                    if (nodes[node].conditions.basis - b).abs().max() > BASIS_TOLERANCE =>
+                {
+                    return Err(issue(
+                        &base,
+                        format!(
+                            "node `{}` already has a different basis from conditions[{first}]; one node has one basis",
+                            nodes[node].name
+                        ),
+                    ));
+                }
+                _ => {
+                    basis_from.insert(node, k);
+                    nodes[node].conditions.basis = b;
+                }
+            }
+        }
+        // Collect this entry's prescribed values and loads per component.
+        let mut prescribed: [Option<(TimeFunction, String)>; 6] = Default::default();
+        let mut loads: [Option<(TimeFunction, String)>; 6] = Default::default();
+        if c.clamp {
+            if c.displacement.is_some() || c.rotation.is_some() || c.symmetry_plane.is_some() {
+                return Err(issue(
+                    format!("{base}.clamp"),
+                    "`clamp` holds all six components: do not also give displacement, rotation or symmetry_plane",
+                ));
+            }
+            for (i, slot) in prescribed.iter_mut().enumerate() {
+                *slot = Some((TimeFunction::zero(), format!("{base}.clamp#{i}")));
+            }
+        }
+        if c.symmetry_plane.is_some() {
+            for i in [0, 4, 5] {
+                prescribed[i] = Some((TimeFunction::zero(), format!("{base}.symmetry_plane")));
+            }
+        }
+        for (field, offset, target) in [
+            ("displacement", 0, &c.displacement),
+            ("rotation", 3, &c.rotation),
+        ] {
+            if let Some(values) = target {
+                for (i, v) in values.iter().enumerate() {
+                    if let ComponentValue::Value(f) = v {
+                        let path = format!("{base}.{field}[{i}]");
+                        if prescribed[offset + i].is_some() {
+                            return Err(issue(
+                                &path,
+                                "this component is already held by symmetry_plane",
+                            ));
+                        }
+                        prescribed[offset + i] = Some((time_function(f, &path)?, path));
+                    }
+                }
+            }
+        }
+        for (field, offset, target) in [("force", 0, &c.force), ("moment", 3, &c.moment)] {
+            if let Some(values) = target {
+                for (i, v) in values.iter().enumerate() {
+                    if let ComponentValue::Value(f) = v {
+                        let path = format!("{base}.{field}[{i}]");
+                        loads[offset + i] = Some((time_function(f, &path)?, path));
+                    }
+                }
+            }
+        }
+        let release = c.release.map(|r| r.0);
+        if release.is_some() && prescribed.iter().all(Option::is_none) {
+            return Err(issue(
+                format!("{base}.release"),
+                "nothing to release: this entry prescribes no component",
+            ));
+        }
+        const NAMES: [&str; 6] = ["u1", "u2", "u3", "θ1", "θ2", "θ3"];
+        for i in 0..6 {
+            let (p, l) = (prescribed[i].take(), loads[i].take());
+            if p.is_none() && l.is_none() {
+                continue;
+            }
+            let path = p
+                .as_ref()
+                .or(l.as_ref())
+                .map(|(_, path)| path.clone())
+                .unwrap_or_default();
+            if let Some(&first) = set_by.get(&(node, i)) {
+                return Err(issue(
+                    path,
+                    format!(
+                        "component {} of node `{}` is already set by conditions[{first}]: one condition per component",
+                        NAMES[i], nodes[node].name
+                    ),
+                ));
+            }
+            set_by.insert((node, i), k);
+            nodes[node].conditions.components[i] = match (p, l) {
+                (Some((value, _)), load) => {
+                    if let (Some((_, lpath)), None) = (&load, release) {
+                        return Err(issue(
+                            lpath,
+                            format!(
+                                "component {} is both prescribed and loaded: a load acts only on a free component (add `release` to load it after release)",
+                                NAMES[i]
+                            ),
+                        ));
+                    }
+                    Component::Prescribed {
+                        value,
+                        release,
+                        load_after_release: load.map_or_else(TimeFunction::zero, |(f, _)| f),
+                    }
+                }
+                (None, Some((f, _))) => Component::Load(f),
+                (None, None) => unreachable!("skipped above"),
+            };
+        }
+    }
+    Ok(())
+}
+
+fn distributed_loads(dto: &DesignDto, patches: &[Patch]) -> Result<Vec<DistributedLoad>> {
+    let mut out = Vec::new();
+    for (k, d) in dto.distributed_loads.iter().enumerate() {
+        let base = format!("distributed_loads[{k}]");
+        let targets: Vec<usize> = if d.patch == "all" {
+            (0..patches.len()).collect()
+        } else {
+            vec![
+                patches
+                    .iter()
+                    .position(|p| p.name == d.patch)
+                    .ok_or_else(|| {
+                        issue(
+                            format!("{base}.patch"),
+                            format!("no patch `{}`: name a patch or write `all`", d.patch),
+                        )
+                    })?,
+            ]
+        };
+        let three = |f: &Option<[TimeFn; 3]>, field: &str| -> Result<[TimeFunction; 3]> {
+            let mut out: [TimeFunction; 3] = std::array::from_fn(|_| TimeFunction::zero());
+            if let Some(fs) = f {
+                for (i, fi) in fs.iter().enumerate() {
+                    out[i] = time_function(fi, &format!("{base}.{field}[{i}]"))?;
+                }
+            }
+            Ok(out)
+        };
+        let force = three(&d.force, "force")?;
+        let couple = three(&d.couple, "couple")?;
+        for patch in targets {
+            out.push(DistributedLoad {
+                patch,
+                force: force.clone(),
+                couple: couple.clone(),
+            });
+        }
+    }
+    Ok(out)
+}
+
+fn time_settings(t: &TimeDto) -> Result<TimeSettings> {
+    let (end, step) = (t.end.0, t.step.0);
+    if step > end {
+        return Err(issue(
+            "time.step",
+            format!("the step {step} exceeds the end time {end}"),
+        ));
+    }
+    let min_step = t.min_step.map_or(step * DEFAULT_MIN_STEP_FRACTION, |m| m.0);
+    if min_step > step {
+        return Err(issue(
+            "time.min_step",
+            format!("min_step {min_step} exceeds the step {step}"),
+        ));
+    }
+    Ok(TimeSettings {
+        end,
+        step,
+        min_step,
+    })
+}
+
+fn solver_settings(s: Option<&SolverDto>) -> Result<SolverSettings> {
+    let mut out = SolverSettings::default();
+    if let Some(s) = s {
+        if let Some(Positive(t)) = s.tolerance {
+            out.tolerance = t;
+        }
+        if let Some(m) = s.max_iterations {
+            if m == 0 {
+                return Err(issue("solver.max_iterations", "must be ≥ 1"));
+            }
+            out.max_iterations = m;
+        }
+    }
+    Ok(out)
+}
+
+fn probes(dto: &DesignDto, patches: &[Patch], nodes: &[Node]) -> Result<Vec<Probe>> {
+    let Some(output) = &dto.output else {
+        return Ok(Vec::new());
+    };
+    let mut out: Vec<Probe> = Vec::new();
+    for (k, p) in output.probes.iter().enumerate() {
+        let base = format!("output.probes[{k}]");
+        if p.name.is_empty() || p.name.contains([',', '"', '\n']) {
+            return Err(issue(
+                format!("{base}.name"),
+                "a probe name must be non-empty, without commas or quotes",
+            ));
+        }
+        if out.iter().any(|q| q.name == p.name) {
+            return Err(issue(
+                format!("{base}.name"),
+                format!("probe name `{}` is used twice", p.name),
+            ));
+        }
+        let location = match (&p.node, &p.patch, &p.u) {
+            (Some(n), None, None) => ProbeLocation::Node(
+                find_node(n, patches, nodes)
+                    .ok_or_else(|| issue(format!("{base}.node"), format!("no node `{n}`")))?,
+            ),
+            (None, Some(name), Some(Finite(u))) => {
+                let patch = patches
+                    .iter()
+                    .position(|q| &q.name == name)
+                    .ok_or_else(|| issue(format!("{base}.patch"), format!("no patch `{name}`")))?;
+                if !(0.0..=1.0).contains(u) {
+                    return Err(issue(
+                        format!("{base}.u"),
+                        format!("u = {u} must lie in [0, 1]"),
+                    ));
+                }
+                ProbeLocation::Patch { patch, u: *u }
+            }
+            _ => {
+                return Err(issue(
+                    &base,
+                    "give either `node`, or `patch` together with `u`",
+                ));
+            }
+        };
+        out.push(Probe {
+            name: p.name.clone(),
+            location,
+        });
+    }
+    Ok(out)
+}

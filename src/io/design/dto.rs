@@ -1,0 +1,524 @@
+//! The design file format, version 1, as serde data-transfer objects.
+//!
+//! Every struct denies unknown fields; numbers are checked while they are read (finite, positive where a
+//! size must be), so serde_yaml reports the offending value with its line and column. Checks that need
+//! several fields at once are in [`super::build`].
+
+use serde::Deserialize;
+use serde::de::{self, Deserializer, SeqAccess, Visitor};
+use std::fmt;
+
+/// A finite number (NaN and ±∞ rejected where read).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Finite(pub f64);
+
+impl<'de> Deserialize<'de> for Finite {
+    fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        let x = f64::deserialize(d)?;
+        if x.is_finite() {
+            Ok(Finite(x))
+        } else {
+            Err(de::Error::custom(format!("{x} is not a finite number")))
+        }
+    }
+}
+
+/// A finite number > 0.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Positive(pub f64);
+
+impl<'de> Deserialize<'de> for Positive {
+    fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        let Finite(x) = Finite::deserialize(d)?;
+        if x > 0.0 {
+            Ok(Positive(x))
+        } else {
+            Err(de::Error::custom(format!("{x} must be > 0")))
+        }
+    }
+}
+
+/// A finite number ≥ 0.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct NonNegative(pub f64);
+
+impl<'de> Deserialize<'de> for NonNegative {
+    fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        let Finite(x) = Finite::deserialize(d)?;
+        if x >= 0.0 {
+            Ok(NonNegative(x))
+        } else {
+            Err(de::Error::custom(format!("{x} must be ≥ 0")))
+        }
+    }
+}
+
+/// A 3-vector of finite numbers, written `[x, y, z]`.
+pub type Vector = [Finite; 3];
+
+/// A function of time: a number (constant) or a table `[[t0, v0], [t1, v1], …]` (piecewise linear).
+#[derive(Debug, Clone, PartialEq)]
+pub enum TimeFn {
+    /// A constant.
+    Constant(f64),
+    /// A table of `(t, value)` points (validated when the model is built).
+    Table(Vec<(f64, f64)>),
+}
+
+impl<'de> Deserialize<'de> for TimeFn {
+    fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        d.deserialize_any(TimeFnVisitor)
+    }
+}
+
+struct TimeFnVisitor;
+
+impl<'de> Visitor<'de> for TimeFnVisitor {
+    type Value = TimeFn;
+
+    fn expecting(&self, f: &mut fmt::Formatter) -> fmt::Result {
+        f.write_str("a number or a table [[t0, v0], [t1, v1], …]")
+    }
+
+    fn visit_f64<E: de::Error>(self, v: f64) -> Result<TimeFn, E> {
+        if v.is_finite() {
+            Ok(TimeFn::Constant(v))
+        } else {
+            Err(E::custom(format!("{v} is not a finite number")))
+        }
+    }
+
+    fn visit_i64<E: de::Error>(self, v: i64) -> Result<TimeFn, E> {
+        Ok(TimeFn::Constant(v as f64))
+    }
+
+    fn visit_u64<E: de::Error>(self, v: u64) -> Result<TimeFn, E> {
+        Ok(TimeFn::Constant(v as f64))
+    }
+
+    fn visit_seq<A: SeqAccess<'de>>(self, mut seq: A) -> Result<TimeFn, A::Error> {
+        let mut points = Vec::new();
+        while let Some([Finite(t), Finite(v)]) = seq.next_element::<[Finite; 2]>()? {
+            points.push((t, v));
+        }
+        Ok(TimeFn::Table(points))
+    }
+}
+
+/// One component of a condition: absent/`null`/`free` (not prescribed), a number or a table.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub enum ComponentValue {
+    /// Not given.
+    #[default]
+    Free,
+    /// Given as a function of time.
+    Value(TimeFn),
+}
+
+impl<'de> Deserialize<'de> for ComponentValue {
+    fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        d.deserialize_any(ComponentVisitor)
+    }
+}
+
+struct ComponentVisitor;
+
+impl<'de> Visitor<'de> for ComponentVisitor {
+    type Value = ComponentValue;
+
+    fn expecting(&self, f: &mut fmt::Formatter) -> fmt::Result {
+        f.write_str("`free`, null, a number or a table [[t0, v0], [t1, v1], …]")
+    }
+
+    fn visit_unit<E: de::Error>(self) -> Result<ComponentValue, E> {
+        Ok(ComponentValue::Free)
+    }
+
+    fn visit_none<E: de::Error>(self) -> Result<ComponentValue, E> {
+        Ok(ComponentValue::Free)
+    }
+
+    fn visit_str<E: de::Error>(self, v: &str) -> Result<ComponentValue, E> {
+        if v == "free" {
+            Ok(ComponentValue::Free)
+        } else {
+            Err(E::custom(format!(
+                "`{v}` is not a component value; allowed: free, null, a number or a table [[t, v], …]"
+            )))
+        }
+    }
+
+    fn visit_f64<E: de::Error>(self, v: f64) -> Result<ComponentValue, E> {
+        TimeFnVisitor.visit_f64(v).map(ComponentValue::Value)
+    }
+
+    fn visit_i64<E: de::Error>(self, v: i64) -> Result<ComponentValue, E> {
+        TimeFnVisitor.visit_i64(v).map(ComponentValue::Value)
+    }
+
+    fn visit_u64<E: de::Error>(self, v: u64) -> Result<ComponentValue, E> {
+        TimeFnVisitor.visit_u64(v).map(ComponentValue::Value)
+    }
+
+    fn visit_seq<A: SeqAccess<'de>>(self, seq: A) -> Result<ComponentValue, A::Error> {
+        TimeFnVisitor.visit_seq(seq).map(ComponentValue::Value)
+    }
+}
+
+/// The unit system.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
+pub enum UnitsDto {
+    /// m, N, Pa, s.
+    #[serde(rename = "SI")]
+    Si,
+    /// mm, N, MPa, s.
+    #[serde(rename = "mm-N-MPa")]
+    MmNMpa,
+}
+
+/// The whole design file.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct DesignDto {
+    /// Format version; only 1 exists.
+    #[serde(default)]
+    pub version: Option<u32>,
+    /// Design name (defaults to the file stem).
+    #[serde(default)]
+    pub name: Option<String>,
+    /// Free text.
+    #[serde(default)]
+    pub description: Option<String>,
+    /// Unit system (required).
+    pub units: UnitsDto,
+    /// The material.
+    pub material: MaterialDto,
+    /// The cross-section of every patch (patches may override the diameter).
+    pub section: SectionDto,
+    /// Default discretisation of patches.
+    #[serde(default)]
+    pub mesh: Option<MeshDto>,
+    /// Rod patches.
+    pub patches: Vec<PatchDto>,
+    /// Automatic joining of coincident patch ends.
+    #[serde(default)]
+    pub joints: Option<JointsDto>,
+    /// Named nodes.
+    #[serde(default)]
+    pub nodes: Vec<NodeDto>,
+    /// Boundary conditions and concentrated loads.
+    #[serde(default)]
+    pub conditions: Vec<ConditionDto>,
+    /// Distributed loads.
+    #[serde(default)]
+    pub distributed_loads: Vec<DistributedLoadDto>,
+    /// Temperature [°C] as a function of time.
+    #[serde(default)]
+    pub temperature: Option<TimeFn>,
+    /// Time stepping.
+    pub time: TimeDto,
+    /// Newton settings.
+    #[serde(default)]
+    pub solver: Option<SolverDto>,
+    /// Outputs.
+    #[serde(default)]
+    pub output: Option<OutputDto>,
+}
+
+/// Material block.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct MaterialDto {
+    /// Equilibrium modulus E∞ [stress], ≥ 0.
+    #[serde(rename = "E_inf")]
+    pub e_inf: NonNegative,
+    /// Maxwell branches `[E_α, τ_G,α]`.
+    #[serde(default)]
+    pub prony: Vec<[Finite; 2]>,
+    /// Poisson's ratio.
+    pub nu: Finite,
+    /// WLF shift (omit for a temperature-independent material).
+    #[serde(default)]
+    pub wlf: Option<WlfDto>,
+    /// Internal-variable update: `trapezoidal` (default), `backward-euler`, `exponential`.
+    #[serde(default)]
+    pub integrator: Option<IntegratorDto>,
+}
+
+/// WLF constants.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct WlfDto {
+    /// C1 [-].
+    #[serde(rename = "C1")]
+    pub c1: Finite,
+    /// C2 [K].
+    #[serde(rename = "C2")]
+    pub c2: Finite,
+    /// Glass transition (reference) temperature [°C].
+    #[serde(rename = "Tg")]
+    pub tg: Finite,
+}
+
+/// Internal-variable update.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum IntegratorDto {
+    /// The paper's trapezoidal rule.
+    Trapezoidal,
+    /// Backward Euler.
+    BackwardEuler,
+    /// Exact for strain linear in reduced time.
+    Exponential,
+}
+
+/// Cross-section.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SectionDto {
+    /// Circular section diameter [length].
+    pub diameter: Positive,
+    /// Shear correction factor (default: Cowper's value for a solid circle).
+    #[serde(default)]
+    pub shear_factor: Option<Positive>,
+}
+
+/// Discretisation.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct MeshDto {
+    /// Degree.
+    pub p: Option<usize>,
+    /// Control (= collocation) points per patch.
+    pub n: Option<usize>,
+}
+
+/// A patch; exactly one geometry key.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PatchDto {
+    /// Unique name.
+    pub name: String,
+    /// Straight line.
+    #[serde(default)]
+    pub line: Option<LineDto>,
+    /// Circular arc (exact).
+    #[serde(default)]
+    pub arc: Option<ArcDto>,
+    /// Helix (fitted).
+    #[serde(default)]
+    pub helix: Option<HelixDto>,
+    /// Sinusoidal crown wire (fitted).
+    #[serde(default)]
+    pub sine_wire: Option<SineWireDto>,
+    /// Curve through points (fitted).
+    #[serde(default)]
+    pub points: Option<Vec<Vector>>,
+    /// Degree (overrides `mesh.p`).
+    #[serde(default)]
+    pub p: Option<usize>,
+    /// Control points (overrides `mesh.n`).
+    #[serde(default)]
+    pub n: Option<usize>,
+    /// Diameter (overrides `section.diameter`).
+    #[serde(default)]
+    pub diameter: Option<Positive>,
+    /// Hint for the first section axis at the start.
+    #[serde(default)]
+    pub normal: Option<Vector>,
+}
+
+/// Line from a point to a point.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct LineDto {
+    /// Start point.
+    pub from: Vector,
+    /// End point.
+    pub to: Vector,
+}
+
+/// Circular arc.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ArcDto {
+    /// Centre.
+    pub center: Vector,
+    /// Start point.
+    pub start: Vector,
+    /// Rotation axis (right-hand rule).
+    pub axis: Vector,
+    /// Swept angle [degrees].
+    pub angle_deg: Finite,
+}
+
+/// Helix about a local z axis.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct HelixDto {
+    /// Radius.
+    pub radius: Positive,
+    /// Rise per turn.
+    pub pitch: Finite,
+    /// Number of turns.
+    pub turns: Positive,
+    /// Start angle [degrees].
+    #[serde(default)]
+    pub start_deg: Option<Finite>,
+    /// Centre of the base circle.
+    #[serde(default)]
+    pub origin: Option<Vector>,
+    /// Helix axis (local z).
+    #[serde(default)]
+    pub axis: Option<Vector>,
+    /// Direction of the local x axis (angle 0).
+    #[serde(default)]
+    pub x_axis: Option<Vector>,
+}
+
+/// Sinusoidal wire on a cylinder about a local z axis.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SineWireDto {
+    /// Cylinder radius.
+    pub radius: Positive,
+    /// Amplitude (half the crown height).
+    pub amplitude: Finite,
+    /// Waves per full turn.
+    pub waves: Positive,
+    /// Start angle [degrees].
+    pub from_deg: Finite,
+    /// End angle [degrees].
+    pub to_deg: Finite,
+    /// Phase [degrees].
+    #[serde(default)]
+    pub phase_deg: Option<Finite>,
+    /// Cylinder centre.
+    #[serde(default)]
+    pub origin: Option<Vector>,
+    /// Cylinder axis (local z).
+    #[serde(default)]
+    pub axis: Option<Vector>,
+    /// Direction of the local x axis (angle 0).
+    #[serde(default)]
+    pub x_axis: Option<Vector>,
+}
+
+/// Automatic joints.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct JointsDto {
+    /// Join every set of patch ends closer than this [length].
+    pub tolerance: Positive,
+}
+
+/// A named node.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct NodeDto {
+    /// Unique name.
+    pub name: String,
+    /// The patch ends it joins (`patch.start`, `patch.end`).
+    #[serde(default)]
+    pub ends: Option<Vec<String>>,
+    /// Or: every patch end at this point.
+    #[serde(default)]
+    pub at: Option<Vector>,
+}
+
+/// Conditions at one node.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ConditionDto {
+    /// Node name (or `patch.start` / `patch.end`).
+    pub node: String,
+    /// Local basis: three rows, the unit axes e1, e2, e3 (orthonormal, right-handed).
+    #[serde(default)]
+    pub basis: Option<[Vector; 3]>,
+    /// All six components held at zero.
+    #[serde(default)]
+    pub clamp: bool,
+    /// Symmetry plane with this normal: normal translation and in-plane rotations held at zero.
+    #[serde(default)]
+    pub symmetry_plane: Option<Vector>,
+    /// Prescribed displacement components (in the local basis).
+    #[serde(default)]
+    pub displacement: Option<[ComponentValue; 3]>,
+    /// Prescribed rotation components [rad] (in the local basis).
+    #[serde(default)]
+    pub rotation: Option<[ComponentValue; 3]>,
+    /// Force components on free components (dead load).
+    #[serde(default)]
+    pub force: Option<[ComponentValue; 3]>,
+    /// Moment components on free components (dead load).
+    #[serde(default)]
+    pub moment: Option<[ComponentValue; 3]>,
+    /// Time from which the prescribed components of this entry are released (become free).
+    #[serde(default)]
+    pub release: Option<NonNegative>,
+}
+
+/// A distributed load.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct DistributedLoadDto {
+    /// Patch name, or `all`.
+    pub patch: String,
+    /// Force per unit length, global components.
+    #[serde(default)]
+    pub force: Option<[TimeFn; 3]>,
+    /// Couple per unit length, global components.
+    #[serde(default)]
+    pub couple: Option<[TimeFn; 3]>,
+}
+
+/// Time stepping.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct TimeDto {
+    /// End time.
+    pub end: Positive,
+    /// Nominal step.
+    pub step: Positive,
+    /// Smallest step of automatic step cutting.
+    #[serde(default)]
+    pub min_step: Option<Positive>,
+}
+
+/// Newton settings.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SolverDto {
+    /// Convergence tolerance.
+    #[serde(default)]
+    pub tolerance: Option<Positive>,
+    /// Iterations per step.
+    #[serde(default)]
+    pub max_iterations: Option<usize>,
+}
+
+/// Outputs.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct OutputDto {
+    /// Recorded points.
+    #[serde(default)]
+    pub probes: Vec<ProbeDto>,
+}
+
+/// A probe: at a node, or on a patch at a parameter.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ProbeDto {
+    /// Column prefix in history.csv.
+    pub name: String,
+    /// Node name.
+    #[serde(default)]
+    pub node: Option<String>,
+    /// Patch name.
+    #[serde(default)]
+    pub patch: Option<String>,
+    /// Curve parameter on the patch, in [0, 1].
+    #[serde(default)]
+    pub u: Option<Finite>,
+}

@@ -1,0 +1,161 @@
+//! YAML design files (format version 1): reading, validation and the errors a designer sees.
+//!
+//! A design is read in three passes: serde_yaml deserialises it into [`dto`] types (unknown fields, missing
+//! fields, wrong types and bad single numbers are reported there with line and column); [`build`] generates
+//! the geometry and checks everything that involves several values; [`locate`] maps the field path of such a
+//! check back to its line and column. Every error names the file, the line and column, the field, what is
+//! wrong and what is allowed.
+
+pub mod build;
+pub mod dto;
+pub mod locate;
+
+use crate::model::Model;
+use std::fmt;
+use std::path::{Path, PathBuf};
+
+/// A design read from a file.
+#[derive(Debug, Clone)]
+pub struct Design {
+    /// The validated model.
+    pub model: Model,
+    /// Things worth knowing that do not stop a run.
+    pub warnings: Vec<String>,
+    /// The YAML text as read (embedded in run recordings).
+    pub source: String,
+    /// Where it was read from.
+    pub path: PathBuf,
+}
+
+/// Why a design could not be read.
+#[derive(Debug)]
+pub enum DesignError {
+    /// The file could not be read.
+    Read {
+        /// The file.
+        file: PathBuf,
+        /// The operating-system error.
+        source: std::io::Error,
+    },
+    /// The file's content is invalid.
+    Invalid {
+        /// The file.
+        file: PathBuf,
+        /// Line, 1-based.
+        line: usize,
+        /// Column, 1-based.
+        column: usize,
+        /// Field path (`patches[2].arc.radius`), empty for syntax errors.
+        field: String,
+        /// What is wrong and what is allowed.
+        message: String,
+    },
+}
+
+impl fmt::Display for DesignError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            DesignError::Read { file, source } => {
+                write!(f, "{}: cannot read the design: {source}", file.display())
+            }
+            DesignError::Invalid {
+                file,
+                line,
+                column,
+                field,
+                message,
+            } => {
+                write!(f, "{}:{line}:{column}: ", file.display())?;
+                if !field.is_empty() {
+                    write!(f, "{field}: ")?;
+                }
+                write!(f, "{message}")
+            }
+        }
+    }
+}
+
+impl std::error::Error for DesignError {
+    fn source(&self) -> Option<&(dyn std::error::Error + 'static)> {
+        match self {
+            DesignError::Read { source, .. } => Some(source),
+            DesignError::Invalid { .. } => None,
+        }
+    }
+}
+
+/// Reads and validates the design file at `path`.
+pub fn load_design(path: &Path) -> Result<Design, DesignError> {
+    let text = std::fs::read_to_string(path).map_err(|source| DesignError::Read {
+        file: path.to_path_buf(),
+        source,
+    })?;
+    parse_design(&text, path)
+}
+
+/// Drops serde_yaml's leading `path: ` and trailing ` at line L column C` (both are reported separately).
+fn strip_location(message: &str) -> String {
+    let mut text = match message.rfind(" at line ") {
+        Some(i) => &message[..i],
+        None => message,
+    };
+    if let Some((path, rest)) = text.split_once(": ")
+        && !path.is_empty()
+        && !path.contains(' ')
+    {
+        text = rest;
+    }
+    text.to_string()
+}
+
+/// Validates a design given as text; `path` names it in errors.
+pub fn parse_design(text: &str, path: &Path) -> Result<Design, DesignError> {
+    let file = path.to_path_buf();
+    let locator = locate::Locator::new(text);
+    let deserializer = serde_yaml::Deserializer::from_str(text);
+    let dto: dto::DesignDto = serde_path_to_error::deserialize(deserializer).map_err(|e| {
+        let field = match e.path().to_string() {
+            p if p == "." => String::new(),
+            p => p,
+        };
+        // A value rejected by a check (a NaN, a negative size) is located exactly by its path; serde_yaml's
+        // own position is better for unknown or missing fields and syntax errors.
+        let position = e.inner().location().map(|l| locate::Position {
+            line: l.line(),
+            column: l.column(),
+        });
+        let unknown_field = e.inner().to_string().contains("unknown field");
+        let pos = match (locator.get(&field), position) {
+            (Some(p), _) if !unknown_field => p,
+            (_, Some(p)) => p,
+            (_, None) => locator.find(&field),
+        };
+        DesignError::Invalid {
+            file: file.clone(),
+            line: pos.line,
+            column: pos.column,
+            field,
+            message: strip_location(&e.inner().to_string()),
+        }
+    })?;
+    let stem = path.file_stem().map_or_else(
+        || "design".to_string(),
+        |s| s.to_string_lossy().into_owned(),
+    );
+    let (model, warnings) = build::build(&dto, &stem).map_err(|issue| {
+        let pos = locator.find(&issue.path);
+        DesignError::Invalid {
+            file: file.clone(),
+            line: pos.line,
+            column: pos.column,
+            field: issue.path,
+            message: issue.message,
+        }
+    })?;
+    Ok(Design {
+        model,
+        warnings,
+        source: text.to_string(),
+        path: file,
+    })
+}

@@ -1,0 +1,4 @@
+//! stentkit's integration tests: one binary, one module per capability.
+
+mod design_errors;
+mod designs;
