@@ -44,7 +44,7 @@ pub const DEGENERATE_TRIANGLE_TOLERANCE: Real = 1e-12;
 /// mesh at `u32::MAX` vertices.
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct TriangleMesh {
-    /// Vertex positions [length].
+    /// Vertex positions \[length\].
     pub vertices: Vec<Vec3>,
     /// Triangles as indices into [`TriangleMesh::vertices`], counter-clockwise seen from outside.
     pub triangles: Vec<[u32; 3]>,
@@ -217,7 +217,7 @@ impl TriangleMesh {
             .unwrap_or_else(Vec3::zeros)
     }
 
-    /// The signed enclosed volume [length³] by the divergence theorem,
+    /// The signed enclosed volume \[length³\] by the divergence theorem,
     /// `V = (1/6) Σ (a − o) · ((b − o) × (c − o))` over all triangles.
     ///
     /// Positive for a closed, outward-oriented surface; for a closed surface the result does not depend on
@@ -240,7 +240,7 @@ impl TriangleMesh {
         six_v / 6.0
     }
 
-    /// The total surface area [length²], `Σ |(b − a) × (c − a)| / 2`.
+    /// The total surface area \[length²\], `Σ |(b − a) × (c − a)| / 2`.
     ///
     /// # Panics
     /// If a triangle index is out of range (see [`TriangleMesh::check_closed`]).
@@ -306,8 +306,8 @@ impl TriangleMesh {
         let relative_heights: Vec<Real> = (0..self.triangles.len())
             .map(|t| self.relative_height(t))
             .collect();
-        // `!(h > tol)` also catches NaN from non-finite coordinates.
-        let is_degenerate = |h: Real| !(h > DEGENERATE_TRIANGLE_TOLERANCE);
+        // NaN comes from non-finite coordinates.
+        let is_degenerate = |h: Real| h.is_nan() || h <= DEGENERATE_TRIANGLE_TOLERANCE;
         let degenerate_count = relative_heights
             .iter()
             .filter(|&&h| is_degenerate(h))
@@ -505,7 +505,7 @@ pub enum TubeError {
     /// The radius is not a positive finite number.
     #[error("radius must be positive and finite, got {radius}")]
     InvalidRadius {
-        /// The radius given [length].
+        /// The radius given \[length\].
         radius: Real,
     },
     /// Fewer than 3 segments around the section.
@@ -655,12 +655,12 @@ pub fn sweep_tube(
     let mut handedness = Vec::with_capacity(n);
     for (index, (frame, tangent)) in frames.iter().zip(&tangents).enumerate() {
         let deviation = (frame.transpose() * frame - Mat3::identity()).abs().max();
-        if !(deviation <= settings.frame_tolerance) {
+        if deviation.is_nan() || deviation > settings.frame_tolerance {
             return Err(TubeError::FrameNotOrthonormal { index, deviation });
         }
         let section_normal = frame.column(1).cross(&frame.column(2));
         let cosine = section_normal.dot(tangent) / section_normal.norm();
-        if !(cosine.abs() >= settings.min_section_cosine) || cosine == 0.0 {
+        if cosine.is_nan() || cosine.abs() < settings.min_section_cosine || cosine == 0.0 {
             return Err(TubeError::SectionNotTransverse { index, cosine });
         }
         handedness.push(cosine.signum());
