@@ -185,7 +185,8 @@ impl TriangleMesh {
             other
                 .triangles
                 .iter()
-                .map(|t| [t[0] + offset, t[1] + offset, t[2] + offset]),
+                // Saturating: an index already out of range in `other` stays out of range here.
+                .map(|t| t.map(|i| i.saturating_add(offset))),
         );
     }
 
