@@ -42,10 +42,20 @@
 //! Constructors validate their data (`try_new`) and report the offending value in a [`MaterialError`];
 //! time stepping reports non-finite inputs (a temperature schedule returning NaN) rather than propagating NaN.
 
+pub mod history;
+pub mod integrator;
 pub mod prony;
 pub mod section;
 pub mod wlf;
 
+pub use history::{
+    BranchHistory, SectionStrains, SectionStress, history_stress, section_stress,
+    update_branch_strains,
+};
+pub use integrator::{
+    Integrator, MAX_STEP_RATE, ReducedTimeQuadrature, StepCoefficients, exponential_coefficients,
+    reduced_time_increment, step_coefficients, step_coefficients_into,
+};
 pub use prony::{Prony, PronyBranch};
 pub use section::{CircularSection, SectionShape, ShearFactor};
 pub use wlf::Wlf;
