@@ -44,6 +44,7 @@
 
 pub mod history;
 pub mod integrator;
+pub mod point;
 pub mod prony;
 pub mod section;
 pub mod wlf;
@@ -56,6 +57,7 @@ pub use integrator::{
     Integrator, MAX_STEP_RATE, ReducedTimeQuadrature, StepCoefficients, exponential_coefficients,
     reduced_time_increment, step_coefficients, step_coefficients_into,
 };
+pub use point::{simulate_strain_history, simulate_stress_history};
 pub use prony::{Prony, PronyBranch};
 pub use section::{CircularSection, SectionShape, ShearFactor};
 pub use wlf::Wlf;
