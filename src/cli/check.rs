@@ -23,21 +23,23 @@ pub fn describe(model: &Model, file: &str, warnings: &[String]) -> String {
     let m = &model.material;
     let _ = write!(
         s,
-        "material    E_inf = {} {}, {} Maxwell branches, nu = {}",
-        m.prony.e_inf,
+        "material    E_inf = {} {}, {} Maxwell branches (E0 = {} {}), nu = {}",
+        m.prony().e_inf(),
         u.stress(),
-        m.prony.branches.len(),
-        m.poisson
+        m.num_branches(),
+        m.prony().instantaneous_modulus(),
+        u.stress(),
+        m.poisson()
     );
-    match &m.wlf {
+    match m.wlf() {
         Some(w) => {
             let _ = writeln!(
                 s,
                 ", WLF C1 = {}, C2 = {} K, Tg = {} °C (frozen at and below {} °C), integrator {:?}",
-                w.c1,
-                w.c2,
-                w.tg,
-                w.tg - w.c2,
+                w.c1(),
+                w.c2(),
+                w.tg(),
+                w.frozen_below(),
                 model.integrator
             );
         }
@@ -50,12 +52,23 @@ pub fn describe(model: &Model, file: &str, warnings: &[String]) -> String {
         }
     }
     for (k, sec) in model.sections.iter().enumerate() {
+        let kind = match sec {
+            crate::material::Section::Circular(_) => {
+                format!("circular, d = {} {}", sec.diameter(), u.length())
+            }
+            crate::material::Section::Properties(_) => format!(
+                "A = {}, I = {}, J = {} (drawn at d = {} {})",
+                sec.area(),
+                sec.second_moment(),
+                sec.polar_moment(),
+                sec.diameter(),
+                u.length()
+            ),
+        };
         let _ = writeln!(
             s,
-            "section {k}   circular, d = {} {}, shear factor {:.4}",
-            sec.diameter,
-            u.length(),
-            sec.shear_factor
+            "section {k}   {kind}, shear factor {:.4}",
+            sec.shear_factor(m.poisson())
         );
     }
     let _ = writeln!(s, "patches     {}", model.patches.len());

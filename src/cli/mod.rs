@@ -1,8 +1,9 @@
 //! The `stentkit` command line: `check` (validate a design and describe it) and `mesh` (write the reference
 //! shape as a closed tube surface). The only module that uses `anyhow` and prints.
 
-mod check;
-mod mesh;
+pub mod check;
+pub mod mesh;
+pub mod run;
 
 use clap::{Parser, Subcommand};
 use std::path::PathBuf;
@@ -28,6 +29,22 @@ pub enum Command {
         /// The design file (YAML).
         design: PathBuf,
     },
+    /// Simulate a design and write the run folder (history.csv, …).
+    ///
+    /// Example: stentkit run designs/bend45.yaml -o runs/bend45
+    Run {
+        /// The design file (YAML).
+        design: PathBuf,
+        /// Run folder (default: runs/<design name>).
+        #[arg(short, long)]
+        output: Option<PathBuf>,
+        /// Overwrite a non-empty run folder.
+        #[arg(long)]
+        force: bool,
+        /// No progress output.
+        #[arg(short, long)]
+        quiet: bool,
+    },
     /// Write the reference (permanent) shape as a closed tube surface: binary STL or OBJ by extension.
     ///
     /// Example: stentkit mesh designs/circular_arch.yaml -o arch.stl
@@ -51,6 +68,12 @@ pub fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match cli.command {
         Command::Check { design } => check::run(&design),
+        Command::Run {
+            design,
+            output,
+            force,
+            quiet,
+        } => run::run(&design, output, force, quiet),
         Command::Mesh {
             design,
             output,

@@ -1509,3 +1509,43 @@ mod tests {
         }
     }
 }
+
+/// The closed tube of radius `radius` around a spline curve, sampled at `samples + 1` uniform parameters with
+/// its rotation-minimising frames. The section polygon is turned by `phase` segments (a fraction in `[0, 1)`)
+/// about the axis: giving each patch of a device its own phase keeps the end rings of patches that meet at a
+/// joint from coinciding vertex for vertex, which would make their edges non-manifold once an STL reader merges
+/// equal vertices.
+pub fn sweep_curve(
+    curve: &crate::math::NurbsCurve,
+    frames: &super::frame::FrameField,
+    radius: Real,
+    samples: usize,
+    phase: Real,
+    settings: &TubeSettings,
+) -> Result<TriangleMesh, SweepError> {
+    let (u0, u1) = curve.knots().domain();
+    let samples = samples.max(1);
+    let turn = crate::math::so3::exp(
+        &(Vec3::x() * (2.0 * PI * phase / settings.segments_around.max(1) as Real)),
+    );
+    let mut centre = Vec::with_capacity(samples + 1);
+    let mut rotations = Vec::with_capacity(samples + 1);
+    for k in 0..=samples {
+        let u = u0 + (u1 - u0) * k as Real / samples as Real;
+        let f = frames.at(curve, u)?;
+        centre.push(f.position);
+        rotations.push(f.rotation * turn.matrix());
+    }
+    Ok(sweep_tube(&centre, &rotations, radius, settings)?)
+}
+
+/// Why a curve could not be swept.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum SweepError {
+    /// The frames could not be evaluated.
+    #[error(transparent)]
+    Frame(#[from] super::GeometryError),
+    /// The tube could not be built.
+    #[error(transparent)]
+    Tube(#[from] TubeError),
+}

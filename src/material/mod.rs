@@ -59,7 +59,7 @@ pub use integrator::{
 };
 pub use point::{simulate_strain_history, simulate_stress_history};
 pub use prony::{Prony, PronyBranch};
-pub use section::{CircularSection, SectionShape, ShearFactor};
+pub use section::{CircularSection, Section, SectionProperties, SectionShape, ShearFactor};
 pub use wlf::Wlf;
 
 use crate::math::Real;
@@ -233,9 +233,9 @@ impl Material {
         self.wlf.as_ref().is_some_and(|w| w.is_frozen(temperature))
     }
 
-    /// The stiffness shapes of a circular section made of this material ([`SectionShape::new`] with this
+    /// The stiffness shapes of a section made of this material ([`SectionShape::new`] with this
     /// material's `ν`).
-    pub fn section_shape(&self, section: &CircularSection) -> SectionShape {
+    pub fn section_shape(&self, section: &Section) -> SectionShape {
         SectionShape::new(section, self.poisson)
     }
 }

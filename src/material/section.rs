@@ -102,6 +102,100 @@ impl CircularSection {
     }
 }
 
+/// A cross-section given by its properties rather than its shape: for verification problems stated in terms
+/// of `A`, `I`, `J` and `k_s` (e.g. the unit square section of Bathe & Bolourchi's 45° bend). Both bending
+/// axes share `I`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SectionProperties {
+    /// Area `A` \[length²\].
+    pub area: Real,
+    /// Second moment of area about either section axis `I` \[length⁴\].
+    pub second_moment: Real,
+    /// Torsion constant `J` \[length⁴\].
+    pub polar_moment: Real,
+    /// Shear correction factor `k_s` \[-\].
+    pub shear_factor: Real,
+    /// Diameter of the circular tube drawn for this section \[length\] (exports only).
+    pub drawing_diameter: Real,
+}
+
+/// A rod cross-section: a solid circle, or given properties.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Section {
+    /// A solid circle (the devices' wires).
+    Circular(CircularSection),
+    /// Given `A, I, J, k_s`.
+    Properties(SectionProperties),
+}
+
+impl Section {
+    /// A section from properties, each finite and `> 0`.
+    pub fn try_from_properties(p: SectionProperties) -> Result<Self, MaterialError> {
+        for (value, ok) in [
+            (p.area, p.area > 0.0),
+            (p.second_moment, p.second_moment > 0.0),
+            (p.polar_moment, p.polar_moment > 0.0),
+            (p.drawing_diameter, p.drawing_diameter > 0.0),
+        ] {
+            if !(value.is_finite() && ok) {
+                return Err(MaterialError::Diameter { value });
+            }
+        }
+        if !(p.shear_factor.is_finite() && p.shear_factor > 0.0) {
+            return Err(MaterialError::ShearFactor {
+                value: p.shear_factor,
+            });
+        }
+        Ok(Section::Properties(p))
+    }
+
+    /// Area `A` \[length²\].
+    pub fn area(&self) -> Real {
+        match self {
+            Section::Circular(c) => c.area(),
+            Section::Properties(p) => p.area,
+        }
+    }
+
+    /// Second moment of area `I` \[length⁴\].
+    pub fn second_moment(&self) -> Real {
+        match self {
+            Section::Circular(c) => c.second_moment(),
+            Section::Properties(p) => p.second_moment,
+        }
+    }
+
+    /// Torsion constant `J` \[length⁴\].
+    pub fn polar_moment(&self) -> Real {
+        match self {
+            Section::Circular(c) => c.polar_moment(),
+            Section::Properties(p) => p.polar_moment,
+        }
+    }
+
+    /// Shear correction factor `k_s` for Poisson's ratio `ν`.
+    pub fn shear_factor(&self, poisson: Real) -> Real {
+        match self {
+            Section::Circular(c) => c.shear_factor().value(poisson),
+            Section::Properties(p) => p.shear_factor,
+        }
+    }
+
+    /// Diameter of the tube that draws the rod \[length\].
+    pub fn diameter(&self) -> Real {
+        match self {
+            Section::Circular(c) => c.diameter(),
+            Section::Properties(p) => p.drawing_diameter,
+        }
+    }
+}
+
+impl From<CircularSection> for Section {
+    fn from(c: CircularSection) -> Self {
+        Section::Circular(c)
+    }
+}
+
 /// The stiffness shapes of a section for a given `ν`: the diagonals of `C_N/E` and `C_M/E`.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct SectionShape {
@@ -113,11 +207,11 @@ pub struct SectionShape {
 
 impl SectionShape {
     /// The shapes of `section` for Poisson's ratio `ν` (validated by [`super::Material`]).
-    pub fn new(section: &CircularSection, poisson: Real) -> Self {
+    pub fn new(section: &Section, poisson: Real) -> Self {
         let a = section.area();
         let i = section.second_moment();
         let j = section.polar_moment();
-        let k_s = section.shear_factor.value(poisson);
+        let k_s = section.shear_factor(poisson);
         let g_per_e = 1.0 / (2.0 * (1.0 + poisson));
         Self {
             force: Vec3::new(a, k_s * g_per_e * a, k_s * g_per_e * a),
@@ -173,7 +267,7 @@ mod tests {
         let nu = 0.33;
         let e = 2394.4e6;
         let s = CircularSection::try_new(0.05).expect("valid diameter");
-        let shape = SectionShape::new(&s, nu);
+        let shape = SectionShape::new(&s.into(), nu);
         let g = e / (2.0 * (1.0 + nu));
         let k = ShearFactor::Cowper.value(nu);
         let cn = shape.force_matrix(e);

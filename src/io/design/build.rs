@@ -8,7 +8,10 @@ use crate::geometry::analytic::{
 };
 use crate::geometry::fit::{FitSettings, fit_curve};
 use crate::geometry::{GeometryError, primitives};
-use crate::material::{Integrator, Material, Prony, PronyBranch, Section, Wlf};
+use crate::material::{
+    CircularSection, Integrator, Material, Prony, PronyBranch, Section, SectionProperties,
+    ShearFactor, Wlf,
+};
 use crate::math::{Mat3, NurbsCurve, Real, Vec3};
 use crate::model::*;
 use std::collections::HashMap;
@@ -55,12 +58,6 @@ fn time_function(f: &TimeFn, path: &str) -> Result<TimeFunction> {
     }
 }
 
-/// Cowper's shear correction factor of a solid circular section, `6(1+ν)/(7+6ν)` (G. R. Cowper, *The shear
-/// coefficient in Timoshenko's beam theory*, J. Appl. Mech. 33 (1966) 335–340).
-pub fn cowper_shear_factor(nu: Real) -> Real {
-    6.0 * (1.0 + nu) / (7.0 + 6.0 * nu)
-}
-
 /// Builds and validates the model; returns it with the warnings found.
 pub fn build(dto: &DesignDto, default_name: &str) -> Result<(Model, Vec<String>)> {
     let mut warnings = Vec::new();
@@ -77,21 +74,14 @@ pub fn build(dto: &DesignDto, default_name: &str) -> Result<(Model, Vec<String>)
         UnitsDto::MmNMpa => Units::MmNMpa,
     };
     let (material, integrator) = material(&dto.material)?;
-    let shear_factor = dto
-        .section
-        .shear_factor
-        .map(|Positive(k)| k)
-        .unwrap_or_else(|| cowper_shear_factor(material.poisson));
-    let mut sections = vec![Section {
-        diameter: dto.section.diameter.0,
-        shear_factor,
-    }];
+    let (section, shear_factor) = section(&dto.section)?;
+    let mut sections = vec![section];
     let patches = patches(dto, &mut sections, shear_factor, &mut warnings)?;
     let tolerance = joint_tolerance(dto, &patches);
     let mut nodes = nodes(dto, &patches, tolerance)?;
     conditions(dto, &patches, &mut nodes)?;
     let distributed_loads = distributed_loads(dto, &patches)?;
-    let temperature = match (&dto.temperature, &material.wlf) {
+    let temperature = match (&dto.temperature, material.wlf()) {
         (Some(f), _) => time_function(f, "temperature")?,
         (None, None) => TimeFunction::constant(20.0),
         (None, Some(_)) => {
@@ -101,8 +91,8 @@ pub fn build(dto: &DesignDto, default_name: &str) -> Result<(Model, Vec<String>)
             ));
         }
     };
-    if let Some(w) = &material.wlf {
-        let freeze = w.tg - w.c2;
+    if let Some(w) = material.wlf() {
+        let freeze = w.frozen_below();
         let (lo, _) = temperature.range();
         if lo <= freeze {
             warnings.push(format!(
@@ -159,13 +149,8 @@ fn material(m: &MaterialDto) -> Result<(Material, Integrator)> {
             tau_g: *tau,
         });
     }
-    let e0 = m.e_inf.0 + branches.iter().map(|b| b.modulus).sum::<Real>();
-    if !(e0 > 0.0) {
-        return Err(issue(
-            "material.E_inf",
-            "the instantaneous modulus E_inf + Σ E_α must be > 0",
-        ));
-    }
+    let prony =
+        Prony::try_new(m.e_inf.0, branches).map_err(|e| issue("material.E_inf", e.to_string()))?;
     let nu = m.nu.0;
     if !(nu > -1.0 && nu < 0.5) {
         return Err(issue(
@@ -188,11 +173,10 @@ fn material(m: &MaterialDto) -> Result<(Material, Integrator)> {
                     format!("C2 = {} must be > 0", w.c2.0),
                 ));
             }
-            Some(Wlf {
-                c1: w.c1.0,
-                c2: w.c2.0,
-                tg: w.tg.0,
-            })
+            Some(
+                Wlf::try_new(w.c1.0, w.c2.0, w.tg.0)
+                    .map_err(|e| issue("material.wlf", e.to_string()))?,
+            )
         }
     };
     let integrator = match m.integrator {
@@ -200,15 +184,53 @@ fn material(m: &MaterialDto) -> Result<(Material, Integrator)> {
         Some(IntegratorDto::BackwardEuler) => Integrator::BackwardEuler,
         Some(IntegratorDto::Exponential) => Integrator::Exponential,
     };
-    let material = Material {
-        prony: Prony {
-            e_inf: m.e_inf.0,
-            branches,
-        },
-        poisson: nu,
-        wlf,
-    };
+    let material =
+        Material::try_new(prony, nu, wlf).map_err(|e| issue("material", e.to_string()))?;
     Ok((material, integrator))
+}
+
+/// The design's section and the shear-factor rule patches with their own diameter inherit.
+fn section(s: &SectionDto) -> Result<(Section, ShearFactor)> {
+    let rule = s
+        .shear_factor
+        .map_or(ShearFactor::Cowper, |Positive(k)| ShearFactor::Given(k));
+    match (s.diameter, s.area, s.inertia, s.polar) {
+        (Some(Positive(d)), None, None, None) => {
+            if s.draw_diameter.is_some() {
+                return Err(issue(
+                    "section.draw_diameter",
+                    "a circular section is drawn at its own diameter",
+                ));
+            }
+            let c = CircularSection::try_with_shear_factor(d, rule)
+                .map_err(|e| issue("section.diameter", e.to_string()))?;
+            Ok((c.into(), rule))
+        }
+        (None, Some(Positive(area)), Some(Positive(inertia)), Some(Positive(polar))) => {
+            let Some(Positive(k)) = s.shear_factor else {
+                return Err(issue(
+                    "section",
+                    "a section given by properties needs `shear_factor`",
+                ));
+            };
+            let p = SectionProperties {
+                area,
+                second_moment: inertia,
+                polar_moment: polar,
+                shear_factor: k,
+                drawing_diameter: s
+                    .draw_diameter
+                    .map_or_else(|| (4.0 * area / std::f64::consts::PI).sqrt(), |d| d.0),
+            };
+            let section =
+                Section::try_from_properties(p).map_err(|e| issue("section", e.to_string()))?;
+            Ok((section, rule))
+        }
+        _ => Err(issue(
+            "section",
+            "give either `diameter` (a solid circle) or all of `area`, `inertia` and `polar` (with `shear_factor`)",
+        )),
+    }
 }
 
 fn geometry_issue(path: &str, e: GeometryError) -> Issue {
@@ -277,7 +299,7 @@ fn fitted(
 fn patches(
     dto: &DesignDto,
     sections: &mut Vec<Section>,
-    shear_factor: Real,
+    shear_factor: ShearFactor,
     warnings: &mut Vec<String>,
 ) -> Result<Vec<Patch>> {
     if dto.patches.is_empty() {
@@ -380,15 +402,21 @@ fn patches(
         let section = match pd.diameter {
             None => 0,
             Some(Positive(d)) => {
-                sections.push(Section {
-                    diameter: d,
-                    shear_factor,
-                });
+                let path = format!("{base}.diameter");
+                if !matches!(sections[0], Section::Circular(_)) {
+                    return Err(issue(
+                        path,
+                        "only a circular section's diameter can be overridden per patch",
+                    ));
+                }
+                let c = CircularSection::try_with_shear_factor(d, shear_factor)
+                    .map_err(|e| issue(&path, e.to_string()))?;
+                sections.push(c.into());
                 sections.len() - 1
             }
         };
         if let Some(dev) = fit_error {
-            let d = sections[section].diameter;
+            let d = sections[section].diameter();
             if dev > FIT_WARNING_FRACTION * d {
                 warnings.push(format!(
                     "patch `{}`: the spline fit deviates up to {dev:.3e} from the curve, {:.1}% of the wire diameter; raise n",

@@ -272,12 +272,25 @@ pub enum IntegratorDto {
     Exponential,
 }
 
-/// Cross-section.
+/// Cross-section: a solid circle (`diameter`) or given properties (`area`, `inertia`, `polar`).
 #[derive(Debug, Clone, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct SectionDto {
     /// Circular section diameter [length].
-    pub diameter: Positive,
+    #[serde(default)]
+    pub diameter: Option<Positive>,
+    /// Area [length²].
+    #[serde(default)]
+    pub area: Option<Positive>,
+    /// Second moment of area about either section axis [length⁴].
+    #[serde(default)]
+    pub inertia: Option<Positive>,
+    /// Torsion constant [length⁴].
+    #[serde(default)]
+    pub polar: Option<Positive>,
+    /// Diameter of the tube drawn for a section given by properties [length].
+    #[serde(default)]
+    pub draw_diameter: Option<Positive>,
     /// Shear correction factor (default: Cowper's value for a solid circle).
     #[serde(default)]
     pub shear_factor: Option<Positive>,

@@ -1,0 +1,87 @@
+//! `history.csv`: one row per converged step (and the initial state): `time`, then for each probe `P` the
+//! displacement columns `P.ux, P.uy, P.uz` (in the design's length unit), then `temperature` [°C],
+//! `iterations` (Newton solves of the step), `residual` (final normalised residual) and `cuts` (step cuts).
+//! Rows are flushed as they are written, so an interrupted run leaves a valid file up to its last step.
+
+use crate::solver::{Observer, Simulation, StepReport};
+use std::fs::File;
+use std::io::{BufWriter, Write};
+use std::ops::ControlFlow;
+use std::path::{Path, PathBuf};
+
+/// Writes `history.csv` as the simulation reports steps.
+pub struct HistoryWriter {
+    path: PathBuf,
+    out: BufWriter<File>,
+    /// First write error; writing stops there and the run is asked to stop.
+    error: Option<std::io::Error>,
+}
+
+impl HistoryWriter {
+    /// Creates (truncates) the file and writes the header for the model's probes.
+    pub fn create(path: &Path, sim: &Simulation<'_>) -> std::io::Result<Self> {
+        let mut out = BufWriter::new(File::create(path)?);
+        let mut header = String::from("time");
+        for p in &sim.model().probes {
+            for c in ["ux", "uy", "uz"] {
+                header.push_str(&format!(",{}.{c}", p.name));
+            }
+        }
+        header.push_str(",temperature,iterations,residual,cuts");
+        writeln!(out, "{header}")?;
+        Ok(Self {
+            path: path.to_path_buf(),
+            out,
+            error: None,
+        })
+    }
+
+    /// The file written.
+    pub fn path(&self) -> &Path {
+        &self.path
+    }
+
+    /// The first write error, if any.
+    pub fn take_error(&mut self) -> Option<std::io::Error> {
+        self.error.take()
+    }
+
+    fn row(&mut self, sim: &Simulation<'_>, report: Option<&StepReport>) -> ControlFlow<()> {
+        let t = sim.time();
+        let mut line = format!("{t:.10e}");
+        for p in &sim.model().probes {
+            let u = sim.probe_displacement(&p.location);
+            line.push_str(&format!(",{:.12e},{:.12e},{:.12e}", u.x, u.y, u.z));
+        }
+        let temperature = sim.model().temperature.value(t);
+        let (iterations, residual, cuts) = match report {
+            Some(r) => (
+                r.newton.iterations,
+                r.newton.residuals.last().copied().unwrap_or(0.0),
+                r.cuts,
+            ),
+            None => (0, 0.0, 0),
+        };
+        line.push_str(&format!(
+            ",{temperature:.6},{iterations},{residual:.3e},{cuts}"
+        ));
+        let result = writeln!(self.out, "{line}").and_then(|_| self.out.flush());
+        match result {
+            Ok(()) => ControlFlow::Continue(()),
+            Err(e) => {
+                self.error = Some(e);
+                ControlFlow::Break(())
+            }
+        }
+    }
+}
+
+impl Observer for HistoryWriter {
+    fn start(&mut self, sim: &Simulation<'_>) -> ControlFlow<()> {
+        self.row(sim, None)
+    }
+
+    fn step(&mut self, sim: &Simulation<'_>, report: &StepReport) -> ControlFlow<()> {
+        self.row(sim, Some(report))
+    }
+}

@@ -1,0 +1,575 @@
+//! Residual and consistent tangent of the collocated equations (paper §3, compact form of DESIGN §4).
+//!
+//! At an interior collocation point the material balance laws (paper Eqs. mat_f, mat_m)
+//! ```text
+//! F = K × N + N,s + Rᵀ n̄ = 0,      T = K × M + M,s + Γ × N + Rᵀ m̄ = 0
+//! ```
+//! with `N = C̄_N (Γ − Γ0) − H_N`, `M = C̄_M (K − K0) − H_M` (N_constitutive_disc, M_constitutive_disc; the
+//! history terms `H` are constant during Newton) and `Γ,s = Rᵀ c,ss − K × Γ`.
+//! Their linearisation under `R exp(εδΘ̃)`, `c + εδη` uses
+//! ```text
+//! δΓ = Γ × δΘ + Rᵀ δη,s            δK = K × δΘ + δΘ,s
+//! δΓ,s = (Rᵀc,ss) × δΘ + Rᵀ δη,ss + Γ × δK − K × δΓ
+//! δK,s = K,s × δΘ + K × δΘ,s + δΘ,ss
+//! ```
+//! which gives 3×3 coefficient blocks of `δΘ, δΘ,s, δΘ,ss, δη,s, δη,ss` per point; multiplied by the basis
+//! values they are the tangent's blocks per control point.
+//!
+//! Patch ends carry the node equations (DESIGN §4 "Joints"): for a node joining ends `e = 1 … k` with outward
+//! signs `σ_e`, the rows of end 1 hold, per component of the node's local basis `B`, either equilibrium
+//! `Bᵀ(Σ σ_e R_e N_e − f̄)`, `Bᵀ(Σ σ_e R_e M_e − m̄)` or, for a prescribed component, the kinematic condition
+//! (`e_i·(c_1 − X_1) = ḡ_i`, or `e_i·φ = ḡ_i` with `R_1 = exp(φ̃) R_1⁰`); the rows of every other end hold
+//! continuity of position and rotation with end 1 (`c_e = c_1`, `R_e = R_1 Q_e` with the reference relative
+//! rotation `Q_e = R_1⁰ᵀ R_e⁰`). The sparsity pattern is the union over all conditions, so it never changes when
+//! a condition is released.
+//!
+//! Every equation row gets a scale that turns its residual into a dimensionless, strain-like number (force
+//! rows by `E A`, moment rows by `E I / L`, per unit length by one more `1/L`, translations by `L`), used by
+//! Newton's normalised norms.
+
+use super::discretisation::{CollocationPoint, Discretisation};
+use super::state::State;
+use crate::math::so3::{hat, log};
+use crate::math::{Mat3, Real, Rot3, Vec3};
+use crate::model::{Component, Model};
+
+/// Receives the tangent's entries in a fixed order: first to record the sparsity pattern, then to fill values.
+pub enum Sink<'a> {
+    /// Records `(row, column)` of every entry.
+    Pattern(&'a mut Vec<(usize, usize)>),
+    /// Writes the values in the recorded order.
+    Values {
+        /// One value per recorded entry.
+        values: &'a mut [Real],
+        /// Next position.
+        next: usize,
+    },
+    /// Discards entries (residual-only assembly).
+    Discard,
+}
+
+impl Sink<'_> {
+    #[inline]
+    fn push(&mut self, row: usize, col: usize, v: Real) {
+        match self {
+            Sink::Pattern(p) => p.push((row, col)),
+            Sink::Values { values, next } => {
+                values[*next] = v;
+                *next += 1;
+            }
+            Sink::Discard => {}
+        }
+    }
+
+    /// Adds a 3×3 block at `(row, col)`.
+    #[inline]
+    fn block(&mut self, row: usize, col: usize, m: &Mat3) {
+        if matches!(self, Sink::Discard) {
+            return;
+        }
+        for i in 0..3 {
+            for j in 0..3 {
+                self.push(row + i, col + j, m[(i, j)]);
+            }
+        }
+    }
+}
+
+/// The loads and prescribed values at one instant, resolved from the model's schedules.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Actions {
+    /// Per node: concentrated force and moment (spatial) on its free components.
+    pub node_force: Vec<Vec3>,
+    /// Per node: concentrated moment (spatial).
+    pub node_moment: Vec<Vec3>,
+    /// Per node and local component: the prescribed value, or `None` when the component is free.
+    pub prescribed: Vec<[Option<Real>; 6]>,
+    /// Per patch: distributed force per unit length (spatial).
+    pub dist_force: Vec<Vec3>,
+    /// Per patch: distributed couple per unit length (spatial).
+    pub dist_couple: Vec<Vec3>,
+}
+
+impl Actions {
+    /// Evaluates every schedule of the model at time `t`.
+    pub fn at(model: &Model, t: Real) -> Self {
+        let mut node_force = Vec::with_capacity(model.nodes.len());
+        let mut node_moment = Vec::with_capacity(model.nodes.len());
+        let mut prescribed = Vec::with_capacity(model.nodes.len());
+        for node in &model.nodes {
+            let mut local = [0.0; 6];
+            let mut fixed = [None; 6];
+            for (i, c) in node.conditions.components.iter().enumerate() {
+                match c {
+                    Component::Load(f) => local[i] = f.value(t),
+                    Component::Prescribed {
+                        value,
+                        release,
+                        load_after_release,
+                    } => {
+                        if release.is_none_or(|r| t < r) {
+                            fixed[i] = Some(value.value(t));
+                        } else {
+                            local[i] = load_after_release.value(t);
+                        }
+                    }
+                }
+            }
+            let b = &node.conditions.basis;
+            node_force.push(b * Vec3::new(local[0], local[1], local[2]));
+            node_moment.push(b * Vec3::new(local[3], local[4], local[5]));
+            prescribed.push(fixed);
+        }
+        let mut dist_force = vec![Vec3::zeros(); model.patches.len()];
+        let mut dist_couple = vec![Vec3::zeros(); model.patches.len()];
+        for load in &model.distributed_loads {
+            dist_force[load.patch] += Vec3::from_fn(|i, _| load.force[i].value(t));
+            dist_couple[load.patch] += Vec3::from_fn(|i, _| load.couple[i].value(t));
+        }
+        Self {
+            node_force,
+            node_moment,
+            prescribed,
+            dist_force,
+            dist_couple,
+        }
+    }
+}
+
+/// The constitutive data of one time step: the effective modulus of `C̄ = modulus · shape` and, per
+/// collocation point, the history stresses `[H_N, H_N,s, H_M, H_M,s]` (empty = all zero, elastic).
+#[derive(Debug, Clone, Copy)]
+pub struct StepMaterial<'a> {
+    /// Effective modulus of `C̄` [stress].
+    pub modulus: Real,
+    /// History stresses per collocation point.
+    pub history: &'a [[Vec3; 4]],
+}
+
+/// One end of a node, as the node equations see it.
+#[derive(Debug, Clone, PartialEq)]
+struct NodeEnd {
+    /// Global collocation point of the end.
+    point: usize,
+    /// Outward sign σ.
+    sign: Real,
+    /// The index `a` of the basis function that equals 1 at the end (the end control point).
+    end_basis: usize,
+    /// Reference relative rotation `Q_e = R_1⁰ᵀ R_e⁰` (identity for the first end).
+    relative: Mat3,
+}
+
+/// The fixed data of one node's equations.
+#[derive(Debug, Clone, PartialEq)]
+struct NodeRows {
+    ends: Vec<NodeEnd>,
+    /// Local basis (columns e1, e2, e3).
+    basis: Mat3,
+    /// Reference position of end 1.
+    position0: Vec3,
+    /// Reference rotation of end 1.
+    rotation0: Mat3,
+}
+
+/// Everything the assembly needs that does not change during a run.
+#[derive(Debug, Clone)]
+pub struct Assembler {
+    nodes: Vec<NodeRows>,
+    /// Reference modulus for residual scales (instantaneous modulus) [stress].
+    modulus_scale: Real,
+    /// Length of each patch [length].
+    patch_length: Vec<Real>,
+}
+
+/// Tangent and residual of one Newton iteration, and the row scales of the residual.
+#[derive(Debug, Clone, Default)]
+pub struct Linearisation {
+    /// Residual vector (one entry per equation).
+    pub residual: Vec<Real>,
+    /// Dimensionless scale of each row (residual / scale is strain-like).
+    pub row_scale: Vec<Real>,
+}
+
+impl Assembler {
+    /// Prepares the node equations of `model` on `disc`.
+    pub fn new(model: &Model, disc: &Discretisation) -> Self {
+        let nodes = model
+            .nodes
+            .iter()
+            .map(|node| {
+                let g1 = disc.end_point(node.ends[0]);
+                let r1 = disc.points[g1].rotation0;
+                let ends = node
+                    .ends
+                    .iter()
+                    .map(|&e| {
+                        let g = disc.end_point(e);
+                        let point = &disc.points[g];
+                        let end_basis = point.basis.iter().position(|row| row[0] == 1.0).unwrap_or(
+                            if e.end.sign() < 0.0 {
+                                0
+                            } else {
+                                point.basis.len() - 1
+                            },
+                        );
+                        NodeEnd {
+                            point: g,
+                            sign: e.end.sign(),
+                            end_basis,
+                            relative: r1.transpose() * point.rotation0,
+                        }
+                    })
+                    .collect();
+                NodeRows {
+                    ends,
+                    basis: node.conditions.basis,
+                    position0: point_position(disc, &disc.control0, g1),
+                    rotation0: r1,
+                }
+            })
+            .collect();
+        let modulus_scale = model.material.prony().instantaneous_modulus();
+        let patch_length = model
+            .patches
+            .iter()
+            .map(|p| curve_length(&p.curve))
+            .collect();
+        Self {
+            nodes,
+            modulus_scale,
+            patch_length,
+        }
+    }
+
+    /// Assembles the residual into `lin` and the tangent into `sink` (entries in the pattern's order).
+    pub fn assemble(
+        &self,
+        disc: &Discretisation,
+        state: &State,
+        material: StepMaterial<'_>,
+        actions: &Actions,
+        lin: &mut Linearisation,
+        sink: &mut Sink<'_>,
+    ) {
+        let n = disc.num_unknowns();
+        lin.residual.resize(n, 0.0);
+        lin.row_scale.resize(n, 1.0);
+        // Interior points.
+        for (g, point) in disc.points.iter().enumerate() {
+            if disc.is_end(g) {
+                continue;
+            }
+            self.interior(disc, state, material, actions, g, point, lin, sink);
+        }
+        // Node rows.
+        for (k, node) in self.nodes.iter().enumerate() {
+            self.node(disc, state, material, actions, k, node, lin, sink);
+        }
+    }
+
+    fn section(
+        &self,
+        disc: &Discretisation,
+        point: &CollocationPoint,
+        modulus: Real,
+    ) -> (Mat3, Mat3) {
+        let shape = &disc.shapes[point.shape];
+        (shape.force_matrix(modulus), shape.moment_matrix(modulus))
+    }
+
+    #[allow(non_snake_case, clippy::too_many_arguments)]
+    fn interior(
+        &self,
+        disc: &Discretisation,
+        state: &State,
+        material: StepMaterial<'_>,
+        actions: &Actions,
+        g: usize,
+        point: &CollocationPoint,
+        lin: &mut Linearisation,
+        sink: &mut Sink<'_>,
+    ) {
+        let (CN, CM) = self.section(disc, point, material.modulus);
+        let k = kinematics(point, state, g);
+        let [hn, hn_s, hm, hm_s] = material
+            .history
+            .get(g)
+            .copied()
+            .unwrap_or([Vec3::zeros(); 4]);
+        let N = CN * (k.gamma - point.gamma0) - hn;
+        let N_s = CN * (k.gamma_s - point.gamma0_s) - hn_s;
+        let K = state.kappa[g];
+        let K_s = state.kappa_s[g];
+        let M = CM * (K - point.kappa0) - hm;
+        let M_s = CM * (K_s - point.kappa0_s) - hm_s;
+        let R = &state.rotation[g];
+        let Rt = R.transpose();
+        let nbar = Rt * actions.dist_force[point.patch];
+        let mbar = Rt * actions.dist_couple[point.patch];
+        let F = K.cross(&N) + N_s + nbar;
+        let T = K.cross(&M) + M_s + k.gamma.cross(&N) + mbar;
+        let row = 6 * g;
+        lin.residual[row..row + 3].copy_from_slice(F.as_slice());
+        lin.residual[row + 3..row + 6].copy_from_slice(T.as_slice());
+        let length = self.patch_length[point.patch];
+        let shape = &disc.shapes[point.shape];
+        let force_scale = self.modulus_scale * shape.force.x / length;
+        let moment_scale = self.modulus_scale * shape.moment.y / (length * length);
+        lin.row_scale[row..row + 3].fill(force_scale);
+        lin.row_scale[row + 3..row + 6].fill(moment_scale);
+        if matches!(sink, Sink::Discard) {
+            return;
+        }
+        let (Kt, Gt, Nt, Mt) = (hat(&K), hat(&k.gamma), hat(&N), hat(&M));
+        let cssm = hat(&(Rt * k.c_ss));
+        let f_th = -Nt * Kt + Kt * CN * Gt + CN * (cssm + Gt * Kt - Kt * Gt) + hat(&nbar);
+        let f_th_s = -Nt + CN * Gt;
+        let f_eta_s = (Kt * CN - CN * Kt) * Rt;
+        let f_eta_ss = CN * Rt;
+        let ng = -Nt + Gt * CN;
+        let t_th = -Mt * Kt + Kt * CM * Kt + CM * hat(&K_s) + ng * Gt + hat(&mbar);
+        let t_th_s = -Mt + Kt * CM + CM * Kt;
+        let t_th_ss = CM;
+        let t_eta_s = ng * Rt;
+        for (a, b) in point.basis.iter().enumerate() {
+            let col = 6 * (point.first + a);
+            sink.block(row, col, &(f_eta_s * b[1] + f_eta_ss * b[2]));
+            sink.block(row, col + 3, &(f_th * b[0] + f_th_s * b[1]));
+            sink.block(row + 3, col, &(t_eta_s * b[1]));
+            sink.block(
+                row + 3,
+                col + 3,
+                &(t_th * b[0] + t_th_s * b[1] + t_th_ss * b[2]),
+            );
+        }
+    }
+
+    #[allow(non_snake_case, clippy::too_many_arguments)]
+    fn node(
+        &self,
+        disc: &Discretisation,
+        state: &State,
+        material: StepMaterial<'_>,
+        actions: &Actions,
+        k: usize,
+        node: &NodeRows,
+        lin: &mut Linearisation,
+        sink: &mut Sink<'_>,
+    ) {
+        let B = &node.basis;
+        let Bt = B.transpose();
+        let first = &node.ends[0];
+        let g1 = first.point;
+        let row1 = 6 * g1;
+        let p1 = &disc.points[g1];
+        let length = self.patch_length[p1.patch];
+        let shape1 = &disc.shapes[p1.shape];
+        let force_scale = self.modulus_scale * shape1.force.x;
+        let moment_scale = self.modulus_scale * shape1.moment.y / length;
+        // Equilibrium residual (spatial) and, per end and support control point, its 6×6 blocks in the local basis.
+        let mut force = -actions.node_force[k];
+        let mut moment = -actions.node_moment[k];
+        struct EndTerms {
+            /// ∂(σ R N)/∂δη,s and ∂(σ R N)/∂δΘ (spatial).
+            n_eta_s: Mat3,
+            n_th: Mat3,
+            /// ∂(σ R M)/∂δΘ and ∂(σ R M)/∂δΘ,s.
+            m_th: Mat3,
+            m_th_s: Mat3,
+        }
+        let mut terms = Vec::with_capacity(node.ends.len());
+        for e in &node.ends {
+            let point = &disc.points[e.point];
+            let (CN, CM) = self.section(disc, point, material.modulus);
+            let kin = kinematics(point, state, e.point);
+            let [hn, _, hm, _] = material
+                .history
+                .get(e.point)
+                .copied()
+                .unwrap_or([Vec3::zeros(); 4]);
+            let N = CN * (kin.gamma - point.gamma0) - hn;
+            let K = state.kappa[e.point];
+            let M = CM * (K - point.kappa0) - hm;
+            let R = &state.rotation[e.point];
+            force += R * N * e.sign;
+            moment += R * M * e.sign;
+            let sR = R * e.sign;
+            terms.push(EndTerms {
+                n_eta_s: sR * CN * R.transpose(),
+                n_th: sR * (-hat(&N) + CN * hat(&kin.gamma)),
+                m_th: sR * (-hat(&M) + CM * hat(&K)),
+                m_th_s: sR * CM,
+            });
+        }
+        let mut r = [0.0; 6];
+        r[..3].copy_from_slice((Bt * force).as_slice());
+        r[3..].copy_from_slice((Bt * moment).as_slice());
+        let mut scale = [
+            force_scale,
+            force_scale,
+            force_scale,
+            moment_scale,
+            moment_scale,
+            moment_scale,
+        ];
+        // Kinematic rows for prescribed components.
+        let prescribed = &actions.prescribed[k];
+        let c1 = point_position(disc, &state.control, g1);
+        let R1 = &state.rotation[g1];
+        let phi = log(&Rot3::from_matrix_unchecked(
+            R1 * node.rotation0.transpose(),
+        ));
+        let jl_inv = crate::math::so3::right_jacobian_inverse(&(-phi));
+        for i in 0..6 {
+            if let Some(value) = prescribed[i] {
+                let axis = B.column(i % 3).into_owned();
+                if i < 3 {
+                    r[i] = axis.dot(&(c1 - node.position0)) - value;
+                    scale[i] = length;
+                } else {
+                    r[i] = axis.dot(&phi) - value;
+                    scale[i] = 1.0;
+                }
+            }
+        }
+        lin.residual[row1..row1 + 6].copy_from_slice(&r);
+        lin.row_scale[row1..row1 + 6].copy_from_slice(&scale);
+        // Continuity rows of the other ends.
+        for e in &node.ends[1..] {
+            let row = 6 * e.point;
+            let ce = point_position(disc, &state.control, e.point);
+            let Re = &state.rotation[e.point];
+            let mismatch = log(&Rot3::from_matrix_unchecked(
+                Re * (R1 * e.relative).transpose(),
+            ));
+            lin.residual[row..row + 3].copy_from_slice((ce - c1).as_slice());
+            lin.residual[row + 3..row + 6].copy_from_slice(mismatch.as_slice());
+            lin.row_scale[row..row + 3].fill(length);
+            lin.row_scale[row + 3..row + 6].fill(1.0);
+        }
+        if matches!(sink, Sink::Discard) {
+            return;
+        }
+        // Tangent of the rows of end 1: equilibrium blocks, with prescribed rows replaced.
+        let kin_rows: [Option<nalgebra::RowVector3<Real>>; 6] = std::array::from_fn(|i| {
+            prescribed[i].map(|_| {
+                let axis = B.column(i % 3).transpose();
+                if i < 3 { axis } else { axis * jl_inv * R1 }
+            })
+        });
+        for (ei, (e, t)) in node.ends.iter().zip(&terms).enumerate() {
+            let point = &disc.points[e.point];
+            for (a, b) in point.basis.iter().enumerate() {
+                let col = 6 * (point.first + a);
+                let mut fe = Bt * t.n_eta_s * b[1];
+                let mut ft = Bt * t.n_th * b[0];
+                let mut me = Mat3::zeros();
+                let mut mt = Bt * (t.m_th * b[0] + t.m_th_s * b[1]);
+                for (i, kr) in kin_rows.iter().enumerate() {
+                    let Some(kr) = kr else { continue };
+                    let on_end = ei == 0 && a == first.end_basis;
+                    let (row_eta, row_th) = if i < 3 {
+                        (
+                            if on_end {
+                                *kr
+                            } else {
+                                nalgebra::RowVector3::zeros()
+                            },
+                            nalgebra::RowVector3::zeros(),
+                        )
+                    } else {
+                        (
+                            nalgebra::RowVector3::zeros(),
+                            if on_end {
+                                *kr
+                            } else {
+                                nalgebra::RowVector3::zeros()
+                            },
+                        )
+                    };
+                    if i < 3 {
+                        fe.set_row(i, &row_eta);
+                        ft.set_row(i, &row_th);
+                    } else {
+                        me.set_row(i - 3, &row_eta);
+                        mt.set_row(i - 3, &row_th);
+                    }
+                }
+                sink.block(row1, col, &fe);
+                sink.block(row1, col + 3, &ft);
+                sink.block(row1 + 3, col, &me);
+                sink.block(row1 + 3, col + 3, &mt);
+            }
+        }
+        // Continuity rows: δη_e − δη_1 = 0 and R_e δΘ_e − R_1 δΘ_1 = 0 at the end control points.
+        for e in &node.ends[1..] {
+            let row = 6 * e.point;
+            let ce = 6 * (disc.points[e.point].first + e.end_basis);
+            let c1col = 6 * (p1.first + first.end_basis);
+            let Re = state.rotation[e.point];
+            let id = Mat3::identity();
+            let zero = Mat3::zeros();
+            sink.block(row, ce, &id);
+            sink.block(row, ce + 3, &zero);
+            sink.block(row + 3, ce, &zero);
+            sink.block(row + 3, ce + 3, &Re);
+            sink.block(row, c1col, &(-id));
+            sink.block(row, c1col + 3, &zero);
+            sink.block(row + 3, c1col, &zero);
+            sink.block(row + 3, c1col + 3, &(-R1));
+        }
+    }
+}
+
+/// Kinematic quantities at a collocation point computed from the control points.
+#[derive(Debug, Clone, Copy)]
+struct Kinematics {
+    gamma: Vec3,
+    gamma_s: Vec3,
+    c_ss: Vec3,
+}
+
+fn kinematics(point: &CollocationPoint, state: &State, g: usize) -> Kinematics {
+    let (mut c_s, mut c_ss) = (Vec3::zeros(), Vec3::zeros());
+    for (a, b) in point.basis.iter().enumerate() {
+        let p = &state.control[point.first + a];
+        c_s += p * b[1];
+        c_ss += p * b[2];
+    }
+    let rt = state.rotation[g].transpose();
+    let gamma = rt * c_s;
+    let gamma_s = rt * c_ss - state.kappa[g].cross(&gamma);
+    Kinematics {
+        gamma,
+        gamma_s,
+        c_ss,
+    }
+}
+
+/// The position `c = Σ N_j p_j` at collocation point `g`.
+pub fn point_position(disc: &Discretisation, control: &[Vec3], g: usize) -> Vec3 {
+    let point = &disc.points[g];
+    point
+        .basis
+        .iter()
+        .enumerate()
+        .map(|(a, b)| control[point.first + a] * b[0])
+        .sum()
+}
+
+/// Arc length of a curve by 5-point Gauss–Legendre on each knot span, subdivided 8 times (round-off accurate
+/// for the smooth analysis splines; used only for residual scales).
+fn curve_length(curve: &crate::math::NurbsCurve) -> Real {
+    let breaks = curve.knots().breakpoints();
+    let mut total = 0.0;
+    for w in breaks.windows(2) {
+        for k in 0..8 {
+            let a = w[0] + (w[1] - w[0]) * k as Real / 8.0;
+            let b = w[0] + (w[1] - w[0]) * (k + 1) as Real / 8.0;
+            total += crate::geometry::analytic::gauss_legendre_5(a, b, |u| {
+                curve.derivatives(u, 1)[1].norm()
+            });
+        }
+    }
+    total
+}

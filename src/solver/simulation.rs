@@ -1,0 +1,379 @@
+//! Time stepping with Newton's method and automatic step cutting.
+//!
+//! A step from `t_n` to `t_{n+1}` (landing on every schedule breakpoint) solves the collocated equations by
+//! Newton's method from the last converged state. Convergence is judged on normalised per-field norms
+//! (DESIGN §4; deal.II step-44 style): the largest scaled residual of force rows, of moment rows and of
+//! kinematic rows, and the largest translation increment over the patch length and rotation increment in
+//! radians, must all be below the tolerance. A NaN or infinity anywhere stops the iteration at once. When
+//! Newton fails the last converged state is restored and the step halved, down to `min_step`; after a success
+//! the step grows back by doubling.
+
+use super::SolverError;
+use super::assembly::{Actions, Assembler, Linearisation, Sink, StepMaterial, point_position};
+use super::discretisation::Discretisation;
+use super::linear::SparseSystem;
+use super::state::State;
+use crate::math::{Real, Vec3};
+use crate::model::{Model, ProbeLocation};
+use std::ops::ControlFlow;
+
+/// What one Newton solve did.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct NewtonReport {
+    /// Linear solves performed.
+    pub iterations: usize,
+    /// Normalised residual norm (largest over fields) at each assembly, the last one at the converged state.
+    pub residuals: Vec<Real>,
+    /// Normalised increment norm of each solve.
+    pub increments: Vec<Real>,
+}
+
+/// One converged time step, as reported to observers.
+#[derive(Debug, Clone, PartialEq)]
+pub struct StepReport {
+    /// Step number, 1-based (0 is the initial state).
+    pub step: usize,
+    /// Time reached.
+    pub time: Real,
+    /// Step size taken.
+    pub dt: Real,
+    /// Temperature at `time` [°C].
+    pub temperature: Real,
+    /// Newton history of the step.
+    pub newton: NewtonReport,
+    /// Step cuts needed before this step converged.
+    pub cuts: usize,
+}
+
+/// Totals of a run.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct RunSummary {
+    /// Converged steps.
+    pub steps: usize,
+    /// Newton iterations (linear solves) over all converged steps.
+    pub iterations: usize,
+    /// Step cuts.
+    pub cuts: usize,
+    /// Time reached.
+    pub time: Real,
+    /// True when an observer asked to stop before the end.
+    pub stopped: bool,
+}
+
+/// Receives the initial state and every converged step; may stop the run.
+pub trait Observer {
+    /// Called once with the initial state (step 0).
+    fn start(&mut self, sim: &Simulation<'_>) -> ControlFlow<()> {
+        let _ = sim;
+        ControlFlow::Continue(())
+    }
+
+    /// Called after each converged step.
+    fn step(&mut self, sim: &Simulation<'_>, report: &StepReport) -> ControlFlow<()>;
+}
+
+/// An observer that records nothing.
+pub struct NoObserver;
+
+impl Observer for NoObserver {
+    fn step(&mut self, _: &Simulation<'_>, _: &StepReport) -> ControlFlow<()> {
+        ControlFlow::Continue(())
+    }
+}
+
+/// Why one Newton solve failed (the step will be cut).
+#[derive(Debug, Clone, PartialEq)]
+enum NewtonFailure {
+    /// Not converged within the iteration limit, or diverging.
+    NotConverged(NewtonReport),
+    /// A fatal error (singular tangent, broken linear algebra).
+    Fatal(SolverError),
+}
+
+/// A running simulation of one model.
+pub struct Simulation<'m> {
+    model: &'m Model,
+    disc: Discretisation,
+    assembler: Assembler,
+    system: SparseSystem,
+    state: State,
+    time: Real,
+    step: usize,
+    lin: Linearisation,
+    values: Vec<Real>,
+    delta: Vec<Real>,
+    /// Length of the patch of each control point, for increment norms.
+    control_length: Vec<Real>,
+}
+
+impl<'m> Simulation<'m> {
+    /// Discretises the model, builds the sparsity pattern and analyses it.
+    pub fn new(model: &'m Model) -> Result<Self, SolverError> {
+        let disc = Discretisation::new(model)?;
+        let assembler = Assembler::new(model, &disc);
+        let state = State::reference(&disc);
+        let mut pattern = Vec::new();
+        let mut lin = Linearisation::default();
+        let actions = Actions::at(model, 0.0);
+        let material = StepMaterial {
+            modulus: model.material.prony().e_inf(),
+            history: &[],
+        };
+        assembler.assemble(
+            &disc,
+            &state,
+            material,
+            &actions,
+            &mut lin,
+            &mut Sink::Pattern(&mut pattern),
+        );
+        let system = SparseSystem::new(disc.num_unknowns(), &pattern)?;
+        let values = vec![0.0; pattern.len()];
+        let control_length = disc
+            .patches
+            .iter()
+            .flat_map(|r| {
+                let length = (disc.control0[r.offset + r.n - 1] - disc.control0[r.offset]).norm();
+                // Chord length, floored by the model size for closed patches.
+                std::iter::repeat_n(length.max(1e-3 * disc.length_scale), r.n)
+            })
+            .collect();
+        let n = disc.num_unknowns();
+        Ok(Self {
+            model,
+            disc,
+            assembler,
+            system,
+            state,
+            time: 0.0,
+            step: 0,
+            lin,
+            values,
+            delta: vec![0.0; n],
+            control_length,
+        })
+    }
+
+    /// The model.
+    pub fn model(&self) -> &Model {
+        self.model
+    }
+
+    /// The discretisation.
+    pub fn discretisation(&self) -> &Discretisation {
+        &self.disc
+    }
+
+    /// The current (last converged) state.
+    pub fn state(&self) -> &State {
+        &self.state
+    }
+
+    /// Time of the current state.
+    pub fn time(&self) -> Real {
+        self.time
+    }
+
+    /// The sparse system (size, pattern).
+    pub fn system(&self) -> &SparseSystem {
+        &self.system
+    }
+
+    /// The material data of a step ending at the current time (elastic: the equilibrium modulus `E∞`).
+    fn step_material(&self) -> StepMaterial<'static> {
+        StepMaterial {
+            modulus: self.model.material.prony().e_inf(),
+            history: &[],
+        }
+    }
+
+    /// Displacement of a probe in the current state.
+    pub fn probe_displacement(&self, location: &ProbeLocation) -> Vec3 {
+        match *location {
+            ProbeLocation::Node(k) => {
+                let g = self.disc.end_point(self.model.nodes[k].ends[0]);
+                point_position(&self.disc, &self.state.control, g)
+                    - point_position(&self.disc, &self.disc.control0, g)
+            }
+            ProbeLocation::Patch { patch, u } => {
+                let curve = &self.model.patches[patch].curve;
+                let range = &self.disc.patches[patch];
+                let table = crate::math::basis::nurbs_basis(curve.knots(), curve.weights(), u, 0);
+                table.ders[0]
+                    .iter()
+                    .enumerate()
+                    .map(|(a, n)| {
+                        let j = range.offset + table.first + a;
+                        (self.state.control[j] - self.disc.control0[j]) * *n
+                    })
+                    .sum()
+            }
+        }
+    }
+
+    /// Assembles residual and tangent at the current state for time `t` and returns the normalised residual
+    /// norm (largest over fields).
+    fn linearise(&mut self, actions: &Actions, with_tangent: bool) -> Result<Real, SolverError> {
+        let material = self.step_material();
+        let mut sink = if with_tangent {
+            Sink::Values {
+                values: &mut self.values,
+                next: 0,
+            }
+        } else {
+            Sink::Discard
+        };
+        self.assembler.assemble(
+            &self.disc,
+            &self.state,
+            material,
+            actions,
+            &mut self.lin,
+            &mut sink,
+        );
+        let mut norm: Real = 0.0;
+        for (r, s) in self.lin.residual.iter().zip(&self.lin.row_scale) {
+            let x = (r / s).abs();
+            if !x.is_finite() {
+                return Ok(Real::INFINITY);
+            }
+            norm = norm.max(x);
+        }
+        Ok(norm)
+    }
+
+    /// Normalised norm of the increment in `self.delta`: translations over the patch length, rotations in
+    /// radians.
+    fn increment_norm(&self) -> Real {
+        let mut norm: Real = 0.0;
+        for (j, d) in self.delta.chunks_exact(6).enumerate() {
+            let l = self.control_length[j];
+            for i in 0..3 {
+                norm = norm.max((d[i] / l).abs()).max(d[i + 3].abs());
+            }
+        }
+        if norm.is_finite() {
+            norm
+        } else {
+            Real::INFINITY
+        }
+    }
+
+    /// Newton's method at time `t` from the current state (modified in place).
+    fn newton(&mut self, t: Real) -> Result<NewtonReport, NewtonFailure> {
+        let actions = Actions::at(self.model, t);
+        let tol = self.model.solver.tolerance;
+        let max_iterations = self.model.solver.max_iterations;
+        let mut report = NewtonReport::default();
+        let mut last_increment = Real::INFINITY;
+        loop {
+            let r = self
+                .linearise(&actions, true)
+                .map_err(NewtonFailure::Fatal)?;
+            report.residuals.push(r);
+            if !r.is_finite() {
+                return Err(NewtonFailure::NotConverged(report));
+            }
+            if r <= tol && (last_increment <= tol || report.iterations == 0) {
+                return Ok(report);
+            }
+            if report.iterations >= max_iterations {
+                return Err(NewtonFailure::NotConverged(report));
+            }
+            let lu = self
+                .system
+                .factor(&self.values)
+                .map_err(NewtonFailure::Fatal)?;
+            for (d, r) in self.delta.iter_mut().zip(&self.lin.residual) {
+                *d = -r;
+            }
+            lu.solve_in_place(&mut self.delta);
+            last_increment = self.increment_norm();
+            report.increments.push(last_increment);
+            report.iterations += 1;
+            if !last_increment.is_finite() {
+                return Err(NewtonFailure::NotConverged(report));
+            }
+            self.state.apply_increment(&self.disc, &self.delta);
+        }
+    }
+
+    /// Runs from the current time to the model's end time, reporting each converged step to `observer`.
+    pub fn run(&mut self, observer: &mut dyn Observer) -> Result<RunSummary, SolverError> {
+        let mut summary = RunSummary {
+            time: self.time,
+            ..RunSummary::default()
+        };
+        if self.step == 0 && observer.start(self).is_break() {
+            summary.stopped = true;
+            return Ok(summary);
+        }
+        let end = self.model.time.end;
+        let nominal = self.model.time.step;
+        let min_step = self.model.time.min_step;
+        let breakpoints = self.model.schedule_breakpoints();
+        // Times closer than this to a target are that target (avoids sliver steps from round-off).
+        let snap = 1e-9 * nominal;
+        let mut h = nominal;
+        let mut cuts = 0;
+        while self.time < end - snap {
+            let next_break = breakpoints
+                .iter()
+                .copied()
+                .find(|&b| b > self.time + snap)
+                .unwrap_or(end)
+                .min(end);
+            let mut target = self.time + h;
+            if target > next_break - snap {
+                target = next_break;
+            }
+            let dt = target - self.time;
+            let saved = self.state.clone();
+            match self.newton(target) {
+                Ok(newton) => {
+                    self.time = target;
+                    self.step += 1;
+                    summary.steps += 1;
+                    summary.iterations += newton.iterations;
+                    summary.time = target;
+                    let report = StepReport {
+                        step: self.step,
+                        time: target,
+                        dt,
+                        temperature: self.model.temperature.value(target),
+                        newton,
+                        cuts,
+                    };
+                    cuts = 0;
+                    if h < nominal {
+                        h = (2.0 * h).min(nominal);
+                    }
+                    if observer.step(self, &report).is_break() {
+                        summary.stopped = true;
+                        return Ok(summary);
+                    }
+                }
+                Err(NewtonFailure::Fatal(e)) => {
+                    self.state = saved;
+                    return Err(e);
+                }
+                Err(NewtonFailure::NotConverged(newton)) => {
+                    self.state = saved;
+                    if dt <= min_step * (1.0 + 1e-12) {
+                        return Err(SolverError::StepFailed {
+                            time: target,
+                            step: self.step + 1,
+                            dt,
+                            iterations: newton.iterations,
+                            residuals: newton.residuals,
+                        });
+                    }
+                    h = (dt / 2.0).max(min_step);
+                    cuts += 1;
+                    summary.cuts += 1;
+                }
+            }
+        }
+        Ok(summary)
+    }
+}
