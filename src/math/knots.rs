@@ -249,7 +249,7 @@ mod tests {
     }
 
     proptest! {
-        #![proptest_config(ProptestConfig { cases: 256, ..ProptestConfig::default() })]
+        #![proptest_config(crate::math::basis::tests::config(256))]
 
         // Checks find_span's defining inequality u_i ≤ u < u_{i+1} (Piegl–Tiller A2.1) against a linear scan, on
         // random clamped vectors with repeated interior knots over a non-unit domain. Exact comparison.
