@@ -169,8 +169,15 @@ impl KnotVector {
     /// increase strictly because no interior knot repeats more than `p` times.
     pub fn greville(&self) -> Vec<Real> {
         let p = self.degree;
+        let (lo, hi) = self.domain();
+        // Averaging the offsets from the first knot makes an average of equal knots exact (a plain sum of
+        // p copies of u, divided by p, can miss u by an ulp and leave the domain).
         (0..self.num_basis())
-            .map(|j| self.knots[j + 1..=j + p].iter().sum::<Real>() / p as Real)
+            .map(|j| {
+                let base = self.knots[j + 1];
+                let offset = self.knots[j + 2..=j + p].iter().map(|u| u - base).sum::<Real>() / p as Real;
+                (base + offset).clamp(lo, hi)
+            })
             .collect()
     }
 
@@ -288,6 +295,8 @@ mod tests {
             }
             let g = kv.greville();
             prop_assert_eq!(g.len(), n);
+            prop_assert_eq!(g[0], lo);
+            prop_assert_eq!(g[n - 1], lo + len);
             prop_assert!(g.windows(2).all(|w| w[0] < w[1]));
         }
     }
