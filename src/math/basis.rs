@@ -92,7 +92,13 @@ pub fn bspline_basis_into(
     work.left.resize(w, 0.0);
     work.right.clear();
     work.right.resize(w, 0.0);
-    let BasisWorkspace { ndu, a, left, right, .. } = work;
+    let BasisWorkspace {
+        ndu,
+        a,
+        left,
+        right,
+        ..
+    } = work;
     // ndu[j][r] (row j, column r) stored at j * w + r.
     // Upper triangle: basis functions N_{span-p+r, j}; lower triangle: knot differences.
     ndu[0] = 1.0;
@@ -168,7 +174,14 @@ pub fn bspline_basis_into(
 #[track_caller]
 pub fn nurbs_basis(knots: &KnotVector, weights: &[Real], u: Real, nders: usize) -> BasisTable {
     let mut table = BasisTable::default();
-    nurbs_basis_into(knots, weights, u, nders, &mut BasisWorkspace::new(), &mut table);
+    nurbs_basis_into(
+        knots,
+        weights,
+        u,
+        nders,
+        &mut BasisWorkspace::new(),
+        &mut table,
+    );
     table
 }
 
@@ -224,13 +237,21 @@ pub(crate) mod tests {
     /// the environment variables `PROPTEST_CASES` and `PROPTEST_RNG_SEED` override both.
     pub(crate) fn config(cases: u32) -> ProptestConfig {
         let base = ProptestConfig::default();
-        let cases = if std::env::var_os("PROPTEST_CASES").is_some() { base.cases } else { cases };
+        let cases = if std::env::var_os("PROPTEST_CASES").is_some() {
+            base.cases
+        } else {
+            cases
+        };
         let rng_seed = if std::env::var_os("PROPTEST_RNG_SEED").is_some() {
             base.rng_seed
         } else {
             proptest::test_runner::RngSeed::Fixed(0x5354_454e_544b_4954)
         };
-        ProptestConfig { cases, rng_seed, ..base }
+        ProptestConfig {
+            cases,
+            rng_seed,
+            ..base
+        }
     }
 
     /// A random clamped knot vector on `[lo, lo + len]` with interior knots of multiplicity ≤ p
@@ -282,10 +303,19 @@ pub(crate) mod tests {
         let kv = KnotVector::try_new(2, vec![0., 0., 0., 1., 2., 3., 4., 4., 5., 5., 5.]).unwrap();
         let t = bspline_basis(&kv, 2.5, 3);
         assert_eq!(t.first, 2);
-        let expect = [[0.125, 0.75, 0.125], [-0.5, 0.0, 0.5], [1.0, -2.0, 1.0], [0.0, 0.0, 0.0]];
+        let expect = [
+            [0.125, 0.75, 0.125],
+            [-0.5, 0.0, 0.5],
+            [1.0, -2.0, 1.0],
+            [0.0, 0.0, 0.0],
+        ];
         for (k, row) in expect.iter().enumerate() {
             for (j, e) in row.iter().enumerate() {
-                assert!((t.ders[k][j] - e).abs() < 1e-15, "k={k} j={j}: {:?}", t.ders);
+                assert!(
+                    (t.ders[k][j] - e).abs() < 1e-15,
+                    "k={k} j={j}: {:?}",
+                    t.ders
+                );
             }
         }
         // At the right end of the domain the last function is 1 (left limit convention of A2.1).
@@ -304,8 +334,8 @@ pub(crate) mod tests {
         let t = nurbs_basis(&kv, &[1.0, s, 1.0], 0.5, 0);
         let wsum = 0.5 + s / 2.0;
         let expect = [0.25 / wsum, 0.5 * s / wsum, 0.25 / wsum];
-        for j in 0..3 {
-            assert!((t.ders[0][j] - expect[j]).abs() < 1e-15);
+        for (value, e) in t.ders[0].iter().zip(expect) {
+            assert!((value - e).abs() < 1e-15);
         }
     }
 
@@ -384,7 +414,10 @@ pub(crate) mod tests {
         let kv = KnotVector::clamped_uniform(4, 9).unwrap();
         let w: Vec<Real> = (0..9).map(|i| 1.0 + 0.1 * i as Real).collect();
         let mut work = BasisWorkspace::new();
-        let mut table = BasisTable { first: 0, ders: vec![vec![7.0; 2]; 6] };
+        let mut table = BasisTable {
+            first: 0,
+            ders: vec![vec![7.0; 2]; 6],
+        };
         for &u in &[0.0, 0.3, 0.77, 1.0] {
             bspline_basis_into(&kv, u, 2, &mut work, &mut table);
             assert_eq!(table, bspline_basis(&kv, u, 2));

@@ -31,7 +31,11 @@ fn invalid(reason: String) -> MathError {
 impl NurbsCurve {
     /// A NURBS curve (Piegl–Tiller Eq. 4.1); fails unless there is one finite point and one positive finite
     /// weight per basis function.
-    pub fn try_new(knots: KnotVector, points: Vec<Vec3>, weights: Vec<Real>) -> Result<Self, MathError> {
+    pub fn try_new(
+        knots: KnotVector,
+        points: Vec<Vec3>,
+        weights: Vec<Real>,
+    ) -> Result<Self, MathError> {
         let n = knots.num_basis();
         if points.len() != n {
             return Err(invalid(format!(
@@ -42,18 +46,35 @@ impl NurbsCurve {
             )));
         }
         if weights.len() != n {
-            return Err(invalid(format!("{} weights for {n} control points", weights.len())));
+            return Err(invalid(format!(
+                "{} weights for {n} control points",
+                weights.len()
+            )));
         }
-        if let Some((j, p)) = points.iter().enumerate().find(|(_, p)| !p.iter().all(|x| x.is_finite())) {
+        if let Some((j, p)) = points
+            .iter()
+            .enumerate()
+            .find(|(_, p)| !p.iter().all(|x| x.is_finite()))
+        {
             return Err(invalid(format!(
                 "control point {j} is not finite ({}, {}, {})",
                 p.x, p.y, p.z
             )));
         }
-        if let Some((j, w)) = weights.iter().enumerate().find(|(_, w)| !(w.is_finite() && **w > 0.0)) {
-            return Err(invalid(format!("weight {j} = {w} is not positive and finite")));
+        if let Some((j, w)) = weights
+            .iter()
+            .enumerate()
+            .find(|(_, w)| !(w.is_finite() && **w > 0.0))
+        {
+            return Err(invalid(format!(
+                "weight {j} = {w} is not positive and finite"
+            )));
         }
-        Ok(Self { knots, points, weights })
+        Ok(Self {
+            knots,
+            points,
+            weights,
+        })
     }
 
     /// A non-rational B-spline curve (all weights 1).
@@ -105,7 +126,12 @@ impl NurbsCurve {
     /// `u` outside the domain is clamped to it.
     pub fn derivatives(&self, u: Real, nders: usize) -> Vec<Vec3> {
         let mut out = vec![Vec3::zeros(); nders + 1];
-        self.derivatives_into(u, &mut BasisWorkspace::new(), &mut BasisTable::default(), &mut out);
+        self.derivatives_into(
+            u,
+            &mut BasisWorkspace::new(),
+            &mut BasisTable::default(),
+            &mut out,
+        );
         out
     }
 
@@ -126,7 +152,10 @@ impl NurbsCurve {
         let pts = &self.points[first..first + self.degree() + 1];
         if self.is_polynomial() {
             for (ck, row) in out.iter_mut().zip(&table.ders) {
-                *ck = row.iter().zip(pts).fold(Vec3::zeros(), |acc, (n, p)| acc + p * *n);
+                *ck = row
+                    .iter()
+                    .zip(pts)
+                    .fold(Vec3::zeros(), |acc, (n, p)| acc + p * *n);
             }
             return;
         }
@@ -162,8 +191,14 @@ impl NurbsCurve {
             .collect()
     }
 
-    /// The curve with knot vector `knots` and homogeneous control points `pw` (projected back to 3-D).
-    fn from_homogeneous(knots: KnotVector, pw: &[Hom]) -> Result<Self, MathError> {
+    /// A curve of the same kind as `self` with knot vector `knots` and homogeneous control points `pw`
+    /// (projected back to 3-D). A polynomial curve stays polynomial: its weights would only drift from 1 by
+    /// rounding, so they are reset to exactly 1 and the points taken as they are.
+    fn with_homogeneous(&self, knots: KnotVector, pw: &[Hom]) -> Result<Self, MathError> {
+        if self.is_polynomial() {
+            let points = pw.iter().map(|q| Vec3::new(q.x, q.y, q.z)).collect();
+            return Self::try_bspline(knots, points);
+        }
         let weights: Vec<Real> = pw.iter().map(|q| q.w).collect();
         let points = pw.iter().map(|q| Vec3::new(q.x, q.y, q.z) / q.w).collect();
         Self::try_new(knots, points, weights)
@@ -176,7 +211,9 @@ impl NurbsCurve {
             Ok(())
         } else {
             Err(MathError::InvalidKnots {
-                reason: format!("cannot insert knot {u}: it must lie strictly inside the domain ({lo}, {hi})"),
+                reason: format!(
+                    "cannot insert knot {u}: it must lie strictly inside the domain ({lo}, {hi})"
+                ),
             })
         }
     }
@@ -212,9 +249,7 @@ impl NurbsCurve {
 
         let mut qw = vec![Hom::zeros(); np + 1 + r];
         qw[..=k - p].copy_from_slice(&pw[..=k - p]);
-        for i in k - s..=np {
-            qw[i + r] = pw[i];
-        }
+        qw[k - s + r..=np + r].copy_from_slice(&pw[k - s..=np]);
         // Affected control points, updated in place by the r insertion steps (Piegl–Tiller Eq. 5.15).
         let mut rw: Vec<Hom> = pw[k - p..=k - s].to_vec();
         let mut l = k - p;
@@ -227,10 +262,10 @@ impl NurbsCurve {
             qw[l] = rw[0];
             qw[k + r - j - s] = rw[p - j - s];
         }
-        for i in l + 1..k - s {
-            qw[i] = rw[i - l];
+        if l + 1 < k - s {
+            qw[l + 1..k - s].copy_from_slice(&rw[1..k - s - l]);
         }
-        Self::from_homogeneous(KnotVector::try_new(p, uq)?, &qw)
+        self.with_homogeneous(KnotVector::try_new(p, uq)?, &qw)
     }
 
     /// The same curve with the non-decreasing knots `x` inserted at once (knot refinement, Piegl–Tiller
@@ -244,7 +279,11 @@ impl NurbsCurve {
         }
         if let Some(i) = (1..x.len()).find(|&i| x[i] < x[i - 1]) {
             return Err(MathError::InvalidKnots {
-                reason: format!("knots to insert decrease at index {i}: {} > {}", x[i - 1], x[i]),
+                reason: format!(
+                    "knots to insert decrease at index {i}: {} > {}",
+                    x[i - 1],
+                    x[i]
+                ),
             });
         }
         let p = self.degree();
@@ -294,7 +333,7 @@ impl NurbsCurve {
             k -= 1;
         }
         debug_assert_eq!(ubar.as_slice(), merged.knots());
-        Self::from_homogeneous(merged, &qw)
+        self.with_homogeneous(merged, &qw)
     }
 
     /// The same curve with its degree raised by `t` (Piegl–Tiller A5.9, on homogeneous coordinates): every
@@ -362,8 +401,16 @@ impl NurbsCurve {
             let ub = uk[b];
             let oldr = r;
             r = p as isize - mul as isize;
-            let lbz = if oldr > 0 { ((oldr + 2) / 2) as usize } else { 1 };
-            let rbz = if r > 0 { ph - ((r + 1) / 2) as usize } else { ph };
+            let lbz = if oldr > 0 {
+                ((oldr + 2) / 2) as usize
+            } else {
+                1
+            };
+            let rbz = if r > 0 {
+                ph - ((r + 1) / 2) as usize
+            } else {
+                ph
+            };
 
             // Insert ub r times to complete the Bézier segment [ua, ub].
             if r > 0 {
@@ -395,12 +442,11 @@ impl NurbsCurve {
             // Remove the knot ua, which was inserted oldr times for the previous segment.
             if oldr > 1 {
                 let oldr = oldr as usize;
-                let mut first = kind as isize - 2;
-                let mut last = kind as isize;
                 let den = ub - ua;
                 let bet = (ub - uh[kind - 1]) / den;
                 for tr in 1..oldr as isize {
-                    let (mut i, mut j) = (first, last);
+                    // A5.9's `first = kind − 2`, `last = kind`, moved outwards by one per removal.
+                    let (mut i, mut j) = (kind as isize - 1 - tr, kind as isize - 1 + tr);
                     let mut kj = j - kind as isize + 1;
                     while j - i > tr {
                         if i < cind as isize {
@@ -421,8 +467,6 @@ impl NurbsCurve {
                         j -= 1;
                         kj -= 1;
                     }
-                    first -= 1;
-                    last += 1;
                 }
             }
 
@@ -454,7 +498,7 @@ impl NurbsCurve {
         let nh = mh - ph - 1;
         qw.truncate(nh + 1);
         uh.truncate(mh + 1);
-        Self::from_homogeneous(KnotVector::try_new(ph, uh)?, &qw)
+        self.with_homogeneous(KnotVector::try_new(ph, uh)?, &qw)
     }
 
     /// The same curve, degree-elevated to `degree` and then knot-refined to exactly `n` control points.
@@ -513,8 +557,14 @@ mod tests {
     ) -> NurbsCurve {
         let kv = knot_vector(p, &raw, lo, len);
         let n = kv.num_basis();
-        let points = (0..n).map(|j| Vec3::new(coords[3 * j], coords[3 * j + 1], coords[3 * j + 2])).collect();
-        let weights = if rational { wraw[..n].to_vec() } else { vec![1.0; n] };
+        let points = (0..n)
+            .map(|j| Vec3::new(coords[3 * j], coords[3 * j + 1], coords[3 * j + 2]))
+            .collect();
+        let weights = if rational {
+            wraw[..n].to_vec()
+        } else {
+            vec![1.0; n]
+        };
         NurbsCurve::try_new(kv, points, weights).unwrap()
     }
 
@@ -547,7 +597,11 @@ mod tests {
         let s = std::f64::consts::FRAC_1_SQRT_2;
         let c = NurbsCurve::try_new(
             KnotVector::clamped_uniform(2, 3).unwrap(),
-            vec![Vec3::new(1.0, 0.0, 0.0), Vec3::new(1.0, 1.0, 0.0), Vec3::new(0.0, 1.0, 0.0)],
+            vec![
+                Vec3::new(1.0, 0.0, 0.0),
+                Vec3::new(1.0, 1.0, 0.0),
+                Vec3::new(0.0, 1.0, 0.0),
+            ],
             vec![1.0, s, 1.0],
         )
         .unwrap();
@@ -565,7 +619,9 @@ mod tests {
         assert!(NurbsCurve::try_bspline(kv.clone(), vec![Vec3::zeros(); 3]).is_err());
         assert!(NurbsCurve::try_new(kv.clone(), pts.clone(), vec![1.0; 3]).is_err());
         for bad in [0.0, -1.0, Real::NAN, Real::INFINITY] {
-            assert!(NurbsCurve::try_new(kv.clone(), pts.clone(), vec![1.0, bad, 1.0, 1.0]).is_err());
+            assert!(
+                NurbsCurve::try_new(kv.clone(), pts.clone(), vec![1.0, bad, 1.0, 1.0]).is_err()
+            );
         }
         let mut nan_pts = pts.clone();
         nan_pts[2].y = Real::NAN;
@@ -584,8 +640,11 @@ mod tests {
         assert!(c.refine_knots(&[0.0]).is_err());
         // Interior knots, lower degree, too few points.
         assert!(c.refined(3, 10).is_err());
-        let bez = NurbsCurve::try_bspline(KnotVector::clamped_uniform(2, 3).unwrap(), vec![Vec3::zeros(); 3])
-            .unwrap();
+        let bez = NurbsCurve::try_bspline(
+            KnotVector::clamped_uniform(2, 3).unwrap(),
+            vec![Vec3::zeros(); 3],
+        )
+        .unwrap();
         assert!(bez.refined(1, 5).is_err());
         assert!(bez.refined(3, 3).is_err());
         assert!(bez.refined(3, 4).is_ok());
@@ -635,6 +694,7 @@ mod tests {
             let c2 = c.insert_knot(u, times).unwrap();
             prop_assert_eq!(c2.num_points(), c.num_points() + times);
             prop_assert_eq!(c2.knots().multiplicity(u), c.knots().multiplicity(u) + times);
+            prop_assert_eq!(c2.is_polynomial(), c.is_polynomial());
             prop_assert!(max_distance(&c, &c2) < 1e-13);
             // Inserting an existing knot value (interior knots from the strategy) also works.
             if let Some(&b) = c.knots().breakpoints().iter().find(|&&b| b > lo && b < hi && c.knots().multiplicity(b) < p) {
@@ -667,6 +727,7 @@ mod tests {
                 inserted = inserted.insert_knot(u, 1).unwrap();
             }
             prop_assert_eq!(refined.knots(), inserted.knots());
+            prop_assert_eq!(refined.is_polynomial(), c.is_polynomial());
             prop_assert!(max_distance(&c, &refined) < 1e-13);
             for (a, b) in refined.points().iter().zip(inserted.points()) {
                 prop_assert!((a - b).norm() < 1e-13);
@@ -684,6 +745,8 @@ mod tests {
         fn degree_elevation_keeps_curve(c in curve_strategy(), t in 1usize..=3) {
             let e = c.elevate_degree(t).unwrap();
             prop_assert_eq!(e.degree(), c.degree() + t);
+            // A B-spline stays a B-spline (weights exactly 1, not 1 ± ulp).
+            prop_assert_eq!(e.is_polynomial(), c.is_polynomial());
             for b in c.knots().breakpoints() {
                 prop_assert_eq!(e.knots().multiplicity(b), c.knots().multiplicity(b) + t);
             }

@@ -40,7 +40,10 @@ impl Interpolator {
         let p = knots.degree();
         if params.len() != n {
             return Err(MathError::InvalidCurve {
-                reason: format!("{} interpolation parameters for {n} basis functions", params.len()),
+                reason: format!(
+                    "{} interpolation parameters for {n} basis functions",
+                    params.len()
+                ),
             });
         }
         let (lo, hi) = knots.domain();
@@ -67,7 +70,10 @@ impl Interpolator {
             let u = params[idx];
             bspline_basis_into(&knots, u, 0, &mut work, &mut table);
             let first = table.first;
-            let diagonal = i.checked_sub(first).and_then(|j| table.ders[0].get(j)).copied();
+            let diagonal = i
+                .checked_sub(first)
+                .and_then(|j| table.ders[0].get(j))
+                .copied();
             if !diagonal.is_some_and(|v| v > 0.0) {
                 return Err(MathError::Singular {
                     context: format!(
@@ -86,8 +92,10 @@ impl Interpolator {
         // Banded LU without pivoting (totally positive matrix).
         for k in 0..n {
             let pivot = band[k * width + p];
-            let row_max = band[k * width..(k + 1) * width].iter().fold(0.0, |m: Real, v| m.max(v.abs()));
-            if !(pivot > MIN_RELATIVE_PIVOT * row_max) {
+            let row_max = band[k * width..(k + 1) * width]
+                .iter()
+                .fold(0.0, |m: Real, v| m.max(v.abs()));
+            if pivot.is_nan() || pivot <= MIN_RELATIVE_PIVOT * row_max {
                 return Err(MathError::Singular {
                     context: format!(
                         "interpolation: pivot {pivot:e} at row {k} (parameters nearly violate \
@@ -124,7 +132,10 @@ impl Interpolator {
         let width = 2 * p + 1;
         if points.len() != n {
             return Err(MathError::InvalidCurve {
-                reason: format!("{} points to interpolate for {n} basis functions", points.len()),
+                reason: format!(
+                    "{} points to interpolate for {n} basis functions",
+                    points.len()
+                ),
             });
         }
         let mut x: Vec<Vec3> = self.order.iter().map(|&i| points[i]).collect();
@@ -153,12 +164,19 @@ impl Interpolator {
 ///
 /// Global interpolation after Piegl–Tiller A9.1 with the caller's knots and parameters, solved by the banded
 /// LU of [`Interpolator`]; errors as for [`Interpolator::try_new`].
-pub fn interpolate(knots: KnotVector, params: &[Real], points: &[Vec3]) -> Result<NurbsCurve, MathError> {
+pub fn interpolate(
+    knots: KnotVector,
+    params: &[Real],
+    points: &[Vec3],
+) -> Result<NurbsCurve, MathError> {
     Interpolator::try_new(knots, params)?.curve(points)
 }
 
 /// The B-spline curve with knot vector `knots` that passes through `points[i]` at the Greville abscissae.
-pub fn interpolate_at_greville(knots: KnotVector, points: &[Vec3]) -> Result<NurbsCurve, MathError> {
+pub fn interpolate_at_greville(
+    knots: KnotVector,
+    points: &[Vec3],
+) -> Result<NurbsCurve, MathError> {
     let params = knots.greville();
     interpolate(knots, &params, points)
 }
@@ -172,9 +190,9 @@ mod tests {
     /// `Σ_k a_k ((u − mid)/len)^k` by Horner, coefficient triples `a_k` taken from `coef`.
     fn polynomial(coef: &[Real], degree: usize, u: Real, mid: Real, len: Real) -> Vec3 {
         let x = (u - mid) / len;
-        (0..=degree)
-            .rev()
-            .fold(Vec3::zeros(), |acc, k| acc * x + Vec3::new(coef[3 * k], coef[3 * k + 1], coef[3 * k + 2]))
+        (0..=degree).rev().fold(Vec3::zeros(), |acc, k| {
+            acc * x + Vec3::new(coef[3 * k], coef[3 * k + 1], coef[3 * k + 2])
+        })
     }
 
     proptest! {
@@ -247,7 +265,10 @@ mod tests {
     fn singular_and_invalid_inputs_are_errors() {
         let kv = KnotVector::clamped_uniform(2, 5).unwrap();
         let pts = vec![Vec3::zeros(); 5];
-        assert!(matches!(interpolate(kv.clone(), &[0.0; 4], &pts), Err(MathError::InvalidCurve { .. })));
+        assert!(matches!(
+            interpolate(kv.clone(), &[0.0; 4], &pts),
+            Err(MathError::InvalidCurve { .. })
+        ));
         assert!(matches!(
             interpolate(kv.clone(), &[0.0, 0.2, 0.5, 0.8, 1.0], &pts[..4]),
             Err(MathError::InvalidCurve { .. })
@@ -274,7 +295,12 @@ mod tests {
     #[test]
     fn linear_interpolation_is_the_polyline() {
         let kv = KnotVector::clamped_with_interior(1, &[0.25, 0.5]).unwrap();
-        let pts = vec![Vec3::new(0.0, 1.0, 2.0), Vec3::new(1.0, -1.0, 0.5), Vec3::new(3.0, 0.0, 0.0), Vec3::x()];
+        let pts = vec![
+            Vec3::new(0.0, 1.0, 2.0),
+            Vec3::new(1.0, -1.0, 0.5),
+            Vec3::new(3.0, 0.0, 0.0),
+            Vec3::x(),
+        ];
         let c = interpolate_at_greville(kv, &pts).unwrap();
         for (a, b) in c.points().iter().zip(&pts) {
             assert!((a - b).norm() < 1e-15);

@@ -98,8 +98,14 @@ impl KnotVector {
     /// The clamped knot vector on `[0, 1]` with the given non-decreasing interior knots in `(0, 1)`: each
     /// entry adds one knot, so a value listed `k ≤ p` times gets multiplicity `k` (Piegl–Tiller Eq. 2.13).
     pub fn clamped_with_interior(degree: usize, interior: &[Real]) -> Result<Self, MathError> {
-        if let Some((i, u)) = interior.iter().enumerate().find(|(_, u)| !(**u > 0.0 && **u < 1.0)) {
-            return Err(invalid(format!("interior knot {i} = {u} does not lie in (0, 1)")));
+        if let Some((i, u)) = interior
+            .iter()
+            .enumerate()
+            .find(|(_, u)| !(**u > 0.0 && **u < 1.0))
+        {
+            return Err(invalid(format!(
+                "interior knot {i} = {u} does not lie in (0, 1)"
+            )));
         }
         let mut knots = Vec::with_capacity(interior.len() + 2 * (degree + 1));
         knots.extend(std::iter::repeat_n(0.0, degree + 1));
@@ -140,7 +146,7 @@ impl KnotVector {
         if u >= hi {
             return n - 1;
         }
-        if !(u > lo) {
+        if u.is_nan() || u <= lo {
             return p;
         }
         // Invariant: k[low] ≤ u < k[high].
@@ -175,7 +181,11 @@ impl KnotVector {
         (0..self.num_basis())
             .map(|j| {
                 let base = self.knots[j + 1];
-                let offset = self.knots[j + 2..=j + p].iter().map(|u| u - base).sum::<Real>() / p as Real;
+                let offset = self.knots[j + 2..=j + p]
+                    .iter()
+                    .map(|u| u - base)
+                    .sum::<Real>()
+                    / p as Real;
                 (base + offset).clamp(lo, hi)
             })
             .collect()
@@ -199,22 +209,53 @@ mod tests {
     #[test]
     fn validation_rejects_bad_vectors() {
         let cases: Vec<(usize, Vec<Real>, &str)> = vec![
-            (2, vec![0.0, 0.0, 0.0, 0.6, 0.5, 1.0, 1.0, 1.0], "decrease at index 4"),
-            (2, vec![0.0, 0.0, 0.0, Real::NAN, 1.0, 1.0, 1.0], "knot 3 is not finite"),
-            (2, vec![0.0, 0.0, 0.0, Real::INFINITY, 1.0, 1.0, 1.0], "knot 3 is not finite"),
-            (2, vec![0.0, 0.0, 0.5, 1.0, 1.0, 1.0], "first knot 0 repeats 2 times"),
-            (2, vec![0.0, 0.0, 0.0, 0.5, 1.0, 1.0], "last knot 1 repeats 2 times"),
-            (2, vec![0.0, 0.0, 0.0, 0.0, 1.0, 1.0, 1.0], "first knot 0 repeats 4 times"),
+            (
+                2,
+                vec![0.0, 0.0, 0.0, 0.6, 0.5, 1.0, 1.0, 1.0],
+                "decrease at index 4",
+            ),
+            (
+                2,
+                vec![0.0, 0.0, 0.0, Real::NAN, 1.0, 1.0, 1.0],
+                "knot 3 is not finite",
+            ),
+            (
+                2,
+                vec![0.0, 0.0, 0.0, Real::INFINITY, 1.0, 1.0, 1.0],
+                "knot 3 is not finite",
+            ),
+            (
+                2,
+                vec![0.0, 0.0, 0.5, 1.0, 1.0, 1.0],
+                "first knot 0 repeats 2 times",
+            ),
+            (
+                2,
+                vec![0.0, 0.0, 0.0, 0.5, 1.0, 1.0],
+                "last knot 1 repeats 2 times",
+            ),
+            (
+                2,
+                vec![0.0, 0.0, 0.0, 0.0, 1.0, 1.0, 1.0],
+                "first knot 0 repeats 4 times",
+            ),
             (2, vec![0.0, 0.0, 1.0, 1.0], "at least 6 knots"),
             (2, vec![], "at least 6 knots"),
             (2, vec![1.0; 6], "empty domain"),
-            (2, vec![0.0, 0.0, 0.0, 0.5, 0.5, 0.5, 1.0, 1.0, 1.0], "repeats 3 times, more than the degree"),
+            (
+                2,
+                vec![0.0, 0.0, 0.0, 0.5, 0.5, 0.5, 1.0, 1.0, 1.0],
+                "repeats 3 times, more than the degree",
+            ),
             (0, vec![0.0, 1.0], "degree must be at least 1"),
         ];
         for (p, knots, expect) in cases {
             let err = KnotVector::try_new(p, knots.clone()).expect_err("bad vector accepted");
             let msg = err.to_string();
-            assert!(msg.contains(expect), "{knots:?}: got '{msg}', expected '{expect}'");
+            assert!(
+                msg.contains(expect),
+                "{knots:?}: got '{msg}', expected '{expect}'"
+            );
         }
         assert!(KnotVector::clamped_uniform(3, 3).is_err());
         assert!(KnotVector::clamped_with_interior(2, &[0.0]).is_err());
