@@ -238,7 +238,7 @@ mod tests {
     fn split_form_equals_the_definition_after_update() {
         let material = Material::pla_van_manen_2021();
         let prony = material.prony();
-        let shape = material.section_shape(&CircularSection::try_new(0.05).expect("valid"));
+        let shape = material.section_shape(&CircularSection::try_new(0.05).expect("valid").into());
         let m = prony.num_branches();
         let mut history = BranchHistory::new(3, m);
         for (k, s) in history.as_mut_slice().iter_mut().enumerate() {

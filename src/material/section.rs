@@ -306,6 +306,9 @@ mod tests {
         ));
         let s =
             CircularSection::try_with_shear_factor(1.0, ShearFactor::Given(0.9)).expect("valid");
-        assert_eq!(SectionShape::new(&s, 0.0).force[1], 0.9 * s.area() / 2.0);
+        assert_eq!(
+            SectionShape::new(&s.into(), 0.0).force[1],
+            0.9 * s.area() / 2.0
+        );
     }
 }

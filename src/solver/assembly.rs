@@ -501,22 +501,27 @@ impl Assembler {
                 sink.block(row1 + 3, col + 3, &mt);
             }
         }
-        // Continuity rows: δη_e − δη_1 = 0 and R_e δΘ_e − R_1 δΘ_1 = 0 at the end control points.
+        // Continuity rows at the end control points: δη_e − δη_1, and for the rotation mismatch
+        // r = log(E), E = R_e (R_1 Q_e)ᵀ, under spatial increments φ = R δΘ: E ← exp(φ̃_e) E exp(−φ̃_1), so
+        // δr = J_l⁻¹(r) (R_e δΘ_e − E R_1 δΘ_1) (= R_e δΘ_e − R_1 δΘ_1 once continuity holds, r = 0).
         for e in &node.ends[1..] {
             let row = 6 * e.point;
             let ce = 6 * (disc.points[e.point].first + e.end_basis);
             let c1col = 6 * (p1.first + first.end_basis);
             let Re = state.rotation[e.point];
+            let E = Re * (R1 * e.relative).transpose();
+            let r = log(&Rot3::from_matrix_unchecked(E));
+            let jl_inv = crate::math::so3::right_jacobian_inverse(&(-r));
             let id = Mat3::identity();
             let zero = Mat3::zeros();
             sink.block(row, ce, &id);
             sink.block(row, ce + 3, &zero);
             sink.block(row + 3, ce, &zero);
-            sink.block(row + 3, ce + 3, &Re);
+            sink.block(row + 3, ce + 3, &(jl_inv * Re));
             sink.block(row, c1col, &(-id));
             sink.block(row, c1col + 3, &zero);
             sink.block(row + 3, c1col, &zero);
-            sink.block(row + 3, c1col + 3, &(-R1));
+            sink.block(row + 3, c1col + 3, &(-jl_inv * E * R1));
         }
     }
 }

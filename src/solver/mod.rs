@@ -55,3 +55,6 @@ pub enum SolverError {
         residuals: Vec<Real>,
     },
 }
+
+#[cfg(test)]
+mod tests;

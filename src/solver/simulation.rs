@@ -274,7 +274,13 @@ impl<'m> Simulation<'m> {
             if !r.is_finite() {
                 return Err(NewtonFailure::NotConverged(report));
             }
-            if r <= tol && (last_increment <= tol || report.iterations == 0) {
+            let converged = if report.iterations == 0 {
+                // Nothing changed since the last converged state (e.g. a hold step).
+                r <= tol
+            } else {
+                last_increment <= tol && r <= self.model.solver.residual_factor * tol
+            };
+            if converged {
                 return Ok(report);
             }
             if report.iterations >= max_iterations {

@@ -359,7 +359,12 @@ fn patches(
                 p,
                 n,
             )
-            .map_err(|e| geometry_issue(&path, e))?;
+            .map_err(|e| match &e {
+                GeometryError::InvalidParameter { what, .. } if what.contains("angle") => {
+                    geometry_issue(&format!("{path}.angle_deg"), e)
+                }
+                _ => geometry_issue(&path, e),
+            })?;
             (c, None)
         } else if let Some(h) = &pd.helix {
             let path = format!("{base}.helix");

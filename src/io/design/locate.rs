@@ -146,7 +146,7 @@ mod tests {
             loc.find("patches[1].line.to[0]"),
             Position {
                 line: 7,
-                column: 36
+                column: 34
             }
         );
         // Missing field: the nearest existing parent.

@@ -93,19 +93,38 @@ pub fn load_design(path: &Path) -> Result<Design, DesignError> {
     parse_design(&text, path)
 }
 
-/// Drops serde_yaml's leading `path: ` and trailing ` at line L column C` (both are reported separately).
-fn strip_location(message: &str) -> String {
-    let mut text = match message.rfind(" at line ") {
-        Some(i) => &message[..i],
-        None => message,
-    };
+/// Splits serde_yaml's message into the text and the position it names. A syntax error reads
+/// `problem at line L column C, while parsing … at line L' column C'`: the problem's own position (the first one)
+/// is where the designer must look. Other messages end in ` at line L column C`. serde_yaml's leading
+/// `path: ` is dropped too (the path is reported separately).
+fn split_message(message: &str) -> (String, Option<locate::Position>) {
+    let mut text = message.to_string();
+    let mut position = None;
+    if let Some(i) = text.find(" at line ") {
+        let rest = &text[i + " at line ".len()..];
+        let digits = |s: &str| {
+            s.chars()
+                .take_while(char::is_ascii_digit)
+                .collect::<String>()
+        };
+        let line = digits(rest);
+        let column = rest[line.len()..].strip_prefix(" column ").map(digits);
+        if let (Ok(line), Some(Ok(column))) = (line.parse(), column.map(|c| c.parse())) {
+            position = Some(locate::Position { line, column });
+            let end = i + " at line ".len() + rest.find(|c: char| c == ',').unwrap_or(rest.len());
+            text.replace_range(i..end, "");
+        }
+    }
+    if let Some(j) = text.find(" at line ") {
+        text.truncate(j);
+    }
     if let Some((path, rest)) = text.split_once(": ")
         && !path.is_empty()
         && !path.contains(' ')
     {
-        text = rest;
+        text = rest.to_string();
     }
-    text.to_string()
+    (text, position)
 }
 
 /// Validates a design given as text; `path` names it in errors.
@@ -120,22 +139,29 @@ pub fn parse_design(text: &str, path: &Path) -> Result<Design, DesignError> {
         };
         // A value rejected by a check (a NaN, a negative size) is located exactly by its path; serde_yaml's
         // own position is better for unknown or missing fields and syntax errors.
-        let position = e.inner().location().map(|l| locate::Position {
+        let inner = e.inner().to_string();
+        let (message, named) = split_message(&inner);
+        // Only libyaml's syntax errors name the position of the problem itself.
+        let named = named.filter(|_| inner.contains(", while "));
+        let serde_position = e.inner().location().map(|l| locate::Position {
             line: l.line(),
             column: l.column(),
         });
-        let unknown_field = e.inner().to_string().contains("unknown field");
-        let pos = match (locator.get(&field), position) {
-            (Some(p), _) if !unknown_field => p,
-            (_, Some(p)) => p,
-            (_, None) => locator.find(&field),
+        let unknown_field = inner.contains("unknown field");
+        // A syntax error names its own position; a rejected value is found exactly by its path; serde_yaml's
+        // position is best for unknown and missing fields.
+        let pos = match (named, locator.get(&field), serde_position) {
+            (Some(p), _, _) => p,
+            (None, Some(p), _) if !unknown_field => p,
+            (None, _, Some(p)) => p,
+            (None, _, None) => locator.find(&field),
         };
         DesignError::Invalid {
             file: file.clone(),
             line: pos.line,
             column: pos.column,
             field,
-            message: strip_location(&e.inner().to_string()),
+            message,
         }
     })?;
     let stem = path.file_stem().map_or_else(
