@@ -267,6 +267,35 @@ impl Assembler {
         }
     }
 
+    /// Per end of node `k`: `(σ R N, σ R M)` in the given state (see [`super::Simulation::node_end_resultants`]).
+    #[allow(non_snake_case)]
+    pub fn node_end_resultants(
+        &self,
+        disc: &Discretisation,
+        state: &State,
+        material: StepMaterial<'_>,
+        k: usize,
+    ) -> Vec<(Vec3, Vec3)> {
+        self.nodes[k]
+            .ends
+            .iter()
+            .map(|e| {
+                let point = &disc.points[e.point];
+                let (CN, CM) = self.section(disc, point, material.modulus);
+                let kin = kinematics(point, state, e.point);
+                let [hn, _, hm, _] = material
+                    .history
+                    .get(e.point)
+                    .copied()
+                    .unwrap_or([Vec3::zeros(); 4]);
+                let N = CN * (kin.gamma - point.gamma0) - hn;
+                let M = CM * (state.kappa[e.point] - point.kappa0) - hm;
+                let R = &state.rotation[e.point];
+                (R * N * e.sign, R * M * e.sign)
+            })
+            .collect()
+    }
+
     fn section(
         &self,
         disc: &Discretisation,

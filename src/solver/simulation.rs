@@ -211,6 +211,14 @@ impl<'m> Simulation<'m> {
         }
     }
 
+    /// The stress resultants that the rod ends of node `k` exert on the node, in the current state: per end
+    /// `(σ R N, σ R M)` (spatial force and moment, outward sign σ), in the order of the node's ends. At
+    /// equilibrium their sums equal the node's applied load (or its reaction, at prescribed components).
+    pub fn node_end_resultants(&self, k: usize) -> Vec<(Vec3, Vec3)> {
+        self.assembler
+            .node_end_resultants(&self.disc, &self.state, self.step_material(), k)
+    }
+
     /// Assembles residual and tangent at the current state for time `t` and returns the normalised residual
     /// norm (largest over fields).
     fn linearise(&mut self, actions: &Actions, with_tangent: bool) -> Result<Real, SolverError> {
