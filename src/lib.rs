@@ -31,6 +31,9 @@
 //! * Strains: `Γ = Rᵀ c,s`, `K = axial(Rᵀ R,s)`, measured from the reference as `Γ_N = Γ − Γ0`, `K_M = K − K0`.
 //! * `s` is the arc length of the *reference* centreline; curve parameters `u` live in `[0, 1]`.
 
+// Checks such as `!(x > 0.0)` are deliberate: they reject NaN along with the out-of-range values.
+#![allow(clippy::neg_cmp_op_on_partial_ord)]
+
 pub mod cli;
 pub mod geometry;
 pub mod io;

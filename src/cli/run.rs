@@ -13,10 +13,16 @@ struct Progress {
     started: Instant,
     last: Instant,
     quiet: bool,
+    /// Notices already printed.
+    said: usize,
 }
 
 impl Observer for Progress {
     fn step(&mut self, sim: &Simulation<'_>, report: &StepReport) -> ControlFlow<()> {
+        for notice in &sim.notices()[self.said..] {
+            eprintln!("note: {notice}");
+        }
+        self.said = sim.notices().len();
         if !self.quiet && self.last.elapsed().as_secs_f64() >= 1.0 {
             self.last = Instant::now();
             let end = sim.model().time.end;
@@ -111,6 +117,7 @@ pub fn run(design: &Path, output: Option<PathBuf>, force: bool, quiet: bool) -> 
         started,
         last: Instant::now(),
         quiet,
+        said: 0,
     };
     let result = sim.run(&mut Tee(vec![&mut history, &mut progress]));
     if let Some(e) = history.take_error() {

@@ -29,6 +29,7 @@
 
 use super::discretisation::{CollocationPoint, Discretisation};
 use super::state::State;
+use crate::material::SectionStrains;
 use crate::math::so3::{hat, log};
 use crate::math::{Mat3, Real, Rot3, Vec3};
 use crate::model::{Component, Model};
@@ -577,6 +578,18 @@ fn kinematics(point: &CollocationPoint, state: &State, g: usize) -> Kinematics {
         gamma,
         gamma_s,
         c_ss,
+    }
+}
+
+/// The total strains `Γ_N = Γ − Γ0`, `K_M = K − K0` and their arc-length derivatives at collocation point `g`.
+pub fn point_strains(disc: &Discretisation, state: &State, g: usize) -> SectionStrains {
+    let point = &disc.points[g];
+    let k = kinematics(point, state, g);
+    SectionStrains {
+        force: k.gamma - point.gamma0,
+        moment: state.kappa[g] - point.kappa0,
+        force_ds: k.gamma_s - point.gamma0_s,
+        moment_ds: state.kappa_s[g] - point.kappa0_s,
     }
 }
 

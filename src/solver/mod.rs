@@ -27,6 +27,9 @@ pub enum SolverError {
         /// What is wrong.
         source: GeometryError,
     },
+    /// The material update failed (non-finite temperature, backwards step).
+    #[error("material: {0}")]
+    Material(#[from] crate::material::MaterialError),
     /// The sparse linear algebra failed for a reason other than singularity.
     #[error("linear solver: {0}")]
     Linear(String),

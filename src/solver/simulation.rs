@@ -9,10 +9,16 @@
 //! the step grows back by doubling.
 
 use super::SolverError;
-use super::assembly::{Actions, Assembler, Linearisation, Sink, StepMaterial, point_position};
+use super::assembly::{
+    Actions, Assembler, Linearisation, Sink, StepMaterial, point_position, point_strains,
+};
 use super::discretisation::Discretisation;
 use super::linear::SparseSystem;
 use super::state::State;
+use crate::material::{
+    BranchHistory, ReducedTimeQuadrature, SectionStrains, StepCoefficients, history_stress,
+    step_coefficients_into, update_branch_strains,
+};
 use crate::math::{Real, Vec3};
 use crate::model::{Model, ProbeLocation};
 use std::ops::ControlFlow;
@@ -104,6 +110,20 @@ pub struct Simulation<'m> {
     delta: Vec<Real>,
     /// Length of the patch of each control point, for increment norms.
     control_length: Vec<Real>,
+    /// Converged total strains per collocation point at the current time.
+    strain_n: Vec<SectionStrains>,
+    /// Maxwell-branch strains per collocation point and branch at the current time.
+    branches: BranchHistory,
+    /// Internal-variable update coefficients of the step being solved (or last solved).
+    coeffs: StepCoefficients,
+    /// Effective modulus `Ē` of that step [stress].
+    modulus: Real,
+    /// History stresses `[H_N, H_N,s, H_M, H_M,s]` per collocation point for that step.
+    history: Vec<[Vec3; 4]>,
+    /// Messages for the user, each said once (e.g. the WLF freeze).
+    notices: Vec<String>,
+    /// Whether the WLF freeze has been reported.
+    freeze_reported: bool,
 }
 
 impl<'m> Simulation<'m> {
@@ -139,6 +159,8 @@ impl<'m> Simulation<'m> {
             })
             .collect();
         let n = disc.num_unknowns();
+        let points = disc.points.len();
+        let branches = BranchHistory::new(points, model.material.num_branches());
         Ok(Self {
             model,
             disc,
@@ -151,7 +173,79 @@ impl<'m> Simulation<'m> {
             values,
             delta: vec![0.0; n],
             control_length,
+            strain_n: vec![SectionStrains::default(); points],
+            branches,
+            coeffs: StepCoefficients::identity(model.material.num_branches()),
+            modulus: model.material.prony().e_inf(),
+            history: vec![[Vec3::zeros(); 4]; points],
+            notices: Vec::new(),
+            freeze_reported: false,
         })
+    }
+
+    /// Messages worth telling the user, each added once (e.g. that relaxation froze below `Tg − C2`), in the
+    /// order they arose.
+    pub fn notices(&self) -> &[String] {
+        &self.notices
+    }
+
+    /// Prepares the constitutive data of the step `t_n → t_np1` (paper §3.1): the internal-variable
+    /// coefficients of the design's integrator, the effective modulus `Ē` of `C̄ = S Ē` and, per collocation
+    /// point, the history stresses from the converged strains at `t_n` (Ψ-terms of N/M_constitutive_disc).
+    fn prepare_step(&mut self, t_n: Real, t_np1: Real) -> Result<(), SolverError> {
+        let material = &self.model.material;
+        let temperature = |t: Real| self.model.temperature.value(t);
+        step_coefficients_into(
+            material,
+            self.model.integrator,
+            &ReducedTimeQuadrature::default(),
+            t_n,
+            t_np1,
+            &temperature,
+            &mut self.coeffs,
+        )?;
+        self.modulus = self.coeffs.effective_modulus(material.prony());
+        if material.num_branches() > 0 {
+            for (g, point) in self.disc.points.iter().enumerate() {
+                let shape = &self.disc.shapes[point.shape];
+                let h = history_stress(
+                    material.prony(),
+                    shape,
+                    &self.coeffs,
+                    &self.strain_n[g],
+                    self.branches.point(g),
+                );
+                self.history[g] = [h.force, h.force_ds, h.moment, h.moment_ds];
+            }
+        }
+        if !self.freeze_reported && material.is_frozen(temperature(t_np1)) {
+            self.freeze_reported = true;
+            if let Some(w) = material.wlf() {
+                self.notices.push(format!(
+                    "at t = {t_np1} the temperature {} °C is at or below Tg − C2 = {} °C: relaxation is frozen there (instantaneous moduli), as in Abaqus' TRS",
+                    temperature(t_np1),
+                    w.frozen_below()
+                ));
+            }
+        }
+        Ok(())
+    }
+
+    /// After a converged step: advances the Maxwell-branch strains and the converged total strains.
+    fn commit_step(&mut self) {
+        let branches = self.model.material.num_branches() > 0;
+        for g in 0..self.disc.points.len() {
+            let strain = point_strains(&self.disc, &self.state, g);
+            if branches {
+                update_branch_strains(
+                    &self.coeffs,
+                    &strain,
+                    &self.strain_n[g],
+                    self.branches.point_mut(g),
+                );
+            }
+            self.strain_n[g] = strain;
+        }
     }
 
     /// The model.
@@ -179,11 +273,11 @@ impl<'m> Simulation<'m> {
         &self.system
     }
 
-    /// The material data of a step ending at the current time (elastic: the equilibrium modulus `E∞`).
-    fn step_material(&self) -> StepMaterial<'static> {
+    /// The constitutive data of the current (or last solved) step: `C̄ = S Ē` and the history stresses.
+    fn step_material(&self) -> StepMaterial<'_> {
         StepMaterial {
-            modulus: self.model.material.prony().e_inf(),
-            history: &[],
+            modulus: self.modulus,
+            history: &self.history,
         }
     }
 
@@ -222,7 +316,10 @@ impl<'m> Simulation<'m> {
     /// Assembles residual and tangent at the current state for time `t` and returns the normalised residual
     /// norm (largest over fields).
     fn linearise(&mut self, actions: &Actions, with_tangent: bool) -> Result<Real, SolverError> {
-        let material = self.step_material();
+        let material = StepMaterial {
+            modulus: self.modulus,
+            history: &self.history,
+        };
         let mut sink = if with_tangent {
             Sink::Values {
                 values: &mut self.values,
@@ -343,8 +440,10 @@ impl<'m> Simulation<'m> {
             }
             let dt = target - self.time;
             let saved = self.state.clone();
+            self.prepare_step(self.time, target)?;
             match self.newton(target) {
                 Ok(newton) => {
+                    self.commit_step();
                     self.time = target;
                     self.step += 1;
                     summary.steps += 1;

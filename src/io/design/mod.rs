@@ -111,7 +111,7 @@ fn split_message(message: &str) -> (String, Option<locate::Position>) {
         let column = rest[line.len()..].strip_prefix(" column ").map(digits);
         if let (Ok(line), Some(Ok(column))) = (line.parse(), column.map(|c| c.parse())) {
             position = Some(locate::Position { line, column });
-            let end = i + " at line ".len() + rest.find(|c: char| c == ',').unwrap_or(rest.len());
+            let end = i + " at line ".len() + rest.find(',').unwrap_or(rest.len());
             text.replace_range(i..end, "");
         }
     }
