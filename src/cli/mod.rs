@@ -4,6 +4,7 @@
 pub mod check;
 pub mod mesh;
 pub mod run;
+pub mod study;
 
 use clap::{Parser, Subcommand};
 use std::path::PathBuf;
@@ -45,6 +46,9 @@ pub enum Command {
         #[arg(short, long)]
         quiet: bool,
     },
+    /// Accuracy against cost: convergence studies.
+    #[command(subcommand)]
+    Study(StudyCommand),
     /// Write the reference (permanent) shape as a closed tube surface: binary STL or OBJ by extension.
     ///
     /// Example: stentkit mesh designs/circular_arch.yaml -o arch.stl
@@ -63,6 +67,40 @@ pub enum Command {
     },
 }
 
+/// The studies.
+#[derive(Debug, Subcommand)]
+pub enum StudyCommand {
+    /// p × n sweep: displacement error against a self-converged run, and wall time, per run (CSV).
+    ///
+    /// Example: stentkit study convergence designs/circular_arch.yaml --time 3 -o runs/arch_convergence
+    Convergence {
+        /// The design file (YAML).
+        design: PathBuf,
+        /// Output folder.
+        #[arg(short, long)]
+        output: PathBuf,
+        /// Degrees p.
+        #[arg(long, value_delimiter = ',', default_value = "2,3,4,5,6,7,8")]
+        degrees: Vec<usize>,
+        /// Control points n per patch.
+        #[arg(
+            long,
+            value_delimiter = ',',
+            default_value = "8,10,12,16,20,24,32,40,48,64"
+        )]
+        points: Vec<usize>,
+        /// Time at which the error is measured (default: the design's end time).
+        #[arg(long)]
+        time: Option<f64>,
+        /// Reference degree and points, `P,N`.
+        #[arg(long, value_delimiter = ',', default_value = "8,150", num_args = 1)]
+        reference: Vec<usize>,
+        /// Sampling points per patch.
+        #[arg(long, default_value_t = 9)]
+        samples: usize,
+    },
+}
+
 /// Runs the command line and returns the process exit code.
 pub fn main() -> ExitCode {
     let cli = Cli::parse();
@@ -74,6 +112,15 @@ pub fn main() -> ExitCode {
             force,
             quiet,
         } => run::run(&design, output, force, quiet),
+        Command::Study(StudyCommand::Convergence {
+            design,
+            output,
+            degrees,
+            points,
+            time,
+            reference,
+            samples,
+        }) => study_convergence(&design, &output, degrees, points, time, reference, samples),
         Command::Mesh {
             design,
             output,
@@ -88,4 +135,37 @@ pub fn main() -> ExitCode {
             ExitCode::FAILURE
         }
     }
+}
+
+fn study_convergence(
+    design: &std::path::Path,
+    output: &std::path::Path,
+    degrees: Vec<usize>,
+    points: Vec<usize>,
+    time: Option<f64>,
+    reference: Vec<usize>,
+    samples: usize,
+) -> anyhow::Result<()> {
+    use anyhow::Context;
+    let text = std::fs::read_to_string(design)
+        .with_context(|| format!("cannot read {}", design.display()))?;
+    let model = crate::io::design::parse_design(&text, design)?.model;
+    let [rp, rn] = reference[..] else {
+        anyhow::bail!("--reference takes two numbers, P,N");
+    };
+    let study = study::ConvergenceStudy {
+        degrees,
+        points,
+        time: time.unwrap_or(model.time.end),
+        reference: (rp, rn),
+        samples,
+    };
+    std::fs::create_dir_all(output)
+        .with_context(|| format!("cannot create {}", output.display()))?;
+    let rows = study::convergence(&text, design, &study, |line| eprintln!("  {line}"))?;
+    let csv = output.join("convergence.csv");
+    std::fs::write(&csv, study::convergence_csv(&rows, &study, &model.name))
+        .with_context(|| format!("cannot write {}", csv.display()))?;
+    println!("{}: {} runs → {}", model.name, rows.len(), csv.display());
+    Ok(())
 }

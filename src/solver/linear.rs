@@ -1,44 +1,94 @@
-//! The global sparse linear system: the pattern and the symbolic LU analysis once per pattern (faer), a
-//! numeric LU per Newton iteration, and solves.
+//! The global sparse linear system (faer): the compressed-column pattern and the symbolic LU analysis once per
+//! pattern, then a numeric LU per Newton iteration into reused storage and scratch (faer's low-level
+//! `factorize_numeric_lu`, no allocation once warm), and solves.
+//!
+//! Assembly pushes entries in a fixed order (repeats allowed, they are summed); the pattern maps each pushed
+//! entry to its slot in the compressed columns once, so refilling the values is one pass with no sorting.
 
 use super::SolverError;
 use crate::math::Real;
-use faer::linalg::solvers::Solve;
+use faer::dyn_stack::{MemBuffer, MemStack, StackReq};
 use faer::sparse::linalg::LuError;
-use faer::sparse::linalg::solvers::{Lu, SymbolicLu};
-use faer::sparse::{Argsort, Pair, SparseColMat, SymbolicSparseColMat};
+use faer::sparse::linalg::lu::{LuRef, NumericLu, SymbolicLu, factorize_symbolic_lu};
+use faer::sparse::{SparseColMatRef, SymbolicSparseColMatRef};
+use faer::{Conj, MatMut, Par};
 
-/// A square sparse matrix pattern with its symbolic LU analysis.
-#[derive(Debug, Clone)]
+/// A square sparse matrix pattern, its symbolic LU analysis and reusable numeric storage.
 pub struct SparseSystem {
     n: usize,
-    /// Number of entries pushed per assembly (duplicates included; they are summed).
-    entries: usize,
-    pattern: SymbolicSparseColMat<usize>,
-    argsort: Argsort<usize>,
+    col_ptr: Vec<usize>,
+    row_idx: Vec<usize>,
+    /// For each pushed entry, its slot in `values`.
+    slot: Vec<usize>,
+    /// Matrix values in compressed-column order.
+    values: Vec<Real>,
     symbolic: SymbolicLu<usize>,
+    numeric: NumericLu<usize, Real>,
+    factor_scratch: MemBuffer,
+    solve_scratch: MemBuffer,
+    factored: bool,
 }
 
-/// A numeric LU factorisation of the system matrix.
-pub struct Factorisation {
-    lu: Lu<usize, Real>,
+impl std::fmt::Debug for SparseSystem {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("SparseSystem")
+            .field("n", &self.n)
+            .field("nonzeros", &self.row_idx.len())
+            .field("entries", &self.slot.len())
+            .finish()
+    }
 }
 
 impl SparseSystem {
     /// Analyses the pattern given as `(row, column)` pairs in assembly order (repeats are summed).
     pub fn new(n: usize, entries: &[(usize, usize)]) -> Result<Self, SolverError> {
-        let pairs: Vec<Pair<usize, usize>> =
-            entries.iter().map(|&(r, c)| Pair::new(r, c)).collect();
-        let (pattern, argsort) = SymbolicSparseColMat::try_new_from_indices(n, n, &pairs)
-            .map_err(|e| SolverError::Linear(format!("sparsity pattern: {e:?}")))?;
-        let symbolic = SymbolicLu::try_new(pattern.as_ref())
+        // Sort entry indices by (column, row) and merge repeats into slots.
+        let mut order: Vec<usize> = (0..entries.len()).collect();
+        order.sort_unstable_by_key(|&k| (entries[k].1, entries[k].0));
+        let mut col_ptr = vec![0usize; n + 1];
+        let mut row_idx = Vec::with_capacity(entries.len());
+        let mut slot = vec![0usize; entries.len()];
+        let mut last: Option<(usize, usize)> = None;
+        for &k in &order {
+            let (r, c) = entries[k];
+            if r >= n || c >= n {
+                return Err(SolverError::Linear(format!(
+                    "entry ({r}, {c}) outside a {n}×{n} system"
+                )));
+            }
+            if last != Some((r, c)) {
+                row_idx.push(r);
+                col_ptr[c + 1] += 1;
+                last = Some((r, c));
+            }
+            slot[k] = row_idx.len() - 1;
+        }
+        for c in 0..n {
+            col_ptr[c + 1] += col_ptr[c];
+        }
+        let pattern = SymbolicSparseColMatRef::new_checked(n, n, &col_ptr, None, &row_idx);
+        let symbolic = factorize_symbolic_lu(pattern, Default::default())
             .map_err(|e| SolverError::Linear(format!("symbolic LU: {e:?}")))?;
+        let factor_req =
+            symbolic.factorize_numeric_lu_scratch::<Real>(Par::Seq, Default::default());
+        let solve_req = symbolic.solve_in_place_scratch::<Real>(1, Par::Seq);
+        let alloc = |req: StackReq| {
+            MemBuffer::try_new(req).map_err(|e| SolverError::Linear(format!("LU workspace: {e:?}")))
+        };
+        let factor_scratch = alloc(factor_req)?;
+        let solve_scratch = alloc(solve_req)?;
+        let nnz = row_idx.len();
         Ok(Self {
             n,
-            entries: entries.len(),
-            pattern,
-            argsort,
+            col_ptr,
+            row_idx,
+            slot,
+            values: vec![0.0; nnz],
             symbolic,
+            numeric: NumericLu::new(),
+            factor_scratch,
+            solve_scratch,
+            factored: false,
         })
     }
 
@@ -49,31 +99,59 @@ impl SparseSystem {
 
     /// Number of entries one assembly pushes.
     pub fn entries(&self) -> usize {
-        self.entries
+        self.slot.len()
     }
 
     /// Number of structural non-zeros.
     pub fn nonzeros(&self) -> usize {
-        self.pattern.compute_nnz()
+        self.row_idx.len()
     }
 
-    /// Factorises the matrix whose entries are `values`, in the pattern's assembly order.
+    /// Factorises the matrix whose pushed entries are `entry_values` (in the pattern's assembly order).
     /// `Err(Singular)` when no pivot is found: the tangent is singular.
-    pub fn factor(&self, values: &[Real]) -> Result<Factorisation, SolverError> {
-        let matrix = SparseColMat::new_from_argsort(self.pattern.clone(), &self.argsort, values)
-            .map_err(|e| SolverError::Linear(format!("matrix values: {e:?}")))?;
-        match Lu::try_new_with_symbolic(self.symbolic.clone(), matrix.as_ref()) {
-            Ok(lu) => Ok(Factorisation { lu }),
+    pub fn factor(&mut self, entry_values: &[Real]) -> Result<(), SolverError> {
+        assert_eq!(
+            entry_values.len(),
+            self.slot.len(),
+            "one value per pushed entry"
+        );
+        self.values.fill(0.0);
+        for (&s, &v) in self.slot.iter().zip(entry_values) {
+            self.values[s] += v;
+        }
+        self.factored = false;
+        let pattern = SymbolicSparseColMatRef::new_checked(
+            self.n,
+            self.n,
+            &self.col_ptr,
+            None,
+            &self.row_idx,
+        );
+        let matrix = SparseColMatRef::new(pattern, &self.values);
+        let stack = MemStack::new(&mut self.factor_scratch);
+        match self.symbolic.factorize_numeric_lu(
+            &mut self.numeric,
+            matrix,
+            Par::Seq,
+            stack,
+            Default::default(),
+        ) {
+            Ok(_) => {
+                self.factored = true;
+                Ok(())
+            }
             Err(LuError::SymbolicSingular { index }) => Err(SolverError::Singular { index }),
             Err(LuError::Generic(e)) => Err(SolverError::Linear(format!("numeric LU: {e:?}"))),
         }
     }
-}
 
-impl Factorisation {
-    /// Solves `A x = b` in place (`rhs` holds `b` on entry and `x` on exit).
-    pub fn solve_in_place(&self, rhs: &mut [Real]) {
-        let col = faer::ColMut::from_slice_mut(rhs);
-        self.lu.solve_in_place(col);
+    /// Solves `A x = b` in place with the last factorisation (`rhs` holds `b` on entry and `x` on exit).
+    pub fn solve_in_place(&mut self, rhs: &mut [Real]) {
+        assert!(self.factored, "solve before a successful factorisation");
+        let lu = LuRef::new_unchecked(&self.symbolic, &self.numeric);
+        let n = rhs.len();
+        let rhs = MatMut::from_column_major_slice_mut(rhs, n, 1);
+        let stack = MemStack::new(&mut self.solve_scratch);
+        lu.solve_in_place_with_conj(Conj::No, rhs, Par::Seq, stack);
     }
 }

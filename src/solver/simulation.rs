@@ -391,14 +391,13 @@ impl<'m> Simulation<'m> {
             if report.iterations >= max_iterations {
                 return Err(NewtonFailure::NotConverged(report));
             }
-            let lu = self
-                .system
+            self.system
                 .factor(&self.values)
                 .map_err(NewtonFailure::Fatal)?;
             for (d, r) in self.delta.iter_mut().zip(&self.lin.residual) {
                 *d = -r;
             }
-            lu.solve_in_place(&mut self.delta);
+            self.system.solve_in_place(&mut self.delta);
             last_increment = self.increment_norm();
             report.increments.push(last_increment);
             report.iterations += 1;

@@ -127,12 +127,61 @@ fn split_message(message: &str) -> (String, Option<locate::Position>) {
     (text, position)
 }
 
+/// Changes applied to a design after it is read and before the model is built (studies vary these).
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct DesignOverrides {
+    /// Degree of every patch (replaces `mesh.p` and per-patch `p`).
+    pub degree: Option<usize>,
+    /// Control points of every patch (replaces `mesh.n` and per-patch `n`).
+    pub points: Option<usize>,
+    /// End time (replaces `time.end`).
+    pub end_time: Option<f64>,
+    /// Time step (replaces `time.step`).
+    pub step: Option<f64>,
+    /// Internal-variable update (replaces `material.integrator`).
+    pub integrator: Option<dto::IntegratorDto>,
+}
+
+impl DesignOverrides {
+    fn apply(&self, d: &mut dto::DesignDto) {
+        if self.degree.is_some() || self.points.is_some() {
+            let mesh = d.mesh.get_or_insert(dto::MeshDto { p: None, n: None });
+            if let Some(p) = self.degree {
+                mesh.p = Some(p);
+                d.patches.iter_mut().for_each(|q| q.p = None);
+            }
+            if let Some(n) = self.points {
+                mesh.n = Some(n);
+                d.patches.iter_mut().for_each(|q| q.n = None);
+            }
+        }
+        if let Some(t) = self.end_time {
+            d.time.end = dto::Positive(t);
+        }
+        if let Some(h) = self.step {
+            d.time.step = dto::Positive(h);
+        }
+        if let Some(i) = self.integrator {
+            d.material.integrator = Some(i);
+        }
+    }
+}
+
 /// Validates a design given as text; `path` names it in errors.
 pub fn parse_design(text: &str, path: &Path) -> Result<Design, DesignError> {
+    parse_design_with(text, path, &DesignOverrides::default())
+}
+
+/// Validates a design given as text with `overrides` applied; `path` names it in errors.
+pub fn parse_design_with(
+    text: &str,
+    path: &Path,
+    overrides: &DesignOverrides,
+) -> Result<Design, DesignError> {
     let file = path.to_path_buf();
     let locator = locate::Locator::new(text);
     let deserializer = serde_yaml::Deserializer::from_str(text);
-    let dto: dto::DesignDto = serde_path_to_error::deserialize(deserializer).map_err(|e| {
+    let mut dto: dto::DesignDto = serde_path_to_error::deserialize(deserializer).map_err(|e| {
         let field = match e.path().to_string() {
             p if p == "." => String::new(),
             p => p,
@@ -164,6 +213,7 @@ pub fn parse_design(text: &str, path: &Path) -> Result<Design, DesignError> {
             message,
         }
     })?;
+    overrides.apply(&mut dto);
     let stem = path.file_stem().map_or_else(
         || "design".to_string(),
         |s| s.to_string_lossy().into_owned(),
