@@ -14,14 +14,27 @@ pub trait ParametricCurve {
     /// The point `c(t)`.
     fn point(&self, t: Real) -> Vec3;
 
-    /// The derivative `c'(t)`; by default a fourth-order central difference of [`Self::point`]
-    /// (step `1e-3` of the domain length, error `O(1e-12)` relative for curves smooth on that scale).
+    /// The derivative `c'(t)`; by default a fourth-order finite difference of [`Self::point`] with step
+    /// `1e-3` of the domain length (error `O(1e-12)` relative for curves smooth on that scale): the central
+    /// five-point formula where its stencil fits in the domain, else the one-sided five-point formula pointing
+    /// into it, so that [`Self::point`] is never evaluated outside `[t0, t1]`, where a curve need not be defined
+    /// (a [`PlacedCurve`] clamps its carrier's arc length there).
     fn derivative(&self, t: Real) -> Vec3 {
         let (t0, t1) = self.domain();
         let h = 1e-3 * (t1 - t0);
-        (self.point(t - 2.0 * h) - self.point(t + 2.0 * h)
-            + (self.point(t + h) - self.point(t - h)) * 8.0)
-            / (12.0 * h)
+        if t - 2.0 * h >= t0 && t + 2.0 * h <= t1 {
+            (self.point(t - 2.0 * h) - self.point(t + 2.0 * h)
+                + (self.point(t + h) - self.point(t - h)) * 8.0)
+                / (12.0 * h)
+        } else {
+            // f'(t) = (−25 f(t) + 48 f(t+h) − 36 f(t+2h) + 16 f(t+3h) − 3 f(t+4h)) / 12h + O(h⁴),
+            // with h < 0 at the upper end.
+            let h = if t - 2.0 * h < t0 { h } else { -h };
+            (self.point(t) * -25.0 + self.point(t + h) * 48.0 - self.point(t + 2.0 * h) * 36.0
+                + self.point(t + 3.0 * h) * 16.0
+                - self.point(t + 4.0 * h) * 3.0)
+                / (12.0 * h)
+        }
     }
 }
 
@@ -358,6 +371,258 @@ impl ParametricCurve for PlacedCurve<'_> {
         match self.centreline.at(s) {
             Ok((c, r)) => c + r * local,
             Err(_) => Vec3::repeat(Real::NAN),
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    //! Point lists, arc-length tables, centrelines and placements against closed forms.
+
+    use super::*;
+    use crate::geometry::primitives::{arc, line};
+    use std::f64::consts::{FRAC_PI_2, PI, TAU};
+
+    /// Round-off level for coordinates of order 1–10 after a few dozen floating-point operations.
+    const ROUND_OFF: Real = 1e-12;
+
+    fn helix() -> Helix {
+        Helix {
+            radius: 1.5,
+            pitch: 2.0,
+            turns: 1.5,
+            start_angle: 0.3,
+            placement: RigidPlacement::identity(),
+        }
+    }
+
+    /// Chord-length parameters of a point list, normalised to [0, 1] (Piegl–Tiller Eq. 9.5), computed here
+    /// independently of [`point_list_curve`].
+    fn chord_parameters(points: &[Vec3]) -> Vec<Real> {
+        let mut t = vec![0.0];
+        for w in points.windows(2) {
+            let last = t[t.len() - 1];
+            t.push(last + (w[1] - w[0]).norm());
+        }
+        let total = t[t.len() - 1];
+        t.iter().map(|x| x / total).collect()
+    }
+
+    #[test]
+    fn point_list_curve_passes_through_its_points() {
+        // Interpolation at chord-length parameters: c(t_i) = p_i to round-off, for the cubic case (9 points on
+        // a helix) and the low-degree cases of 3 (quadratic) and 2 points (a line).
+        let h = helix();
+        for count in [2usize, 3, 4, 9] {
+            let points: Vec<Vec3> = (0..count)
+                .map(|k| h.point(h.domain().1 * k as Real / (count - 1) as Real))
+                .collect();
+            let curve = point_list_curve(&points).unwrap();
+            assert_eq!(curve.degree(), 3.min(count - 1));
+            for (p, t) in points.iter().zip(chord_parameters(&points)) {
+                assert!(
+                    (curve.point(t) - p).norm() < ROUND_OFF,
+                    "{count} points, t = {t}"
+                );
+            }
+        }
+        // Coincident or too few points are data errors, not panics.
+        let p = Vec3::new(1.0, 2.0, 3.0);
+        assert!(point_list_curve(&[p, p, Vec3::zeros()]).is_err());
+        assert!(point_list_curve(&[p]).is_err());
+    }
+
+    #[test]
+    fn arc_length_of_a_quarter_circle_and_its_inverse() {
+        // Exact NURBS quarter circle of radius 2: length π; the arc length to parameter t is R times the angle
+        // of c(t), so parameter_at(s) must return the point at angle s/R. The speed of the rational arc is
+        // smooth, so 5-point Gauss–Legendre on 64 panels is exact to round-off.
+        let r = 2.0;
+        let curve = arc(
+            Vec3::zeros(),
+            Vec3::new(r, 0.0, 0.0),
+            Vec3::z(),
+            FRAC_PI_2,
+            3,
+            6,
+        )
+        .unwrap();
+        let table = ArcLengthTable::new(&curve, 64);
+        assert!(
+            (table.length() - PI).abs() < ROUND_OFF,
+            "{}",
+            table.length()
+        );
+        for k in 0..=100 {
+            let s = table.length() * k as Real / 100.0;
+            let t = table.parameter_at(&curve, s);
+            let p = curve.point(t);
+            assert!((r * p.y.atan2(p.x) - s).abs() < ROUND_OFF, "s = {s}");
+        }
+        assert_eq!(table.parameter_at(&curve, 0.0), 0.0);
+        assert!((table.parameter_at(&curve, PI) - 1.0).abs() < ROUND_OFF);
+        // Clamped outside [0, L].
+        assert_eq!(table.parameter_at(&curve, -1.0), 0.0);
+        assert!((table.parameter_at(&curve, 10.0) - 1.0).abs() < ROUND_OFF);
+        // Helix: s = t √(r² + c²) exactly.
+        let h = helix();
+        let speed = (h.radius.powi(2) + (h.pitch / TAU).powi(2)).sqrt();
+        let table = ArcLengthTable::new(&h, 64);
+        assert!((table.length() - h.domain().1 * speed).abs() < ROUND_OFF);
+        for k in 0..=50 {
+            let s = table.length() * k as Real / 50.0;
+            assert!((table.parameter_at(&h, s) - s / speed).abs() < ROUND_OFF);
+        }
+    }
+
+    #[test]
+    fn centreline_on_a_line_and_an_arc_matches_closed_forms() {
+        // Line from a to b: c(s) = a + s e, R(s) constant with first column e.
+        let a = Vec3::new(1.0, 2.0, 3.0);
+        let e = Vec3::new(2.0, -1.0, 2.0) / 3.0;
+        let b = a + 5.0 * e;
+        let centreline = Centreline::new(line(a, b, 3, 5).unwrap(), None).unwrap();
+        assert!((centreline.length() - 5.0).abs() < ROUND_OFF);
+        let (_, r0) = centreline.at(0.0).unwrap();
+        for k in 0..=20 {
+            let s = 5.0 * k as Real / 20.0;
+            let (c, r) = centreline.at(s).unwrap();
+            assert!((c - (a + s * e)).norm() < ROUND_OFF);
+            assert!((r - r0).norm() < ROUND_OFF);
+            assert!((r.column(0) - e).norm() < ROUND_OFF);
+            assert!((r.transpose() * r - Mat3::identity()).norm() < ROUND_OFF);
+        }
+        // Arc of radius 3 about z from (3, 0, 0) through 120°: c(s) = 3(cos φ, sin φ, 0), φ = s/3,
+        // t = (−sin φ, cos φ, 0). A planar rotation-minimising frame keeps d2 = e_z when started there, and keeps
+        // d2 radial (outward, (cos φ, sin φ, 0)) when started radial.
+        let radius = 3.0;
+        let angle = 120f64.to_radians();
+        let curve = arc(
+            Vec3::zeros(),
+            Vec3::new(radius, 0.0, 0.0),
+            Vec3::z(),
+            angle,
+            4,
+            9,
+        )
+        .unwrap();
+        let out_of_plane = Centreline::new(curve.clone(), Some(Vec3::z())).unwrap();
+        let radial = Centreline::new(curve, Some(Vec3::x())).unwrap();
+        assert!((out_of_plane.length() - radius * angle).abs() < ROUND_OFF);
+        for k in 0..=24 {
+            let s = radius * angle * k as Real / 24.0;
+            let phi = s / radius;
+            let (c, r) = out_of_plane.at(s).unwrap();
+            assert!((c - radius * Vec3::new(phi.cos(), phi.sin(), 0.0)).norm() < ROUND_OFF);
+            assert!((r.column(0) - Vec3::new(-phi.sin(), phi.cos(), 0.0)).norm() < ROUND_OFF);
+            assert!((r.column(1) - Vec3::z()).norm() < ROUND_OFF);
+            let (_, r) = radial.at(s).unwrap();
+            assert!((r.column(1) - Vec3::new(phi.cos(), phi.sin(), 0.0)).norm() < ROUND_OFF);
+            assert!((r.determinant() - 1.0).abs() < ROUND_OFF);
+        }
+    }
+
+    #[test]
+    fn placed_curves_on_a_straight_centreline_are_rigidly_moved() {
+        // On a straight carrier c(s) = a + s e with constant frame R, both placements reduce to the rigid motion
+        // P = c(s0) + R P_local (Follow: c(s0 + x) + R (0, y, z) = a + s0 e + R (x, y, z) because R e1 = e). The
+        // points agree to round-off; derivatives to the accuracy of the default fourth-order finite difference
+        // (~1e-11 here); lengths to that of the arc-length table.
+        let a = Vec3::new(1.0, 2.0, 3.0);
+        let e = Vec3::new(2.0, -1.0, 2.0) / 3.0;
+        let centreline = Centreline::new(line(a, a + 5.0 * e, 3, 4).unwrap(), None).unwrap();
+        let (_, r) = centreline.at(0.0).unwrap();
+        // A wire bump along local x (x ∈ [0, 0.6]) and a helix about local x (x ∈ [0, 1]): both start at the
+        // carrier's start when s0 = 0, where the finite-difference stencil must not leave the domain.
+        let wire = SineWire {
+            radius: 0.3,
+            amplitude: 0.1,
+            waves: 2.0,
+            phase: 0.0,
+            from: 0.0,
+            to: PI,
+            placement: RigidPlacement {
+                origin: Vec3::new(0.3, 0.0, 0.0),
+                rotation: Mat3::identity(),
+            },
+        };
+        let coil = Helix {
+            radius: 0.2,
+            pitch: 1.0,
+            turns: 1.0,
+            start_angle: 0.0,
+            placement: RigidPlacement {
+                origin: Vec3::zeros(),
+                rotation: frame_from_axis(&Vec3::x(), Some(Vec3::y())).unwrap(),
+            },
+        };
+        for station in [
+            Station::Rigid(1.2),
+            Station::Follow(0.0),
+            Station::Follow(0.7),
+        ] {
+            for local in [&wire as &dyn ParametricCurve, &coil] {
+                let placed = PlacedCurve {
+                    local,
+                    centreline: &centreline,
+                    station,
+                };
+                let (Station::Rigid(s0) | Station::Follow(s0)) = station;
+                let (t0, t1) = local.domain();
+                for k in 0..=100 {
+                    let t = t0 + (t1 - t0) * k as Real / 100.0;
+                    let expected = a + s0 * e + r * local.point(t);
+                    assert!(
+                        (placed.point(t) - expected).norm() < ROUND_OFF,
+                        "{station:?} t = {t}"
+                    );
+                    let slope = r * local.derivative(t);
+                    assert!(
+                        (placed.derivative(t) - slope).norm() < 1e-9 * slope.norm(),
+                        "{station:?} t = {t}: {:?} vs {slope:?}",
+                        placed.derivative(t)
+                    );
+                }
+                let (placed_length, local_length) = (
+                    ArcLengthTable::new(&placed, 512).length(),
+                    ArcLengthTable::new(local, 512).length(),
+                );
+                assert!(
+                    (placed_length / local_length - 1.0).abs() < 1e-10,
+                    "{station:?}"
+                );
+            }
+        }
+    }
+
+    /// A curve defined only on its domain (NaN outside), as a carrier-clamped placement effectively is.
+    struct OnlyOnDomain;
+
+    impl ParametricCurve for OnlyOnDomain {
+        fn domain(&self) -> (Real, Real) {
+            (1.0, 2.0)
+        }
+        fn point(&self, t: Real) -> Vec3 {
+            if (1.0..=2.0).contains(&t) {
+                Vec3::new(t.sin(), t * t, t.exp())
+            } else {
+                Vec3::repeat(Real::NAN)
+            }
+        }
+    }
+
+    #[test]
+    fn default_derivative_never_leaves_the_domain() {
+        // Regression: the central stencil used to sample t ± 2h outside [t0, t1] near the ends. The one-sided
+        // fourth-order formula has error (h⁴/5)|c⁽⁵⁾| ≈ 2e-13 relative at h = 1e-3; asserted 1e-10.
+        let c = OnlyOnDomain;
+        for t in [1.0_f64, 1.0005, 1.001, 1.5, 1.999, 2.0] {
+            let exact = Vec3::new(t.cos(), 2.0 * t, t.exp());
+            let d = c.derivative(t);
+            assert!(
+                (d - exact).norm() < 1e-10 * exact.norm(),
+                "t = {t}: {d:?} vs {exact:?}"
+            );
         }
     }
 }

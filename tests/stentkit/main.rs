@@ -1,5 +1,7 @@
 //! stentkit's integration tests: one binary, one module per capability.
 
+mod cli;
 mod design_errors;
 mod designs;
+mod mesh;
 mod viscoelastic;
