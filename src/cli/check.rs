@@ -35,19 +35,19 @@ pub fn describe(model: &Model, file: &str, warnings: &[String]) -> String {
         Some(w) => {
             let _ = writeln!(
                 s,
-                ", WLF C1 = {}, C2 = {} K, Tg = {} °C (frozen at and below {} °C), integrator {:?}",
+                ", WLF C1 = {}, C2 = {} K, Tg = {} °C (frozen at and below {} °C), integrator {}",
                 w.c1(),
                 w.c2(),
                 w.tg(),
                 w.frozen_below(),
-                model.integrator
+                model.integrator.name()
             );
         }
         None => {
             let _ = writeln!(
                 s,
-                ", no WLF shift (temperature-independent), integrator {:?}",
-                model.integrator
+                ", no WLF shift (temperature-independent), integrator {}",
+                model.integrator.name()
             );
         }
     }

@@ -91,6 +91,15 @@ pub enum Integrator {
 }
 
 impl Integrator {
+    /// The design-file spelling: `trapezoidal`, `backward-euler`, `exponential`.
+    pub fn name(&self) -> &'static str {
+        match self {
+            Integrator::Trapezoidal => "trapezoidal",
+            Integrator::BackwardEuler => "backward-euler",
+            Integrator::Exponential => "exponential",
+        }
+    }
+
     /// The asymptotic order of accuracy in `h` for smooth histories: 2, 1, 2.
     pub fn order(&self) -> u32 {
         match self {

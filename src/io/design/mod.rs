@@ -75,14 +75,9 @@ impl fmt::Display for DesignError {
     }
 }
 
-impl std::error::Error for DesignError {
-    fn source(&self) -> Option<&(dyn std::error::Error + 'static)> {
-        match self {
-            DesignError::Read { source, .. } => Some(source),
-            DesignError::Invalid { .. } => None,
-        }
-    }
-}
+/// The I/O cause is part of the message (so it is not also returned as the error's source, which would make
+/// error chains print it twice).
+impl std::error::Error for DesignError {}
 
 /// Reads and validates the design file at `path`.
 pub fn load_design(path: &Path) -> Result<Design, DesignError> {
