@@ -8,6 +8,7 @@
 pub mod assembly;
 pub mod discretisation;
 pub mod linear;
+pub mod shape;
 pub mod simulation;
 pub mod state;
 
