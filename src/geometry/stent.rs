@@ -70,6 +70,9 @@ use std::collections::BTreeMap;
 use std::f64::consts::{PI, TAU};
 use std::sync::Arc;
 
+/// A mirror of the device as a map of angles `ϑ`, with the plane's description.
+type Mirror = (fn(Real) -> Real, &'static str);
+
 /// Tolerance on angles [rad] when testing whether a node lies on a symmetry plane, whether crests face
 /// troughs and whether `m α` is a multiple of π. Angles are built from the design's numbers by a few
 /// operations, so they carry ~1e-15 rad of round-off; a rotation typed in degrees with ten significant digits is
@@ -266,8 +269,9 @@ pub enum WireEnd {
 /// degree and number of control points.
 #[derive(Debug, Clone)]
 pub struct GeneratedPatch {
-    /// Name: `c<k>_w<j>` for wire `j` of crown `k`, `b<k>_<i>` for the bridge from crest `i` of crown `k`
-    /// (all 1-based, as in the full device).
+    /// Name: `c<k>_w<i>` for the wire of crown `k` that starts at node `c<k>_n<i>`, `b<k>_<i>` for the bridge
+    /// from node `c<k>_n<i>` (a crest) to crown `k + 1` (see [`GeneratedNode::name`]; names are those of the full
+    /// device, so a reduced model's names say where its patches are).
     pub name: String,
     /// Crown wire or bridge.
     pub role: PatchRole,
@@ -304,7 +308,8 @@ impl GeneratedPatch {
 /// One generated node: a crest or trough of a crown, where wires (and bridges) meet.
 #[derive(Debug, Clone, PartialEq)]
 pub struct GeneratedNode {
-    /// Name `c<k>_n<j>` (1-based crown and node number; odd `j` are crests).
+    /// Name `c<k>_n<i>`: crown `k` (1-based), node `i` counted from 1 at the first node at or after `ϑ = 0`
+    /// by increasing angle (for symmetric devices node `i` is at `ϑ = (i − 1) π/m`).
     pub name: String,
     /// Exact position [length].
     pub position: Vec3,
@@ -422,7 +427,7 @@ impl Axis {
                 finite("centreline", origin)?;
                 finite("centreline", direction)?;
                 let n = direction.norm();
-                if !(n > 0.0) {
+                if !(n.is_finite() && n > 0.0) {
                     return Err(invalid("centreline", "the direction is zero"));
                 }
                 Ok(Axis::Straight {
@@ -450,13 +455,15 @@ impl Axis {
                     ));
                 }
                 let a = axis.norm();
-                if !(a > 0.0) {
+                if !(a.is_finite() && a > 0.0) {
                     return Err(invalid("centreline", "the arc axis is zero"));
                 }
                 let axis = axis / a;
                 let offset = start - centre;
                 let radius = offset.norm();
-                if !(radius > 0.0) || offset.dot(&axis).abs() > PLANARITY_TOLERANCE * radius {
+                if !(radius.is_finite() && radius > 0.0)
+                    || offset.dot(&axis).abs() > PLANARITY_TOLERANCE * radius
+                {
                     return Err(invalid(
                         "centreline",
                         "the start point must differ from the centre and lie in the plane through the centre normal to the axis",
@@ -529,7 +536,10 @@ impl Axis {
             Axis::Straight { frame, .. } => Some((frame.column(0).into_owned(), Mat3::zeros())),
             Axis::Arc { axis, radius, .. } => {
                 let (_, r) = self.frame(s);
-                Some((r.column(0).into_owned(), (axis / *radius).cross_matrix() * r))
+                Some((
+                    r.column(0).into_owned(),
+                    (axis / *radius).cross_matrix() * r,
+                ))
             }
             Axis::Curve { .. } => None,
         }
@@ -925,10 +935,23 @@ impl StentSpec {
         // Nodes: every crest and trough of every crown, kept when in the sector.
         let mut nodes = Vec::new();
         let mut node_index = vec![vec![None; 2 * m]; n];
+        // Node numbers (0-based) by increasing angle from ϑ = 0, whatever the crown's rotation.
+        let first: Vec<usize> = (0..n)
+            .map(|k| {
+                let key = |j: usize| {
+                    let x = (phase(k) + half_wave * j as Real).rem_euclid(TAU);
+                    if TAU - x <= ANGLE_TOLERANCE { 0.0 } else { x }
+                };
+                (0..2 * m)
+                    .min_by(|&a, &b| key(a).total_cmp(&key(b)))
+                    .unwrap_or(0)
+            })
+            .collect();
+        let number = |k: usize, j: usize| (j + 2 * m - first[k]) % (2 * m);
         for (k, &s) in stations.iter().enumerate() {
             let (c, r) = axis.frame(s);
             let t = r.column(0).into_owned();
-            for j in 0..2 * m {
+            for j in (0..2 * m).map(|i| (i + first[k]) % (2 * m)) {
                 let a = phase(k) + half_wave * j as Real;
                 if !retained(a) {
                     continue;
@@ -938,7 +961,7 @@ impl StentSpec {
                 let radial = r * Vec3::new(0.0, ca, sa);
                 node_index[k][j] = Some(nodes.len());
                 nodes.push(GeneratedNode {
-                    name: format!("c{}_n{}", k + 1, j + 1),
+                    name: format!("c{}_n{}", k + 1, number(k, j) + 1),
                     position: c + r * Vec3::new(x, big_r * ca, big_r * sa),
                     ends: Vec::new(),
                     crown: k,
@@ -963,7 +986,7 @@ impl StentSpec {
         let mut patches = Vec::new();
         for (k, &s) in stations.iter().enumerate() {
             let (_, r) = axis.frame(s);
-            for j in 0..2 * m {
+            for j in (0..2 * m).map(|i| (i + first[k]) % (2 * m)) {
                 let from = phase(k) + half_wave * j as Real;
                 let to = from + half_wave;
                 if !retained(0.5 * (from + to)) {
@@ -971,11 +994,13 @@ impl StentSpec {
                 }
                 let (Some(a), Some(b)) = (node_index[k][j], node_index[k][(j + 1) % (2 * m)])
                 else {
-                    unreachable!("the ends of a retained wire are retained (cuts pass through nodes)");
+                    unreachable!(
+                        "the ends of a retained wire are retained (cuts pass through nodes)"
+                    );
                 };
                 let (sa, ca) = from.sin_cos();
                 patches.push(GeneratedPatch {
-                    name: format!("c{}_w{}", k + 1, j + 1),
+                    name: format!("c{}_w{}", k + 1, number(k, j) + 1),
                     role: PatchRole::Crown { crown: k, wire: j },
                     curve: curve(CurveKind::Crown {
                         station: s,
@@ -995,7 +1020,8 @@ impl StentSpec {
         let mut bridge_ends = Vec::new();
         if let Some(b) = &self.bridges {
             for k in 0..n.saturating_sub(1) {
-                let crests: Vec<usize> = (0..m).filter(|c| c % b.every == b.first).collect();
+                let mut crests: Vec<usize> = (0..m).filter(|c| c % b.every == b.first).collect();
+                crests.sort_by_key(|&c| number(k, 2 * c));
                 let angles: Vec<Real> = crests
                     .iter()
                     .map(|&c| phase(k) + 2.0 * half_wave * c as Real)
@@ -1009,7 +1035,9 @@ impl StentSpec {
                     // The facing trough of crown k + 1.
                     let q = (a - phase(k + 1)) / half_wave;
                     let j = (q.round() as i64).rem_euclid(2 * m as i64) as usize;
-                    debug_assert!(j % 2 == 1 && same_angle(a, phase(k + 1) + half_wave * j as Real));
+                    debug_assert!(
+                        j % 2 == 1 && same_angle(a, phase(k + 1) + half_wave * j as Real)
+                    );
                     let start = node_index[k][2 * c].expect("retained crest");
                     let end = node_index[k + 1][j].expect("retained trough");
                     let in_plane = plane_of(a);
@@ -1048,7 +1076,7 @@ impl StentSpec {
                     let (sa, ca) = a.sin_cos();
                     bridge_ends.extend([start, end]);
                     patches.push(GeneratedPatch {
-                        name: format!("b{}_{}", k + 1, c + 1),
+                        name: format!("b{}_{}", k + 1, number(k, 2 * c) + 1),
                         role: PatchRole::Bridge { pair: k, crest: c },
                         curve: curve(CurveKind::Bridge {
                             from: stations[k],
@@ -1082,7 +1110,9 @@ impl StentSpec {
         for (name, kind) in [("crests", NodeKind::Crest), ("troughs", NodeKind::Trough)] {
             node_sets.insert(
                 name.into(),
-                (0..nodes.len()).filter(|&i| nodes[i].kind == kind).collect(),
+                (0..nodes.len())
+                    .filter(|&i| nodes[i].kind == kind)
+                    .collect(),
             );
         }
         bridge_ends.sort_unstable();
@@ -1106,7 +1136,7 @@ impl StentSpec {
     /// The bridges of pair `k` at crest angles `angles` must map onto themselves under every mirror of the
     /// device's symmetry.
     fn check_bridge_symmetry(&self, k: usize, angles: &[Real]) -> Result<(), GeometryError> {
-        let mirrors: &[(fn(Real) -> Real, &str)] = match self.symmetry {
+        let mirrors: &[Mirror] = match self.symmetry {
             Symmetry::None => &[],
             Symmetry::Half => &[(|a| -a, "ϑ = 0°/180°")],
             Symmetry::Quarter => &[(|a| -a, "ϑ = 0°/180°"), (|a| PI - a, "ϑ = ±90°")],
@@ -1274,7 +1304,11 @@ mod tests {
         assert_eq!(quarter.nodes.len(), 12);
         assert_eq!(quarter.node_sets["symmetry"].len(), 6);
         assert_eq!(
-            quarter.patches.iter().filter(|p| p.in_plane.is_some()).count(),
+            quarter
+                .patches
+                .iter()
+                .filter(|p| p.in_plane.is_some())
+                .count(),
             2
         );
         let half = straight(Symmetry::Half, true).generate().unwrap();
@@ -1334,7 +1368,11 @@ mod tests {
                 let h = 1e-5;
                 let fd = (p.curve.point(t + h) - p.curve.point(t - h)) / (2.0 * h);
                 let d = p.curve.derivative(t);
-                assert!((fd - d).norm() <= 1e-8 * d.norm(), "{}: {fd} vs {d}", p.name);
+                assert!(
+                    (fd - d).norm() <= 1e-8 * d.norm(),
+                    "{}: {fd} vs {d}",
+                    p.name
+                );
             }
         }
     }

@@ -224,12 +224,16 @@ mod tests {
         nodes[0].conditions.basis = Mat3::from_columns(&[Vec3::z(), Vec3::x(), Vec3::y()]);
         nodes[0].conditions.components[0] = Component::fixed();
         p.apply(&mut nodes).unwrap();
-        let Component::Prescribed { value, release, .. } = &nodes[0].conditions.components[2] else {
+        let Component::Prescribed { value, release, .. } = &nodes[0].conditions.components[2]
+        else {
             panic!("u3 (global y) is prescribed");
         };
         assert_eq!(value.value(1.0), -15.0);
         assert_eq!(*release, Some(1.75));
-        assert!(nodes[0].conditions.components[0].is_prescribed_at(10.0), "symmetry is never released");
+        assert!(
+            nodes[0].conditions.components[0].is_prescribed_at(10.0),
+            "symmetry is never released"
+        );
         let mut bad = p.clone();
         bad.nodes[0].target = Vec3::new(0.0, -15.0, 1.0);
         let mut nodes = vec![node("a")];

@@ -2,3 +2,4 @@
 
 mod design_errors;
 mod designs;
+mod stent;

@@ -370,10 +370,7 @@ fn bridges(b: &BridgesDto) -> Result<BridgeSpec> {
     let every = b.every.unwrap_or(1);
     let first = b.first.unwrap_or(1);
     if first == 0 {
-        return Err(issue(
-            format!("{base}.first"),
-            "crests are numbered from 1",
-        ));
+        return Err(issue(format!("{base}.first"), "crests are numbered from 1"));
     }
     Ok(BridgeSpec {
         shape,
@@ -420,7 +417,9 @@ fn discretisation(
             (None, Some(v)) => Ok((v, format!("mesh.{key}"))),
             (None, None) => Err(issue(
                 "stent",
-                format!("no `{key}` for the stent's patches: give `mesh.{key}` or `{own_path}.{key}`"),
+                format!(
+                    "no `{key}` for the stent's patches: give `mesh.{key}` or `{own_path}.{key}`"
+                ),
             )),
         }
     };
