@@ -1,6 +1,6 @@
 //! Geometry: exact NURBS primitives (lines, circular arcs), analytic curves and their spline fits,
-//! rotation-minimising section frames, the stent generator, and tube surfaces swept along centrelines (vertices and triangles only;
-//! writing files is the `io` layer's job).
+//! rotation-minimising section frames, the stent generator, and tube surfaces swept along centrelines
+//! (vertices and triangles only; writing files is the `io` layer's job).
 
 pub mod analytic;
 pub mod fit;

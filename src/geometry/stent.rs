@@ -831,7 +831,7 @@ impl StentSpec {
                 for k in 0..=samples {
                     let (c, r) = axis.frame(length * k as Real / samples as Real);
                     if (c - c0).dot(&normal).abs() > PLANARITY_TOLERANCE * length
-                        || (r.column(2) - normal).norm() > 1e3 * PLANARITY_TOLERANCE
+                        || (r.column(2) - normal).norm() > PLANARITY_TOLERANCE
                     {
                         return Err(invalid(
                             "symmetry",
@@ -886,8 +886,8 @@ impl StentSpec {
             kind,
         };
 
-        // Sector tests (angles are multiples of π/m for symmetric devices, so the tolerance is generous).
-        let sin_tol = 1e-9;
+        // Sector tests: near a plane, |sin| (or |cos|) is the angular distance from it.
+        let sin_tol = ANGLE_TOLERANCE;
         let on_plane_a = |a: Real| self.symmetry != Symmetry::None && a.sin().abs() <= sin_tol;
         let on_plane_b = |a: Real| self.symmetry == Symmetry::Quarter && a.cos().abs() <= sin_tol;
         let retained = |a: Real| match (self.cut, self.symmetry) {

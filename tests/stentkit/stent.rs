@@ -533,7 +533,15 @@ fn stent_block_errors_are_located() {
     use stentkit::io::design::DesignError;
     let base = parse_design(BASE, Path::new("base.yaml")).unwrap_or_else(|e| panic!("{e}"));
     assert_eq!(base.model.programme.as_ref().unwrap().nodes.len(), 4);
-    let cases: &[(&str, &str, (usize, usize), &str, &str)] = &[
+    // (text replaced, replacement, (line, column), field path, message fragment)
+    type Case = (
+        &'static str,
+        &'static str,
+        (usize, usize),
+        &'static str,
+        &'static str,
+    );
+    let cases: &[Case] = &[
         (
             "delta_r: 5",
             "delta_r: 10",

@@ -764,7 +764,7 @@ fn conditions(
             }
             (None, Some(n)) => {
                 let n = vec3(n);
-                if !(n.norm() > 0.0) {
+                if n.norm() == 0.0 {
                     return Err(issue(
                         format!("{base}.symmetry_plane"),
                         "the plane normal must be non-zero",
