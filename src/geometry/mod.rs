@@ -1,11 +1,12 @@
 //! Geometry: exact NURBS primitives (lines, circular arcs), analytic curves and their spline fits,
-//! rotation-minimising section frames, and tube surfaces swept along centrelines (vertices and triangles only;
-//! writing files is the `io` layer's job).
+//! rotation-minimising section frames, the stent generator, and tube surfaces swept along centrelines
+//! (vertices and triangles only; writing files is the `io` layer's job).
 
 pub mod analytic;
 pub mod fit;
 pub mod frame;
 pub mod primitives;
+pub mod stent;
 pub mod tube;
 
 use crate::math::{MathError, Real};

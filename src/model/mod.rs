@@ -6,12 +6,15 @@
 //! file names or YAML positions. Every physical field is in the design's consistent unit system
 //! ([`Units`]); temperatures are in °C.
 
+pub mod programme;
 pub mod schedule;
 
+pub use programme::{DrivenNode, Programme, ProgrammeError, ProgrammeKind};
 pub use schedule::{ScheduleError, TimeFunction};
 
 use crate::material::{Integrator, Material, Section};
 use crate::math::{Mat3, NurbsCurve, Real, Vec3};
+use std::collections::BTreeMap;
 
 /// The consistent unit system a design declares; every length, force, stress and time in the model is in it.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -297,6 +300,14 @@ pub struct Model {
     pub solver: SolverSettings,
     /// Recorded points.
     pub probes: Vec<Probe>,
+    /// Named node sets (indices into `nodes`), e.g. a generated stent's `all_joints`, `crown_1`, `symmetry`.
+    pub node_sets: BTreeMap<String, Vec<usize>>,
+    /// The programme driving a node set to a target shape, if any.
+    pub programme: Option<Programme>,
+    /// Symmetry planes `(point, unit normal)` of a reduced model; exports mirror the model about each (the
+    /// normal points into the modelled side). A patch lying in a plane ([`Model::patch_symmetry_plane`]) is its
+    /// own mirror image and carries half its section in the reduced model.
+    pub symmetry_planes: Vec<(Vec3, Vec3)>,
 }
 
 impl Model {
@@ -318,6 +329,26 @@ impl Model {
     /// The node that holds the given patch end.
     pub fn node_of(&self, end: PatchEnd) -> Option<usize> {
         self.nodes.iter().position(|n| n.ends.contains(&end))
+    }
+
+    /// The symmetry plane (index into [`Model::symmetry_planes`]) that patch `patch` lies in, if any: every
+    /// control point within `1e-9` of the model size from the plane.
+    pub fn patch_symmetry_plane(&self, patch: usize) -> Option<usize> {
+        // Relative distance below which a control point is on a plane: generated in-plane patches are there
+        // to round-off (~1e-15), other patches are a wire's length away.
+        const IN_PLANE: Real = 1e-9;
+        let points = self.patches[patch].curve.points();
+        let scale = self
+            .nodes
+            .iter()
+            .map(|n| n.position.norm())
+            .fold(0.0, Real::max)
+            .max(Real::MIN_POSITIVE);
+        self.symmetry_planes.iter().position(|(point, normal)| {
+            points
+                .iter()
+                .all(|q| (q - point).dot(normal).abs() <= IN_PLANE * scale)
+        })
     }
 
     /// Every time at which a schedule changes slope or a condition switches, within `(0, end]`, sorted and

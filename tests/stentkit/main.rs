@@ -4,4 +4,5 @@ mod cli;
 mod design_errors;
 mod designs;
 mod mesh;
+mod stent;
 mod viscoelastic;

@@ -3,6 +3,7 @@
 //! naming the field path; [`super`] turns it into a line and column.
 
 use super::dto::*;
+use super::stent;
 use crate::geometry::analytic::{
     Helix, ParametricCurve, RigidPlacement, SineWire, frame_from_axis, point_list_curve,
 };
@@ -14,7 +15,7 @@ use crate::material::{
 };
 use crate::math::{Mat3, NurbsCurve, Real, Vec3};
 use crate::model::*;
-use std::collections::HashMap;
+use std::collections::{BTreeMap, HashMap};
 
 /// A problem found while building the model, at a field path.
 #[derive(Debug, Clone, PartialEq)]
@@ -40,7 +41,7 @@ type Result<T> = std::result::Result<T, Issue>;
 const DEFAULT_JOINT_TOLERANCE: Real = 1e-8;
 
 /// Fit deviation, as a fraction of the wire diameter, above which the design gets a warning.
-const FIT_WARNING_FRACTION: Real = 0.01;
+pub(super) const FIT_WARNING_FRACTION: Real = 0.01;
 
 /// Default smallest step, as a fraction of the nominal step: ten halvings.
 const DEFAULT_MIN_STEP_FRACTION: Real = 1.0 / 1024.0;
@@ -76,10 +77,51 @@ pub fn build(dto: &DesignDto, default_name: &str) -> Result<(Model, Vec<String>)
     let (material, integrator) = material(&dto.material)?;
     let (section, shear_factor) = section(&dto.section)?;
     let mut sections = vec![section];
-    let patches = patches(dto, &mut sections, shear_factor, &mut warnings)?;
+    // A generated stent's patches and nodes come first; its node sets index the model's nodes.
+    let stent = match &dto.stent {
+        Some(s) => Some(stent::generate(
+            s,
+            dto.mesh.as_ref(),
+            &mut sections,
+            material.poisson(),
+            &mut warnings,
+        )?),
+        None => None,
+    };
+    let generated = stent.as_ref().map_or_else(Vec::new, |s| s.patches.clone());
+    let patches = patches(dto, generated, &mut sections, shear_factor, &mut warnings)?;
     let tolerance = joint_tolerance(dto, &patches);
-    let mut nodes = nodes(dto, &patches, tolerance)?;
-    conditions(dto, &patches, &mut nodes)?;
+    let initial = stent.as_ref().map_or_else(Vec::new, |s| s.nodes.clone());
+    let mut nodes = nodes(dto, &patches, tolerance, initial)?;
+    let node_sets = stent.as_ref().map_or_else(BTreeMap::new, stent::node_sets);
+    let symmetry_planes = stent.as_ref().map_or_else(Vec::new, stent::symmetry_planes);
+    // Components set by the stent's symmetry planes and the programme, which `conditions` must not override.
+    let mut preset: HashMap<(usize, usize), String> = HashMap::new();
+    if let Some(s) = &stent {
+        for (k, g) in s.geometry.nodes.iter().enumerate() {
+            if g.symmetry_plane.is_some() {
+                for i in [0, 4, 5] {
+                    preset.insert((k, i), "the stent's symmetry plane".into());
+                }
+            }
+        }
+    }
+    let programme = match &dto.programme {
+        Some(p) => {
+            let end = time_settings(&dto.time)?.end;
+            let programme = stent::programme(p, stent.as_ref(), &mut nodes, end, &mut warnings)?;
+            for d in &programme.nodes {
+                for i in 0..3 {
+                    preset
+                        .entry((d.node, i))
+                        .or_insert_with(|| "the programme".into());
+                }
+            }
+            Some(programme)
+        }
+        None => None,
+    };
+    conditions(dto, &patches, &mut nodes, &node_sets, &preset)?;
     let distributed_loads = distributed_loads(dto, &patches)?;
     let temperature = match (&dto.temperature, material.wlf()) {
         (Some(f), _) => time_function(f, "temperature")?,
@@ -125,6 +167,9 @@ pub fn build(dto: &DesignDto, default_name: &str) -> Result<(Model, Vec<String>)
         time,
         solver,
         probes,
+        node_sets,
+        programme,
+        symmetry_planes,
     };
     Ok((model, warnings))
 }
@@ -298,15 +343,19 @@ fn fitted(
 
 fn patches(
     dto: &DesignDto,
+    generated: Vec<Patch>,
     sections: &mut Vec<Section>,
     shear_factor: ShearFactor,
     warnings: &mut Vec<String>,
 ) -> Result<Vec<Patch>> {
-    if dto.patches.is_empty() {
-        return Err(issue("patches", "a design needs at least one patch"));
+    if dto.patches.is_empty() && generated.is_empty() {
+        return Err(issue(
+            "patches",
+            "a design needs at least one patch: give `patches` or a `stent` block",
+        ));
     }
     let mut names: HashMap<&str, usize> = HashMap::new();
-    let mut out = Vec::with_capacity(dto.patches.len());
+    let mut out = generated;
     for (k, pd) in dto.patches.iter().enumerate() {
         let base = format!("patches[{k}]");
         if pd.name.is_empty() || pd.name.contains('.') || pd.name.contains(char::is_whitespace) {
@@ -314,6 +363,15 @@ fn patches(
                 format!("{base}.name"),
                 format!(
                     "`{}` is not a valid patch name: use a non-empty name without dots or spaces",
+                    pd.name
+                ),
+            ));
+        }
+        if out.iter().any(|p| p.name == pd.name) && !names.contains_key(pd.name.as_str()) {
+            return Err(issue(
+                format!("{base}.name"),
+                format!(
+                    "patch name `{}` is already used by the generated stent",
                     pd.name
                 ),
             ));
@@ -478,9 +536,18 @@ fn parse_end(name: &str, patches: &[Patch]) -> Option<PatchEnd> {
     Some(PatchEnd { patch, end })
 }
 
-fn nodes(dto: &DesignDto, patches: &[Patch], tolerance: Real) -> Result<Vec<Node>> {
+/// The nodes: `initial` (a generated stent's) first, then the declared ones, then the remaining ends.
+fn nodes(
+    dto: &DesignDto,
+    patches: &[Patch],
+    tolerance: Real,
+    initial: Vec<Node>,
+) -> Result<Vec<Node>> {
     let mut owner: HashMap<PatchEnd, usize> = HashMap::new();
-    let mut nodes: Vec<Node> = Vec::new();
+    for (k, n) in initial.iter().enumerate() {
+        owner.extend(n.ends.iter().map(|&e| (e, k)));
+    }
+    let mut nodes: Vec<Node> = initial;
     let mut names: HashMap<String, usize> = HashMap::new();
     for (k, nd) in dto.nodes.iter().enumerate() {
         let base = format!("nodes[{k}]");
@@ -488,6 +555,15 @@ fn nodes(dto: &DesignDto, patches: &[Patch], tolerance: Real) -> Result<Vec<Node
             return Err(issue(
                 format!("{base}.name"),
                 "a node needs a non-empty name",
+            ));
+        }
+        if nodes.iter().any(|n| n.name == nd.name) && !names.contains_key(&nd.name) {
+            return Err(issue(
+                format!("{base}.name"),
+                format!(
+                    "node name `{}` is already used by the generated stent",
+                    nd.name
+                ),
             ));
         }
         if let Some(first) = names.insert(nd.name.clone(), k) {
@@ -620,18 +696,51 @@ fn basis_from_normal(n: &Vec3) -> Mat3 {
 /// Orthonormality tolerance of a user-given basis: rows typed with about seven significant digits pass.
 const BASIS_TOLERANCE: Real = 1e-6;
 
-fn conditions(dto: &DesignDto, patches: &[Patch], nodes: &mut [Node]) -> Result<()> {
-    // Which entry set each node's basis and each component, to report contradictions.
-    let mut basis_from: HashMap<usize, usize> = HashMap::new();
-    let mut set_by: HashMap<(usize, usize), usize> = HashMap::new();
+/// Applies the design's `conditions` to `nodes`. An entry names one node (`node`) or every node of a set
+/// (`node_set`); `preset` names what already set a component (a stent's symmetry plane, the programme), which an
+/// entry may not override.
+fn conditions(
+    dto: &DesignDto,
+    patches: &[Patch],
+    nodes: &mut [Node],
+    node_sets: &BTreeMap<String, Vec<usize>>,
+    preset: &HashMap<(usize, usize), String>,
+) -> Result<()> {
+    // What set each node's basis and each component, to report contradictions.
+    let mut basis_from: HashMap<usize, String> = HashMap::new();
+    for &(node, _) in preset.keys() {
+        if nodes[node].conditions.basis != Mat3::identity() {
+            basis_from.insert(node, "the stent's symmetry plane".into());
+        }
+    }
+    let mut set_by: HashMap<(usize, usize), String> = preset.clone();
     for (k, c) in dto.conditions.iter().enumerate() {
         let base = format!("conditions[{k}]");
-        let node = find_node(&c.node, patches, nodes).ok_or_else(|| {
-            issue(
-                format!("{base}.node"),
-                format!("no node `{}`: name a node from `nodes` or a patch end `<patch>.start` / `<patch>.end`", c.node),
-            )
-        })?;
+        let targets: Vec<usize> = match (&c.node, &c.node_set) {
+            (Some(name), None) => vec![find_node(name, patches, nodes).ok_or_else(|| {
+                issue(
+                    format!("{base}.node"),
+                    format!("no node `{name}`: name a node from `nodes` or a patch end `<patch>.start` / `<patch>.end`"),
+                )
+            })?],
+            (None, Some(set)) => node_sets.get(set).cloned().ok_or_else(|| {
+                let known: Vec<&str> = node_sets.keys().map(String::as_str).collect();
+                issue(
+                    format!("{base}.node_set"),
+                    if known.is_empty() {
+                        format!("no node set `{set}`: node sets come from a generated `stent`")
+                    } else {
+                        format!("no node set `{set}`; known sets: {}", known.join(", "))
+                    },
+                )
+            })?,
+            _ => {
+                return Err(issue(
+                    &base,
+                    "give exactly one of `node` (a node name) or `node_set` (a set name)",
+                ));
+            }
+        };
         let basis = match (&c.basis, &c.symmetry_plane) {
             (Some(_), Some(_)) => {
                 return Err(issue(
@@ -655,7 +764,7 @@ fn conditions(dto: &DesignDto, patches: &[Patch], nodes: &mut [Node]) -> Result<
             }
             (None, Some(n)) => {
                 let n = vec3(n);
-                if !(n.norm() > 0.0) {
+                if n.norm() == 0.0 {
                     return Err(issue(
                         format!("{base}.symmetry_plane"),
                         "the plane normal must be non-zero",
@@ -665,25 +774,6 @@ fn conditions(dto: &DesignDto, patches: &[Patch], nodes: &mut [Node]) -> Result<
             }
             (None, None) => None,
         };
-        if let Some(b) = basis {
-            match basis_from.get(&node) {
-                Some(&first)
-                    if (nodes[node].conditions.basis - b).abs().max() > BASIS_TOLERANCE =>
-                {
-                    return Err(issue(
-                        &base,
-                        format!(
-                            "node `{}` already has a different basis from conditions[{first}]; one node has one basis",
-                            nodes[node].name
-                        ),
-                    ));
-                }
-                _ => {
-                    basis_from.insert(node, k);
-                    nodes[node].conditions.basis = b;
-                }
-            }
-        }
         // Collect this entry's prescribed values and loads per component.
         let mut prescribed: [Option<(TimeFunction, String)>; 6] = Default::default();
         let mut loads: [Option<(TimeFunction, String)>; 6] = Default::default();
@@ -740,46 +830,69 @@ fn conditions(dto: &DesignDto, patches: &[Patch], nodes: &mut [Node]) -> Result<
             ));
         }
         const NAMES: [&str; 6] = ["u1", "u2", "u3", "θ1", "θ2", "θ3"];
-        for i in 0..6 {
-            let (p, l) = (prescribed[i].take(), loads[i].take());
-            if p.is_none() && l.is_none() {
-                continue;
-            }
-            let path = p
-                .as_ref()
-                .or(l.as_ref())
-                .map(|(_, path)| path.clone())
-                .unwrap_or_default();
-            if let Some(&first) = set_by.get(&(node, i)) {
-                return Err(issue(
-                    path,
-                    format!(
-                        "component {} of node `{}` is already set by conditions[{first}]: one condition per component",
-                        NAMES[i], nodes[node].name
-                    ),
-                ));
-            }
-            set_by.insert((node, i), k);
-            nodes[node].conditions.components[i] = match (p, l) {
-                (Some((value, _)), load) => {
-                    if let (Some((_, lpath)), None) = (&load, release) {
+        for node in targets {
+            if let Some(b) = basis {
+                match basis_from.get(&node) {
+                    Some(first)
+                        if (nodes[node].conditions.basis - b).abs().max() > BASIS_TOLERANCE =>
+                    {
                         return Err(issue(
-                            lpath,
+                            &base,
                             format!(
-                                "component {} is both prescribed and loaded: a load acts only on a free component (add `release` to load it after release)",
-                                NAMES[i]
+                                "node `{}` already has a different basis from {first}; one node has one basis",
+                                nodes[node].name
                             ),
                         ));
                     }
-                    Component::Prescribed {
-                        value,
-                        release,
-                        load_after_release: load.map_or_else(TimeFunction::zero, |(f, _)| f),
+                    _ => {
+                        basis_from.insert(node, base.clone());
+                        nodes[node].conditions.basis = b;
                     }
                 }
-                (None, Some((f, _))) => Component::Load(f),
-                (None, None) => unreachable!("skipped above"),
-            };
+            }
+            for i in 0..6 {
+                let (p, l) = (&prescribed[i], &loads[i]);
+                if p.is_none() && l.is_none() {
+                    continue;
+                }
+                let path = p
+                    .as_ref()
+                    .or(l.as_ref())
+                    .map(|(_, path)| path.clone())
+                    .unwrap_or_default();
+                if let Some(first) = set_by.get(&(node, i)) {
+                    return Err(issue(
+                        path,
+                        format!(
+                            "component {} of node `{}` is already set by {first}: one condition per component",
+                            NAMES[i], nodes[node].name
+                        ),
+                    ));
+                }
+                set_by.insert((node, i), base.clone());
+                nodes[node].conditions.components[i] = match (p, l) {
+                    (Some((value, _)), load) => {
+                        if let (Some((_, lpath)), None) = (load, release) {
+                            return Err(issue(
+                                lpath,
+                                format!(
+                                    "component {} is both prescribed and loaded: a load acts only on a free component (add `release` to load it after release)",
+                                    NAMES[i]
+                                ),
+                            ));
+                        }
+                        Component::Prescribed {
+                            value: value.clone(),
+                            release,
+                            load_after_release: load
+                                .as_ref()
+                                .map_or_else(TimeFunction::zero, |(f, _)| f.clone()),
+                        }
+                    }
+                    (None, Some((f, _))) => Component::Load(f.clone()),
+                    (None, None) => unreachable!("skipped above"),
+                };
+            }
         }
     }
     Ok(())

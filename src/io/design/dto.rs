@@ -198,8 +198,15 @@ pub struct DesignDto {
     /// Default discretisation of patches.
     #[serde(default)]
     pub mesh: Option<MeshDto>,
-    /// Rod patches.
+    /// Rod patches (besides those of a generated `stent`).
+    #[serde(default)]
     pub patches: Vec<PatchDto>,
+    /// A generated stent: crowns, bridges, centreline, symmetry ([`super::stent`]).
+    #[serde(default)]
+    pub stent: Option<super::stent::StentDto>,
+    /// A programme driving a node set of the stent to a target shape ([`super::stent`]).
+    #[serde(default)]
+    pub programme: Option<super::stent::ProgrammeDto>,
     /// Automatic joining of coincident patch ends.
     #[serde(default)]
     pub joints: Option<JointsDto>,
@@ -439,12 +446,16 @@ pub struct NodeDto {
     pub at: Option<Vector>,
 }
 
-/// Conditions at one node.
+/// Conditions at one node, or at every node of a named set; exactly one of `node` and `node_set`.
 #[derive(Debug, Clone, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct ConditionDto {
     /// Node name (or `patch.start` / `patch.end`).
-    pub node: String,
+    #[serde(default)]
+    pub node: Option<String>,
+    /// Node set name (e.g. a generated stent's `all_joints`, `crown_1`).
+    #[serde(default)]
+    pub node_set: Option<String>,
     /// Local basis: three rows, the unit axes e1, e2, e3 (orthonormal, right-handed).
     #[serde(default)]
     pub basis: Option<[Vector; 3]>,

@@ -9,6 +9,7 @@
 pub mod build;
 pub mod dto;
 pub mod locate;
+pub mod stent;
 
 use crate::model::Model;
 use std::fmt;
