@@ -45,6 +45,9 @@ pub enum Command {
         /// No progress output.
         #[arg(short, long)]
         quiet: bool,
+        /// Report every failed Newton attempt (before the step is cut).
+        #[arg(short, long)]
+        verbose: bool,
     },
     /// Accuracy against cost: convergence studies.
     #[command(subcommand)]
@@ -111,7 +114,8 @@ pub fn main() -> ExitCode {
             output,
             force,
             quiet,
-        } => run::run(&design, output, force, quiet),
+            verbose,
+        } => run::run(&design, output, force, quiet, verbose),
         Command::Study(StudyCommand::Convergence {
             design,
             output,

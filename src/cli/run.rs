@@ -2,7 +2,8 @@
 
 use crate::io::design::load_design;
 use crate::io::history::HistoryWriter;
-use crate::solver::{Observer, Simulation, StepReport};
+use crate::math::Real;
+use crate::solver::{NewtonReport, Observer, Simulation, StepReport};
 use anyhow::{Context, bail};
 use std::ops::ControlFlow;
 use std::path::{Path, PathBuf};
@@ -15,6 +16,8 @@ struct Progress {
     quiet: bool,
     /// Notices already printed.
     said: usize,
+    /// Print every failed Newton attempt.
+    verbose: bool,
 }
 
 impl Observer for Progress {
@@ -44,6 +47,15 @@ impl Observer for Progress {
         }
         ControlFlow::Continue(())
     }
+
+    fn step_failed(&mut self, time: Real, dt: Real, newton: &NewtonReport) {
+        if self.verbose {
+            eprintln!(
+                "  step to t = {time} (dt = {dt:.3e}) failed after {} iterations; normalised residuals {:?}",
+                newton.iterations, newton.residuals
+            );
+        }
+    }
 }
 
 /// Forwards every report to several observers; stops when any asks to.
@@ -69,6 +81,12 @@ impl Observer for Tee<'_> {
         }
         flow
     }
+
+    fn step_failed(&mut self, time: Real, dt: Real, newton: &NewtonReport) {
+        for o in &mut self.0 {
+            o.step_failed(time, dt, newton);
+        }
+    }
 }
 
 /// The run folder for a design: `-o DIR` or `runs/<design name>`.
@@ -77,7 +95,7 @@ fn run_dir(output: Option<PathBuf>, name: &str) -> PathBuf {
 }
 
 /// Simulates the design and writes the run folder.
-pub fn run(design: &Path, output: Option<PathBuf>, force: bool, quiet: bool) -> anyhow::Result<()> {
+pub fn run(design: &Path, output: Option<PathBuf>, force: bool, quiet: bool, verbose: bool) -> anyhow::Result<()> {
     let started = Instant::now();
     let design = load_design(design)?;
     let model = &design.model;
@@ -118,6 +136,7 @@ pub fn run(design: &Path, output: Option<PathBuf>, force: bool, quiet: bool) -> 
         last: Instant::now(),
         quiet,
         said: 0,
+        verbose,
     };
     let result = sim.run(&mut Tee(vec![&mut history, &mut progress]));
     if let Some(e) = history.take_error() {

@@ -1,6 +1,10 @@
 //! `history.csv`: one row per converged step (and the initial state): `time`, then for each probe `P` the
 //! displacement columns `P.ux, P.uy, P.uz` (in the design's length unit), then `temperature` [°C],
 //! `iterations` (Newton solves of the step), `residual` (final normalised residual) and `cuts` (step cuts).
+//! A design with a programme (stents) adds `recovery_ratio_mean` and `recovery_ratio_max`, the mean (weighted
+//! over the full device) and largest `‖η_l‖ / ‖η_temp,l‖` over the driven nodes — 1 at the temporary shape, 0 at
+//! the permanent one — and, for a radial contraction, `delta_r`: the mean radial contraction of the driven
+//! nodes (positive towards the axis; the paper's Δr).
 //! Rows are flushed as they are written, so an interrupted run leaves a valid file up to its last step.
 
 use crate::solver::{Observer, Simulation, StepReport};
@@ -28,6 +32,12 @@ impl HistoryWriter {
             }
         }
         header.push_str(",temperature,iterations,residual,cuts");
+        if let Some(programme) = &sim.model().programme {
+            header.push_str(",recovery_ratio_mean,recovery_ratio_max");
+            if matches!(programme.kind, crate::model::ProgrammeKind::RadialContraction { .. }) {
+                header.push_str(",delta_r");
+            }
+        }
         writeln!(out, "{header}")?;
         Ok(Self {
             path: path.to_path_buf(),
@@ -65,6 +75,21 @@ impl HistoryWriter {
         line.push_str(&format!(
             ",{temperature:.6},{iterations},{residual:.3e},{cuts}"
         ));
+        if let Some(programme) = &sim.model().programme {
+            let u: Vec<_> = programme
+                .nodes
+                .iter()
+                .map(|d| sim.probe_displacement(&crate::model::ProbeLocation::Node(d.node)))
+                .collect();
+            line.push_str(&format!(
+                ",{:.9e},{:.9e}",
+                programme.target_fraction(&u),
+                programme.target_fraction_max(&u)
+            ));
+            if matches!(programme.kind, crate::model::ProgrammeKind::RadialContraction { .. }) {
+                line.push_str(&format!(",{:.9e}", -programme.mean_radial_displacement(&u)));
+            }
+        }
         let result = writeln!(self.out, "{line}").and_then(|_| self.out.flush());
         match result {
             Ok(()) => ControlFlow::Continue(()),

@@ -243,6 +243,11 @@ pub struct TimeSettings {
     pub step: Real,
     /// Smallest step that automatic step cutting may reach before giving up [time].
     pub min_step: Real,
+    /// Duration over which a released component's reaction is ramped to its load after release [time]
+    /// (default: one nominal step). At the release time the component becomes free under exactly the reaction
+    /// that held it, so the node stays in equilibrium; the reaction then falls linearly to the prescribed load
+    /// after release. This turns the release snap into a continuation that step cutting can subdivide.
+    pub release_ramp: Real,
 }
 
 /// Newton settings.
@@ -366,6 +371,7 @@ impl Model {
                     } => {
                         times.extend(value.breakpoints());
                         times.extend(*release);
+                        times.extend(release.map(|r| r + self.time.release_ramp));
                         times.extend(load_after_release.breakpoints());
                     }
                 }

@@ -161,6 +161,15 @@ impl Programme {
         if weight > 0.0 { sum / weight } else { 0.0 }
     }
 
+    /// Largest `|η_l| / |η_temp,l|` over the driven nodes with a non-zero target (0 when there is none).
+    pub fn target_fraction_max(&self, u: &[Vec3]) -> Real {
+        self.nodes
+            .iter()
+            .zip(u)
+            .filter(|(d, _)| d.target.norm() > 0.0)
+            .fold(0.0, |m, (d, uk)| m.max(uk.norm() / d.target.norm()))
+    }
+
     fn weighted_mean(&self, value: impl Fn(usize) -> Real) -> Real {
         let (mut sum, mut weight) = (0.0, 0.0);
         for (k, d) in self.nodes.iter().enumerate() {

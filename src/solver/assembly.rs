@@ -28,6 +28,7 @@
 //! Newton's normalised norms.
 
 use super::discretisation::{CollocationPoint, Discretisation};
+use super::gauge::Gauge;
 use super::state::State;
 use crate::material::SectionStrains;
 use crate::math::so3::{hat, log};
@@ -76,6 +77,26 @@ impl Sink<'_> {
     }
 }
 
+/// A released component's reaction, ramped to the load after release (see
+/// [`crate::model::TimeSettings::release_ramp`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ReleaseRamp {
+    /// The reaction component that held the node at the release, in the node's local basis [force or moment].
+    pub reaction: Real,
+    /// Release time [time].
+    pub start: Real,
+    /// Ramp duration [time].
+    pub duration: Real,
+}
+
+impl ReleaseRamp {
+    /// The part of the reaction still applied at time `t`.
+    pub fn value(&self, t: Real) -> Real {
+        let f = if self.duration > 0.0 { 1.0 - (t - self.start) / self.duration } else { 0.0 };
+        self.reaction * f.clamp(0.0, 1.0)
+    }
+}
+
 /// The loads and prescribed values at one instant, resolved from the model's schedules.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Actions {
@@ -92,12 +113,13 @@ pub struct Actions {
 }
 
 impl Actions {
-    /// Evaluates every schedule of the model at time `t`.
-    pub fn at(model: &Model, t: Real) -> Self {
+    /// Evaluates every schedule of the model at time `t`; `ramps[k][i]` is the release ramp of node `k`'s
+    /// component `i` once it has been released (empty: none).
+    pub fn at(model: &Model, t: Real, ramps: &[[Option<ReleaseRamp>; 6]]) -> Self {
         let mut node_force = Vec::with_capacity(model.nodes.len());
         let mut node_moment = Vec::with_capacity(model.nodes.len());
         let mut prescribed = Vec::with_capacity(model.nodes.len());
-        for node in &model.nodes {
+        for (k, node) in model.nodes.iter().enumerate() {
             let mut local = [0.0; 6];
             let mut fixed = [None; 6];
             for (i, c) in node.conditions.components.iter().enumerate() {
@@ -111,7 +133,8 @@ impl Actions {
                         if release.is_none_or(|r| t < r) {
                             fixed[i] = Some(value.value(t));
                         } else {
-                            local[i] = load_after_release.value(t);
+                            let ramp = ramps.get(k).and_then(|r| r[i]).map_or(0.0, |r| r.value(t));
+                            local[i] = load_after_release.value(t) + ramp;
                         }
                     }
                 }
@@ -243,18 +266,23 @@ impl Assembler {
     }
 
     /// Assembles the residual into `lin` and the tangent into `sink` (entries in the pattern's order).
+    /// With active gauge constraints ([`Gauge`]) the system has one more unknown (a multiplier, in
+    /// `state.multipliers`) and equation per constraint, after the rod's.
+    #[allow(clippy::too_many_arguments)]
     pub fn assemble(
         &self,
         disc: &Discretisation,
         state: &State,
         material: StepMaterial<'_>,
         actions: &Actions,
+        gauge: Option<&Gauge>,
         lin: &mut Linearisation,
         sink: &mut Sink<'_>,
     ) {
         let n = disc.num_unknowns();
-        lin.residual.resize(n, 0.0);
-        lin.row_scale.resize(n, 1.0);
+        let m = gauge.map_or(0, Gauge::len);
+        lin.residual.resize(n + m, 0.0);
+        lin.row_scale.resize(n + m, 1.0);
         // Interior points.
         for (g, point) in disc.points.iter().enumerate() {
             if disc.is_end(g) {
@@ -265,6 +293,42 @@ impl Assembler {
         // Node rows.
         for (k, node) in self.nodes.iter().enumerate() {
             self.node(disc, state, material, actions, k, node, lin, sink);
+        }
+        if let Some(gauge) = gauge {
+            self.gauge(disc, state, actions, gauge, lin, sink);
+        }
+    }
+
+    /// The gauge constraints' rows (`C_j`, rows `n + j`) and their multipliers' columns in the free
+    /// translational rows of the constrained nodes (always emitted, zero where a component is prescribed, so
+    /// the pattern does not depend on the conditions).
+    fn gauge(&self, disc: &Discretisation, state: &State, actions: &Actions, gauge: &Gauge, lin: &mut Linearisation, sink: &mut Sink<'_>) {
+        let n = disc.num_unknowns();
+        for (j, row) in gauge.rows.iter().enumerate() {
+            let lambda = state.multipliers.get(j).copied().unwrap_or(0.0);
+            let mut c = 0.0;
+            for &(k, a) in &row.terms {
+                let node = &self.nodes[k];
+                let first = &node.ends[0];
+                let g1 = first.point;
+                let position = point_position(disc, &state.control, g1);
+                let frozen = gauge.frozen.iter().find(|(l, _)| *l == k).map_or(position, |(_, x)| *x);
+                c += a.dot(&(position - frozen));
+                let local = node.basis.transpose() * a;
+                let col = 6 * (disc.points[g1].first + first.end_basis);
+                for i in 0..3 {
+                    let free = actions.prescribed[k][i].is_none();
+                    if free {
+                        lin.residual[6 * g1 + i] -= lambda * local[i];
+                    }
+                    sink.push(6 * g1 + i, n + j, if free { -local[i] } else { 0.0 });
+                }
+                for i in 0..3 {
+                    sink.push(n + j, col + i, a[i]);
+                }
+            }
+            lin.residual[n + j] = c;
+            lin.row_scale[n + j] = gauge.scale;
         }
     }
 

@@ -7,6 +7,7 @@
 
 pub mod assembly;
 pub mod discretisation;
+pub mod gauge;
 pub mod linear;
 pub mod shape;
 pub mod simulation;

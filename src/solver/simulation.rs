@@ -10,9 +10,10 @@
 
 use super::SolverError;
 use super::assembly::{
-    Actions, Assembler, Linearisation, Sink, StepMaterial, point_position, point_strains,
+    Actions, Assembler, Linearisation, ReleaseRamp, Sink, StepMaterial, point_position, point_strains,
 };
 use super::discretisation::Discretisation;
+use super::gauge::Gauge;
 use super::linear::SparseSystem;
 use super::state::State;
 use crate::material::{
@@ -76,6 +77,11 @@ pub trait Observer {
 
     /// Called after each converged step.
     fn step(&mut self, sim: &Simulation<'_>, report: &StepReport) -> ControlFlow<()>;
+
+    /// Called when Newton fails on a step that is then cut (`time` is the target that was not reached).
+    fn step_failed(&mut self, time: Real, dt: Real, newton: &NewtonReport) {
+        let _ = (time, dt, newton);
+    }
 }
 
 /// An observer that records nothing.
@@ -124,6 +130,12 @@ pub struct Simulation<'m> {
     notices: Vec<String>,
     /// Whether the WLF freeze has been reported.
     freeze_reported: bool,
+    /// Per node and local component: the release ramp, once the component has been released.
+    ramps: Vec<[Option<ReleaseRamp>; 6]>,
+    /// Gauge constraints after a programme's release, with their extended system and entry values.
+    gauge: Option<(Gauge, SparseSystem, Vec<Real>)>,
+    /// Whether the gauge constraints apply to the step being solved.
+    gauge_active: bool,
 }
 
 impl<'m> Simulation<'m> {
@@ -134,7 +146,7 @@ impl<'m> Simulation<'m> {
         let state = State::reference(&disc);
         let mut pattern = Vec::new();
         let mut lin = Linearisation::default();
-        let actions = Actions::at(model, 0.0);
+        let actions = Actions::at(model, 0.0, &[]);
         let material = StepMaterial {
             modulus: model.material.prony().e_inf(),
             history: &[],
@@ -144,6 +156,7 @@ impl<'m> Simulation<'m> {
             &state,
             material,
             &actions,
+            None,
             &mut lin,
             &mut Sink::Pattern(&mut pattern),
         );
@@ -180,6 +193,9 @@ impl<'m> Simulation<'m> {
             history: vec![[Vec3::zeros(); 4]; points],
             notices: Vec::new(),
             freeze_reported: false,
+            ramps: vec![[None; 6]; model.nodes.len()],
+            gauge: None,
+            gauge_active: false,
         })
     }
 
@@ -228,6 +244,75 @@ impl<'m> Simulation<'m> {
                 ));
             }
         }
+        Ok(())
+    }
+
+    /// Before a step ending at `t_np1`: every prescribed component released at or before `t_np1` and not yet
+    /// ramped gets its reaction in the current (converged) state, which is then applied as a load falling
+    /// linearly to the load after release over `time.release_ramp` (the release snap as a continuation).
+    /// Returns the `(node, component)` pairs captured, so a failed step can forget them (the step may then be
+    /// cut to end before the release, and the reaction is captured again from the state just before it).
+    fn capture_releases(&mut self, t_np1: Real) -> Vec<(usize, usize)> {
+        use crate::model::Component;
+        let mut captured = Vec::new();
+        for k in 0..self.model.nodes.len() {
+            let node = &self.model.nodes[k];
+            let pending: Vec<(usize, Real)> = node
+                .conditions
+                .components
+                .iter()
+                .enumerate()
+                .filter_map(|(i, c)| match c {
+                    Component::Prescribed { release: Some(r), .. } if *r <= t_np1 && self.ramps[k][i].is_none() => Some((i, *r)),
+                    _ => None,
+                })
+                .collect();
+            if pending.is_empty() {
+                continue;
+            }
+            let (force, moment) = self
+                .node_end_resultants(k)
+                .iter()
+                .fold((Vec3::zeros(), Vec3::zeros()), |(f, m), (ef, em)| (f + ef, m + em));
+            let basis = node.conditions.basis;
+            for (i, start) in pending {
+                let axis = basis.column(i % 3);
+                let reaction = if i < 3 { axis.dot(&force) } else { axis.dot(&moment) };
+                self.ramps[k][i] = Some(ReleaseRamp {
+                    reaction,
+                    start,
+                    duration: self.model.time.release_ramp,
+                });
+                captured.push((k, i));
+            }
+        }
+        captured
+    }
+
+    /// Activates the gauge constraints for a step ending at `t_np1` once the programme's release has happened by
+    /// then (building them, and their extended system, the first time), and deactivates them otherwise.
+    fn set_gauge(&mut self, t_np1: Real) -> Result<(), SolverError> {
+        let release = self.model.programme.as_ref().and_then(|p| p.release);
+        let active = release.is_some_and(|r| r <= t_np1);
+        if active && self.gauge.is_none() {
+            let positions: Vec<Vec3> = (0..self.model.nodes.len())
+                .map(|k| point_position(&self.disc, &self.state.control, self.disc.end_point(self.model.nodes[k].ends[0])))
+                .collect();
+            if let Some(gauge) = Gauge::new(self.model, &positions, self.disc.length_scale).filter(|g| !g.is_empty()) {
+                let mut pattern = Vec::new();
+                let actions = Actions::at(self.model, t_np1, &self.ramps);
+                let material = self.step_material();
+                let mut lin = Linearisation::default();
+                self.assembler
+                    .assemble(&self.disc, &self.state, material, &actions, Some(&gauge), &mut lin, &mut Sink::Pattern(&mut pattern));
+                let system = SparseSystem::new(self.disc.num_unknowns() + gauge.len(), &pattern)?;
+                let values = vec![0.0; pattern.len()];
+                self.gauge = Some((gauge, system, values));
+            }
+        }
+        self.gauge_active = active && self.gauge.is_some();
+        let m = if self.gauge_active { self.gauge.as_ref().map_or(0, |g| g.0.len()) } else { 0 };
+        self.state.multipliers.resize(m, 0.0);
         Ok(())
     }
 
@@ -320,11 +405,12 @@ impl<'m> Simulation<'m> {
             modulus: self.modulus,
             history: &self.history,
         };
+        let (gauge, values) = match (&mut self.gauge, self.gauge_active) {
+            (Some((g, _, v)), true) => (Some(&*g), v),
+            _ => (None, &mut self.values),
+        };
         let mut sink = if with_tangent {
-            Sink::Values {
-                values: &mut self.values,
-                next: 0,
-            }
+            Sink::Values { values, next: 0 }
         } else {
             Sink::Discard
         };
@@ -333,6 +419,7 @@ impl<'m> Simulation<'m> {
             &self.state,
             material,
             actions,
+            gauge,
             &mut self.lin,
             &mut sink,
         );
@@ -351,7 +438,8 @@ impl<'m> Simulation<'m> {
     /// radians.
     fn increment_norm(&self) -> Real {
         let mut norm: Real = 0.0;
-        for (j, d) in self.delta.chunks_exact(6).enumerate() {
+        let n = self.disc.num_unknowns();
+        for (j, d) in self.delta[..n].chunks_exact(6).enumerate() {
             let l = self.control_length[j];
             for i in 0..3 {
                 norm = norm.max((d[i] / l).abs()).max(d[i + 3].abs());
@@ -366,7 +454,7 @@ impl<'m> Simulation<'m> {
 
     /// Newton's method at time `t` from the current state (modified in place).
     fn newton(&mut self, t: Real) -> Result<NewtonReport, NewtonFailure> {
-        let actions = Actions::at(self.model, t);
+        let actions = Actions::at(self.model, t, &self.ramps);
         let tol = self.model.solver.tolerance;
         let max_iterations = self.model.solver.max_iterations;
         let mut report = NewtonReport::default();
@@ -391,13 +479,16 @@ impl<'m> Simulation<'m> {
             if report.iterations >= max_iterations {
                 return Err(NewtonFailure::NotConverged(report));
             }
-            self.system
-                .factor(&self.values)
-                .map_err(NewtonFailure::Fatal)?;
+            let (system, values) = match (&mut self.gauge, self.gauge_active) {
+                (Some((_, s, v)), true) => (s, &*v),
+                _ => (&mut self.system, &self.values),
+            };
+            system.factor(values).map_err(NewtonFailure::Fatal)?;
+            self.delta.resize(self.lin.residual.len(), 0.0);
             for (d, r) in self.delta.iter_mut().zip(&self.lin.residual) {
                 *d = -r;
             }
-            self.system.solve_in_place(&mut self.delta);
+            system.solve_in_place(&mut self.delta);
             last_increment = self.increment_norm();
             report.increments.push(last_increment);
             report.iterations += 1;
@@ -439,6 +530,8 @@ impl<'m> Simulation<'m> {
             }
             let dt = target - self.time;
             let saved = self.state.clone();
+            let captured = self.capture_releases(target);
+            self.set_gauge(target)?;
             self.prepare_step(self.time, target)?;
             match self.newton(target) {
                 Ok(newton) => {
@@ -471,6 +564,10 @@ impl<'m> Simulation<'m> {
                 }
                 Err(NewtonFailure::NotConverged(newton)) => {
                     self.state = saved;
+                    for (k, i) in captured {
+                        self.ramps[k][i] = None;
+                    }
+                    observer.step_failed(target, dt, &newton);
                     if dt <= min_step * (1.0 + 1e-12) {
                         return Err(SolverError::StepFailed {
                             time: target,

@@ -17,6 +17,8 @@ pub struct State {
     pub kappa: Vec<Vec3>,
     /// Its arc-length derivative `K,s` [1/length²].
     pub kappa_s: Vec<Vec3>,
+    /// Lagrange multipliers of the active gauge constraints ([`super::gauge`]) [force].
+    pub multipliers: Vec<f64>,
 }
 
 impl State {
@@ -27,13 +29,19 @@ impl State {
             rotation: disc.points.iter().map(|p| p.rotation0).collect(),
             kappa: disc.points.iter().map(|p| p.kappa0).collect(),
             kappa_s: disc.points.iter().map(|p| p.kappa0_s).collect(),
+            multipliers: Vec::new(),
         }
     }
 
     /// Applies a Newton increment `δ` (6 per control point: `δη` then `δθ`):
     /// `p_j ← p_j + δη_j` and, at each collocation point with `δΘ = Σ N_j δθ_j` (and its s-derivatives),
     /// `R ← R Λ`, `K ← Λᵀ K + w`, `K,s ← Λᵀ K,s − w × (Λᵀ K) + w,s` with `Λ = exp(δΘ̃)`, `w = T(δΘ) δΘ,s`.
+    /// Entries of `delta` past the control points are the multipliers' increments.
     pub fn apply_increment(&mut self, disc: &Discretisation, delta: &[f64]) {
+        let n = disc.num_unknowns();
+        for (m, d) in self.multipliers.iter_mut().zip(&delta[n.min(delta.len())..]) {
+            *m += d;
+        }
         for (j, p) in self.control.iter_mut().enumerate() {
             *p += Vec3::new(delta[6 * j], delta[6 * j + 1], delta[6 * j + 2]);
         }

@@ -89,7 +89,7 @@ fn residual(
     actions: &Actions,
 ) -> Vec<Real> {
     let mut lin = Linearisation::default();
-    asm.assemble(disc, state, material, actions, &mut lin, &mut Sink::Discard);
+    asm.assemble(disc, state, material, actions, None, &mut lin, &mut Sink::Discard);
     lin.residual
 }
 
@@ -104,7 +104,7 @@ fn tangent_matches_central_differences_of_the_residual() {
     let model = test_model();
     let disc = Discretisation::new(&model).expect("discretisation");
     let asm = Assembler::new(&model, &disc);
-    let actions = Actions::at(&model, 1.0);
+    let actions = Actions::at(&model, 1.0, &[]);
     let material = StepMaterial {
         modulus: model.material.prony().e_inf(),
         history: &[],

@@ -958,6 +958,7 @@ fn time_settings(t: &TimeDto) -> Result<TimeSettings> {
         end,
         step,
         min_step,
+        release_ramp: t.release_ramp.map_or(step, |r| r.0),
     })
 }
 

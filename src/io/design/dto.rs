@@ -507,6 +507,9 @@ pub struct TimeDto {
     /// Smallest step of automatic step cutting.
     #[serde(default)]
     pub min_step: Option<Positive>,
+    /// Duration of the ramp from a released component's reaction to its load after release.
+    #[serde(default)]
+    pub release_ramp: Option<Positive>,
 }
 
 /// Newton settings.
