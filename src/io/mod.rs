@@ -1,5 +1,6 @@
-//! Files: YAML design files, STL and OBJ meshes.
+//! Files: YAML design files, STL and OBJ meshes, SVG charts.
 
+pub mod chart;
 pub mod design;
 pub mod history;
 pub mod obj;

@@ -1,8 +1,12 @@
 //! stentkit's integration tests: one binary, one module per capability.
 
+#[path = "../common/mod.rs"]
+mod common;
+
 mod cli;
 mod design_errors;
 mod designs;
 mod mesh;
+mod solver;
 mod stent;
 mod viscoelastic;
