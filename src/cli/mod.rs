@@ -170,6 +170,14 @@ fn study_convergence(
     let csv = output.join("convergence.csv");
     std::fs::write(&csv, study::convergence_csv(&rows, &study, &model.name))
         .with_context(|| format!("cannot write {}", csv.display()))?;
-    println!("{}: {} runs → {}", model.name, rows.len(), csv.display());
+    let [by_n, by_time] = study::convergence_charts(&rows, &study, &model.name);
+    crate::io::chart::write_svg(&by_n, &output.join("error_vs_n.svg"))?;
+    crate::io::chart::write_svg(&by_time, &output.join("error_vs_time.svg"))?;
+    println!(
+        "{}: {} runs → {} (and error_vs_n.svg, error_vs_time.svg)",
+        model.name,
+        rows.len(),
+        csv.display()
+    );
     Ok(())
 }

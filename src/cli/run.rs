@@ -95,7 +95,13 @@ fn run_dir(output: Option<PathBuf>, name: &str) -> PathBuf {
 }
 
 /// Simulates the design and writes the run folder.
-pub fn run(design: &Path, output: Option<PathBuf>, force: bool, quiet: bool, verbose: bool) -> anyhow::Result<()> {
+pub fn run(
+    design: &Path,
+    output: Option<PathBuf>,
+    force: bool,
+    quiet: bool,
+    verbose: bool,
+) -> anyhow::Result<()> {
     let started = Instant::now();
     let design = load_design(design)?;
     let model = &design.model;

@@ -6,6 +6,7 @@
 //! does for its Fig. conv_circ: `err = ‖u_ref − u_h‖ / ‖u_ref‖` over the grid. It writes the table as CSV with
 //! the wall time of each run, so error can be charted against `n` and against time (work–precision).
 
+use crate::io::chart::{LineChart, Scale, Series};
 use crate::io::design::{DesignOverrides, parse_design_with};
 use crate::math::{Real, Vec3};
 use crate::model::ProbeLocation;
@@ -143,4 +144,57 @@ pub fn convergence_csv(
         );
     }
     s
+}
+
+/// The two charts of a convergence study: error against `n` and error against wall time (work–precision),
+/// one series per degree, on log–log axes.
+pub fn convergence_charts(
+    rows: &[ConvergencePoint],
+    study: &ConvergenceStudy,
+    design: &str,
+) -> [LineChart; 2] {
+    let reference = format!(
+        "against p = {}, n = {} at t = {}",
+        study.reference.0, study.reference.1, study.time
+    );
+    let mut by_n = LineChart::new(
+        format!("{design}: displacement error vs n ({reference})"),
+        "control points per patch n",
+        "relative displacement error",
+    );
+    let mut by_time = LineChart::new(
+        format!("{design}: work-precision ({reference})"),
+        "wall time of the run [s]",
+        "relative displacement error",
+    );
+    for chart in [&mut by_n, &mut by_time] {
+        chart.x_scale = Scale::Log;
+        chart.y_scale = Scale::Log;
+    }
+    for (index, &p) in study.degrees.iter().enumerate() {
+        let of_p: Vec<&ConvergencePoint> = rows
+            .iter()
+            .filter(|r| r.degree == p && r.error > 0.0)
+            .collect();
+        if of_p.is_empty() {
+            continue;
+        }
+        by_n.series.push(
+            Series::new(
+                format!("p = {p}"),
+                of_p.iter().map(|r| (r.points as Real, r.error)).collect(),
+            )
+            .with_markers()
+            .with_color(index),
+        );
+        by_time.series.push(
+            Series::new(
+                format!("p = {p}"),
+                of_p.iter().map(|r| (r.wall.max(1e-6), r.error)).collect(),
+            )
+            .with_markers()
+            .with_color(index),
+        );
+    }
+    [by_n, by_time]
 }

@@ -34,7 +34,10 @@ impl HistoryWriter {
         header.push_str(",temperature,iterations,residual,cuts");
         if let Some(programme) = &sim.model().programme {
             header.push_str(",recovery_ratio_mean,recovery_ratio_max");
-            if matches!(programme.kind, crate::model::ProgrammeKind::RadialContraction { .. }) {
+            if matches!(
+                programme.kind,
+                crate::model::ProgrammeKind::RadialContraction { .. }
+            ) {
                 header.push_str(",delta_r");
             }
         }
@@ -86,7 +89,10 @@ impl HistoryWriter {
                 programme.target_fraction(&u),
                 programme.target_fraction_max(&u)
             ));
-            if matches!(programme.kind, crate::model::ProgrammeKind::RadialContraction { .. }) {
+            if matches!(
+                programme.kind,
+                crate::model::ProgrammeKind::RadialContraction { .. }
+            ) {
                 line.push_str(&format!(",{:.9e}", -programme.mean_radial_displacement(&u)));
             }
         }

@@ -92,7 +92,11 @@ pub struct ReleaseRamp {
 impl ReleaseRamp {
     /// The part of the reaction still applied at time `t`.
     pub fn value(&self, t: Real) -> Real {
-        let f = if self.duration > 0.0 { 1.0 - (t - self.start) / self.duration } else { 0.0 };
+        let f = if self.duration > 0.0 {
+            1.0 - (t - self.start) / self.duration
+        } else {
+            0.0
+        };
         self.reaction * f.clamp(0.0, 1.0)
     }
 }
@@ -302,7 +306,15 @@ impl Assembler {
     /// The gauge constraints' rows (`C_j`, rows `n + j`) and their multipliers' columns in the free
     /// translational rows of the constrained nodes (always emitted, zero where a component is prescribed, so
     /// the pattern does not depend on the conditions).
-    fn gauge(&self, disc: &Discretisation, state: &State, actions: &Actions, gauge: &Gauge, lin: &mut Linearisation, sink: &mut Sink<'_>) {
+    fn gauge(
+        &self,
+        disc: &Discretisation,
+        state: &State,
+        actions: &Actions,
+        gauge: &Gauge,
+        lin: &mut Linearisation,
+        sink: &mut Sink<'_>,
+    ) {
         let n = disc.num_unknowns();
         for (j, row) in gauge.rows.iter().enumerate() {
             let lambda = state.multipliers.get(j).copied().unwrap_or(0.0);
@@ -312,7 +324,11 @@ impl Assembler {
                 let first = &node.ends[0];
                 let g1 = first.point;
                 let position = point_position(disc, &state.control, g1);
-                let frozen = gauge.frozen.iter().find(|(l, _)| *l == k).map_or(position, |(_, x)| *x);
+                let frozen = gauge
+                    .frozen
+                    .iter()
+                    .find(|(l, _)| *l == k)
+                    .map_or(position, |(_, x)| *x);
                 c += a.dot(&(position - frozen));
                 let local = node.basis.transpose() * a;
                 let col = 6 * (disc.points[g1].first + first.end_basis);

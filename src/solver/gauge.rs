@@ -51,7 +51,10 @@ fn complement(normals: &[Vec3]) -> Vec<Vec3> {
     }
     let mut basis = Vec::new();
     for axis in [Vec3::x(), Vec3::y(), Vec3::z()] {
-        let w = spanned.iter().chain(&basis).fold(axis, |w, q: &Vec3| w - q * q.dot(&w));
+        let w = spanned
+            .iter()
+            .chain(&basis)
+            .fold(axis, |w, q: &Vec3| w - q * q.dot(&w));
         if w.norm() > DEPENDENT {
             basis.push(w.normalize());
         }
@@ -64,7 +67,11 @@ impl Gauge {
     /// the position of node `k`). `None` when the model has no programme.
     pub fn new(model: &Model, positions: &[Vec3], length_scale: Real) -> Option<Self> {
         let programme = model.programme.as_ref()?;
-        let normals: Vec<Vec3> = model.symmetry_planes.iter().map(|(_, n)| n.normalize()).collect();
+        let normals: Vec<Vec3> = model
+            .symmetry_planes
+            .iter()
+            .map(|(_, n)| n.normalize())
+            .collect();
         let translations = complement(&normals);
         let rotations: Vec<Vec3> = match normals.len() {
             0 => vec![Vec3::x(), Vec3::y(), Vec3::z()],
@@ -75,11 +82,20 @@ impl Gauge {
         if total <= 0.0 {
             return None;
         }
-        let centroid = programme.nodes.iter().map(|d| d.position * d.weight).sum::<Vec3>() / total;
+        let centroid = programme
+            .nodes
+            .iter()
+            .map(|d| d.position * d.weight)
+            .sum::<Vec3>()
+            / total;
         let mut rows = Vec::new();
         for t in &translations {
             rows.push(GaugeRow {
-                terms: programme.nodes.iter().map(|d| (d.node, t * (d.weight / total))).collect(),
+                terms: programme
+                    .nodes
+                    .iter()
+                    .map(|d| (d.node, t * (d.weight / total)))
+                    .collect(),
             });
         }
         for w in &rotations {
@@ -87,11 +103,20 @@ impl Gauge {
                 terms: programme
                     .nodes
                     .iter()
-                    .map(|d| (d.node, w.cross(&(d.position - centroid)) * (d.weight / total / length_scale)))
+                    .map(|d| {
+                        (
+                            d.node,
+                            w.cross(&(d.position - centroid)) * (d.weight / total / length_scale),
+                        )
+                    })
                     .collect(),
             });
         }
-        let frozen = programme.nodes.iter().map(|d| (d.node, positions[d.node])).collect();
+        let frozen = programme
+            .nodes
+            .iter()
+            .map(|d| (d.node, positions[d.node]))
+            .collect();
         Some(Self {
             rows,
             frozen,

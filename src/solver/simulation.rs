@@ -10,7 +10,8 @@
 
 use super::SolverError;
 use super::assembly::{
-    Actions, Assembler, Linearisation, ReleaseRamp, Sink, StepMaterial, point_position, point_strains,
+    Actions, Assembler, Linearisation, ReleaseRamp, Sink, StepMaterial, point_position,
+    point_strains,
 };
 use super::discretisation::Discretisation;
 use super::gauge::Gauge;
@@ -263,7 +264,9 @@ impl<'m> Simulation<'m> {
                 .iter()
                 .enumerate()
                 .filter_map(|(i, c)| match c {
-                    Component::Prescribed { release: Some(r), .. } if *r <= t_np1 && self.ramps[k][i].is_none() => Some((i, *r)),
+                    Component::Prescribed {
+                        release: Some(r), ..
+                    } if *r <= t_np1 && self.ramps[k][i].is_none() => Some((i, *r)),
                     _ => None,
                 })
                 .collect();
@@ -273,11 +276,17 @@ impl<'m> Simulation<'m> {
             let (force, moment) = self
                 .node_end_resultants(k)
                 .iter()
-                .fold((Vec3::zeros(), Vec3::zeros()), |(f, m), (ef, em)| (f + ef, m + em));
+                .fold((Vec3::zeros(), Vec3::zeros()), |(f, m), (ef, em)| {
+                    (f + ef, m + em)
+                });
             let basis = node.conditions.basis;
             for (i, start) in pending {
                 let axis = basis.column(i % 3);
-                let reaction = if i < 3 { axis.dot(&force) } else { axis.dot(&moment) };
+                let reaction = if i < 3 {
+                    axis.dot(&force)
+                } else {
+                    axis.dot(&moment)
+                };
                 self.ramps[k][i] = Some(ReleaseRamp {
                     reaction,
                     start,
@@ -296,22 +305,41 @@ impl<'m> Simulation<'m> {
         let active = release.is_some_and(|r| r <= t_np1);
         if active && self.gauge.is_none() {
             let positions: Vec<Vec3> = (0..self.model.nodes.len())
-                .map(|k| point_position(&self.disc, &self.state.control, self.disc.end_point(self.model.nodes[k].ends[0])))
+                .map(|k| {
+                    point_position(
+                        &self.disc,
+                        &self.state.control,
+                        self.disc.end_point(self.model.nodes[k].ends[0]),
+                    )
+                })
                 .collect();
-            if let Some(gauge) = Gauge::new(self.model, &positions, self.disc.length_scale).filter(|g| !g.is_empty()) {
+            if let Some(gauge) =
+                Gauge::new(self.model, &positions, self.disc.length_scale).filter(|g| !g.is_empty())
+            {
                 let mut pattern = Vec::new();
                 let actions = Actions::at(self.model, t_np1, &self.ramps);
                 let material = self.step_material();
                 let mut lin = Linearisation::default();
-                self.assembler
-                    .assemble(&self.disc, &self.state, material, &actions, Some(&gauge), &mut lin, &mut Sink::Pattern(&mut pattern));
+                self.assembler.assemble(
+                    &self.disc,
+                    &self.state,
+                    material,
+                    &actions,
+                    Some(&gauge),
+                    &mut lin,
+                    &mut Sink::Pattern(&mut pattern),
+                );
                 let system = SparseSystem::new(self.disc.num_unknowns() + gauge.len(), &pattern)?;
                 let values = vec![0.0; pattern.len()];
                 self.gauge = Some((gauge, system, values));
             }
         }
         self.gauge_active = active && self.gauge.is_some();
-        let m = if self.gauge_active { self.gauge.as_ref().map_or(0, |g| g.0.len()) } else { 0 };
+        let m = if self.gauge_active {
+            self.gauge.as_ref().map_or(0, |g| g.0.len())
+        } else {
+            0
+        };
         self.state.multipliers.resize(m, 0.0);
         Ok(())
     }

@@ -39,7 +39,11 @@ impl State {
     /// Entries of `delta` past the control points are the multipliers' increments.
     pub fn apply_increment(&mut self, disc: &Discretisation, delta: &[f64]) {
         let n = disc.num_unknowns();
-        for (m, d) in self.multipliers.iter_mut().zip(&delta[n.min(delta.len())..]) {
+        for (m, d) in self
+            .multipliers
+            .iter_mut()
+            .zip(&delta[n.min(delta.len())..])
+        {
             *m += d;
         }
         for (j, p) in self.control.iter_mut().enumerate() {

@@ -59,6 +59,7 @@ fn dense_tangent(
         state,
         material,
         actions,
+        None,
         &mut lin,
         &mut Sink::Pattern(&mut pattern),
     );
@@ -68,6 +69,7 @@ fn dense_tangent(
         state,
         material,
         actions,
+        None,
         &mut lin,
         &mut Sink::Values {
             values: &mut values,
@@ -89,7 +91,15 @@ fn residual(
     actions: &Actions,
 ) -> Vec<Real> {
     let mut lin = Linearisation::default();
-    asm.assemble(disc, state, material, actions, None, &mut lin, &mut Sink::Discard);
+    asm.assemble(
+        disc,
+        state,
+        material,
+        actions,
+        None,
+        &mut lin,
+        &mut Sink::Discard,
+    );
     lin.residual
 }
 

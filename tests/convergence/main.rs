@@ -1,7 +1,9 @@
 //! Slow verification: spatial convergence of the collocation solver (DESIGN §6; paper §4.1, Fig. conv_circ).
 //! Separate from the fast `stentkit` test binary (STYLE 16). Run with
 //! `cargo test --release --test convergence -- --nocapture` to see the table, rates, iterations and timings;
-//! it rewrites `tests/data/arch_convergence.csv` and `tests/data/arch_convergence.svg`.
+//! it writes the table and chart to the test's target directory, and rewrites the committed
+//! `tests/data/arch_convergence.csv` and `tests/data/arch_convergence.svg` when `STENTKIT_WRITE_DATA=1` (their
+//! wall-time column changes on every run, so a plain test run leaves the repository untouched).
 
 #[path = "../common/mod.rs"]
 mod common;
@@ -25,6 +27,15 @@ const STEPS: usize = 20;
 /// x1–x2 plane, clamped at (1, 0, 0)), section (d = 0.05 m) and equilibrium modulus E∞ = 80.59 MPa with
 /// ν = 0.33, but no Maxwell branches, no WLF shift and no temperature; the tip couples M2 = M3 ramp from 0 to
 /// 25 N·m over t ∈ [0, 1] in `STEPS` steps; degree `p`, `n` control points.
+/// Where the study's data go: `tests/data/` when `STENTKIT_WRITE_DATA=1`, else the test's target directory.
+fn output_file(name: &str) -> std::path::PathBuf {
+    if std::env::var_os("STENTKIT_WRITE_DATA").is_some_and(|v| v == "1") {
+        repo_file(&format!("tests/data/{name}"))
+    } else {
+        std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join(name)
+    }
+}
+
 fn elastic_arch(p: usize, n: usize) -> String {
     let text = design_text("circular_arch.yaml");
     let text = remove_lines(&text, "prony:");
@@ -153,7 +164,7 @@ fn arch_tip_error_converges_at_the_collocation_rates() {
         )
         .expect("string write");
     }
-    std::fs::write(repo_file("tests/data/arch_convergence.csv"), csv).expect("write CSV");
+    std::fs::write(output_file("arch_convergence.csv"), csv).expect("write CSV");
 
     // Rates and chart.
     let mut chart = LineChart::new(
@@ -222,7 +233,7 @@ fn arch_tip_error_converges_at_the_collocation_rates() {
             );
         }
     }
-    write_svg(&chart, &repo_file("tests/data/arch_convergence.svg")).expect("write SVG");
+    write_svg(&chart, &output_file("arch_convergence.svg")).expect("write SVG");
 
     for r in runs.iter().filter(|r| r.p == 6 && r.n == 20) {
         println!("p = 6, n = 20: {}", r.recorder.summary());
