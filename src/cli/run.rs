@@ -51,8 +51,8 @@ impl Observer for Progress {
     fn step_failed(&mut self, time: Real, dt: Real, newton: &NewtonReport) {
         if self.verbose {
             eprintln!(
-                "  step to t = {time} (dt = {dt:.3e}) failed after {} iterations; normalised residuals {:?}",
-                newton.iterations, newton.residuals
+                "  step to t = {time} (dt = {dt:.3e}) failed after {} iterations; normalised residuals {:?}; increments {:?}",
+                newton.iterations, newton.residuals, newton.increments
             );
         }
     }

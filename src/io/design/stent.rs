@@ -26,7 +26,7 @@
 use super::build::{FIT_WARNING_FRACTION, Issue};
 use super::dto::{Finite, MeshDto, NonNegative, Positive, Vector};
 use crate::geometry::GeometryError;
-use crate::geometry::fit::{FitSettings, fit_curve};
+use crate::geometry::fit::{FitSettings, best_fit_rigid, fit_curve};
 use crate::geometry::frame::normal_to;
 use crate::geometry::primitives;
 use crate::geometry::stent::{
@@ -237,9 +237,52 @@ pub struct TemporaryDto {
     /// Crown radius in the temporary shape (default: the permanent one) [length].
     #[serde(default)]
     pub radius: Option<Positive>,
+    /// Place the temporary shape by the rigid motion that best fits its driven nodes to their permanent
+    /// positions (default true), so that `η_temp` has no rigid part.
+    #[serde(default)]
+    pub align: Option<bool>,
 }
 
 type Result<T> = std::result::Result<T, Issue>;
+
+/// The temporary node positions moved by the rigid motion that best fits the driven nodes (`set`) of the FULL
+/// device — every node mirrored about every combination of symmetry planes, weights shared among the copies —
+/// onto their permanent positions ([`best_fit_rigid`]). A free device has no preferred placement once released;
+/// placing the temporary shape this way gives its displacement `η_temp = P_temp − P_0` no rigid part, so the
+/// gauge that fixes the free device's rigid motion at the release ([`crate::solver::gauge`]) holds it where a full
+/// recovery brings every node back to `P_0`. By symmetry of the mirrored point sets the fitted motion respects
+/// the symmetry planes.
+fn align_temporary(
+    geometry: &StentGeometry,
+    positions: &[Vec3],
+    set: &[usize],
+) -> Option<Vec<Vec3>> {
+    let planes: Vec<(Vec3, Vec3)> = geometry
+        .symmetry_planes
+        .iter()
+        .map(|p| (p.point, p.normal.normalize()))
+        .collect();
+    let reflect = |x: Vec3, mask: usize| {
+        planes.iter().enumerate().fold(x, |x, (i, (p, n))| {
+            if mask >> i & 1 == 1 {
+                x - n * (2.0 * n.dot(&(x - p)))
+            } else {
+                x
+            }
+        })
+    };
+    let copies = 1usize << planes.len();
+    let (mut from, mut to, mut weights) = (Vec::new(), Vec::new(), Vec::new());
+    for &k in set {
+        for mask in 0..copies {
+            from.push(reflect(positions[k], mask));
+            to.push(reflect(geometry.nodes[k].position, mask));
+            weights.push(geometry.nodes[k].multiplicity as Real / copies as Real);
+        }
+    }
+    let (r, t) = best_fit_rigid(&from, &to, &weights)?;
+    Some(positions.iter().map(|p| r * p + t).collect())
+}
 
 fn issue(path: impl Into<String>, message: impl Into<String>) -> Issue {
     Issue {
@@ -698,6 +741,16 @@ pub fn programme(
                 .spec
                 .temporary_node_positions(geometry, &temporary)
                 .map_err(geometry_issue)?;
+            let positions = if t.align.unwrap_or(true) {
+                align_temporary(geometry, &positions, &set).ok_or_else(|| {
+                    issue(
+                        format!("{tpath}.align"),
+                        "the driven nodes do not define a rigid placement",
+                    )
+                })?
+            } else {
+                positions
+            };
             (
                 ProgrammeKind::TargetShape,
                 positions
