@@ -263,6 +263,13 @@ pub struct SolverSettings {
     pub residual_factor: Real,
     /// Newton iterations allowed per step before the step is cut.
     pub max_iterations: usize,
+    /// Reuse the last LU factorisation of the tangent while it still contracts the residual fast enough
+    /// (the chord method, refactorising when an iteration reduces the residual by less than
+    /// `refactor_ratio`); a step that fails this way is retried with a fresh factorisation every iteration
+    /// before it is cut. `false`: Newton's method with a factorisation per iteration.
+    pub reuse_factorisation: bool,
+    /// Residual reduction per iteration below which a reused factorisation is kept.
+    pub refactor_ratio: Real,
 }
 
 impl Default for SolverSettings {
@@ -273,6 +280,8 @@ impl Default for SolverSettings {
         Self {
             tolerance: 1e-9,
             residual_factor: 100.0,
+            reuse_factorisation: true,
+            refactor_ratio: 0.25,
             max_iterations: 25,
         }
     }

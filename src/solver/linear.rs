@@ -102,6 +102,11 @@ impl SparseSystem {
         self.slot.len()
     }
 
+    /// True when a factorisation is available for solves.
+    pub fn is_factored(&self) -> bool {
+        self.factored
+    }
+
     /// Number of structural non-zeros.
     pub fn nonzeros(&self) -> usize {
         self.row_idx.len()

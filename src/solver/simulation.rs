@@ -34,6 +34,8 @@ pub struct NewtonReport {
     pub residuals: Vec<Real>,
     /// Normalised increment norm of each solve.
     pub increments: Vec<Real>,
+    /// LU factorisations performed (fewer than `iterations` when a factorisation was reused).
+    pub factorisations: usize,
 }
 
 /// One converged time step, as reported to observers.
@@ -62,6 +64,8 @@ pub struct RunSummary {
     pub iterations: usize,
     /// Step cuts.
     pub cuts: usize,
+    /// LU factorisations over all converged steps.
+    pub factorisations: usize,
     /// Time reached.
     pub time: Real,
     /// True when an observer asked to stop before the end.
@@ -480,17 +484,19 @@ impl<'m> Simulation<'m> {
         }
     }
 
-    /// Newton's method at time `t` from the current state (modified in place).
-    fn newton(&mut self, t: Real) -> Result<NewtonReport, NewtonFailure> {
+    /// Newton's method at time `t` from the current state (modified in place). With `reuse`, the last
+    /// factorisation of the tangent (from an earlier iteration or step) is kept while each iteration reduces the
+    /// normalised residual at least by the factor `refactor_ratio`; otherwise the tangent is assembled and
+    /// factorised afresh.
+    fn newton(&mut self, t: Real, reuse: bool) -> Result<NewtonReport, NewtonFailure> {
         let actions = Actions::at(self.model, t, &self.ramps);
-        let tol = self.model.solver.tolerance;
-        let max_iterations = self.model.solver.max_iterations;
+        let settings = &self.model.solver;
+        let (tol, max_iterations, ratio) = (settings.tolerance, settings.max_iterations, settings.refactor_ratio);
         let mut report = NewtonReport::default();
         let mut last_increment = Real::INFINITY;
+        let mut previous = Real::INFINITY;
         loop {
-            let r = self
-                .linearise(&actions, true)
-                .map_err(NewtonFailure::Fatal)?;
+            let r = self.linearise(&actions, false).map_err(NewtonFailure::Fatal)?;
             report.residuals.push(r);
             if !r.is_finite() {
                 return Err(NewtonFailure::NotConverged(report));
@@ -507,11 +513,23 @@ impl<'m> Simulation<'m> {
             if report.iterations >= max_iterations {
                 return Err(NewtonFailure::NotConverged(report));
             }
+            let factored = match (&self.gauge, self.gauge_active) {
+                (Some((_, s, _)), true) => s.is_factored(),
+                _ => self.system.is_factored(),
+            };
+            // A reused factorisation is kept while it contracts the residual fast enough.
+            let fresh_tangent = !reuse || !factored || r > ratio * previous;
+            if fresh_tangent {
+                self.linearise(&actions, true).map_err(NewtonFailure::Fatal)?;
+            }
             let (system, values) = match (&mut self.gauge, self.gauge_active) {
                 (Some((_, s, v)), true) => (s, &*v),
                 _ => (&mut self.system, &self.values),
             };
-            system.factor(values).map_err(NewtonFailure::Fatal)?;
+            if fresh_tangent {
+                system.factor(values).map_err(NewtonFailure::Fatal)?;
+                report.factorisations += 1;
+            }
             self.delta.resize(self.lin.residual.len(), 0.0);
             for (d, r) in self.delta.iter_mut().zip(&self.lin.residual) {
                 *d = -r;
@@ -524,6 +542,7 @@ impl<'m> Simulation<'m> {
                 return Err(NewtonFailure::NotConverged(report));
             }
             self.state.apply_increment(&self.disc, &self.delta);
+            previous = if fresh_tangent { Real::INFINITY } else { r };
         }
     }
 
@@ -561,13 +580,27 @@ impl<'m> Simulation<'m> {
             let captured = self.capture_releases(target);
             self.set_gauge(target)?;
             self.prepare_step(self.time, target)?;
-            match self.newton(target) {
+            let reuse = self.model.solver.reuse_factorisation;
+            let mut attempt = self.newton(target, reuse);
+            if reuse && let Err(NewtonFailure::NotConverged(failed)) = &attempt {
+                // A reused factorisation may be what failed: retry the same step with Newton's method proper
+                // before cutting it.
+                observer.step_failed(target, dt, failed);
+                let factorisations = failed.factorisations;
+                self.state = saved.clone();
+                attempt = self.newton(target, false);
+                if let Ok(newton) = &mut attempt {
+                    newton.factorisations += factorisations;
+                }
+            }
+            match attempt {
                 Ok(newton) => {
                     self.commit_step();
                     self.time = target;
                     self.step += 1;
                     summary.steps += 1;
                     summary.iterations += newton.iterations;
+                    summary.factorisations += newton.factorisations;
                     summary.time = target;
                     let report = StepReport {
                         step: self.step,

@@ -974,6 +974,9 @@ fn solver_settings(s: Option<&SolverDto>) -> Result<SolverSettings> {
             }
             out.max_iterations = m;
         }
+        if let Some(r) = s.reuse_factorisation {
+            out.reuse_factorisation = r;
+        }
     }
     Ok(out)
 }

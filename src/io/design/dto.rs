@@ -522,6 +522,9 @@ pub struct SolverDto {
     /// Iterations per step.
     #[serde(default)]
     pub max_iterations: Option<usize>,
+    /// Reuse the tangent's factorisation across iterations and steps (default true).
+    #[serde(default)]
+    pub reuse_factorisation: Option<bool>,
 }
 
 /// Outputs.
