@@ -157,12 +157,13 @@ pub fn run(
     })?;
     let wall = started.elapsed().as_secs_f64();
     println!(
-        "{}: {} steps to t = {} s, {} Newton iterations ({:.2} per step), {} step cuts, wall time {wall:.2} s → {}",
+        "{}: {} steps to t = {} s, {} Newton iterations ({:.2} per step), {} factorisations, {} step cuts, wall time {wall:.2} s → {}",
         model.name,
         summary.steps,
         summary.time,
         summary.iterations,
         summary.iterations as f64 / summary.steps.max(1) as f64,
+        summary.factorisations,
         summary.cuts,
         dir.display()
     );

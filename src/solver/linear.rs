@@ -102,6 +102,11 @@ impl SparseSystem {
         self.slot.len()
     }
 
+    /// Forgets the factorisation (it belonged to a state that was abandoned).
+    pub fn invalidate(&mut self) {
+        self.factored = false;
+    }
+
     /// True when a factorisation is available for solves.
     pub fn is_factored(&self) -> bool {
         self.factored
