@@ -296,10 +296,7 @@ where
     let span = |scale: Scale, coordinate: fn(&(Real, Real)) -> Real| {
         axis_range(chart, scale, coordinate).map_or(0.0, |(lo, hi)| hi - lo)
     };
-    let (x_span, y_span) = (
-        span(chart.x_scale, |p| p.0),
-        span(chart.y_scale, |p| p.1),
-    );
+    let (x_span, y_span) = (span(chart.x_scale, |p| p.0), span(chart.y_scale, |p| p.1));
     let tick = |scale: Scale, v: &f64, span: Real| {
         if scale == Scale::Linear && v.abs() <= 1e-9 * span {
             "0".to_string()

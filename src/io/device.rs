@@ -15,7 +15,51 @@ use crate::geometry::tube::{
 };
 use crate::math::{Real, Vec3};
 use crate::model::Model;
-use crate::solver::shape::PatchShape;
+use crate::solver::Simulation;
+use crate::solver::shape::{PatchShape, current_shapes};
+
+/// Indices of about `target` of `n` samples, evenly spaced (every k-th, `k = round((n − 1)/(target − 1))`),
+/// the first and the last always included; all of them when `n ≤ target`.
+pub fn decimation(n: usize, target: usize) -> Vec<usize> {
+    let target = target.max(2);
+    if n <= target {
+        return (0..n).collect();
+    }
+    let k = (((n - 1) as Real / (target - 1) as Real).round() as usize).max(1);
+    let mut out: Vec<usize> = (0..n).step_by(k).collect();
+    if (n - 1) % k != 0 {
+        out.push(n - 1);
+    }
+    out
+}
+
+/// `shape` reduced to about `target` samples ([`decimation`]).
+pub fn decimated(shape: &PatchShape, target: usize) -> PatchShape {
+    let keep = decimation(shape.points.len(), target);
+    PatchShape {
+        points: keep.iter().map(|&i| shape.points[i]).collect(),
+        frames: keep.iter().map(|&i| shape.frames[i]).collect(),
+    }
+}
+
+/// Every patch of the simulation in its current configuration with about `samples` samples (rings of a tube,
+/// points of a centreline) per patch, whatever its number of control points `n`: sampled at the smallest whole
+/// number of samples per control point that gives at least that many for every patch, then reduced
+/// ([`decimated`]). The ends of every patch are always samples.
+pub fn current_device_shapes(sim: &Simulation<'_>, samples: usize) -> Vec<PatchShape> {
+    let per_point = sim
+        .model()
+        .patches
+        .iter()
+        .map(|p| (samples.saturating_sub(1)).div_ceil(p.curve.num_points().max(1)))
+        .max()
+        .unwrap_or(1)
+        .max(1);
+    current_shapes(sim, per_point)
+        .iter()
+        .map(|s| decimated(s, samples))
+        .collect()
+}
 
 /// Samples every patch of the model in its reference shape with rotation-minimising frames: `m + 1` points
 /// at `u = k/m`, `m = samples_per_point · n` (the sampling of [`crate::solver::shape`]).
@@ -129,4 +173,22 @@ pub fn device_centrelines(model: &Model, shapes: &[PatchShape]) -> Vec<Vec<Vec3>
             })
         })
         .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn decimation_keeps_the_ends_and_spreads_evenly() {
+        // n = 82 (p = 6, n = 81 patches sampled once per control point): every 4th, 0 … 80, and the end.
+        let d = decimation(82, 21);
+        assert_eq!(d.len(), 22);
+        assert_eq!((d[0], d[20], d[21]), (0, 80, 81));
+        assert_eq!(decimation(21, 21), (0..21).collect::<Vec<_>>());
+        assert_eq!(decimation(24, 21).len(), 24);
+        let d = decimation(41, 21);
+        assert_eq!((d.len(), d[20]), (21, 40));
+        assert_eq!(decimation(5, 0), (0..2).map(|i| 4 * i).collect::<Vec<_>>());
+    }
 }

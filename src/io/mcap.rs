@@ -18,12 +18,11 @@
 //! the simulation succeeded or failed.
 
 use super::design::{Design, RecordingSettings, SnapshotSettings};
-use super::device::{device_centrelines, device_tube_mesh};
+use super::device::{current_device_shapes, device_centrelines, device_tube_mesh};
 use super::snapshots::SnapshotSchedule;
 use super::state::{LoadChannel, StateSample, load_channels};
 use crate::math::{Real, Vec3};
 use crate::model::Model;
-use crate::solver::shape::current_shapes;
 use crate::solver::{Observer, Simulation, StepReport};
 use serde_json::{Map, Value, json};
 use std::borrow::Cow;
@@ -186,20 +185,6 @@ fn scene_update(id: &str, nanoseconds: u64, lines: &str, triangles: &str) -> Str
     format!(
         r#"{{"deletions":[],"entities":[{{"timestamp":{{"sec":{sec},"nsec":{nsec}}},"frame_id":"{FRAME_ID}","id":"{id}","lifetime":{{"sec":0,"nsec":0}},"frame_locked":false,"metadata":[],"arrows":[],"cubes":[],"spheres":[],"cylinders":[],"lines":[{lines}],"triangles":[{triangles}],"texts":[],"models":[]}}]}}"#
     )
-}
-
-/// Every `k`-th of `points` with `k` chosen for about `target` points, the last point always included.
-fn decimated(points: &[Vec3], target: usize) -> Vec<Vec3> {
-    let n = points.len();
-    if n <= target.max(2) {
-        return points.to_vec();
-    }
-    let k = (((n - 1) as Real / (target.max(2) - 1) as Real).round() as usize).max(1);
-    let mut out: Vec<Vec3> = points.iter().step_by(k).copied().collect();
-    if (n - 1) % k != 0 {
-        out.push(points[n - 1]);
-    }
-    out
 }
 
 /// JSON Schema of the `foxglove.SceneUpdate` fields used here (entities with line and triangle-list
@@ -612,10 +597,7 @@ impl McapRecorder {
     }
 
     fn centreline_message(&self, sim: &Simulation<'_>, log_time: u64) -> String {
-        let mut shapes = current_shapes(sim, 1);
-        for shape in &mut shapes {
-            shape.points = decimated(&shape.points, self.settings.centreline_points);
-        }
+        let shapes = current_device_shapes(sim, self.settings.centreline_points);
         let (lo, hi) = self.temperature_range;
         let color = temperature_color(sim.model().temperature.value(sim.time()), lo, hi);
         let mut lines = String::new();
@@ -643,7 +625,7 @@ impl McapRecorder {
         step: usize,
         log_time: u64,
     ) -> Result<String, McapError> {
-        let shapes = current_shapes(sim, self.settings.mesh_samples);
+        let shapes = current_device_shapes(sim, self.settings.mesh_rings);
         let mesh =
             device_tube_mesh(sim.model(), &shapes, self.settings.mesh_segments).map_err(|e| {
                 McapError::Mesh {
@@ -817,19 +799,6 @@ mod tests {
         assert_eq!(entity["lines"][0]["points"][1]["x"], 20.0);
         assert_eq!(entity["lines"][0]["points"][0]["z"], 1e-7);
         assert_eq!(entity["triangles"], json!([]));
-    }
-
-    #[test]
-    fn decimation_keeps_the_ends() {
-        let points: Vec<Vec3> = (0..82).map(|i| Vec3::new(i as Real, 0.0, 0.0)).collect();
-        // n = 82 (p = 6, n = 81 patches): every 4th point, 0 … 80, and the end.
-        let d = decimated(&points, 21);
-        assert_eq!(d.len(), 22);
-        assert_eq!((d[0].x, d[20].x, d[21].x), (0.0, 80.0, 81.0));
-        assert_eq!(decimated(&points[..21], 21).len(), 21);
-        assert_eq!(decimated(&points[..24], 21).len(), 24);
-        let d = decimated(&points[..41], 21);
-        assert_eq!((d.len(), d[20].x), (21, 40.0));
     }
 
     #[test]

@@ -4,13 +4,12 @@
 //! model's record times).
 
 use super::design::SnapshotSettings;
-use super::device::device_tube_mesh;
+use super::device::{current_device_shapes, device_tube_mesh};
 use super::stl::MeshIoError;
 use super::{obj, stl};
 use crate::geometry::tube::{DeviceMeshError, TriangleMesh};
 use crate::math::Real;
 use crate::model::Model;
-use crate::solver::shape::current_shapes;
 use crate::solver::{Observer, Simulation, StepReport};
 use std::ops::ControlFlow;
 use std::path::{Path, PathBuf};
@@ -100,16 +99,17 @@ pub enum SnapshotError {
     Write(#[from] MeshIoError),
 }
 
-/// The full device's tube mesh in the current state of `sim`.
+/// The full device's tube mesh in the current state of `sim`, with `segments` vertices around and about
+/// `rings` rings per patch.
 ///
 /// # Errors
 /// [`DeviceMeshError`] naming the patch index that cannot be swept.
 pub fn current_device_mesh(
     sim: &Simulation<'_>,
     segments: usize,
-    samples_per_point: usize,
+    rings: usize,
 ) -> Result<TriangleMesh, DeviceMeshError> {
-    let shapes = current_shapes(sim, samples_per_point);
+    let shapes = current_device_shapes(sim, rings);
     device_tube_mesh(sim.model(), &shapes, segments)
 }
 
@@ -119,7 +119,7 @@ pub struct SnapshotWriter {
     run_dir: PathBuf,
     schedule: SnapshotSchedule,
     segments: usize,
-    samples: usize,
+    rings: usize,
     /// Time and step of the last state seen.
     last: Option<(usize, Real)>,
     written: Vec<Snapshot>,
@@ -148,7 +148,7 @@ impl SnapshotWriter {
             run_dir: run_dir.to_path_buf(),
             schedule: SnapshotSchedule::new(settings, model),
             segments: settings.segments,
-            samples: settings.samples,
+            rings: settings.rings,
             last: None,
             written: Vec::new(),
             error: None,
@@ -181,7 +181,7 @@ impl SnapshotWriter {
     fn write(&mut self, sim: &Simulation<'_>, step: usize) -> Result<(), SnapshotError> {
         let model = sim.model();
         let time = sim.time();
-        let mesh = current_device_mesh(sim, self.segments, self.samples).map_err(|e| {
+        let mesh = current_device_mesh(sim, self.segments, self.rings).map_err(|e| {
             SnapshotError::Mesh {
                 step,
                 time,

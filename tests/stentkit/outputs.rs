@@ -401,10 +401,10 @@ fn curved_stent_half_model_snapshots_are_closed() {
     };
     let design = parse_design_with(&text, &file, &overrides).expect("valid design");
     let dir = test_outputs("curved_stent_snapshots");
-    // A coarse drawing (8 segments, one ring per control point) keeps the files small; the welds are the same.
+    // A coarse drawing (8 segments, 21 rings per patch) keeps the files small; the welds are the same.
     let settings = stentkit::io::design::SnapshotSettings {
         segments: 8,
-        samples: 1,
+        rings: 21,
         ..design.output.snapshots.clone()
     };
     let written = snapshots_of(&design.model, &settings, &dir);

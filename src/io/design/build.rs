@@ -229,11 +229,11 @@ fn output_settings(
             3,
             "output.snapshots.segments",
         )?,
-        samples: at_least(
-            snapshots.and_then(|s| s.samples),
-            SnapshotSettings::DEFAULT_SAMPLES,
-            1,
-            "output.snapshots.samples",
+        rings: at_least(
+            snapshots.and_then(|s| s.rings),
+            SnapshotSettings::DEFAULT_RINGS,
+            2,
+            "output.snapshots.rings",
         )?,
     };
     let recording = output.and_then(|o| o.recording.as_ref());
@@ -251,11 +251,11 @@ fn output_settings(
             3,
             "output.recording.mesh_segments",
         )?,
-        mesh_samples: at_least(
-            recording.and_then(|r| r.mesh_samples),
-            RecordingSettings::DEFAULT_MESH_SAMPLES,
-            1,
-            "output.recording.mesh_samples",
+        mesh_rings: at_least(
+            recording.and_then(|r| r.mesh_rings),
+            RecordingSettings::DEFAULT_MESH_RINGS,
+            2,
+            "output.recording.mesh_rings",
         )?,
     };
     Ok(OutputSettings {

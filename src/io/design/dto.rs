@@ -620,9 +620,9 @@ pub struct SnapshotsDto {
     /// Vertices around each tube section (default 16, at least 3).
     #[serde(default)]
     pub segments: Option<usize>,
-    /// Centreline samples along each patch per control point (default 2, at least 1).
+    /// Rings (sections) along each patch, about (default 41, at least 2).
     #[serde(default)]
-    pub samples: Option<usize>,
+    pub rings: Option<usize>,
 }
 
 /// Resolution of the recording (`run.mcap`).
@@ -639,9 +639,9 @@ pub struct RecordingDto {
     /// Vertices around each tube section of the recorded meshes (default 8, at least 3).
     #[serde(default)]
     pub mesh_segments: Option<usize>,
-    /// Samples per control point along the recorded meshes (default 1, at least 1).
+    /// Rings along each patch of the recorded meshes, about (default 21, at least 2).
     #[serde(default)]
-    pub mesh_samples: Option<usize>,
+    pub mesh_rings: Option<usize>,
 }
 
 /// A probe: at a node, or on a patch at a parameter.

@@ -26,8 +26,9 @@ pub struct SnapshotSettings {
     pub every: usize,
     /// Vertices around each tube section.
     pub segments: usize,
-    /// Centreline samples per control point along each patch.
-    pub samples: usize,
+    /// Rings (sections) along each patch, about: every k-th of the samples taken at a whole number of samples
+    /// per control point, the ends always included ([`crate::io::device::current_device_shapes`]).
+    pub rings: usize,
 }
 
 impl SnapshotSettings {
@@ -35,9 +36,9 @@ impl SnapshotSettings {
     pub const DEFAULT_COUNT: usize = 20;
     /// Default vertices around a section: 16, the section polygon has 97.4 % of the circle's area.
     pub const DEFAULT_SEGMENTS: usize = 16;
-    /// Default samples per control point: 2, about one ring per wire diameter on the paper's stents, which
-    /// keeps a full straight stent near 10⁵ triangles (6 MB of binary STL).
-    pub const DEFAULT_SAMPLES: usize = 2;
+    /// Default rings per patch: 41, about one per wire diameter along a crown wire of the paper's stents
+    /// (the full straight stent: 134 000 triangles, 6.7 MB of binary STL), whatever the patch's `n`.
+    pub const DEFAULT_RINGS: usize = 41;
 }
 
 /// What `run.mcap` records (the design's `output.recording`).
@@ -50,8 +51,8 @@ pub struct RecordingSettings {
     pub meshes: bool,
     /// Vertices around each section of a recorded mesh.
     pub mesh_segments: usize,
-    /// Samples per control point along a recorded mesh.
-    pub mesh_samples: usize,
+    /// Rings per patch of a recorded mesh, about.
+    pub mesh_rings: usize,
 }
 
 impl RecordingSettings {
@@ -61,8 +62,8 @@ impl RecordingSettings {
     pub const DEFAULT_CENTRELINE_POINTS: usize = 21;
     /// Default vertices around a recorded section: 8, enough to see a round wire in Foxglove.
     pub const DEFAULT_MESH_SEGMENTS: usize = 8;
-    /// Default samples per control point along a recorded mesh: 1.
-    pub const DEFAULT_MESH_SAMPLES: usize = 1;
+    /// Default rings per patch of a recorded mesh: 21.
+    pub const DEFAULT_MESH_RINGS: usize = 21;
 }
 
 /// The validated `output:` block besides the probes (which are part of the model).
