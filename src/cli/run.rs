@@ -10,8 +10,9 @@
 //!
 //! The outputs are observers of the simulation, composed here with a progress bar (indicatif, on stderr,
 //! hidden when stderr is not a terminal or with `--quiet`). Every file is finished whether the run completes,
-//! fails or is stopped by an output error: the MCAP recording is closed, the last state gets a snapshot and
-//! the summary says where the run stopped.
+//! fails, is interrupted (Ctrl-C stops it after the current step; a second Ctrl-C quits at once) or is
+//! stopped by an output error: the MCAP recording is closed, the last state gets a snapshot and the summary
+//! says where the run stopped.
 
 use crate::io::design::{Design, load_design};
 use crate::io::history::HistoryWriter;
@@ -26,7 +27,45 @@ use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use std::collections::BTreeMap;
 use std::ops::ControlFlow;
 use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::{Duration, Instant};
+
+/// Set by the Ctrl-C handler: the run stops after the current step.
+static INTERRUPTED: AtomicBool = AtomicBool::new(false);
+
+/// Installs the Ctrl-C handler: the first Ctrl-C asks the run to stop after the current step, a second one
+/// quits at once (exit status 130) without finishing the files.
+fn install_interrupt_handler() {
+    // Only fails if a handler is already installed (a second run in the same process): keep that one.
+    let _ = ctrlc::set_handler(|| {
+        if INTERRUPTED.swap(true, Ordering::SeqCst) {
+            std::process::exit(130);
+        }
+    });
+}
+
+/// Stops the run once Ctrl-C was pressed.
+struct Interrupt;
+
+impl Observer for Interrupt {
+    fn start(&mut self, _: &Simulation<'_>) -> ControlFlow<()> {
+        self.check()
+    }
+
+    fn step(&mut self, _: &Simulation<'_>, _: &StepReport) -> ControlFlow<()> {
+        self.check()
+    }
+}
+
+impl Interrupt {
+    fn check(&self) -> ControlFlow<()> {
+        if INTERRUPTED.load(Ordering::SeqCst) {
+            ControlFlow::Break(())
+        } else {
+            ControlFlow::Continue(())
+        }
+    }
+}
 
 /// Positions of the progress bar over the run (simulated time is mapped onto them).
 const PROGRESS_RESOLUTION: u64 = 10_000;
@@ -286,6 +325,7 @@ fn run_in(
     let mut recorder = McapRecorder::create(&mcap_path, design, &info, &design.output.snapshots)?;
     let mut charts = RunCharts::new(model);
     let mut progress = Progress::new(model.time.end, options.quiet, options.verbose);
+    install_interrupt_handler();
     let setup = started.elapsed();
 
     let run_started = Instant::now();
@@ -301,6 +341,7 @@ fn run_in(
             &mut recorder,
             &mut charts,
             &mut progress,
+            &mut Interrupt,
         ]));
         for (name, spent) in [
             ("history", history.spent),
@@ -347,8 +388,16 @@ fn run_in(
     };
     let finish = finish_started.elapsed();
 
+    let interrupted = INTERRUPTED.load(Ordering::SeqCst);
     let (status, error) = match (&result, problems.first()) {
         (Err(e), _) => (RunStatus::Failed, Some(format!("{e}"))),
+        (Ok(s), None) if s.stopped && interrupted => (
+            RunStatus::Interrupted,
+            Some(format!(
+                "interrupted (Ctrl-C) at t = {} s",
+                short_time(sim.time())
+            )),
+        ),
         (Ok(s), Some(p)) if s.stopped => (RunStatus::Stopped, Some(format!("{p:#}"))),
         (Ok(_), Some(p)) => (RunStatus::Completed, Some(format!("{p:#}"))),
         (Ok(_), None) => (RunStatus::Completed, None),
@@ -414,14 +463,22 @@ fn run_in(
     let totals = result.with_context(|| {
         format!(
             "the run stopped at t = {} s; results up to there are in {}",
-            sim.time(),
+            short_time(sim.time()),
             dir.display()
         )
     })?;
+    if totals.stopped && interrupted {
+        bail!(
+            "interrupted at t = {} s after {} steps; results up to there are in {}",
+            short_time(sim.time()),
+            totals.steps,
+            dir.display()
+        );
+    }
     if let Some(problem) = problems.into_iter().next() {
         return Err(problem.context(format!(
             "the run stopped at t = {} s; results up to there are in {}",
-            sim.time(),
+            short_time(sim.time()),
             dir.display()
         )));
     }
@@ -438,6 +495,12 @@ fn run_in(
         dir.display()
     );
     Ok(())
+}
+
+/// A time for messages: at most 9 decimals, trailing zeros dropped (`0.1`, not `0.10000000000000005`).
+fn short_time(t: Real) -> String {
+    let s = format!("{t:.9}");
+    s.trim_end_matches('0').trim_end_matches('.').to_string()
 }
 
 /// `1.2 MB`-style size.

@@ -20,6 +20,8 @@ pub enum RunStatus {
     Stopped,
     /// The solver failed (see `error`); the outputs hold the states up to the last converged step.
     Failed,
+    /// Interrupted by the user (Ctrl-C); the outputs hold the states up to the last converged step.
+    Interrupted,
 }
 
 /// The unit system of every number in the run folder.

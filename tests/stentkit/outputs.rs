@@ -471,3 +471,101 @@ fn schema_describes_the_design_format() {
     }
     assert_eq!(defs["SnapshotsDto"]["additionalProperties"], false);
 }
+
+#[test]
+fn failed_run_leaves_every_file_valid() {
+    // The 45° bend whose tip load (60 per step, as in the design) jumps from 180 to 6·10⁵ between t = 0.3 and 0.4 s with no step cutting
+    // (min_step = step): the step to 0.4 s fails. The command fails, naming
+    // where it stopped; the run folder holds the three converged steps, a snapshot of the last one, a finished
+    // recording and a summary with status `failed`.
+    let root = test_outputs("failed_run");
+    std::fs::create_dir_all(&root).expect("folder");
+    let file = root.join("bend45_overload.yaml");
+    let text = std::fs::read_to_string(design("bend45.yaml"))
+        .expect("design")
+        .replace("[[0, 0], [1, 600]]", "[[0, 0], [0.3, 180], [0.4, 600000]]")
+        .replace(
+            "time: {end: 1.0, step: 0.1}",
+            "time: {end: 1.0, step: 0.1, min_step: 0.1}",
+        );
+    assert!(text.contains("600000") && text.contains("min_step"));
+    std::fs::write(&file, text).expect("design written");
+    let dir = root.join("run");
+    let out = stentkit(&["run", path_str(&file), "-o", path_str(&dir), "--quiet"]);
+    assert!(!out.status.success());
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        stderr.contains("the run stopped at t = 0.3") && !stderr.contains("panicked"),
+        "{stderr}"
+    );
+    let s = summary(&dir);
+    assert_eq!(s["status"], "failed");
+    assert!(
+        s["error"]
+            .as_str()
+            .expect("error")
+            .contains("no convergence")
+    );
+    assert_eq!(s["steps"], 3);
+    let steps: Vec<u64> = s["snapshots"]
+        .as_array()
+        .expect("list")
+        .iter()
+        .map(|x| x["step"].as_u64().expect("step"))
+        .collect();
+    assert_eq!(
+        steps.last(),
+        Some(&3),
+        "the last converged state has a snapshot"
+    );
+    check_snapshots(&dir);
+    check_recording(&dir, &file);
+}
+
+#[test]
+fn interrupted_run_leaves_every_file_valid() {
+    // Ctrl-C (SIGINT) during the straight stent's run: the run stops after the current step, every file is
+    // finished (the recording closed, a snapshot of the last state, the summary says `interrupted`) and the
+    // command fails saying where it stopped.
+    let dir = test_outputs("interrupted_run");
+    let mut child = Command::new(env!("CARGO_BIN_EXE_stentkit"))
+        .args([
+            "run",
+            path_str(&design("straight_stent.yaml")),
+            "-o",
+            path_str(&dir),
+        ])
+        .stdout(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .expect("stentkit starts");
+    // Wait until a few steps are recorded, then interrupt.
+    let history = dir.join("history.csv");
+    let started = std::time::Instant::now();
+    while std::fs::read_to_string(&history).map_or(0, |h| h.lines().count()) < 4 {
+        assert!(started.elapsed().as_secs() < 120, "no progress");
+        std::thread::sleep(std::time::Duration::from_millis(50));
+    }
+    let kill = Command::new("kill")
+        .args(["-INT", &child.id().to_string()])
+        .status()
+        .expect("kill runs");
+    assert!(kill.success());
+    let out = child.wait_with_output().expect("stentkit ends");
+    assert!(!out.status.success());
+    let stderr = text(&out.stderr);
+    assert!(stderr.contains("interrupted at t = "), "{stderr}");
+    let s = summary(&dir);
+    assert_eq!(s["status"], "interrupted");
+    let steps = s["steps"].as_u64().expect("steps");
+    assert!((3..1300).contains(&steps), "{steps} steps");
+    let last = s["snapshots"]
+        .as_array()
+        .expect("list")
+        .last()
+        .expect("snapshot")["step"]
+        .as_u64();
+    assert_eq!(last, Some(steps), "the last state has a snapshot");
+    check_snapshots(&dir);
+    check_recording(&dir, &design("straight_stent.yaml"));
+}
