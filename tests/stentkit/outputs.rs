@@ -528,7 +528,7 @@ fn interrupted_run_leaves_every_file_valid() {
     // finished (the recording closed, a snapshot of the last state, the summary says `interrupted`) and the
     // command fails saying where it stopped.
     let dir = test_outputs("interrupted_run");
-    let mut child = Command::new(env!("CARGO_BIN_EXE_stentkit"))
+    let child = Command::new(env!("CARGO_BIN_EXE_stentkit"))
         .args([
             "run",
             path_str(&design("straight_stent.yaml")),
