@@ -11,7 +11,8 @@
 //! command line, the design name and the units. Log times are the simulated time in nanoseconds (1 s of
 //! simulation is 1 s of playback), strictly increasing per channel: a step shorter than 1 ns (impossible with
 //! sane settings) is moved to 1 ns after the previous one. Coordinates are in the design's length unit
-//! (Foxglove's 3D panel reads them as metres); they are rounded to [`COORDINATE_DIGITS`] significant digits,
+//! (Foxglove's 3D panel reads them as metres); they are rounded to a fixed number of decimals,
+//! [`coordinate_decimals`]: a resolution between 10⁻⁶ and 10⁻⁵ of the device's size (1 µm on a 100 mm stent),
 //! far below what a viewer shows, which keeps the file small.
 //!
 //! The file is complete only after [`McapRecorder::finish`] (also called on drop): the run calls it whether
@@ -33,8 +34,15 @@ use std::io::{BufWriter, Write};
 use std::ops::ControlFlow;
 use std::path::{Path, PathBuf};
 
-/// Significant digits of recorded coordinates: 6 (1 µm on a 20 mm stent).
-pub const COORDINATE_DIGITS: i32 = 6;
+/// Decimals of recorded coordinates for a device of size `scale` (largest distance of a control point from
+/// the origin) [length]: `max(0, 5 − ⌊log₁₀ scale⌋)`, a resolution `10^(⌊log₁₀ scale⌋ − 5)` between `10⁻⁶` and
+/// `10⁻⁵` of the size.
+pub fn coordinate_decimals(scale: Real) -> usize {
+    if !(scale > 0.0 && scale.is_finite()) {
+        return 6;
+    }
+    (5 - scale.log10().floor() as i64).clamp(0, 12) as usize
+}
 
 /// Topic of the state channel.
 pub const STATE_TOPIC: &str = "/state";
@@ -97,56 +105,48 @@ pub enum McapError {
     },
 }
 
-/// `x` rounded to `digits` significant decimal digits (so that its shortest decimal form is short).
-fn round_significant(x: Real, digits: i32) -> Real {
-    if x == 0.0 || !x.is_finite() {
-        return if x.is_finite() { 0.0 } else { x };
-    }
-    let exponent = digits - 1 - x.abs().log10().floor() as i32;
-    if exponent >= 0 {
-        let scale = 10f64.powi(exponent);
-        (x * scale).round() / scale
-    } else {
-        let scale = 10f64.powi(-exponent);
-        (x / scale).round() * scale
-    }
-}
-
 /// A JSON number, `null` for NaN or infinity (which JSON cannot hold).
 fn number(x: Real) -> Value {
     serde_json::Number::from_f64(x).map_or(Value::Null, Value::Number)
 }
 
-/// Appends `x` rounded to [`COORDINATE_DIGITS`] as a JSON number (`null` if not finite). Rust prints the
-/// shortest decimal that reads back as the same `f64`, never in exponent form: valid JSON.
-fn push_coordinate(out: &mut String, x: Real) {
-    let r = round_significant(x, COORDINATE_DIGITS);
-    if r.is_finite() {
-        let _ = write!(out, "{r}");
-    } else {
+/// Appends `x` with `decimals` decimals, trailing zeros dropped, as a JSON number (`null` if not finite).
+fn push_coordinate(out: &mut String, x: Real, decimals: usize) {
+    if !x.is_finite() {
         out.push_str("null");
+        return;
+    }
+    let start = out.len();
+    let _ = write!(out, "{x:.decimals$}");
+    if out[start..].contains('.') {
+        let trimmed = out.trim_end_matches('0').trim_end_matches('.').len();
+        out.truncate(trimmed);
+    }
+    if &out[start..] == "-0" {
+        out.truncate(start);
+        out.push('0');
     }
 }
 
 /// Appends a `foxglove.Point3`.
-fn push_point(out: &mut String, p: &Vec3) {
+fn push_point(out: &mut String, p: &Vec3, decimals: usize) {
     out.push_str("{\"x\":");
-    push_coordinate(out, p.x);
+    push_coordinate(out, p.x, decimals);
     out.push_str(",\"y\":");
-    push_coordinate(out, p.y);
+    push_coordinate(out, p.y, decimals);
     out.push_str(",\"z\":");
-    push_coordinate(out, p.z);
+    push_coordinate(out, p.z, decimals);
     out.push('}');
 }
 
 /// Appends a JSON array of points.
-fn push_points(out: &mut String, points: &[Vec3]) {
+fn push_points(out: &mut String, points: &[Vec3], decimals: usize) {
     out.push('[');
     for (i, p) in points.iter().enumerate() {
         if i > 0 {
             out.push(',');
         }
-        push_point(out, p);
+        push_point(out, p, decimals);
     }
     out.push(']');
 }
@@ -392,6 +392,8 @@ pub struct McapRecorder {
     thickness: Vec<Real>,
     /// Temperature range of the schedule, for the colours.
     temperature_range: (Real, Real),
+    /// Decimals of the recorded coordinates.
+    decimals: usize,
     sequence: u32,
     /// Log time, step and time of the last state recorded.
     last: Option<(u64, usize, Real)>,
@@ -523,6 +525,13 @@ impl McapRecorder {
             settings,
             thickness,
             temperature_range: model.temperature.range(),
+            decimals: coordinate_decimals(
+                model
+                    .patches
+                    .iter()
+                    .flat_map(|p| p.curve.points().iter().map(|q| q.norm()))
+                    .fold(0.0, Real::max),
+            ),
             sequence: 0,
             last: None,
             last_mesh: None,
@@ -613,7 +622,7 @@ impl McapRecorder {
                 lines,
                 r#"{{"type":0,"pose":{IDENTITY_POSE},"thickness":{thickness},"scale_invariant":false,"color":{color},"colors":[],"indices":[],"points":"#
             );
-            push_points(&mut lines, points);
+            push_points(&mut lines, points, self.decimals);
             lines.push('}');
         }
         scene_update("centrelines", log_time, &lines, "")
@@ -638,7 +647,7 @@ impl McapRecorder {
             r#"{{"pose":{IDENTITY_POSE},"color":{},"colors":[],"points":"#,
             color(0.80, 0.72, 0.45)
         );
-        push_points(&mut triangles, &mesh.vertices);
+        push_points(&mut triangles, &mesh.vertices, self.decimals);
         triangles.push_str(r#","indices":["#);
         for (i, index) in mesh.triangles.iter().flatten().enumerate() {
             if i > 0 {
@@ -764,15 +773,23 @@ mod tests {
     use super::*;
 
     #[test]
-    fn rounding_keeps_significant_digits_and_short_decimals() {
-        assert_eq!(round_significant(12.345_678_9, 6), 12.3457);
-        assert_eq!(round_significant(-0.000_123_456_78, 6), -0.000_123_457);
-        assert_eq!(round_significant(123_456_789.0, 6), 123_457_000.0);
-        assert_eq!(round_significant(0.0, 6), 0.0);
-        assert_eq!(
-            number(round_significant(19.999_999_9, 6)).to_string(),
-            "20.0"
-        );
+    fn coordinates_are_short_fixed_point_numbers() {
+        assert_eq!(coordinate_decimals(110.0), 3);
+        assert_eq!(coordinate_decimals(75.0), 4);
+        assert_eq!(coordinate_decimals(1.0), 5);
+        assert_eq!(coordinate_decimals(1e7), 0);
+        let text = |x: Real, d: usize| {
+            let mut s = String::new();
+            push_coordinate(&mut s, x, d);
+            s
+        };
+        assert_eq!(text(109.856_4, 3), "109.856");
+        assert_eq!(text(0.050_943_5, 3), "0.051");
+        assert_eq!(text(19.999_999_9, 4), "20");
+        assert_eq!(text(-0.000_01, 3), "0");
+        assert_eq!(text(-2.5, 3), "-2.5");
+        assert_eq!(text(1234.0, 0), "1234");
+        assert_eq!(text(Real::NAN, 3), "null");
         assert_eq!(number(Real::NAN), Value::Null);
     }
 
@@ -785,6 +802,7 @@ mod tests {
                 Vec3::new(1.0, -0.5, 1e-7),
                 Vec3::new(19.999_999_9, 0.0, -0.0),
             ],
+            6,
         );
         let line = format!(
             r#"{{"type":0,"pose":{IDENTITY_POSE},"thickness":0.6,"scale_invariant":false,"color":{},"colors":[],"indices":[],"points":{points}}}"#,
@@ -797,7 +815,8 @@ mod tests {
         assert_eq!(entity["timestamp"]["sec"], 1);
         assert_eq!(entity["timestamp"]["nsec"], 500_000_001);
         assert_eq!(entity["lines"][0]["points"][1]["x"], 20.0);
-        assert_eq!(entity["lines"][0]["points"][0]["z"], 1e-7);
+        assert_eq!(entity["lines"][0]["points"][0]["z"], 0.0);
+        assert_eq!(entity["lines"][0]["points"][0]["y"], -0.5);
         assert_eq!(entity["triangles"], json!([]));
     }
 
