@@ -1,43 +1,27 @@
-//! `stentkit mesh`: the reference shape as a closed tube surface.
+//! `stentkit mesh`: the reference shape of the full device as a closed tube surface.
 
-use crate::geometry::frame::{FrameField, FrameSettings};
-use crate::geometry::tube::{TriangleMesh, TubeSettings, sweep_curve};
+use crate::geometry::tube::TriangleMesh;
 use crate::io::design::load_design;
+use crate::io::device::{device_tube_mesh, reference_patch_shapes};
 use crate::io::{obj, stl};
 use crate::model::Model;
 use anyhow::{Context, bail};
 use std::path::Path;
 
-/// Golden-ratio conjugate: successive multiples modulo 1 are as evenly spread as possible, so no two patches
-/// get (nearly) the same section phase.
-const PHASE_STEP: f64 = 0.618_033_988_749_894_9;
-
-/// The closed tube surface of every patch of the model in its reference shape.
+/// The closed tube surface of the full device (mirrored back from a symmetry-reduced model) in its reference
+/// shape.
 pub fn reference_mesh(
     model: &Model,
     segments: usize,
     samples_per_point: usize,
 ) -> anyhow::Result<TriangleMesh> {
-    let settings = TubeSettings {
-        segments_around: segments,
-        ..TubeSettings::default()
-    };
-    let mut mesh = TriangleMesh::new();
-    for (k, patch) in model.patches.iter().enumerate() {
-        let frames = FrameField::rotation_minimising(
-            &patch.curve,
-            patch.normal_hint,
-            &FrameSettings::default(),
-        )
-        .with_context(|| format!("patch `{}`", patch.name))?;
-        let radius = 0.5 * model.sections[patch.section].diameter();
-        let samples = samples_per_point.max(1) * patch.curve.num_points();
-        let phase = (k as f64 * PHASE_STEP).fract();
-        let tube = sweep_curve(&patch.curve, &frames, radius, samples, phase, &settings)
-            .with_context(|| format!("patch `{}`", patch.name))?;
-        mesh.append(&tube);
-    }
-    Ok(mesh)
+    let shapes = reference_patch_shapes(model, samples_per_point).map_err(|(k, e)| {
+        anyhow::Error::new(e).context(format!("patch `{}`", model.patches[k].name))
+    })?;
+    device_tube_mesh(model, &shapes, segments).map_err(|e| {
+        let name = &model.patches[e.rod].name;
+        anyhow::Error::new(e.source).context(format!("patch `{name}`"))
+    })
 }
 
 /// Writes the reference shape of the design to `output` (`.stl` or `.obj`).
@@ -65,10 +49,17 @@ pub fn run(design: &Path, output: &Path, segments: usize, samples: usize) -> any
         _ => obj::write_obj(output, &mesh, &header)?,
     }
     println!(
-        "wrote {} ({} triangles, {} patches, volume {:.6e} {}³)",
+        "wrote {} ({} triangles, {} patches{}, volume {:.6e} {}³)",
         output.display(),
         mesh.triangles.len(),
         model.patches.len(),
+        match model.symmetry_planes.len() {
+            0 => String::new(),
+            n => format!(
+                " mirrored about {n} symmetry plane{}",
+                if n > 1 { "s" } else { "" }
+            ),
+        },
         mesh.volume(),
         model.units.length()
     );

@@ -1,5 +1,6 @@
-//! The `stentkit` command line: `check` (validate a design and describe it) and `mesh` (write the reference
-//! shape as a closed tube surface). The only module that uses `anyhow` and prints.
+//! The `stentkit` command line: `check` (validate a design and describe it), `mesh` (write the reference
+//! shape as a closed tube surface), `run` (simulate and write the run folder), `study` (convergence studies)
+//! and `schema` (the JSON Schema of the design format). The only module that uses `anyhow` and prints.
 
 pub mod check;
 pub mod mesh;
@@ -30,9 +31,10 @@ pub enum Command {
         /// The design file (YAML).
         design: PathBuf,
     },
-    /// Simulate a design and write the run folder (history.csv, …).
+    /// Simulate a design and write the run folder: history.csv, summary.json, snapshots/ (STL and OBJ of the
+    /// full device), run.mcap (open it in Foxglove) and charts/ (SVG).
     ///
-    /// Example: stentkit run designs/bend45.yaml -o runs/bend45
+    /// Example: stentkit run designs/straight_stent.yaml -o runs/straight_stent
     Run {
         /// The design file (YAML).
         design: PathBuf,
@@ -42,7 +44,7 @@ pub enum Command {
         /// Overwrite a non-empty run folder.
         #[arg(long)]
         force: bool,
-        /// No progress output.
+        /// No progress bar (it is also hidden when stderr is not a terminal); the summary line is printed.
         #[arg(short, long)]
         quiet: bool,
         /// Report every failed Newton attempt (before the step is cut).
@@ -50,8 +52,15 @@ pub enum Command {
         verbose: bool,
     },
     /// Accuracy against cost: convergence studies.
+    ///
+    /// Example: stentkit study convergence designs/circular_arch.yaml --time 3 -o runs/arch_convergence
     #[command(subcommand)]
     Study(StudyCommand),
+    /// Print the JSON Schema of the design format, for editors that complete and check YAML (e.g. the YAML
+    /// language server: `# yaml-language-server: $schema=stentkit.schema.json` at the top of a design).
+    ///
+    /// Example: stentkit schema > stentkit.schema.json
+    Schema,
     /// Write the reference (permanent) shape as a closed tube surface: binary STL or OBJ by extension.
     ///
     /// Example: stentkit mesh designs/circular_arch.yaml -o arch.stl
@@ -115,7 +124,16 @@ pub fn main() -> ExitCode {
             force,
             quiet,
             verbose,
-        } => run::run(&design, output, force, quiet, verbose),
+        } => run::run(
+            &design,
+            run::RunOptions {
+                output,
+                force,
+                quiet,
+                verbose,
+            },
+        ),
+        Command::Schema => schema(),
         Command::Study(StudyCommand::Convergence {
             design,
             output,
@@ -139,6 +157,15 @@ pub fn main() -> ExitCode {
             ExitCode::FAILURE
         }
     }
+}
+
+/// Prints the design format's JSON Schema.
+fn schema() -> anyhow::Result<()> {
+    println!(
+        "{}",
+        serde_json::to_string_pretty(&crate::io::design::design_schema())?
+    );
+    Ok(())
 }
 
 fn study_convergence(

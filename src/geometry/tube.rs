@@ -421,7 +421,8 @@ impl TriangleMesh {
     /// outward-oriented (a reflection reverses handedness). Volume and area are preserved.
     ///
     /// Used to restore the full device from a symmetry-reduced model: append the mirrored copy to the
-    /// original. Vertices on the plane are duplicated, not merged, so each half stays a closed shell.
+    /// original. Vertices on the plane are duplicated, not merged, so each half stays a closed shell
+    /// ([`TriangleMesh::mirrored_welded`] joins open surfaces along the plane instead).
     ///
     /// # Panics
     /// If `plane_normal` is zero or not finite (a symmetry plane is validated when the design is read).
@@ -441,6 +442,56 @@ impl TriangleMesh {
                 .collect(),
             triangles: self.triangles.iter().map(|&[a, b, c]| [a, c, b]).collect(),
         }
+    }
+
+    /// This mesh together with its mirror image in the plane through `plane_point` with normal `plane_normal`,
+    /// welded along `seam`: vertices of this mesh lying in the plane (ends of rods on a symmetry plane, left
+    /// uncapped). A seam vertex is projected onto the plane and shared by both copies, so the boundary rings
+    /// of an open surface and of its mirror image become interior edges of one surface.
+    ///
+    /// Returns the welded mesh and, for every vertex `i` of this mesh, the index of its mirror image in the
+    /// result (`i` itself for a seam vertex). Vertex `i < self.vertices.len()` of the result is vertex `i` of
+    /// this mesh; the mirrored triangles follow the original ones, with their winding reversed.
+    ///
+    /// # Panics
+    /// As [`TriangleMesh::mirrored`]; also if a seam index is out of range.
+    #[track_caller]
+    pub fn mirrored_welded(
+        &self,
+        plane_point: &Vec3,
+        plane_normal: &Vec3,
+        seam: &[u32],
+    ) -> (TriangleMesh, Vec<u32>) {
+        let mirror = self.mirrored(plane_point, plane_normal);
+        let normal = plane_normal.normalize();
+        let count = self.vertices.len();
+        let mut on_seam = vec![false; count];
+        let mut out = self.clone();
+        for &i in seam {
+            let i = i as usize;
+            assert!(i < count, "seam vertex {i} of a mesh with {count} vertices");
+            on_seam[i] = true;
+            let v = out.vertices[i];
+            out.vertices[i] = v - (v - plane_point).dot(&normal) * normal;
+        }
+        let mut image = Vec::with_capacity(count);
+        for (i, &seam_vertex) in on_seam.iter().enumerate() {
+            if seam_vertex {
+                image.push(i as u32);
+            } else {
+                image.push(u32::try_from(out.vertices.len()).unwrap_or_else(|_| {
+                    panic!("mirroring {count} vertices overflows the u32 vertex indices")
+                }));
+                out.vertices.push(mirror.vertices[i]);
+            }
+        }
+        out.triangles.extend(
+            mirror
+                .triangles
+                .iter()
+                .map(|t| t.map(|i| image[i as usize])),
+        );
+        (out, image)
     }
 }
 
@@ -465,15 +516,22 @@ pub struct TubeSettings {
     /// rotations are orthonormal to rounding (`~1e-15`); anything worse than `1e-6` would draw a visibly
     /// elliptic or skewed section and indicates a bug or unnormalised input.
     pub frame_tolerance: Real,
+    /// Largest distance of an end ring from a symmetry plane, as a fraction of the tube radius, for
+    /// [`device_mesh`] to treat the ring as lying in the plane (left open and welded to its mirror image).
+    /// Default `1e-6`: a rod end held by symmetry conditions lies in the plane to the solver's round-off
+    /// (~1e-12 of the radius), while any end not on a plane is at least a fraction of a radius away.
+    pub seam_tolerance: Real,
 }
 
 impl Default for TubeSettings {
-    /// 16 segments around, `min_section_cosine = 1e-3`, `frame_tolerance = 1e-6` (see the fields).
+    /// 16 segments around, `min_section_cosine = 1e-3`, `frame_tolerance = 1e-6`, `seam_tolerance = 1e-6`
+    /// (see the fields).
     fn default() -> Self {
         Self {
             segments_around: 16,
             min_section_cosine: 1e-3,
             frame_tolerance: 1e-6,
+            seam_tolerance: 1e-6,
         }
     }
 }
@@ -583,6 +641,13 @@ impl TubeSettings {
                 expected: "finite and >= 0",
             });
         }
+        if !(self.seam_tolerance >= 0.0 && self.seam_tolerance.is_finite()) {
+            return Err(TubeError::InvalidSetting {
+                name: "seam_tolerance",
+                value: self.seam_tolerance,
+                expected: "finite and >= 0",
+            });
+        }
         Ok(())
     }
 }
@@ -618,6 +683,43 @@ pub fn sweep_tube(
     centre: &[Vec3],
     frames: &[Mat3],
     radius: Real,
+    settings: &TubeSettings,
+) -> Result<TriangleMesh, TubeError> {
+    sweep_tube_with_caps(centre, frames, radius, EndCaps::BOTH, settings)
+}
+
+/// Which ends of a swept tube get a flat cap.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct EndCaps {
+    /// Cap at the first sample.
+    pub start: bool,
+    /// Cap at the last sample.
+    pub end: bool,
+}
+
+impl EndCaps {
+    /// Both ends capped: a closed tube.
+    pub const BOTH: EndCaps = EndCaps {
+        start: true,
+        end: true,
+    };
+}
+
+/// [`sweep_tube`] with a choice of caps. An uncapped end leaves its ring as a boundary: the surface is open
+/// there, meant to be welded to another surface sharing the same ring (the mirror image of a rod ending on a
+/// symmetry plane, see [`device_mesh`]).
+///
+/// **Layout.** As [`sweep_tube`]: vertex `i·m + k` is point `k` of ring `i`; then the centre of the start cap
+/// (if capped), then that of the end cap (if capped). The start ring is vertices `0 … m−1`, the end ring
+/// `(n−1)·m … n·m − 1`.
+///
+/// # Errors
+/// As [`sweep_tube`].
+pub fn sweep_tube_with_caps(
+    centre: &[Vec3],
+    frames: &[Mat3],
+    radius: Real,
+    caps: EndCaps,
     settings: &TubeSettings,
 ) -> Result<TriangleMesh, TubeError> {
     settings.validate()?;
@@ -682,8 +784,6 @@ pub fn sweep_tube(
                 .map(|&(sin, cos)| c + radius * (cos * d2 + sign * sin * d3)),
         );
     }
-    mesh.vertices.push(centre[0]);
-    mesh.vertices.push(centre[n - 1]);
 
     // Indices fit u32: checked above.
     let m32 = m as u32;
@@ -695,11 +795,20 @@ pub fn sweep_tube(
             mesh.triangles.push([a, c, d]);
         }
     }
-    let (start, end) = ((n * m) as u32, (n * m + 1) as u32);
-    for k in 0..m32 {
-        // The start cap faces backwards (against the marching direction), the end cap forwards.
-        mesh.triangles.push([start, at(0, k + 1), at(0, k)]);
-        mesh.triangles.push([end, at(n - 1, k), at(n - 1, k + 1)]);
+    // The start cap faces backwards (against the marching direction), the end cap forwards.
+    if caps.start {
+        let start = mesh.vertices.len() as u32;
+        mesh.vertices.push(centre[0]);
+        for k in 0..m32 {
+            mesh.triangles.push([start, at(0, k + 1), at(0, k)]);
+        }
+    }
+    if caps.end {
+        let end = mesh.vertices.len() as u32;
+        mesh.vertices.push(centre[n - 1]);
+        for k in 0..m32 {
+            mesh.triangles.push([end, at(n - 1, k), at(n - 1, k + 1)]);
+        }
     }
     Ok(mesh)
 }
@@ -1548,4 +1657,277 @@ pub enum SweepError {
     /// The tube could not be built.
     #[error(transparent)]
     Tube(#[from] TubeError),
+}
+
+/// Golden-ratio conjugate: successive multiples modulo 1 are as evenly spread as possible, so no two patches
+/// get (nearly) the same section phase.
+const PHASE_STEP: Real = 0.618_033_988_749_894_9;
+
+/// The section phase of the `k`-th rod of a device, a fraction of a segment in `[0, 1)`: `k φ mod 1` with
+/// `φ` the golden-ratio conjugate. Sweeping each rod with its own phase keeps the end rings of rods meeting at
+/// a joint from coinciding vertex for vertex (see [`sweep_curve`]).
+pub fn section_phase(k: usize) -> Real {
+    (k as Real * PHASE_STEP).fract()
+}
+
+/// The rotation about the rod axis `d1` that turns a section polygon of `segments` vertices by `phase`
+/// segments: multiply a frame by it on the right.
+pub fn phase_turn(phase: Real, segments: usize) -> Mat3 {
+    *crate::math::so3::exp(&(Vec3::x() * (2.0 * PI * phase / segments.max(1) as Real))).matrix()
+}
+
+/// One rod of a device, sampled for drawing as a tube.
+#[derive(Debug, Clone, Copy)]
+pub struct RodTube<'a> {
+    /// Centreline samples \[length\].
+    pub centre: &'a [Vec3],
+    /// Section frames at the samples (columns `d1, d2, d3`).
+    pub frames: &'a [Mat3],
+    /// Tube radius \[length\].
+    pub radius: Real,
+    /// Section phase, a fraction of a segment (see [`section_phase`]).
+    pub phase: Real,
+    /// The symmetry plane (index into the planes given to [`device_mesh`]) the rod lies in, if any: it is its
+    /// own mirror image there and is drawn once, not mirrored about that plane.
+    pub in_plane: Option<usize>,
+}
+
+/// Why a device could not be meshed: which rod failed and why.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[error("rod {rod}: {source}")]
+pub struct DeviceMeshError {
+    /// Index of the rod.
+    pub rod: usize,
+    /// What went wrong.
+    #[source]
+    pub source: TubeError,
+}
+
+/// The closed surface of a whole device from the rods of a symmetry-reduced model: one tube per rod, mirrored
+/// about every symmetry plane `(point, normal)` in turn (a quarter model gives four copies of each rod), with
+/// the rods lying in a plane ([`RodTube::in_plane`]) not mirrored about it.
+///
+/// A rod end whose ring lies in a plane the rod does not lie in (within [`TubeSettings::seam_tolerance`] of
+/// the radius) continues in the mirror image: it is left uncapped and welded to its image
+/// ([`TriangleMesh::mirrored_welded`]), so the rod and its image form one closed tube, without two caps
+/// coinciding (which would make their edges non-manifold once an STL reader merges equal vertices). Every
+/// other end is capped. The result is closed ([`TriangleMesh::check_closed`]) and outward; like any device
+/// from [`sweep_tube`], tubes overlap at joints.
+///
+/// Mirroring about several planes assumes that the reflections commute (orthogonal planes, as for half and
+/// quarter models).
+///
+/// # Errors
+/// [`DeviceMeshError`] naming the rod whose tube cannot be swept.
+pub fn device_mesh(
+    rods: &[RodTube<'_>],
+    planes: &[(Vec3, Vec3)],
+    settings: &TubeSettings,
+) -> Result<TriangleMesh, DeviceMeshError> {
+    /// A rod's tube and its copies so far, with the rings still to be welded per plane.
+    struct Piece {
+        mesh: TriangleMesh,
+        in_plane: Option<usize>,
+        /// `(plane, ring vertex indices)` of open ends.
+        seams: Vec<(usize, Vec<u32>)>,
+    }
+    let m = settings.segments_around;
+    let units: Vec<Vec3> = planes
+        .iter()
+        .map(|(_, n)| n.try_normalize(0.0).unwrap_or_else(Vec3::zeros))
+        .collect();
+    let mut pieces = Vec::with_capacity(rods.len());
+    for (index, rod) in rods.iter().enumerate() {
+        let error = |source| DeviceMeshError { rod: index, source };
+        let n = rod.centre.len();
+        if n < 2 {
+            return Err(error(TubeError::TooFewSamples { count: n }));
+        }
+        if rod.frames.len() != n {
+            return Err(error(TubeError::LengthMismatch {
+                centre: n,
+                frames: rod.frames.len(),
+            }));
+        }
+        let turn = phase_turn(rod.phase, m);
+        let frames: Vec<Mat3> = rod.frames.iter().map(|f| f * turn).collect();
+        // The plane an end ring lies in: its largest distance from the plane is
+        // |(c − p)·n| + r |(d2·n, d3·n)|.
+        let ring_plane = |i: usize| {
+            let (c, f) = (rod.centre[i], frames[i]);
+            planes.iter().zip(&units).position(|((p, _), u)| {
+                let tilt = Real::hypot(f.column(1).dot(u), f.column(2).dot(u));
+                let distance = (c - p).dot(u).abs() + rod.radius * tilt;
+                distance <= settings.seam_tolerance * rod.radius
+            })
+        };
+        let open =
+            [ring_plane(0), ring_plane(n - 1)].map(|j| j.filter(|&j| Some(j) != rod.in_plane));
+        let caps = EndCaps {
+            start: open[0].is_none(),
+            end: open[1].is_none(),
+        };
+        let mesh =
+            sweep_tube_with_caps(rod.centre, &frames, rod.radius, caps, settings).map_err(error)?;
+        let ring = |i: usize| (i * m..(i + 1) * m).map(|v| v as u32).collect::<Vec<u32>>();
+        let seams = [(open[0], 0), (open[1], n - 1)]
+            .into_iter()
+            .filter_map(|(j, i)| j.map(|j| (j, ring(i))))
+            .collect();
+        pieces.push(Piece {
+            mesh,
+            in_plane: rod.in_plane,
+            seams,
+        });
+    }
+    for (j, (point, normal)) in planes.iter().enumerate() {
+        for piece in &mut pieces {
+            if piece.in_plane == Some(j) {
+                continue;
+            }
+            let seam: Vec<u32> = piece
+                .seams
+                .iter()
+                .filter(|(plane, _)| *plane == j)
+                .flat_map(|(_, ring)| ring.iter().copied())
+                .collect();
+            let (mesh, image) = piece.mesh.mirrored_welded(point, normal, &seam);
+            let others: Vec<(usize, Vec<u32>)> = piece
+                .seams
+                .iter()
+                .filter(|(plane, _)| *plane != j)
+                .cloned()
+                .collect();
+            let mirrored = others
+                .iter()
+                .map(|(plane, ring)| (*plane, ring.iter().map(|&v| image[v as usize]).collect()));
+            piece.seams = others.iter().cloned().chain(mirrored).collect();
+            piece.mesh = mesh;
+        }
+    }
+    let mut device = TriangleMesh::new();
+    for piece in &pieces {
+        device.append(&piece.mesh);
+    }
+    Ok(device)
+}
+
+#[cfg(test)]
+mod device_tests {
+    use super::*;
+
+    /// Samples and frames of a circular arc of radius `big_r` in the (x, y) plane about the origin, from angle
+    /// `a0` to `a1`: d1 the tangent, d2 radial, d3 = e_z.
+    fn arc(big_r: Real, a0: Real, a1: Real, n: usize) -> (Vec<Vec3>, Vec<Mat3>) {
+        (0..n)
+            .map(|i| {
+                let a = a0 + (a1 - a0) * i as Real / (n - 1) as Real;
+                let (s, c) = a.sin_cos();
+                let radial = Vec3::new(c, s, 0.0);
+                let tangent = Vec3::new(-s, c, 0.0);
+                (
+                    big_r * radial,
+                    Mat3::from_columns(&[tangent, radial, Vec3::z()]),
+                )
+            })
+            .unzip()
+    }
+
+    fn polygon_area(r: Real, m: usize) -> Real {
+        0.5 * m as Real * r * r * (2.0 * PI / m as Real).sin()
+    }
+
+    #[test]
+    fn quarter_ring_mirrored_about_two_planes_is_one_closed_torus() {
+        // A quarter of a ring (R = 1, r = 0.1) from the x axis to the y axis ends on both symmetry planes
+        // (y = 0 and x = 0): both ends stay open and the four copies weld into one closed torus whose volume is
+        // that of the full ring, ≈ A_m · 2πR (second order in the sampling).
+        let (centre, frames) = arc(1.0, 0.0, 0.5 * PI, 33);
+        let planes = [
+            (Vec3::zeros(), Vec3::new(0.0, 1.0, 0.0)),
+            (Vec3::zeros(), Vec3::new(1.0, 0.0, 0.0)),
+        ];
+        let settings = TubeSettings::default();
+        let rod = RodTube {
+            centre: &centre,
+            frames: &frames,
+            radius: 0.1,
+            phase: section_phase(3),
+            in_plane: None,
+        };
+        let mesh = device_mesh(&[rod], &planes, &settings).expect("device mesh");
+        assert_eq!(mesh.check_closed(), Ok(()));
+        // 4 × 32 quads of 16 segments, no caps; 4 × 33 rings of which 4 are shared.
+        assert_eq!(mesh.triangles.len(), 4 * 32 * 2 * 16);
+        assert_eq!(mesh.vertices.len(), (4 * 33 - 4) * 16);
+        let expected = polygon_area(0.1, 16) * 2.0 * PI;
+        let volume = mesh.volume();
+        assert!(
+            (volume / expected - 1.0).abs() < 2e-3,
+            "volume {volume} vs {expected}"
+        );
+    }
+
+    #[test]
+    fn rods_in_a_plane_are_drawn_once_and_ends_off_planes_are_capped() {
+        // A straight rod lying in the plane y = 0 is not mirrored about it (one copy, capped); a rod ending off
+        // every plane is mirrored and capped at both ends (two closed copies).
+        let line = |from: Vec3, to: Vec3| -> (Vec<Vec3>, Vec<Mat3>) {
+            let d1 = (to - from).normalize();
+            let frame = Mat3::from_columns(&[d1, Vec3::y(), d1.cross(&Vec3::y())]);
+            (0..5)
+                .map(|i| (from + (to - from) * (i as Real / 4.0), frame))
+                .unzip()
+        };
+        let (c0, f0) = line(Vec3::new(0.0, 0.0, 0.0), Vec3::new(0.0, 0.0, 1.0));
+        let (c1, f1) = line(Vec3::new(1.0, 0.5, 0.0), Vec3::new(1.0, 0.5, 1.0));
+        let planes = [(Vec3::zeros(), Vec3::y())];
+        let settings = TubeSettings::default();
+        let rods = [
+            RodTube {
+                centre: &c0,
+                frames: &f0,
+                radius: 0.1,
+                phase: 0.0,
+                in_plane: Some(0),
+            },
+            RodTube {
+                centre: &c1,
+                frames: &f1,
+                radius: 0.1,
+                phase: 0.5,
+                in_plane: None,
+            },
+        ];
+        let mesh = device_mesh(&rods, &planes, &settings).expect("device mesh");
+        assert_eq!(mesh.check_closed(), Ok(()));
+        let tube = polygon_area(0.1, 16);
+        assert!((mesh.volume() / (3.0 * tube) - 1.0).abs() < 1e-12);
+        assert_eq!(mesh.triangles.len(), 3 * (4 * 2 * 16 + 2 * 16));
+    }
+
+    #[test]
+    fn welded_half_ring_survives_stl_style_vertex_merging() {
+        // After welding, no two distinct vertices share a position (an STL reader merging equal positions
+        // would otherwise change the topology).
+        let (centre, frames) = arc(2.0, 0.0, PI, 41);
+        let planes = [(Vec3::zeros(), Vec3::y())];
+        let rod = RodTube {
+            centre: &centre,
+            frames: &frames,
+            radius: 0.05,
+            phase: 0.25,
+            in_plane: None,
+        };
+        let mesh = device_mesh(&[rod], &planes, &TubeSettings::default()).expect("mesh");
+        assert_eq!(mesh.check_closed(), Ok(()));
+        let mut keys: Vec<[u32; 3]> = mesh
+            .vertices
+            .iter()
+            .map(|v| [v.x as f32, v.y as f32, v.z as f32].map(f32::to_bits))
+            .collect();
+        keys.sort_unstable();
+        keys.dedup();
+        assert_eq!(keys.len(), mesh.vertices.len());
+    }
 }

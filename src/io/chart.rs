@@ -291,13 +291,25 @@ where
         .y_label_area_size(75)
         .build_cartesian_2d(x, y)
         .map_err(err)?;
-    let tick = |scale: Scale, v: &f64| tick_label(scale, *v);
+    // A linear tick within round-off of zero (1e-9 of the axis span) is zero: plotters places ticks by adding
+    // steps, and `-2.22e-16` is not a label anyone wants.
+    let span = |scale: Scale, coordinate: fn(&(Real, Real)) -> Real| {
+        axis_range(chart, scale, coordinate).map_or(0.0, |(lo, hi)| hi - lo)
+    };
+    let (x_span, y_span) = (span(chart.x_scale, |p| p.0), span(chart.y_scale, |p| p.1));
+    let tick = |scale: Scale, v: &f64, span: Real| {
+        if scale == Scale::Linear && v.abs() <= 1e-9 * span {
+            "0".to_string()
+        } else {
+            tick_label(scale, *v)
+        }
+    };
     let (xs, ys) = (chart.x_scale, chart.y_scale);
     ctx.configure_mesh()
         .x_desc(&chart.x_label)
         .y_desc(&chart.y_label)
-        .x_label_formatter(&|v| tick(xs, v))
-        .y_label_formatter(&|v| tick(ys, v))
+        .x_label_formatter(&|v| tick(xs, v, x_span))
+        .y_label_formatter(&|v| tick(ys, v, y_span))
         .light_line_style(RGBColor(235, 235, 235))
         .draw()
         .map_err(err)?;

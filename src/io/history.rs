@@ -78,22 +78,10 @@ impl HistoryWriter {
         line.push_str(&format!(
             ",{temperature:.6},{iterations},{residual:.3e},{cuts}"
         ));
-        if let Some(programme) = &sim.model().programme {
-            let u: Vec<_> = programme
-                .nodes
-                .iter()
-                .map(|d| sim.probe_displacement(&crate::model::ProbeLocation::Node(d.node)))
-                .collect();
-            line.push_str(&format!(
-                ",{:.9e},{:.9e}",
-                programme.target_fraction(&u),
-                programme.target_fraction_max(&u)
-            ));
-            if matches!(
-                programme.kind,
-                crate::model::ProgrammeKind::RadialContraction { .. }
-            ) {
-                line.push_str(&format!(",{:.9e}", -programme.mean_radial_displacement(&u)));
+        if let Some(r) = super::state::recovery(sim) {
+            line.push_str(&format!(",{:.9e},{:.9e}", r.ratio_mean, r.ratio_max));
+            if let Some(delta_r) = r.delta_r {
+                line.push_str(&format!(",{delta_r:.9e}"));
             }
         }
         let result = writeln!(self.out, "{line}").and_then(|_| self.out.flush());

@@ -1,7 +1,14 @@
-//! Files: YAML design files, STL and OBJ meshes, SVG charts.
+//! Files: YAML design files, STL and OBJ meshes, the run folder (history CSV, snapshots, MCAP recording,
+//! charts, summary), SVG charts.
 
 pub mod chart;
 pub mod design;
+pub mod device;
 pub mod history;
+pub mod mcap;
 pub mod obj;
+pub mod run_charts;
+pub mod snapshots;
+pub mod state;
 pub mod stl;
+pub mod summary;

@@ -322,6 +322,9 @@ pub struct Model {
     /// normal points into the modelled side). A patch lying in a plane ([`Model::patch_symmetry_plane`]) is its
     /// own mirror image and carries half its section in the reduced model.
     pub symmetry_planes: Vec<(Vec3, Vec3)>,
+    /// Times within `(0, end]` at which the state is recorded (snapshots) [time]: time stepping lands on each,
+    /// as on a schedule breakpoint.
+    pub record_times: Vec<Real>,
 }
 
 impl Model {
@@ -365,10 +368,11 @@ impl Model {
         })
     }
 
-    /// Every time at which a schedule changes slope or a condition switches, within `(0, end]`, sorted and
-    /// deduplicated: time stepping lands on each.
+    /// Every time at which a schedule changes slope or a condition switches, and every record time, within
+    /// `(0, end]`, sorted and deduplicated: time stepping lands on each.
     pub fn schedule_breakpoints(&self) -> Vec<Real> {
         let mut times: Vec<Real> = self.temperature.breakpoints().collect();
+        times.extend(&self.record_times);
         for node in &self.nodes {
             for c in &node.conditions.components {
                 match c {

@@ -196,11 +196,23 @@ fn mesh_refuses_other_extensions() {
 
 #[test]
 fn every_subcommand_help_has_an_example() {
-    for command in ["check", "mesh", "run"] {
-        let out = stentkit(&[command, "--help"]);
+    for command in [
+        &["check"][..],
+        &["mesh"],
+        &["run"],
+        &["schema"],
+        &["study"],
+        &["study", "convergence"],
+    ] {
+        let mut args = command.to_vec();
+        args.push("--help");
+        let out = stentkit(&args);
         assert!(out.status.success());
         let help = text(&out.stdout);
-        assert!(help.contains("Example"), "{command} --help:\n{help}");
-        assert!(help.contains(&format!("stentkit {command}")), "{help}");
+        assert!(help.contains("Example"), "{command:?} --help:\n{help}");
+        assert!(
+            help.contains(&format!("stentkit {}", command.join(" "))),
+            "{help}"
+        );
     }
 }

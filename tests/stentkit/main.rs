@@ -7,6 +7,7 @@ mod cli;
 mod design_errors;
 mod designs;
 mod mesh;
+mod outputs;
 mod solver;
 mod stent;
 mod viscoelastic;

@@ -12,6 +12,11 @@
 //! The union of overlapping shells at joints is not subtracted: `volume()` of a union of closed shells is the
 //! sum of their volumes, which is what we compare with.
 //!
+//! A symmetry-reduced stent is exported as the full device: each patch counts once per mirror copy
+//! (`io::device::patch_copies`: 4 in a quarter model, 2 for a bridge lying in a plane). A wire ending on a
+//! plane is welded to its image without caps; the two flat caps it would otherwise have coincide with opposite
+//! orientations and contribute nothing to the volume, so the sum is unchanged.
+//!
 //! STL stores `f32`: every coordinate moves by at most `2⁻²⁴|x|`, so the volume moves by at most
 //! `area · 2⁻²⁴ · max|x|`; the read-back volume must match the in-memory one within twice that.
 
@@ -22,6 +27,7 @@ use stentkit::geometry::analytic::ArcLengthTable;
 use stentkit::geometry::frame::{FrameField, FrameSettings};
 use stentkit::geometry::tube::{TriangleMesh, TubeSettings, sweep_curve};
 use stentkit::io::design::load_design;
+use stentkit::io::device::patch_copies;
 use stentkit::io::{obj, stl};
 use stentkit::math::{Real, Vec3};
 use stentkit::model::Model;
@@ -123,11 +129,12 @@ fn expected_volume(model: &Model) -> (Real, Real) {
     let m = SEGMENTS as Real;
     let mut volume = 0.0;
     let mut tolerance: Real = 1e-12;
-    for patch in &model.patches {
+    for (k, patch) in model.patches.iter().enumerate() {
         let r = 0.5 * model.sections[patch.section].diameter();
         let area = 0.5 * m * r * r * (std::f64::consts::TAU / m).sin();
         let length = ArcLengthTable::new(&patch.curve, 256).length();
-        volume += area * length;
+        let copies = patch_copies(model, k).len() as Real;
+        volume += copies * area * length;
         let samples = SAMPLES_PER_POINT * patch.curve.num_points();
         let tangent = |k: usize| {
             let u = k as Real / samples as Real;

@@ -59,8 +59,11 @@ fn time_function(f: &TimeFn, path: &str) -> Result<TimeFunction> {
     }
 }
 
-/// Builds and validates the model; returns it with the warnings found.
-pub fn build(dto: &DesignDto, default_name: &str) -> Result<(Model, Vec<String>)> {
+/// Builds and validates the model; returns it with the output settings and the warnings found.
+pub fn build(
+    dto: &DesignDto,
+    default_name: &str,
+) -> Result<(Model, super::OutputSettings, Vec<String>)> {
     let mut warnings = Vec::new();
     if let Some(v) = dto.version
         && v != 1
@@ -154,6 +157,14 @@ pub fn build(dto: &DesignDto, default_name: &str) -> Result<(Model, Vec<String>)
     if !any_prescribed {
         warnings.push("no component of any node is prescribed: rigid-body motion is unconstrained and the tangent will be singular".to_string());
     }
+    let output = output_settings(dto.output.as_ref(), &time)?;
+    let record_times = output
+        .snapshots
+        .times
+        .iter()
+        .copied()
+        .filter(|&t| t > 0.0)
+        .collect();
     let model = Model {
         name: dto.name.clone().unwrap_or_else(|| default_name.to_string()),
         units,
@@ -170,8 +181,87 @@ pub fn build(dto: &DesignDto, default_name: &str) -> Result<(Model, Vec<String>)
         node_sets,
         programme,
         symmetry_planes,
+        record_times,
     };
-    Ok((model, warnings))
+    Ok((model, output, warnings))
+}
+
+/// The `output:` block's snapshot and recording settings, with their defaults.
+fn output_settings(
+    output: Option<&OutputDto>,
+    time: &TimeSettings,
+) -> Result<super::OutputSettings> {
+    use super::{OutputSettings, RecordingSettings, SnapshotSettings};
+    let at_least = |value: Option<usize>, default: usize, min: usize, path: &str| match value {
+        None => Ok(default),
+        Some(v) if v >= min => Ok(v),
+        Some(v) => Err(issue(path, format!("{v} must be at least {min}"))),
+    };
+    let snapshots = output.and_then(|o| o.snapshots.as_ref());
+    let mut times = Vec::new();
+    for (k, NonNegative(t)) in snapshots
+        .and_then(|s| s.times.as_ref())
+        .into_iter()
+        .flatten()
+        .enumerate()
+    {
+        if *t > time.end {
+            return Err(issue(
+                format!("output.snapshots.times[{k}]"),
+                format!(
+                    "{t} is after the end of the run (time.end = {}); allowed: 0 ≤ t ≤ time.end",
+                    time.end
+                ),
+            ));
+        }
+        times.push(*t);
+    }
+    times.sort_by(Real::total_cmp);
+    times.dedup();
+    let nominal_steps = (time.end / time.step - 1e-9).ceil().max(1.0) as usize;
+    let default_every = nominal_steps.div_ceil(SnapshotSettings::DEFAULT_COUNT);
+    let snapshot_settings = SnapshotSettings {
+        times,
+        every: snapshots.and_then(|s| s.every).unwrap_or(default_every),
+        segments: at_least(
+            snapshots.and_then(|s| s.segments),
+            SnapshotSettings::DEFAULT_SEGMENTS,
+            3,
+            "output.snapshots.segments",
+        )?,
+        rings: at_least(
+            snapshots.and_then(|s| s.rings),
+            SnapshotSettings::DEFAULT_RINGS,
+            2,
+            "output.snapshots.rings",
+        )?,
+    };
+    let recording = output.and_then(|o| o.recording.as_ref());
+    let recording_settings = RecordingSettings {
+        centreline_points: at_least(
+            recording.and_then(|r| r.centreline_points),
+            RecordingSettings::DEFAULT_CENTRELINE_POINTS,
+            2,
+            "output.recording.centreline_points",
+        )?,
+        meshes: recording.and_then(|r| r.meshes).unwrap_or(true),
+        mesh_segments: at_least(
+            recording.and_then(|r| r.mesh_segments),
+            RecordingSettings::DEFAULT_MESH_SEGMENTS,
+            3,
+            "output.recording.mesh_segments",
+        )?,
+        mesh_rings: at_least(
+            recording.and_then(|r| r.mesh_rings),
+            RecordingSettings::DEFAULT_MESH_RINGS,
+            2,
+            "output.recording.mesh_rings",
+        )?,
+    };
+    Ok(OutputSettings {
+        snapshots: snapshot_settings,
+        recording: recording_settings,
+    })
 }
 
 fn material(m: &MaterialDto) -> Result<(Material, Integrator)> {

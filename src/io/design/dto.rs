@@ -4,9 +4,76 @@
 //! size must be), so serde_yaml reports the offending value with its line and column. Checks that need
 //! several fields at once are in [`super::build`].
 
+use schemars::{JsonSchema, Schema, SchemaGenerator, json_schema};
 use serde::Deserialize;
 use serde::de::{self, Deserializer, SeqAccess, Visitor};
+use std::borrow::Cow;
 use std::fmt;
+
+/// JSON Schema of a number table `[[t0, v0], [t1, v1], …]` (piecewise linear in time).
+fn table_schema() -> serde_json::Value {
+    serde_json::json!({
+        "type": "array",
+        "description": "a table [[t0, v0], [t1, v1], …] of times and values, piecewise linear in time (held constant outside)",
+        "items": {
+            "type": "array",
+            "items": {"type": "number"},
+            "minItems": 2,
+            "maxItems": 2
+        }
+    })
+}
+
+/// Small schemas written out by hand for the number types that check their values while reading.
+macro_rules! inline_schema {
+    ($t:ty, $name:literal, $schema:expr) => {
+        impl JsonSchema for $t {
+            fn inline_schema() -> bool {
+                true
+            }
+
+            fn schema_name() -> Cow<'static, str> {
+                $name.into()
+            }
+
+            fn json_schema(_: &mut SchemaGenerator) -> Schema {
+                $schema
+            }
+        }
+    };
+}
+
+inline_schema!(
+    Finite,
+    "Finite",
+    json_schema!({"type": "number", "description": "a finite number"})
+);
+inline_schema!(
+    Positive,
+    "Positive",
+    json_schema!({"type": "number", "exclusiveMinimum": 0, "description": "a finite number > 0"})
+);
+inline_schema!(
+    NonNegative,
+    "NonNegative",
+    json_schema!({"type": "number", "minimum": 0, "description": "a finite number ≥ 0"})
+);
+inline_schema!(
+    TimeFn,
+    "TimeFn",
+    json_schema!({
+        "description": "a function of time: a number (constant) or a table [[t0, v0], [t1, v1], …]",
+        "anyOf": [{"type": "number"}, table_schema()]
+    })
+);
+inline_schema!(
+    ComponentValue,
+    "ComponentValue",
+    json_schema!({
+        "description": "one component: free (`free` or null), a number, or a table [[t0, v0], [t1, v1], …]",
+        "anyOf": [{"type": "null"}, {"const": "free"}, {"type": "number"}, table_schema()]
+    })
+);
 
 /// A finite number (NaN and ±∞ rejected where read).
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -166,7 +233,7 @@ impl<'de> Visitor<'de> for ComponentVisitor {
 }
 
 /// The unit system.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, JsonSchema)]
 pub enum UnitsDto {
     /// m, N, Pa, s.
     #[serde(rename = "SI")]
@@ -177,7 +244,7 @@ pub enum UnitsDto {
 }
 
 /// The whole design file.
-#[derive(Debug, Clone, Deserialize)]
+#[derive(Debug, Clone, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct DesignDto {
     /// Format version; only 1 exists.
@@ -233,7 +300,7 @@ pub struct DesignDto {
 }
 
 /// Material block.
-#[derive(Debug, Clone, Deserialize)]
+#[derive(Debug, Clone, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct MaterialDto {
     /// Equilibrium modulus E∞ [stress], ≥ 0.
@@ -253,7 +320,7 @@ pub struct MaterialDto {
 }
 
 /// WLF constants.
-#[derive(Debug, Clone, Deserialize)]
+#[derive(Debug, Clone, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct WlfDto {
     /// C1 [-].
@@ -268,7 +335,7 @@ pub struct WlfDto {
 }
 
 /// Internal-variable update.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, JsonSchema)]
 #[serde(rename_all = "kebab-case")]
 pub enum IntegratorDto {
     /// The paper's trapezoidal rule.
@@ -280,7 +347,7 @@ pub enum IntegratorDto {
 }
 
 /// Cross-section: a solid circle (`diameter`) or given properties (`area`, `inertia`, `polar`).
-#[derive(Debug, Clone, Deserialize)]
+#[derive(Debug, Clone, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct SectionDto {
     /// Circular section diameter [length].
@@ -304,7 +371,7 @@ pub struct SectionDto {
 }
 
 /// Discretisation.
-#[derive(Debug, Clone, Deserialize)]
+#[derive(Debug, Clone, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct MeshDto {
     /// Degree.
@@ -314,7 +381,7 @@ pub struct MeshDto {
 }
 
 /// A patch; exactly one geometry key.
-#[derive(Debug, Clone, Deserialize)]
+#[derive(Debug, Clone, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct PatchDto {
     /// Unique name.
@@ -349,7 +416,7 @@ pub struct PatchDto {
 }
 
 /// Line from a point to a point.
-#[derive(Debug, Clone, Deserialize)]
+#[derive(Debug, Clone, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct LineDto {
     /// Start point.
@@ -359,7 +426,7 @@ pub struct LineDto {
 }
 
 /// Circular arc.
-#[derive(Debug, Clone, Deserialize)]
+#[derive(Debug, Clone, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct ArcDto {
     /// Centre.
@@ -373,7 +440,7 @@ pub struct ArcDto {
 }
 
 /// Helix about a local z axis.
-#[derive(Debug, Clone, Deserialize)]
+#[derive(Debug, Clone, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct HelixDto {
     /// Radius.
@@ -397,7 +464,7 @@ pub struct HelixDto {
 }
 
 /// Sinusoidal wire on a cylinder about a local z axis.
-#[derive(Debug, Clone, Deserialize)]
+#[derive(Debug, Clone, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct SineWireDto {
     /// Cylinder radius.
@@ -425,7 +492,7 @@ pub struct SineWireDto {
 }
 
 /// Automatic joints.
-#[derive(Debug, Clone, Deserialize)]
+#[derive(Debug, Clone, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct JointsDto {
     /// Join every set of patch ends closer than this [length].
@@ -433,7 +500,7 @@ pub struct JointsDto {
 }
 
 /// A named node.
-#[derive(Debug, Clone, Deserialize)]
+#[derive(Debug, Clone, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct NodeDto {
     /// Unique name.
@@ -447,7 +514,7 @@ pub struct NodeDto {
 }
 
 /// Conditions at one node, or at every node of a named set; exactly one of `node` and `node_set`.
-#[derive(Debug, Clone, Deserialize)]
+#[derive(Debug, Clone, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct ConditionDto {
     /// Node name (or `patch.start` / `patch.end`).
@@ -483,7 +550,7 @@ pub struct ConditionDto {
 }
 
 /// A distributed load.
-#[derive(Debug, Clone, Deserialize)]
+#[derive(Debug, Clone, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct DistributedLoadDto {
     /// Patch name, or `all`.
@@ -497,7 +564,7 @@ pub struct DistributedLoadDto {
 }
 
 /// Time stepping.
-#[derive(Debug, Clone, Deserialize)]
+#[derive(Debug, Clone, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct TimeDto {
     /// End time.
@@ -513,7 +580,7 @@ pub struct TimeDto {
 }
 
 /// Newton settings.
-#[derive(Debug, Clone, Deserialize)]
+#[derive(Debug, Clone, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct SolverDto {
     /// Convergence tolerance.
@@ -528,16 +595,60 @@ pub struct SolverDto {
 }
 
 /// Outputs.
-#[derive(Debug, Clone, Deserialize)]
+#[derive(Debug, Clone, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct OutputDto {
     /// Recorded points.
     #[serde(default)]
     pub probes: Vec<ProbeDto>,
+    /// Tube meshes of the full device written during a run (`snapshots/step_NNNNN.stl`, `.obj`).
+    #[serde(default)]
+    pub snapshots: Option<SnapshotsDto>,
+    /// What `run.mcap` holds besides the state per step.
+    #[serde(default)]
+    pub recording: Option<RecordingDto>,
+}
+
+/// Snapshots: the initial and final shapes always, plus every `every` steps and at the given times.
+#[derive(Debug, Clone, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct SnapshotsDto {
+    /// Times at which to write a snapshot [time], within [0, time.end]; time stepping lands on each.
+    #[serde(default)]
+    pub times: Option<Vec<NonNegative>>,
+    /// A snapshot every this many converged steps (0: none besides `times`, the initial and the final
+    /// shape). Default: about 20 snapshots over the run, ⌈nominal steps / 20⌉.
+    #[serde(default)]
+    pub every: Option<usize>,
+    /// Vertices around each tube section (default 16, at least 3).
+    #[serde(default)]
+    pub segments: Option<usize>,
+    /// Rings (sections) along each patch, about (default 41, at least 2).
+    #[serde(default)]
+    pub rings: Option<usize>,
+}
+
+/// Resolution of the recording (`run.mcap`).
+#[derive(Debug, Clone, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct RecordingDto {
+    /// Points per patch of the centrelines recorded at every step (default 21, at least 2; never more than
+    /// one per control point).
+    #[serde(default)]
+    pub centreline_points: Option<usize>,
+    /// Record the tube meshes at snapshot steps (default true).
+    #[serde(default)]
+    pub meshes: Option<bool>,
+    /// Vertices around each tube section of the recorded meshes (default 8, at least 3).
+    #[serde(default)]
+    pub mesh_segments: Option<usize>,
+    /// Rings along each patch of the recorded meshes, about (default 21, at least 2).
+    #[serde(default)]
+    pub mesh_rings: Option<usize>,
 }
 
 /// A probe: at a node, or on a patch at a parameter.
-#[derive(Debug, Clone, Deserialize)]
+#[derive(Debug, Clone, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct ProbeDto {
     /// Column prefix in history.csv.

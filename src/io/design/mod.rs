@@ -11,15 +11,77 @@ pub mod dto;
 pub mod locate;
 pub mod stent;
 
+use crate::math::Real;
 use crate::model::Model;
 use std::fmt;
 use std::path::{Path, PathBuf};
+
+/// Which tube meshes of the full device a run writes (the design's `output.snapshots`).
+#[derive(Debug, Clone, PartialEq)]
+pub struct SnapshotSettings {
+    /// Requested snapshot times [time], sorted, within `[0, end]` (the model's record times: steps land on
+    /// them).
+    pub times: Vec<Real>,
+    /// A snapshot every this many converged steps; 0 for none.
+    pub every: usize,
+    /// Vertices around each tube section.
+    pub segments: usize,
+    /// Rings (sections) along each patch, about: every k-th of the samples taken at a whole number of samples
+    /// per control point, the ends always included ([`crate::io::device::current_device_shapes`]).
+    pub rings: usize,
+}
+
+impl SnapshotSettings {
+    /// Default number of periodic snapshots over a run: `every = ⌈nominal steps / 20⌉`.
+    pub const DEFAULT_COUNT: usize = 20;
+    /// Default vertices around a section: 16, the section polygon has 97.4 % of the circle's area.
+    pub const DEFAULT_SEGMENTS: usize = 16;
+    /// Default rings per patch: 41, about one per wire diameter along a crown wire of the paper's stents
+    /// (the full straight stent: 134 000 triangles, 6.7 MB of binary STL), whatever the patch's `n`.
+    pub const DEFAULT_RINGS: usize = 41;
+}
+
+/// What `run.mcap` records (the design's `output.recording`).
+#[derive(Debug, Clone, PartialEq)]
+pub struct RecordingSettings {
+    /// Points per patch of the centrelines recorded every step (about: every k-th point of one sample per
+    /// control point, the ends always included).
+    pub centreline_points: usize,
+    /// Whether the tube meshes are recorded at snapshot steps.
+    pub meshes: bool,
+    /// Vertices around each section of a recorded mesh.
+    pub mesh_segments: usize,
+    /// Rings per patch of a recorded mesh, about.
+    pub mesh_rings: usize,
+}
+
+impl RecordingSettings {
+    /// Default centreline points per patch: 21 (one per control point of the paper's n = 20 patches). The
+    /// centrelines are recorded at every step, so they dominate the file size: the straight stent's run gives
+    /// a recording of about 20 MB.
+    pub const DEFAULT_CENTRELINE_POINTS: usize = 21;
+    /// Default vertices around a recorded section: 8, enough to see a round wire in Foxglove.
+    pub const DEFAULT_MESH_SEGMENTS: usize = 8;
+    /// Default rings per patch of a recorded mesh: 21.
+    pub const DEFAULT_MESH_RINGS: usize = 21;
+}
+
+/// The validated `output:` block besides the probes (which are part of the model).
+#[derive(Debug, Clone, PartialEq)]
+pub struct OutputSettings {
+    /// Snapshot meshes.
+    pub snapshots: SnapshotSettings,
+    /// The MCAP recording.
+    pub recording: RecordingSettings,
+}
 
 /// A design read from a file.
 #[derive(Debug, Clone)]
 pub struct Design {
     /// The validated model.
     pub model: Model,
+    /// Snapshot and recording settings.
+    pub output: OutputSettings,
     /// Things worth knowing that do not stop a run.
     pub warnings: Vec<String>,
     /// The YAML text as read (embedded in run recordings).
@@ -163,6 +225,13 @@ impl DesignOverrides {
     }
 }
 
+/// The JSON Schema (draft 2020-12) of the design format, for editors that complete and check YAML.
+pub fn design_schema() -> serde_json::Value {
+    let mut schema = schemars::schema_for!(dto::DesignDto);
+    schema.insert("title".into(), "stentkit design, format version 1".into());
+    schema.to_value()
+}
+
 /// Validates a design given as text; `path` names it in errors.
 pub fn parse_design(text: &str, path: &Path) -> Result<Design, DesignError> {
     parse_design_with(text, path, &DesignOverrides::default())
@@ -214,7 +283,7 @@ pub fn parse_design_with(
         || "design".to_string(),
         |s| s.to_string_lossy().into_owned(),
     );
-    let (model, warnings) = build::build(&dto, &stem).map_err(|issue| {
+    let (model, output, warnings) = build::build(&dto, &stem).map_err(|issue| {
         let pos = locator.find(&issue.path);
         DesignError::Invalid {
             file: file.clone(),
@@ -226,6 +295,7 @@ pub fn parse_design_with(
     })?;
     Ok(Design {
         model,
+        output,
         warnings,
         source: text.to_string(),
         path: file,

@@ -38,11 +38,12 @@ use crate::math::{Mat3, Real, Vec3};
 use crate::model::{
     Component, DrivenNode, End, Node, NodeConditions, Patch, PatchEnd, Programme, ProgrammeKind,
 };
+use schemars::JsonSchema;
 use serde::Deserialize;
 use std::collections::BTreeMap;
 
 /// The `stent:` block.
-#[derive(Debug, Clone, Deserialize)]
+#[derive(Debug, Clone, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct StentDto {
     /// Number of crowns.
@@ -80,7 +81,7 @@ pub struct StentDto {
 }
 
 /// Bridge shape keyword.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, JsonSchema)]
 #[serde(rename_all = "snake_case")]
 pub enum BridgeShapeDto {
     /// Straight.
@@ -90,7 +91,7 @@ pub enum BridgeShapeDto {
 }
 
 /// Sinusoidal bridge direction keyword.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, JsonSchema)]
 #[serde(rename_all = "snake_case")]
 pub enum BridgeDirectionDto {
     /// On the cylinder.
@@ -100,7 +101,7 @@ pub enum BridgeDirectionDto {
 }
 
 /// The bridges.
-#[derive(Debug, Clone, Deserialize)]
+#[derive(Debug, Clone, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct BridgesDto {
     /// `straight` or `sinusoidal`.
@@ -123,7 +124,7 @@ pub struct BridgesDto {
 }
 
 /// The centreline: exactly one of `straight`, `arc`, `points`.
-#[derive(Debug, Clone, Deserialize)]
+#[derive(Debug, Clone, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct CentrelineDto {
     /// A straight axis.
@@ -138,7 +139,7 @@ pub struct CentrelineDto {
 }
 
 /// A straight axis.
-#[derive(Debug, Clone, Deserialize)]
+#[derive(Debug, Clone, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct StraightDto {
     /// Centre of the first crown (default origin).
@@ -153,7 +154,7 @@ pub struct StraightDto {
 }
 
 /// A circular-arc axis.
-#[derive(Debug, Clone, Deserialize)]
+#[derive(Debug, Clone, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct ArcCentrelineDto {
     /// Centre of the circle.
@@ -170,7 +171,7 @@ pub struct ArcCentrelineDto {
 }
 
 /// A point-list axis.
-#[derive(Debug, Clone, Deserialize)]
+#[derive(Debug, Clone, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct PointsCentrelineDto {
     /// The points (a cubic spline passes through them).
@@ -181,7 +182,7 @@ pub struct PointsCentrelineDto {
 }
 
 /// Symmetry keyword.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, JsonSchema)]
 #[serde(rename_all = "snake_case")]
 pub enum SymmetryDto {
     /// No symmetry.
@@ -193,7 +194,7 @@ pub enum SymmetryDto {
 }
 
 /// Programme kind keyword.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, JsonSchema)]
 #[serde(rename_all = "snake_case")]
 pub enum ProgrammeKindDto {
     /// `η = −Δr e_r`.
@@ -203,7 +204,7 @@ pub enum ProgrammeKindDto {
 }
 
 /// The `programme:` block.
-#[derive(Debug, Clone, Deserialize)]
+#[derive(Debug, Clone, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct ProgrammeDto {
     /// `radial_contraction` or `target_shape`.
@@ -225,7 +226,7 @@ pub struct ProgrammeDto {
 }
 
 /// The temporary placement of a target-shape programme.
-#[derive(Debug, Clone, Deserialize)]
+#[derive(Debug, Clone, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct TemporaryDto {
     /// Straighten the centreline about its middle station.

@@ -1,0 +1,228 @@
+#!/usr/bin/env python3
+"""Independent check of stentkit's run outputs with the official readers (CI runs it after the tests).
+
+Usage: check_outputs.py DIR [DIR ...]
+
+Every DIR is searched recursively. Checked:
+
+* every ``*.mcap`` file, with the official Python ``mcap`` reader: the file is finalised (summary section with
+  statistics), the channels ``/state`` and ``/centrelines`` (and ``/device`` if present) have JSON encoding and
+  the expected JSON schemas (``stentkit.State``, ``foxglove.SceneUpdate``), message counts agree with the
+  statistics (and with the run's ``summary.json``: one ``/state`` per step plus the initial state, one
+  ``/device`` per snapshot), log times increase strictly per channel and never decrease in file order, every
+  message is valid JSON of its schema's shape (Foxglove scene entities with line strips and indexed triangle
+  lists), the design YAML is attached, and a ``stentkit`` metadata record names version, command line and
+  units;
+* every ``*.stl`` file, with trimesh: watertight, consistently wound, positive volume (and, for snapshots
+  listed in a ``summary.json``, the volume stentkit reported, to single precision);
+* every run folder (a folder with ``summary.json``): ``history.csv`` has one row per recorded state, the files
+  the summary lists exist, and the charts are SVG documents.
+
+Exits with status 1 if anything fails, or if no MCAP file was found at all; prints one line per file and a
+closing ``N passed, N failed`` line.
+"""
+
+import csv
+import json
+import math
+import pathlib
+import sys
+
+import numpy as np
+import trimesh
+from mcap.reader import make_reader
+
+STATE = "/state"
+CENTRELINES = "/centrelines"
+DEVICE = "/device"
+SCHEMAS = {STATE: "stentkit.State", CENTRELINES: "foxglove.SceneUpdate", DEVICE: "foxglove.SceneUpdate"}
+ENTITY_FIELDS = ["timestamp", "frame_id", "id", "lifetime", "frame_locked", "metadata", "arrows", "cubes",
+                 "spheres", "cylinders", "lines", "triangles", "texts", "models"]
+
+
+class Failure(Exception):
+    pass
+
+
+def require(condition, message):
+    if not condition:
+        raise Failure(message)
+
+
+def run_summary(folder):
+    path = folder / "summary.json"
+    if path.is_file():
+        return json.loads(path.read_text())
+    return None
+
+
+def check_point(p):
+    require(isinstance(p, dict) and all(isinstance(p.get(k), (int, float)) for k in "xyz"), f"bad point {p!r}")
+
+
+def check_scene_update(message, topic):
+    require(set(message) >= {"deletions", "entities"}, f"{topic}: SceneUpdate without deletions/entities")
+    require(len(message["entities"]) >= 1, f"{topic}: SceneUpdate without entity")
+    for entity in message["entities"]:
+        missing = [f for f in ENTITY_FIELDS if f not in entity]
+        require(not missing, f"{topic}: entity lacks {missing}")
+        for line in entity["lines"]:
+            require(line["type"] == 0, f"{topic}: line type {line['type']} is not LINE_STRIP")
+            require(len(line["points"]) >= 2, f"{topic}: line with {len(line['points'])} points")
+            require(line["thickness"] > 0, f"{topic}: line thickness {line['thickness']}")
+            for p in line["points"]:
+                check_point(p)
+        for tri in entity["triangles"]:
+            points, indices = tri["points"], tri["indices"]
+            require(len(points) >= 3 and len(indices) % 3 == 0 and len(indices) > 0,
+                    f"{topic}: triangle list with {len(points)} points and {len(indices)} indices")
+            require(0 <= min(indices) and max(indices) < len(points), f"{topic}: triangle index out of range")
+            for p in points[:: max(1, len(points) // 100)]:
+                check_point(p)
+    return sum(len(e["lines"]) for e in message["entities"]), sum(len(e["triangles"]) for e in message["entities"])
+
+
+def check_mcap(path):
+    folder = path.parent
+    summary_json = run_summary(folder)
+    with open(path, "rb") as f:
+        reader = make_reader(f)
+        summary = reader.get_summary()
+        require(summary is not None and summary.statistics is not None, "no summary section: the file was not finished")
+        stats = summary.statistics
+        topics = {c.topic: c for c in summary.channels.values()}
+        require(STATE in topics and CENTRELINES in topics, f"channels {sorted(topics)}")
+        for topic, channel in topics.items():
+            require(topic in SCHEMAS, f"unexpected channel {topic}")
+            require(channel.message_encoding == "json", f"{topic}: encoding {channel.message_encoding}")
+            schema = summary.schemas[channel.schema_id]
+            require(schema.name == SCHEMAS[topic], f"{topic}: schema {schema.name}")
+            require(schema.encoding == "jsonschema", f"{topic}: schema encoding {schema.encoding}")
+            body = json.loads(schema.data)
+            require(body.get("type") == "object" and "properties" in body, f"{topic}: schema is not an object schema")
+
+        counts = {t: 0 for t in topics}
+        last_per_channel = {}
+        last_log_time = -1
+        state_times = []
+        for schema, channel, message in reader.iter_messages(log_time_order=False):
+            topic = channel.topic
+            counts[topic] += 1
+            t = message.log_time
+            require(t >= last_log_time, f"log time {t} after {last_log_time} in file order")
+            require(t > last_per_channel.get(topic, -1), f"{topic}: log time {t} not after {last_per_channel.get(topic)}")
+            last_log_time = t
+            last_per_channel[topic] = t
+            data = json.loads(message.data)
+            if topic == STATE:
+                for key in ("step", "time", "temperature", "iterations", "residual", "probes", "loads"):
+                    require(key in data, f"/state lacks {key}")
+                require(math.isfinite(data["temperature"]), "/state temperature not finite")
+                require(abs(data["time"] * 1e9 - t) <= 1 + 1e-6 * t, f"/state time {data['time']} vs log time {t}")
+                state_times.append(data["time"])
+            else:
+                lines, triangles = check_scene_update(data, topic)
+                require(lines > 0 if topic == CENTRELINES else triangles > 0, f"{topic}: empty scene")
+
+        by_id = {topics[t].id: t for t in topics}
+        for channel_id, n in stats.channel_message_counts.items():
+            require(counts[by_id[channel_id]] == n, f"{by_id[channel_id]}: {counts[by_id[channel_id]]} messages, statistics say {n}")
+        require(sum(counts.values()) == stats.message_count, "message count differs from statistics")
+        require(counts[STATE] == counts[CENTRELINES] and counts[STATE] >= 1, f"counts {counts}")
+        require(all(b > a for a, b in zip(state_times, state_times[1:])), "/state times do not increase")
+        if summary_json is not None:
+            require(counts[STATE] == summary_json["steps"] + 1,
+                    f"{counts[STATE]} states for {summary_json['steps']} steps")
+            if DEVICE in counts:
+                require(counts[DEVICE] == len(summary_json["snapshots"]),
+                        f"{counts[DEVICE]} meshes for {len(summary_json['snapshots'])} snapshots")
+            require(summary_json["files"]["mcap_bytes"] == path.stat().st_size, "mcap_bytes differs from the file size")
+
+        attachments = list(reader.iter_attachments())
+        require(len(attachments) == 1, f"{len(attachments)} attachments")
+        design = attachments[0]
+        require(design.media_type == "application/yaml", f"attachment type {design.media_type}")
+        text = design.data.decode("utf-8")
+        require("units:" in text, "the attached design has no `units:`")
+        metadata = [m for m in reader.iter_metadata() if m.name == "stentkit"]
+        require(len(metadata) == 1, "no `stentkit` metadata record")
+        for key in ("stentkit_version", "command_line", "units", "length_unit"):
+            require(metadata[0].metadata.get(key), f"metadata lacks {key}")
+    return f"{counts} messages, {path.stat().st_size} bytes"
+
+
+
+
+SNAPSHOT_VOLUMES = {}
+
+
+def check_stl(path):
+    mesh = trimesh.load(str(path), force="mesh")
+    require(len(mesh.faces) > 0, "no triangles")
+    require(mesh.is_watertight, "not watertight")
+    require(mesh.is_winding_consistent, "inconsistent winding")
+    volume = float(mesh.volume)
+    require(volume > 0, f"volume {volume} ≤ 0")
+    expected = SNAPSHOT_VOLUMES.get(path.resolve())
+    if expected is not None:
+        extent = float(np.abs(mesh.vertices).max())
+        bound = 4.0 * float(mesh.area) * extent * 2.0 ** -24 + 1e-9 * abs(expected)
+        require(abs(volume - expected) <= bound, f"volume {volume} vs {expected} reported (bound {bound:.2e})")
+    return f"{len(mesh.faces)} triangles, volume {volume:.6g}"
+
+
+def check_run_folder(folder):
+    summary = run_summary(folder)
+    for key in ("design", "units", "stentkit_version", "command_line", "wall_time_s", "steps",
+                "newton_iterations", "step_cuts", "final_time", "unknowns", "snapshots", "warnings", "notices"):
+        require(key in summary, f"summary.json lacks {key}")
+    with open(folder / "history.csv", newline="") as f:
+        rows = list(csv.reader(f))
+    require(rows and rows[0][0] == "time", "history.csv header")
+    require(len(rows) - 1 == summary["steps"] + 1, f"history.csv has {len(rows) - 1} rows for {summary['steps']} steps")
+    require(summary["snapshots"], "no snapshots")
+    steps = [s["step"] for s in summary["snapshots"]]
+    require(steps[0] == 0, "no initial snapshot")
+    require(steps == sorted(set(steps)), "snapshot steps not increasing")
+    for s in summary["snapshots"]:
+        for key in ("stl", "obj"):
+            require((folder / s[key]).is_file(), f"missing {s[key]}")
+        SNAPSHOT_VOLUMES[(folder / s["stl"]).resolve()] = s["volume"]
+    for chart in summary["files"]["charts"]:
+        head = (folder / chart).read_text()[:200]
+        require("<svg" in head, f"{chart} is not SVG")
+    require(summary["files"]["charts"], "no charts")
+    return f"{summary['design']}: {summary['status']}, {summary['steps']} steps, {len(steps)} snapshots"
+
+
+def main(argv):
+    if len(argv) < 2:
+        print(__doc__)
+        return 2
+    roots = [pathlib.Path(a) for a in argv[1:]]
+    missing = [r for r in roots if not r.is_dir()]
+    if missing:
+        print(f"not a directory: {', '.join(map(str, missing))}")
+        return 1
+    folders = sorted({p.parent for r in roots for p in r.rglob("summary.json")})
+    mcaps = sorted(p for r in roots for p in r.rglob("*.mcap"))
+    stls = sorted(p for r in roots for p in r.rglob("*.stl"))
+    passed = failed = 0
+    for kind, paths, check in (("run", folders, check_run_folder), ("mcap", mcaps, check_mcap), ("stl", stls, check_stl)):
+        for path in paths:
+            try:
+                detail = check(path)
+                passed += 1
+                print(f"ok    {kind:4} {path}: {detail}")
+            except Exception as e:  # noqa: BLE001 - every failure is reported, then counted
+                failed += 1
+                print(f"FAIL  {kind:4} {path}: {type(e).__name__}: {e}")
+    if not mcaps:
+        failed += 1
+        print("FAIL  no MCAP file found under " + ", ".join(map(str, roots)))
+    print(f"check_outputs: {passed} passed, {failed} failed")
+    return 1 if failed else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main(sys.argv))

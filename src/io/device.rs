@@ -1,0 +1,194 @@
+//! The full device from a (possibly symmetry-reduced) model, as exports draw it (DESIGN §5: exports always
+//! show the full device): closed tube meshes and centrelines, mirrored back about the model's symmetry planes.
+//!
+//! Both take the rods sampled as [`PatchShape`]s, from a running simulation
+//! ([`crate::solver::shape::current_shapes`], with the solver's section frames) or from the reference geometry
+//! ([`reference_patch_shapes`], rotation-minimising frames, no simulation needed). Each patch is swept with its
+//! own section phase ([`section_phase`]) so that tubes meeting at a joint never share a ring; rods lying in a
+//! symmetry plane (bridges kept with half their section) are drawn once at their full drawing diameter, and
+//! rods ending on a plane are welded to their mirror images ([`device_mesh`]).
+
+use crate::geometry::GeometryError;
+use crate::geometry::frame::{FrameField, FrameSettings};
+use crate::geometry::tube::{
+    DeviceMeshError, RodTube, TriangleMesh, TubeSettings, device_mesh, section_phase,
+};
+use crate::math::{Real, Vec3};
+use crate::model::Model;
+use crate::solver::Simulation;
+use crate::solver::shape::{PatchShape, current_shapes};
+
+/// Indices of about `target` of `n` samples, evenly spaced (every k-th, `k = round((n − 1)/(target − 1))`),
+/// the first and the last always included; all of them when `n ≤ target`.
+pub fn decimation(n: usize, target: usize) -> Vec<usize> {
+    let target = target.max(2);
+    if n <= target {
+        return (0..n).collect();
+    }
+    let k = (((n - 1) as Real / (target - 1) as Real).round() as usize).max(1);
+    let mut out: Vec<usize> = (0..n).step_by(k).collect();
+    if (n - 1) % k != 0 {
+        out.push(n - 1);
+    }
+    out
+}
+
+/// `shape` reduced to about `target` samples ([`decimation`]).
+pub fn decimated(shape: &PatchShape, target: usize) -> PatchShape {
+    let keep = decimation(shape.points.len(), target);
+    PatchShape {
+        points: keep.iter().map(|&i| shape.points[i]).collect(),
+        frames: keep.iter().map(|&i| shape.frames[i]).collect(),
+    }
+}
+
+/// Every patch of the simulation in its current configuration with about `samples` samples (rings of a tube,
+/// points of a centreline) per patch, whatever its number of control points `n`: sampled at the smallest whole
+/// number of samples per control point that gives at least that many for every patch, then reduced
+/// ([`decimated`]). The ends of every patch are always samples.
+pub fn current_device_shapes(sim: &Simulation<'_>, samples: usize) -> Vec<PatchShape> {
+    let per_point = sim
+        .model()
+        .patches
+        .iter()
+        .map(|p| (samples.saturating_sub(1)).div_ceil(p.curve.num_points().max(1)))
+        .max()
+        .unwrap_or(1)
+        .max(1);
+    current_shapes(sim, per_point)
+        .iter()
+        .map(|s| decimated(s, samples))
+        .collect()
+}
+
+/// Samples every patch of the model in its reference shape with rotation-minimising frames: `m + 1` points
+/// at `u = k/m`, `m = samples_per_point · n` (the sampling of [`crate::solver::shape`]).
+///
+/// # Errors
+/// [`GeometryError`] with the patch index when a frame cannot be evaluated.
+pub fn reference_patch_shapes(
+    model: &Model,
+    samples_per_point: usize,
+) -> Result<Vec<PatchShape>, (usize, GeometryError)> {
+    model
+        .patches
+        .iter()
+        .enumerate()
+        .map(|(k, patch)| {
+            let frames = FrameField::rotation_minimising(
+                &patch.curve,
+                patch.normal_hint,
+                &FrameSettings::default(),
+            )
+            .map_err(|e| (k, e))?;
+            let (u0, u1) = patch.curve.knots().domain();
+            let m = (samples_per_point.max(1) * patch.curve.num_points()).max(1);
+            let mut shape = PatchShape {
+                points: Vec::with_capacity(m + 1),
+                frames: Vec::with_capacity(m + 1),
+            };
+            for i in 0..=m {
+                let u = u0 + (u1 - u0) * i as Real / m as Real;
+                let f = frames.at(&patch.curve, u).map_err(|e| (k, e))?;
+                shape.points.push(f.position);
+                shape.frames.push(f.rotation);
+            }
+            Ok(shape)
+        })
+        .collect()
+}
+
+/// The closed tube surface of the full device: one tube per patch of `shapes` (in the model's patch order)
+/// with `segments` vertices around, mirrored about the model's symmetry planes.
+///
+/// # Errors
+/// [`DeviceMeshError`] whose `rod` is the index of the patch that cannot be swept.
+pub fn device_tube_mesh(
+    model: &Model,
+    shapes: &[PatchShape],
+    segments: usize,
+) -> Result<TriangleMesh, DeviceMeshError> {
+    let settings = TubeSettings {
+        segments_around: segments,
+        ..TubeSettings::default()
+    };
+    let rods: Vec<RodTube<'_>> = shapes
+        .iter()
+        .enumerate()
+        .map(|(k, shape)| {
+            let patch = &model.patches[k];
+            RodTube {
+                centre: &shape.points,
+                frames: &shape.frames,
+                radius: 0.5 * model.sections[patch.section].diameter(),
+                phase: section_phase(k),
+                in_plane: model.patch_symmetry_plane(k),
+            }
+        })
+        .collect();
+    device_mesh(&rods, &model.symmetry_planes, &settings)
+}
+
+/// The reflections that make the full device's copies of patch `patch`: each entry lists the symmetry planes
+/// (indices into [`Model::symmetry_planes`]) to reflect about, the empty list being the patch itself. A patch
+/// lying in a plane is not reflected about that plane.
+pub fn patch_copies(model: &Model, patch: usize) -> Vec<Vec<usize>> {
+    let own = model.patch_symmetry_plane(patch);
+    let mut copies = vec![Vec::new()];
+    for j in 0..model.symmetry_planes.len() {
+        if own == Some(j) {
+            continue;
+        }
+        let more: Vec<Vec<usize>> = copies
+            .iter()
+            .map(|c| c.iter().copied().chain([j]).collect())
+            .collect();
+        copies.extend(more);
+    }
+    copies
+}
+
+/// `point` reflected about each listed symmetry plane in turn.
+pub fn reflect(model: &Model, planes: &[usize], point: Vec3) -> Vec3 {
+    planes.iter().fold(point, |x, &j| {
+        let (p, n) = &model.symmetry_planes[j];
+        let n = n.normalize();
+        x - 2.0 * (x - p).dot(&n) * n
+    })
+}
+
+/// The centrelines of the full device: every patch's points and their mirror images (a quarter model gives
+/// four polylines per patch off the planes, two for a patch lying in one).
+pub fn device_centrelines(model: &Model, shapes: &[PatchShape]) -> Vec<Vec<Vec3>> {
+    shapes
+        .iter()
+        .enumerate()
+        .flat_map(|(k, shape)| {
+            patch_copies(model, k).into_iter().map(move |planes| {
+                shape
+                    .points
+                    .iter()
+                    .map(|&x| reflect(model, &planes, x))
+                    .collect()
+            })
+        })
+        .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn decimation_keeps_the_ends_and_spreads_evenly() {
+        // n = 82 (p = 6, n = 81 patches sampled once per control point): every 4th, 0 … 80, and the end.
+        let d = decimation(82, 21);
+        assert_eq!(d.len(), 22);
+        assert_eq!((d[0], d[20], d[21]), (0, 80, 81));
+        assert_eq!(decimation(21, 21), (0..21).collect::<Vec<_>>());
+        assert_eq!(decimation(24, 21).len(), 24);
+        let d = decimation(41, 21);
+        assert_eq!((d.len(), d[20]), (21, 40));
+        assert_eq!(decimation(5, 0), (0..2).map(|i| 4 * i).collect::<Vec<_>>());
+    }
+}

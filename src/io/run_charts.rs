@@ -1,0 +1,224 @@
+//! The charts of a run folder (`charts/*.svg`), drawn from the states recorded during the run, in the spirit of
+//! the paper's history figures:
+//!
+//! * `temperature.svg` — temperature against time (every run);
+//! * `displacement.svg` — the displacement components of every probe against time (designs with probes);
+//! * `normalised.svg` — the probe components, the loads and the temperature each divided by its largest
+//!   magnitude over the run, on the same axes (the paper's cantilever figure: how the response follows the
+//!   programme);
+//! * `recovery.svg` — the mean and largest recovery ratio against time with the normalised temperature and
+//!   the programme's ramp (designs with a programme: 1 at the temporary shape, 0 at the permanent one);
+//! * `delta_r.svg` — the mean radial contraction Δr against time (radial-contraction programmes);
+//! * `newton.svg` — Newton iterations per step against time (every run).
+
+use super::chart::{ChartError, LineChart, Series, write_svg};
+use super::state::{LoadChannel, StateSample, load_channels};
+use crate::math::Real;
+use crate::model::Model;
+use crate::solver::{Observer, Simulation, StepReport};
+use std::ops::ControlFlow;
+use std::path::{Path, PathBuf};
+
+/// Collects the states of a run for its charts.
+pub struct RunCharts {
+    channels: Vec<LoadChannel>,
+    samples: Vec<StateSample>,
+}
+
+impl RunCharts {
+    /// Folder of the charts inside the run folder.
+    pub const FOLDER: &'static str = "charts";
+
+    /// An empty collection for a run of `model`.
+    pub fn new(model: &Model) -> Self {
+        Self {
+            channels: load_channels(model),
+            samples: Vec::new(),
+        }
+    }
+
+    /// The states recorded so far.
+    pub fn samples(&self) -> &[StateSample] {
+        &self.samples
+    }
+
+    /// The charts of the states recorded so far (see the module documentation).
+    pub fn charts(&self, model: &Model) -> Vec<(&'static str, LineChart)> {
+        let name = &model.name;
+        let length = model.units.length();
+        let times: Vec<Real> = self.samples.iter().map(|s| s.time).collect();
+        let series = |f: &dyn Fn(&StateSample) -> Real| -> Vec<(Real, Real)> {
+            times
+                .iter()
+                .zip(&self.samples)
+                .map(|(&t, s)| (t, f(s)))
+                .collect()
+        };
+        let normalised = |points: Vec<(Real, Real)>| -> Vec<(Real, Real)> {
+            let peak = points.iter().map(|p| p.1.abs()).fold(0.0, Real::max);
+            let scale = if peak > 0.0 { 1.0 / peak } else { 1.0 };
+            points.into_iter().map(|(t, v)| (t, v * scale)).collect()
+        };
+        let mut charts = Vec::new();
+
+        let mut temperature = LineChart::new(
+            format!("{name}: temperature"),
+            "time [s]",
+            "temperature [°C]",
+        );
+        temperature
+            .series
+            .push(Series::new("T", series(&|s| s.temperature)).with_color(3));
+        charts.push(("temperature.svg", temperature));
+
+        if !model.probes.is_empty() {
+            let mut displacement = LineChart::new(
+                format!("{name}: probe displacements"),
+                "time [s]",
+                format!("displacement [{length}]"),
+            );
+            let mut overlay = LineChart::new(
+                format!("{name}: response and programme, each divided by its largest magnitude"),
+                "time [s]",
+                "normalised value [-]",
+            );
+            for (p, probe) in model.probes.iter().enumerate() {
+                for (c, axis) in ["ux", "uy", "uz"].iter().enumerate() {
+                    let points = series(&|s| s.probes[p][c]);
+                    if points.iter().all(|q| q.1.abs() == 0.0) {
+                        continue;
+                    }
+                    let label = format!("{}.{axis}", probe.name);
+                    displacement
+                        .series
+                        .push(Series::new(label.clone(), points.clone()));
+                    overlay.series.push(Series::new(label, normalised(points)));
+                }
+            }
+            for (l, channel) in self.channels.iter().enumerate() {
+                overlay.series.push(
+                    Series::new(
+                        format!("{} [{}]", channel.name, channel.unit),
+                        normalised(series(&|s| s.loads[l])),
+                    )
+                    .dashed(),
+                );
+            }
+            overlay.series.push(
+                Series::new("T", normalised(series(&|s| s.temperature)))
+                    .dashed()
+                    .with_color(3),
+            );
+            if !displacement.series.is_empty() {
+                charts.push(("displacement.svg", displacement));
+                charts.push(("normalised.svg", overlay));
+            }
+        }
+
+        if self.samples.iter().any(|s| s.recovery.is_some()) {
+            let recovery = |f: &dyn Fn(&super::state::Recovery) -> Real| {
+                self.samples
+                    .iter()
+                    .filter_map(|s| s.recovery.as_ref().map(|r| (s.time, f(r))))
+                    .collect::<Vec<_>>()
+            };
+            let mut chart = LineChart::new(
+                format!("{name}: recovery ratio |η|/|η_temp| (1: temporary shape, 0: permanent)"),
+                "time [s]",
+                "ratio [-], normalised temperature [-]",
+            );
+            chart
+                .series
+                .push(Series::new("mean ratio", recovery(&|r| r.ratio_mean)));
+            chart
+                .series
+                .push(Series::new("largest ratio", recovery(&|r| r.ratio_max)));
+            let (lo, hi) = model.temperature.range();
+            let span = if hi > lo { hi - lo } else { 1.0 };
+            chart.series.push(
+                Series::new(
+                    format!("(T − {lo} °C)/{span} °C"),
+                    series(&|s| (s.temperature - lo) / span),
+                )
+                .dashed()
+                .with_color(3),
+            );
+            if let Some(l) = self.channels.iter().position(|c| c.name == "programme") {
+                chart.series.push(
+                    Series::new("programme ramp f(t)", series(&|s| s.loads[l]))
+                        .dashed()
+                        .with_color(7),
+                );
+            }
+            charts.push(("recovery.svg", chart));
+            let delta_r: Vec<(Real, Real)> = self
+                .samples
+                .iter()
+                .filter_map(|s| s.recovery.and_then(|r| r.delta_r).map(|d| (s.time, d)))
+                .collect();
+            if !delta_r.is_empty() {
+                let mut chart = LineChart::new(
+                    format!("{name}: mean radial contraction Δr of the driven nodes"),
+                    "time [s]",
+                    format!("Δr [{length}]"),
+                );
+                chart.series.push(Series::new("Δr", delta_r));
+                charts.push(("delta_r.svg", chart));
+            }
+        }
+
+        let mut newton = LineChart::new(
+            format!("{name}: Newton iterations per step"),
+            "time [s]",
+            "iterations",
+        );
+        newton.series.push(
+            Series::new(
+                "iterations",
+                self.samples
+                    .iter()
+                    .skip(1)
+                    .map(|s| (s.time, s.iterations as Real))
+                    .collect(),
+            )
+            .with_color(4),
+        );
+        if newton.series[0].points.is_empty() {
+            newton.series[0].points.push((0.0, 0.0));
+        }
+        charts.push(("newton.svg", newton));
+        charts
+    }
+
+    /// Writes the charts into `run_dir/charts`; returns the files written (relative to `run_dir`).
+    ///
+    /// # Errors
+    /// [`ChartError`] when a chart cannot be drawn or written.
+    pub fn write(&self, model: &Model, run_dir: &Path) -> Result<Vec<PathBuf>, ChartError> {
+        let folder = run_dir.join(Self::FOLDER);
+        std::fs::create_dir_all(&folder).map_err(|source| ChartError::Io {
+            path: folder.clone(),
+            source,
+        })?;
+        let mut written = Vec::new();
+        for (file, chart) in self.charts(model) {
+            write_svg(&chart, &folder.join(file))?;
+            written.push(Path::new(Self::FOLDER).join(file));
+        }
+        Ok(written)
+    }
+}
+
+impl Observer for RunCharts {
+    fn start(&mut self, sim: &Simulation<'_>) -> ControlFlow<()> {
+        self.samples
+            .push(StateSample::of(sim, &self.channels, None));
+        ControlFlow::Continue(())
+    }
+
+    fn step(&mut self, sim: &Simulation<'_>, report: &StepReport) -> ControlFlow<()> {
+        self.samples
+            .push(StateSample::of(sim, &self.channels, Some(report)));
+        ControlFlow::Continue(())
+    }
+}

@@ -1,0 +1,243 @@
+//! Snapshots of a run: the full device as closed tubes swept along the deformed centrelines with the solver's
+//! section frames, written as binary STL and OBJ (`snapshots/step_NNNNN.stl`, `.obj`) at the initial state, at
+//! the final one, every `every` steps and at the requested times (time stepping lands on those: they are the
+//! model's record times).
+
+use super::design::SnapshotSettings;
+use super::device::{current_device_shapes, device_tube_mesh};
+use super::stl::MeshIoError;
+use super::{obj, stl};
+use crate::geometry::tube::{DeviceMeshError, TriangleMesh};
+use crate::math::Real;
+use crate::model::Model;
+use crate::solver::{Observer, Simulation, StepReport};
+use std::ops::ControlFlow;
+use std::path::{Path, PathBuf};
+
+/// Decides which states get a snapshot (shared by the snapshot files and the meshes of the recording).
+#[derive(Debug, Clone, PartialEq)]
+pub struct SnapshotSchedule {
+    /// Requested times, sorted.
+    times: Vec<Real>,
+    /// Every this many steps (0: never).
+    every: usize,
+    /// End time of the run.
+    end: Real,
+    /// Times closer than this are equal: the solver's landing tolerance, `1e-9` of the nominal step.
+    snap: Real,
+}
+
+impl SnapshotSchedule {
+    /// The schedule of a design's snapshot settings for its model.
+    pub fn new(settings: &SnapshotSettings, model: &Model) -> Self {
+        Self {
+            times: settings.times.clone(),
+            every: settings.every,
+            end: model.time.end,
+            snap: 1e-9 * model.time.step,
+        }
+    }
+
+    /// Whether the state of step `step` at `time`, reached from `previous` (the time of the step before),
+    /// gets a snapshot: step 0 and the end always; every `every` steps; and the first step at or after each
+    /// requested time (which is the step landing on it).
+    pub fn is_due(&self, step: usize, previous: Real, time: Real) -> bool {
+        step == 0
+            || (self.every > 0 && step % self.every == 0)
+            || time >= self.end - self.snap
+            || self
+                .times
+                .iter()
+                .any(|&t| t > previous + self.snap && t <= time + self.snap)
+    }
+}
+
+/// One written snapshot.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Snapshot {
+    /// Step number (0: the initial state).
+    pub step: usize,
+    /// Time [time].
+    pub time: Real,
+    /// The STL file, relative to the run folder.
+    pub stl: PathBuf,
+    /// The OBJ file, relative to the run folder.
+    pub obj: PathBuf,
+    /// Triangles of the mesh.
+    pub triangles: usize,
+    /// Enclosed volume [length³].
+    pub volume: Real,
+}
+
+/// Why a snapshot could not be written.
+#[derive(Debug, thiserror::Error)]
+pub enum SnapshotError {
+    /// The snapshot folder could not be created.
+    #[error("cannot create {path}: {source}")]
+    Folder {
+        /// The folder.
+        path: PathBuf,
+        /// The operating-system error.
+        #[source]
+        source: std::io::Error,
+    },
+    /// The deformed tubes could not be built (e.g. a section turned into the centreline).
+    #[error("step {step} (t = {time}): patch `{patch}`: {source}")]
+    Mesh {
+        /// Step.
+        step: usize,
+        /// Time.
+        time: Real,
+        /// Patch name.
+        patch: String,
+        /// What failed.
+        #[source]
+        source: crate::geometry::tube::TubeError,
+    },
+    /// A file could not be written.
+    #[error(transparent)]
+    Write(#[from] MeshIoError),
+}
+
+/// The full device's tube mesh in the current state of `sim`, with `segments` vertices around and about
+/// `rings` rings per patch.
+///
+/// # Errors
+/// [`DeviceMeshError`] naming the patch index that cannot be swept.
+pub fn current_device_mesh(
+    sim: &Simulation<'_>,
+    segments: usize,
+    rings: usize,
+) -> Result<TriangleMesh, DeviceMeshError> {
+    let shapes = current_device_shapes(sim, rings);
+    device_tube_mesh(sim.model(), &shapes, segments)
+}
+
+/// Writes the snapshots of a run as the simulation reports its steps.
+pub struct SnapshotWriter {
+    /// The run folder (file names in [`Snapshot`] are relative to it).
+    run_dir: PathBuf,
+    schedule: SnapshotSchedule,
+    segments: usize,
+    rings: usize,
+    /// Time and step of the last state seen.
+    last: Option<(usize, Real)>,
+    written: Vec<Snapshot>,
+    error: Option<SnapshotError>,
+}
+
+impl SnapshotWriter {
+    /// Folder of the snapshots inside the run folder.
+    pub const FOLDER: &'static str = "snapshots";
+
+    /// Creates `run_dir/snapshots`.
+    ///
+    /// # Errors
+    /// [`SnapshotError::Folder`] when the folder cannot be created.
+    pub fn create(
+        run_dir: &Path,
+        settings: &SnapshotSettings,
+        model: &Model,
+    ) -> Result<Self, SnapshotError> {
+        let folder = run_dir.join(Self::FOLDER);
+        std::fs::create_dir_all(&folder).map_err(|source| SnapshotError::Folder {
+            path: folder.clone(),
+            source,
+        })?;
+        Ok(Self {
+            run_dir: run_dir.to_path_buf(),
+            schedule: SnapshotSchedule::new(settings, model),
+            segments: settings.segments,
+            rings: settings.rings,
+            last: None,
+            written: Vec::new(),
+            error: None,
+        })
+    }
+
+    /// The snapshots written so far.
+    pub fn snapshots(&self) -> &[Snapshot] {
+        &self.written
+    }
+
+    /// The first error, if any (writing stops there and the run is asked to stop).
+    pub fn take_error(&mut self) -> Option<SnapshotError> {
+        self.error.take()
+    }
+
+    /// Writes the final snapshot of a run that ended (or stopped, or failed) at a step without one.
+    ///
+    /// # Errors
+    /// As the snapshots during the run.
+    pub fn finish(&mut self, sim: &Simulation<'_>) -> Result<(), SnapshotError> {
+        if let Some((step, _)) = self.last
+            && self.written.last().is_none_or(|s| s.step != step)
+        {
+            self.write(sim, step)?;
+        }
+        Ok(())
+    }
+
+    fn write(&mut self, sim: &Simulation<'_>, step: usize) -> Result<(), SnapshotError> {
+        let model = sim.model();
+        let time = sim.time();
+        let mesh = current_device_mesh(sim, self.segments, self.rings).map_err(|e| {
+            SnapshotError::Mesh {
+                step,
+                time,
+                patch: model.patches[e.rod].name.clone(),
+                source: e.source,
+            }
+        })?;
+        let name = format!("step_{step:05}");
+        let stl_path = Path::new(Self::FOLDER).join(format!("{name}.stl"));
+        let obj_path = Path::new(Self::FOLDER).join(format!("{name}.obj"));
+        let header = format!(
+            "{} step {step} t={time:.6} {}",
+            model.name,
+            model.units.name()
+        );
+        stl::write_stl_with_header(&self.run_dir.join(&stl_path), &mesh, &header)?;
+        let obj_header = format!(
+            "{}: full device at step {step}, t = {time} s; units {} (lengths in {})",
+            model.name,
+            model.units.name(),
+            model.units.length()
+        );
+        obj::write_obj(&self.run_dir.join(&obj_path), &mesh, &obj_header)?;
+        self.written.push(Snapshot {
+            step,
+            time,
+            stl: stl_path,
+            obj: obj_path,
+            triangles: mesh.triangles.len(),
+            volume: mesh.volume(),
+        });
+        Ok(())
+    }
+
+    fn observe(&mut self, sim: &Simulation<'_>, step: usize) -> ControlFlow<()> {
+        let previous = self.last.map_or(0.0, |(_, t)| t);
+        self.last = Some((step, sim.time()));
+        if self.error.is_some() || !self.schedule.is_due(step, previous, sim.time()) {
+            return ControlFlow::Continue(());
+        }
+        match self.write(sim, step) {
+            Ok(()) => ControlFlow::Continue(()),
+            Err(e) => {
+                self.error = Some(e);
+                ControlFlow::Break(())
+            }
+        }
+    }
+}
+
+impl Observer for SnapshotWriter {
+    fn start(&mut self, sim: &Simulation<'_>) -> ControlFlow<()> {
+        self.observe(sim, 0)
+    }
+
+    fn step(&mut self, sim: &Simulation<'_>, report: &StepReport) -> ControlFlow<()> {
+        self.observe(sim, report.step)
+    }
+}

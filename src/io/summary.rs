@@ -1,0 +1,230 @@
+//! `summary.json`: what a run was and what it did — design, units, version and command line, status, wall
+//! time and its split, steps, Newton iterations, step cuts, size of the problem, the snapshots and other files
+//! written, the final state, warnings and notices. Written at the end of every run, also one that failed.
+
+use super::snapshots::Snapshot;
+use super::state::StateSample;
+use crate::math::Real;
+use crate::model::Model;
+use serde::Serialize;
+use std::collections::BTreeMap;
+use std::path::Path;
+
+/// How the run ended.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum RunStatus {
+    /// Reached the end time.
+    Completed,
+    /// Stopped early by an output that could not be written (see `error`).
+    Stopped,
+    /// The solver failed (see `error`); the outputs hold the states up to the last converged step.
+    Failed,
+    /// Interrupted by the user (Ctrl-C); the outputs hold the states up to the last converged step.
+    Interrupted,
+}
+
+/// The unit system of every number in the run folder.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct UnitsSummary {
+    /// `SI` or `mm-N-MPa`.
+    pub system: String,
+    /// Length unit.
+    pub length: String,
+    /// Force unit.
+    pub force: String,
+    /// Stress unit.
+    pub stress: String,
+    /// Moment unit.
+    pub moment: String,
+    /// Time unit (always s).
+    pub time: String,
+    /// Temperature unit (always °C).
+    pub temperature: String,
+}
+
+impl UnitsSummary {
+    /// The units of `model`.
+    pub fn of(model: &Model) -> Self {
+        let u = model.units;
+        Self {
+            system: u.name().into(),
+            length: u.length().into(),
+            force: u.force().into(),
+            stress: u.stress().into(),
+            moment: u.moment().into(),
+            time: "s".into(),
+            temperature: "°C".into(),
+        }
+    }
+}
+
+/// Where the wall time went [s]. `recording` splits the time spent in each output during the run; later
+/// versions add the solver's own split (assembly, factorisation, solve) under `solver`.
+#[derive(Debug, Clone, PartialEq, Default, Serialize)]
+pub struct Timing {
+    /// Reading the design, building the model and the discretisation, creating the outputs.
+    pub setup_s: Real,
+    /// Time stepping, including the outputs recorded during it.
+    pub run_s: Real,
+    /// Time spent in each output during the run (`history`, `snapshots`, `mcap`, `charts`).
+    pub recording: BTreeMap<String, Real>,
+    /// Writing the final snapshot, closing the recording and drawing the charts.
+    pub finish_s: Real,
+    /// The solver's own split, when it reports one.
+    pub solver: BTreeMap<String, Real>,
+}
+
+/// One snapshot as listed in the summary.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct SnapshotEntry {
+    /// Step (0: initial state).
+    pub step: usize,
+    /// Time [s].
+    pub time: Real,
+    /// Binary STL, relative to the run folder.
+    pub stl: String,
+    /// OBJ, relative to the run folder.
+    pub obj: String,
+    /// Triangles.
+    pub triangles: usize,
+    /// Enclosed volume [length³].
+    pub volume: Real,
+}
+
+impl From<&Snapshot> for SnapshotEntry {
+    fn from(s: &Snapshot) -> Self {
+        Self {
+            step: s.step,
+            time: s.time,
+            stl: s.stl.display().to_string(),
+            obj: s.obj.display().to_string(),
+            triangles: s.triangles,
+            volume: s.volume,
+        }
+    }
+}
+
+/// The last recorded state.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct FinalState {
+    /// Step.
+    pub step: usize,
+    /// Time [s].
+    pub time: Real,
+    /// Temperature [°C].
+    pub temperature: Real,
+    /// Displacement `[ux, uy, uz]` of every probe [length].
+    pub probes: BTreeMap<String, [Real; 3]>,
+    /// Mean recovery ratio (programmes).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub recovery_ratio_mean: Option<Real>,
+    /// Largest recovery ratio (programmes).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub recovery_ratio_max: Option<Real>,
+    /// Mean radial contraction [length] (radial-contraction programmes).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub delta_r: Option<Real>,
+}
+
+impl FinalState {
+    /// The summary of `sample`.
+    pub fn of(model: &Model, sample: &StateSample) -> Self {
+        Self {
+            step: sample.step,
+            time: sample.time,
+            temperature: sample.temperature,
+            probes: model
+                .probes
+                .iter()
+                .zip(&sample.probes)
+                .map(|(p, u)| (p.name.clone(), [u.x, u.y, u.z]))
+                .collect(),
+            recovery_ratio_mean: sample.recovery.map(|r| r.ratio_mean),
+            recovery_ratio_max: sample.recovery.map(|r| r.ratio_max),
+            delta_r: sample.recovery.and_then(|r| r.delta_r),
+        }
+    }
+}
+
+/// Files of the run folder besides the snapshots.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Files {
+    /// The history CSV.
+    pub history: String,
+    /// The MCAP recording.
+    pub mcap: String,
+    /// Its size in bytes.
+    pub mcap_bytes: u64,
+    /// The charts.
+    pub charts: Vec<String>,
+}
+
+/// The content of `summary.json`.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct RunSummaryFile {
+    /// Design name.
+    pub design: String,
+    /// The design file as given on the command line.
+    pub design_file: String,
+    /// stentkit's version.
+    pub stentkit_version: String,
+    /// The command line.
+    pub command_line: String,
+    /// Units of every number in the run folder.
+    pub units: UnitsSummary,
+    /// How the run ended.
+    pub status: RunStatus,
+    /// Why it stopped or failed.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub error: Option<String>,
+    /// Wall time of the whole command [s].
+    pub wall_time_s: Real,
+    /// Its split.
+    pub timing: Timing,
+    /// Converged steps.
+    pub steps: usize,
+    /// Newton iterations over all steps.
+    pub newton_iterations: usize,
+    /// Mean Newton iterations per step.
+    pub iterations_per_step: Real,
+    /// Step cuts.
+    pub step_cuts: usize,
+    /// Time reached [s].
+    pub final_time: Real,
+    /// End time of the design [s].
+    pub end_time: Real,
+    /// Nominal time step [s].
+    pub time_step: Real,
+    /// Patches of the (possibly reduced) model.
+    pub patches: usize,
+    /// Collocation points.
+    pub collocation_points: usize,
+    /// Unknowns of the global system.
+    pub unknowns: usize,
+    /// Symmetry planes the exports mirror about.
+    pub symmetry_planes: usize,
+    /// The snapshots written.
+    pub snapshots: Vec<SnapshotEntry>,
+    /// Other files.
+    pub files: Files,
+    /// The last recorded state.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub final_state: Option<FinalState>,
+    /// Warnings about the design.
+    pub warnings: Vec<String>,
+    /// Notices of the solver (e.g. relaxation frozen below Tg − C2).
+    pub notices: Vec<String>,
+}
+
+impl RunSummaryFile {
+    /// Writes the summary as pretty-printed JSON.
+    ///
+    /// # Errors
+    /// The I/O error when the file cannot be written.
+    pub fn write(&self, path: &Path) -> std::io::Result<()> {
+        let mut text = serde_json::to_string_pretty(self).map_err(std::io::Error::other)?;
+        text.push('\n');
+        std::fs::write(path, text)
+    }
+}

@@ -1,0 +1,571 @@
+//! The run folder (DESIGN §7) end to end: `stentkit run` on a rod and on a shortened straight stent writes
+//! history.csv, summary.json, snapshots (binary STL and OBJ of the full device), run.mcap and charts; the
+//! snapshots of the symmetry-reduced stents are closed full devices after the STL round trip; the recording
+//! has the promised channels, counts, log times, attachment and metadata; `stentkit schema` prints the JSON
+//! Schema of the design format.
+//!
+//! The run folders are left in [`test_outputs`] for the independent check with the official readers
+//! (`scripts/check_outputs.py`, run by `.ci/run` after the tests).
+
+use crate::mesh::designs_and_good_small;
+use serde_json::Value;
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+use stentkit::io::design::{DesignOverrides, parse_design_with};
+use stentkit::io::device::patch_copies;
+use stentkit::io::snapshots::SnapshotWriter;
+use stentkit::io::stl::read_stl;
+use stentkit::math::Real;
+use stentkit::model::Model;
+use stentkit::solver::Simulation;
+
+/// A fresh folder for test `name`'s outputs under `$STENTKIT_TEST_OUTPUTS` (set by `.ci/run`), or under
+/// `<target>/tmp/test-outputs`. Left in place after the test, for `scripts/check_outputs.py`.
+pub fn test_outputs(name: &str) -> PathBuf {
+    let root = std::env::var_os("STENTKIT_TEST_OUTPUTS")
+        .map(PathBuf::from)
+        .unwrap_or_else(|| Path::new(env!("CARGO_TARGET_TMPDIR")).join("test-outputs"));
+    let dir = root.join(name);
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&root).expect("test output root");
+    dir
+}
+
+fn stentkit(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_stentkit"))
+        .args(args)
+        .output()
+        .expect("stentkit runs")
+}
+
+fn text(bytes: &[u8]) -> String {
+    String::from_utf8_lossy(bytes).into_owned()
+}
+
+fn path_str(p: &Path) -> &str {
+    p.to_str().expect("UTF-8 path")
+}
+
+fn design(name: &str) -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("designs")
+        .join(name)
+}
+
+/// Runs `stentkit run DESIGN -o DIR` (plus `extra`) and asserts success.
+fn run_ok(design: &Path, dir: &Path, extra: &[&str]) -> Output {
+    let mut args = vec!["run", path_str(design), "-o", path_str(dir)];
+    args.extend_from_slice(extra);
+    let out = stentkit(&args);
+    assert!(
+        out.status.success(),
+        "stentkit {args:?} failed:\n{}",
+        text(&out.stderr)
+    );
+    assert!(!text(&out.stderr).contains("panicked"));
+    out
+}
+
+fn summary(dir: &Path) -> Value {
+    let text = std::fs::read_to_string(dir.join("summary.json")).expect("summary.json");
+    serde_json::from_str(&text).expect("summary.json is JSON")
+}
+
+/// What the recording holds, read back with the mcap crate.
+struct Recording {
+    /// Messages per topic: (log time, JSON body).
+    messages: BTreeMap<String, Vec<(u64, Value)>>,
+    /// Schema name per topic.
+    schemas: BTreeMap<String, String>,
+    /// Attachments: (name, media type, data).
+    attachments: Vec<(String, String, Vec<u8>)>,
+    /// Metadata records by name.
+    metadata: BTreeMap<String, BTreeMap<String, String>>,
+}
+
+fn read_recording(path: &Path) -> Recording {
+    let bytes = std::fs::read(path).expect("run.mcap");
+    let summary = mcap::Summary::read(&bytes)
+        .expect("readable summary")
+        .expect("finished file (summary section)");
+    let stats = summary.stats.as_ref().expect("statistics");
+    let mut messages: BTreeMap<String, Vec<(u64, Value)>> = BTreeMap::new();
+    let mut schemas = BTreeMap::new();
+    for message in mcap::MessageStream::new(&bytes).expect("message stream") {
+        let message = message.expect("valid message");
+        let channel = &message.channel;
+        assert_eq!(channel.message_encoding, "json");
+        let schema = channel.schema.as_ref().expect("every channel has a schema");
+        assert_eq!(schema.encoding, "jsonschema");
+        let _: Value = serde_json::from_slice(&schema.data).expect("JSON schema is JSON");
+        schemas.insert(channel.topic.clone(), schema.name.clone());
+        let body: Value = serde_json::from_slice(&message.data).expect("JSON message");
+        messages
+            .entry(channel.topic.clone())
+            .or_default()
+            .push((message.log_time, body));
+    }
+    assert_eq!(
+        messages.values().map(Vec::len).sum::<usize>() as u64,
+        stats.message_count
+    );
+    let attachments = summary
+        .attachment_indexes
+        .iter()
+        .map(|index| {
+            let a = mcap::read::attachment(&bytes, index).expect("attachment");
+            (a.name, a.media_type, a.data.into_owned())
+        })
+        .collect();
+    let metadata = summary
+        .metadata_indexes
+        .iter()
+        .map(|index| {
+            let m = mcap::read::metadata(&bytes, index).expect("metadata");
+            (m.name, m.metadata)
+        })
+        .collect();
+    Recording {
+        messages,
+        schemas,
+        attachments,
+        metadata,
+    }
+}
+
+/// Checks the recording against the summary and the design file; returns it.
+fn check_recording(dir: &Path, design_file: &Path) -> Recording {
+    let s = summary(dir);
+    let rec = read_recording(&dir.join("run.mcap"));
+    let steps = s["steps"].as_u64().expect("steps") as usize;
+    assert_eq!(rec.schemas["/state"], "stentkit.State");
+    assert_eq!(rec.schemas["/centrelines"], "foxglove.SceneUpdate");
+    assert_eq!(rec.schemas["/device"], "foxglove.SceneUpdate");
+    assert_eq!(rec.messages["/state"].len(), steps + 1);
+    assert_eq!(rec.messages["/centrelines"].len(), steps + 1);
+    assert_eq!(
+        rec.messages["/device"].len(),
+        s["snapshots"].as_array().expect("snapshots").len()
+    );
+    for (topic, messages) in &rec.messages {
+        assert!(
+            messages.windows(2).all(|w| w[1].0 > w[0].0),
+            "{topic}: log times increase strictly"
+        );
+    }
+    // The state's time is the log time (1 s of simulation = 1 s of log time).
+    for (log_time, state) in &rec.messages["/state"] {
+        let t = state["time"].as_f64().expect("time");
+        assert!(
+            (t * 1e9 - *log_time as f64).abs() <= 1.0,
+            "{t} vs {log_time}"
+        );
+    }
+    let design_text = std::fs::read(design_file).expect("design");
+    assert_eq!(rec.attachments.len(), 1);
+    assert_eq!(rec.attachments[0].1, "application/yaml");
+    assert_eq!(
+        rec.attachments[0].2, design_text,
+        "the design is attached as read"
+    );
+    let meta = &rec.metadata["stentkit"];
+    assert_eq!(meta["stentkit_version"], env!("CARGO_PKG_VERSION"));
+    assert!(meta["command_line"].contains(" run "), "{meta:?}");
+    assert_eq!(meta["units"], s["units"]["system"].as_str().expect("units"));
+    assert_eq!(
+        s["files"]["mcap_bytes"].as_u64(),
+        Some(std::fs::metadata(dir.join("run.mcap")).expect("mcap").len())
+    );
+    rec
+}
+
+/// Reads every snapshot STL back (vertices merged by their f32 coordinates) and checks it closed with a
+/// positive volume equal to the reported one; returns the meshes' (volume, triangles) per snapshot.
+fn check_snapshots(dir: &Path) -> Vec<(Real, usize)> {
+    let s = summary(dir);
+    let mut out = Vec::new();
+    for snapshot in s["snapshots"].as_array().expect("snapshots") {
+        let stl = dir.join(snapshot["stl"].as_str().expect("stl"));
+        let obj = dir.join(snapshot["obj"].as_str().expect("obj"));
+        assert!(obj.is_file(), "{}", obj.display());
+        let mesh = read_stl(&stl).expect("STL read back");
+        mesh.check_closed()
+            .unwrap_or_else(|e| panic!("{}: {e}", stl.display()));
+        let volume = mesh.volume();
+        let reported = snapshot["volume"].as_f64().expect("volume");
+        assert!(volume > 0.0, "{}: volume {volume}", stl.display());
+        assert!(
+            (volume / reported - 1.0).abs() < 1e-5,
+            "{}: {volume} vs {reported}",
+            stl.display()
+        );
+        assert_eq!(
+            mesh.triangles.len() as u64,
+            snapshot["triangles"].as_u64().expect("triangles")
+        );
+        out.push((volume, mesh.triangles.len()));
+    }
+    out
+}
+
+#[test]
+fn rod_run_writes_the_run_folder() {
+    // The 45° bend (10 steps, elastic): every file of the run folder, a refused second run without --force,
+    // and an overwrite with it.
+    let file = design("bend45.yaml");
+    let dir = test_outputs("bend45");
+    let out = run_ok(&file, &dir, &[]);
+    let stdout = text(&out.stdout);
+    assert_eq!(stdout.lines().count(), 1, "one summary line: {stdout}");
+    assert!(
+        stdout.contains("wall time") && stdout.contains("10 steps"),
+        "{stdout}"
+    );
+    let s = summary(&dir);
+    assert_eq!(s["status"], "completed");
+    assert_eq!(s["design"], "bend45");
+    assert_eq!(s["units"]["system"], "SI");
+    assert_eq!(s["steps"], 10);
+    assert_eq!(s["unknowns"], 120);
+    assert!(s["newton_iterations"].as_u64().expect("iterations") >= 10);
+    assert!(s["wall_time_s"].as_f64().expect("wall time") > 0.0);
+    assert!(s["timing"]["recording"]["mcap"].as_f64().is_some());
+    assert_eq!(s["final_time"], 1.0);
+    // Default: about 20 snapshots, here every step (⌈10/20⌉ = 1).
+    assert_eq!(s["snapshots"].as_array().expect("list").len(), 11);
+    assert!(s["final_state"]["probes"]["tip"].is_array());
+    let history = std::fs::read_to_string(dir.join("history.csv")).expect("history");
+    assert_eq!(history.lines().count(), 1 + 11);
+    for chart in ["temperature", "displacement", "normalised", "newton"] {
+        let svg = std::fs::read_to_string(dir.join(format!("charts/{chart}.svg")))
+            .unwrap_or_else(|e| panic!("{chart}.svg: {e}"));
+        assert!(svg.contains("<svg"), "{chart}");
+    }
+    let snapshots = check_snapshots(&dir);
+    assert!(snapshots.iter().all(|&(_, t)| t == snapshots[0].1));
+    let rec = check_recording(&dir, &file);
+    let last = &rec.messages["/state"].last().expect("states").1;
+    assert_eq!(last["step"], 10);
+    assert_eq!(last["loads"]["tip_F3"], 600.0, "{last}");
+    // The tip displacement of the state channel is the history's last row.
+    let row: Vec<f64> = history
+        .lines()
+        .last()
+        .expect("row")
+        .split(',')
+        .map(|v| v.parse().expect("number"))
+        .collect();
+    let ux = last["probes"]["tip"]["x"].as_f64().expect("tip x");
+    assert!(
+        (ux - row[1]).abs() <= 1e-10 * row[1].abs().max(1.0),
+        "{ux} vs {}",
+        row[1]
+    );
+    let scene = &rec.messages["/centrelines"][0].1["entities"][0];
+    assert_eq!(scene["frame_id"], "world");
+    assert_eq!(scene["lines"].as_array().expect("lines").len(), 1);
+    let mesh = &rec.messages["/device"][0].1["entities"][0]["triangles"][0];
+    assert_eq!(mesh["indices"].as_array().expect("indices").len() % 3, 0);
+
+    // Not overwritten without --force; overwritten with it.
+    let again = stentkit(&["run", path_str(&file), "-o", path_str(&dir)]);
+    assert!(!again.status.success());
+    assert!(
+        text(&again.stderr).contains("--force"),
+        "{}",
+        text(&again.stderr)
+    );
+    run_ok(&file, &dir, &["--force", "--quiet"]);
+    assert_eq!(summary(&dir)["status"], "completed");
+}
+
+/// The straight stent's design with its end time and snapshot settings replaced.
+fn shortened(file: &Path, end: &str, output: &str) -> String {
+    let text = std::fs::read_to_string(file).expect("design");
+    let mut out: String = text
+        .lines()
+        .map(|l| {
+            if l.starts_with("time:") {
+                format!("time: {{end: {end}, step: 2.5e-3}}")
+            } else {
+                l.to_string()
+            }
+        })
+        .collect::<Vec<_>>()
+        .join("\n");
+    out.push('\n');
+    out.push_str(output);
+    out
+}
+
+#[test]
+fn straight_stent_run_writes_closed_full_device_snapshots() {
+    // The flagship quarter model run for 11 steps (t = 0.025 s, Δr reaches 0.375 mm), snapshots every 4 steps
+    // and at t = 0.0137 s, which is not on the 2.5 ms grid: a step lands on it. Every snapshot, read back from
+    // binary STL with vertices merged, is one closed surface: the four copies of each crown wire are welded
+    // where they cross the symmetry planes, and the bridges lying in a plane are drawn once.
+    let root = test_outputs("straight_stent_short");
+    let dir = root.join("run");
+    std::fs::create_dir_all(&root).expect("folder");
+    let file = root.join("straight_stent_short.yaml");
+    std::fs::write(
+        &file,
+        shortened(
+            &design("straight_stent.yaml"),
+            "0.025",
+            "output:\n  snapshots: {times: [0.0137], every: 4}\n",
+        ),
+    )
+    .expect("design written");
+    let out = run_ok(&file, &dir, &[]);
+    let s = summary(&dir);
+    assert_eq!(s["status"], "completed", "{}", text(&out.stderr));
+    assert_eq!(
+        s["steps"], 11,
+        "10 steps of 2.5 ms plus the landing on 0.0137 s"
+    );
+    let steps: Vec<u64> = s["snapshots"]
+        .as_array()
+        .expect("list")
+        .iter()
+        .map(|x| x["step"].as_u64().expect("step"))
+        .collect();
+    assert_eq!(steps, [0, 4, 6, 8, 11]);
+    let landed = s["snapshots"][2]["time"].as_f64().expect("time");
+    assert!((landed - 0.0137).abs() < 1e-12, "{landed}");
+    let measured = check_snapshots(&dir);
+    // Full device: symmetric about both planes (x3 = 0 and x2 = 0) and four times the quarter's volume up to
+    // the stretching of the wires (under 1 % at Δr = 0.375 mm).
+    let mesh = read_stl(&dir.join("snapshots/step_00011.stl")).expect("final STL");
+    let (lo, hi) = mesh.bounding_box().expect("box");
+    let size = (hi - lo).amax();
+    assert!((lo.y + hi.y).abs() < 1e-5 * size && (lo.z + hi.z).abs() < 1e-5 * size);
+    let (v0, vn) = (measured[0].0, measured.last().expect("final").0);
+    assert!((vn / v0 - 1.0).abs() < 1e-2, "volume {v0} → {vn}");
+    println!(
+        "straight stent (short): snapshots at steps {steps:?}, {} triangles each, volume {v0:.4} → {vn:.4} mm³",
+        measured[0].1
+    );
+
+    let rec = check_recording(&dir, &file);
+    let model = stentkit::io::design::load_design(&file)
+        .expect("design")
+        .model;
+    let rods: usize = (0..model.patches.len())
+        .map(|k| patch_copies(&model, k).len())
+        .sum();
+    assert_eq!(
+        rods,
+        4 * 18 + 30,
+        "the full device's 72 crown wires and 30 bridges"
+    );
+    let lines = rec.messages["/centrelines"][0].1["entities"][0]["lines"]
+        .as_array()
+        .expect("lines")
+        .len();
+    assert_eq!(lines, rods);
+    let last = &rec.messages["/state"].last().expect("state").1;
+    assert!(
+        (last["delta_r"].as_f64().expect("Δr") - 0.375).abs() < 1e-9,
+        "{last}"
+    );
+    for chart in ["recovery", "delta_r", "temperature", "newton"] {
+        assert!(dir.join(format!("charts/{chart}.svg")).is_file(), "{chart}");
+    }
+}
+
+/// Runs `model` for its (shortened) time with a snapshot writer into `dir`; returns the writer.
+fn snapshots_of(
+    model: &Model,
+    settings: &stentkit::io::design::SnapshotSettings,
+    dir: &Path,
+) -> Vec<stentkit::io::snapshots::Snapshot> {
+    let mut sim = Simulation::new(model).expect("simulation");
+    let mut writer = SnapshotWriter::create(dir, settings, model).expect("snapshot folder");
+    sim.run(&mut writer).expect("run");
+    writer.finish(&sim).expect("final snapshot");
+    assert!(writer.take_error().is_none());
+    writer.snapshots().to_vec()
+}
+
+#[test]
+fn curved_stent_half_model_snapshots_are_closed() {
+    // The curved stent (half model about x2 = 0, sinusoidal radial bridges, two of them in the plane), two
+    // steps of its programme: initial and final snapshots are closed after the STL round trip.
+    let file = design("curved_stent.yaml");
+    let text = std::fs::read_to_string(&file).expect("design");
+    let overrides = DesignOverrides {
+        end_time: Some(2e-3),
+        ..DesignOverrides::default()
+    };
+    let design = parse_design_with(&text, &file, &overrides).expect("valid design");
+    let dir = test_outputs("curved_stent_snapshots");
+    // A coarse drawing (8 segments, 21 rings per patch) keeps the files small; the welds are the same.
+    let settings = stentkit::io::design::SnapshotSettings {
+        segments: 8,
+        rings: 21,
+        ..design.output.snapshots.clone()
+    };
+    let written = snapshots_of(&design.model, &settings, &dir);
+    assert_eq!(
+        written.iter().map(|s| s.step).collect::<Vec<_>>(),
+        [0, 1, 2],
+        "⌈2/20⌉ = 1: every step"
+    );
+    for s in &written {
+        let mesh = read_stl(&dir.join(&s.stl)).expect("STL");
+        mesh.check_closed()
+            .unwrap_or_else(|e| panic!("step {}: {e}", s.step));
+        assert!(mesh.volume() > 0.0);
+        let (lo, hi) = mesh.bounding_box().expect("box");
+        assert!(
+            (lo.y + hi.y).abs() < 1e-5 * (hi - lo).amax(),
+            "symmetric about x2 = 0"
+        );
+    }
+}
+
+#[test]
+fn schema_describes_the_design_format() {
+    let out = stentkit(&["schema"]);
+    assert!(out.status.success());
+    let schema: Value = serde_json::from_slice(&out.stdout).expect("JSON");
+    assert_eq!(schema["type"], "object");
+    assert_eq!(
+        schema["additionalProperties"], false,
+        "unknown fields are errors"
+    );
+    let properties = schema["properties"].as_object().expect("properties");
+    // Every top-level key of every design is in the schema, and `units` and `time` are required.
+    for file in designs_and_good_small() {
+        let yaml: serde_yaml::Value =
+            serde_yaml::from_str(&std::fs::read_to_string(&file).expect("design")).expect("YAML");
+        for key in yaml.as_mapping().expect("mapping").keys() {
+            let key = key.as_str().expect("string key");
+            assert!(properties.contains_key(key), "{}: `{key}`", file.display());
+        }
+    }
+    let required: Vec<&str> = schema["required"]
+        .as_array()
+        .expect("required")
+        .iter()
+        .filter_map(Value::as_str)
+        .collect();
+    for key in ["units", "material", "section", "time"] {
+        assert!(required.contains(&key), "{key} required: {required:?}");
+    }
+    // The hand-written schemas of checked numbers and time functions are inlined where used.
+    let text = text(&out.stdout);
+    assert!(text.contains("\"exclusiveMinimum\": 0"), "Positive");
+    assert!(text.contains("a table [[t0, v0], [t1, v1], …]"), "TimeFn");
+    let defs = schema["$defs"].as_object().expect("definitions");
+    for name in [
+        "SnapshotsDto",
+        "RecordingDto",
+        "StentDto",
+        "ProgrammeDto",
+        "ConditionDto",
+    ] {
+        assert!(defs.contains_key(name), "{name} in {:?}", defs.keys());
+    }
+    assert_eq!(defs["SnapshotsDto"]["additionalProperties"], false);
+}
+
+#[test]
+fn failed_run_leaves_every_file_valid() {
+    // The 45° bend whose tip load (60 per step, as in the design) jumps from 180 to 6·10⁵ between t = 0.3 and 0.4 s with no step cutting
+    // (min_step = step): the step to 0.4 s fails. The command fails, naming
+    // where it stopped; the run folder holds the three converged steps, a snapshot of the last one, a finished
+    // recording and a summary with status `failed`.
+    let root = test_outputs("failed_run");
+    std::fs::create_dir_all(&root).expect("folder");
+    let file = root.join("bend45_overload.yaml");
+    let text = std::fs::read_to_string(design("bend45.yaml"))
+        .expect("design")
+        .replace("[[0, 0], [1, 600]]", "[[0, 0], [0.3, 180], [0.4, 600000]]")
+        .replace(
+            "time: {end: 1.0, step: 0.1}",
+            "time: {end: 1.0, step: 0.1, min_step: 0.1}",
+        );
+    assert!(text.contains("600000") && text.contains("min_step"));
+    std::fs::write(&file, text).expect("design written");
+    let dir = root.join("run");
+    let out = stentkit(&["run", path_str(&file), "-o", path_str(&dir), "--quiet"]);
+    assert!(!out.status.success());
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        stderr.contains("the run stopped at t = 0.3") && !stderr.contains("panicked"),
+        "{stderr}"
+    );
+    let s = summary(&dir);
+    assert_eq!(s["status"], "failed");
+    assert!(
+        s["error"]
+            .as_str()
+            .expect("error")
+            .contains("no convergence")
+    );
+    assert_eq!(s["steps"], 3);
+    let steps: Vec<u64> = s["snapshots"]
+        .as_array()
+        .expect("list")
+        .iter()
+        .map(|x| x["step"].as_u64().expect("step"))
+        .collect();
+    assert_eq!(
+        steps.last(),
+        Some(&3),
+        "the last converged state has a snapshot"
+    );
+    check_snapshots(&dir);
+    check_recording(&dir, &file);
+}
+
+#[test]
+fn interrupted_run_leaves_every_file_valid() {
+    // Ctrl-C (SIGINT) during the straight stent's run: the run stops after the current step, every file is
+    // finished (the recording closed, a snapshot of the last state, the summary says `interrupted`) and the
+    // command fails saying where it stopped.
+    let dir = test_outputs("interrupted_run");
+    let child = Command::new(env!("CARGO_BIN_EXE_stentkit"))
+        .args([
+            "run",
+            path_str(&design("straight_stent.yaml")),
+            "-o",
+            path_str(&dir),
+        ])
+        .stdout(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .expect("stentkit starts");
+    // Wait until a few steps are recorded, then interrupt.
+    let history = dir.join("history.csv");
+    let started = std::time::Instant::now();
+    while std::fs::read_to_string(&history).map_or(0, |h| h.lines().count()) < 4 {
+        assert!(started.elapsed().as_secs() < 120, "no progress");
+        std::thread::sleep(std::time::Duration::from_millis(50));
+    }
+    let kill = Command::new("kill")
+        .args(["-INT", &child.id().to_string()])
+        .status()
+        .expect("kill runs");
+    assert!(kill.success());
+    let out = child.wait_with_output().expect("stentkit ends");
+    assert!(!out.status.success());
+    let stderr = text(&out.stderr);
+    assert!(stderr.contains("interrupted at t = "), "{stderr}");
+    let s = summary(&dir);
+    assert_eq!(s["status"], "interrupted");
+    let steps = s["steps"].as_u64().expect("steps");
+    assert!((3..1300).contains(&steps), "{steps} steps");
+    let last = s["snapshots"]
+        .as_array()
+        .expect("list")
+        .last()
+        .expect("snapshot")["step"]
+        .as_u64();
+    assert_eq!(last, Some(steps), "the last state has a snapshot");
+    check_snapshots(&dir);
+    check_recording(&dir, &design("straight_stent.yaml"));
+}
