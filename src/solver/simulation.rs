@@ -36,16 +36,11 @@ pub struct NewtonReport {
     pub increments: Vec<Real>,
     /// LU factorisations performed (fewer than `iterations` when a factorisation was reused).
     pub factorisations: usize,
-    /// Iterations whose increment was shortened by backtracking.
-    pub backtracks: usize,
 }
 
 /// An iteration counts as stagnant when its residual is above this fraction of the previous one.
 const STAGNATION_RATIO: Real = 0.5;
-/// Backtracking halves an increment while the residual grows by more than this factor.
-const GROWTH_LIMIT: Real = 10.0;
-/// At most this many halvings per iteration.
-const MAX_HALVINGS: usize = 5;
+
 
 /// One converged time step, as reported to observers.
 #[derive(Debug, Clone, PartialEq)]
@@ -504,13 +499,8 @@ impl<'m> Simulation<'m> {
         let mut report = NewtonReport::default();
         let mut last_increment = Real::INFINITY;
         let mut previous = Real::INFINITY;
-        // The residual of the current state when the backtracking check already assembled it.
-        let mut known: Option<Real> = None;
         loop {
-            let r = match known.take() {
-                Some(r) => r,
-                None => self.linearise(&actions, false).map_err(NewtonFailure::Fatal)?,
-            };
+            let r = self.linearise(&actions, false).map_err(NewtonFailure::Fatal)?;
             report.residuals.push(r);
             if !r.is_finite() {
                 return Err(NewtonFailure::NotConverged(report));
@@ -522,10 +512,11 @@ impl<'m> Simulation<'m> {
                 let small = r <= self.model.solver.residual_factor * tol;
                 // At the residual's round-off floor an ill-conditioned tangent (a free device after a release)
                 // leaves increments of noise that never fall below the tolerance: accept when the residual is
-                // small and stopped falling (quadratic or chord convergence would still reduce it many-fold).
+                // below the tolerance itself and stopped falling (quadratic or chord convergence would still reduce
+                // it many-fold).
                 let n = report.residuals.len();
                 let stagnant = n >= 3 && r > STAGNATION_RATIO * report.residuals[n - 2];
-                small && (last_increment <= tol || stagnant)
+                (small && last_increment <= tol) || (r <= tol && stagnant)
             };
             if converged {
                 return Ok(report);
@@ -561,28 +552,7 @@ impl<'m> Simulation<'m> {
             if !last_increment.is_finite() {
                 return Err(NewtonFailure::NotConverged(report));
             }
-            // Backtracking: halve the increment while the residual grows by more than GROWTH_LIMIT (a far-off
-            // first iterate, e.g. at a release snap); a plain Newton step is taken when it does not.
-            let before = self.state.clone();
-            let mut scale = 1.0;
-            for _ in 0..=MAX_HALVINGS {
-                self.state.apply_increment(&self.disc, &self.delta);
-                let trial = self.linearise(&actions, false).map_err(NewtonFailure::Fatal)?;
-                known = Some(trial);
-                if trial.is_finite() && trial <= GROWTH_LIMIT * r.max(tol) {
-                    break;
-                }
-                scale *= 0.5;
-                if scale < 0.5f64.powi(MAX_HALVINGS as i32) {
-                    break;
-                }
-                self.state = before.clone();
-                self.delta.iter_mut().for_each(|d| *d *= 0.5);
-                known = None;
-            }
-            if scale < 1.0 {
-                report.backtracks += 1;
-            }
+            self.state.apply_increment(&self.disc, &self.delta);
             previous = if fresh_tangent { Real::INFINITY } else { r };
         }
     }
