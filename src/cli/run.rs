@@ -429,7 +429,7 @@ fn run_in(
             run_s: run_time.as_secs_f64(),
             recording,
             finish_s: finish.as_secs_f64(),
-            solver: BTreeMap::new(),
+            solver: sim.timing().entries().into_iter().collect(),
         },
         steps: totals.steps,
         newton_iterations: totals.iterations,

@@ -59,8 +59,9 @@ impl UnitsSummary {
     }
 }
 
-/// Where the wall time went [s]. `recording` splits the time spent in each output during the run; later
-/// versions add the solver's own split (assembly, factorisation, solve) under `solver`.
+/// Where the wall time went [s]. `recording` splits the time spent in each output during the run; `solver`
+/// splits the solver's share (residual and tangent assembly, factorisation, solves, material updates: seconds
+/// as `<part>_s`, counts as `<part>_count`).
 #[derive(Debug, Clone, PartialEq, Default, Serialize)]
 pub struct Timing {
     /// Reading the design, building the model and the discretisation, creating the outputs.
@@ -71,7 +72,7 @@ pub struct Timing {
     pub recording: BTreeMap<String, Real>,
     /// Writing the final snapshot, closing the recording and drawing the charts.
     pub finish_s: Real,
-    /// The solver's own split, when it reports one.
+    /// The solver's own split ([`crate::solver::SolverTiming::entries`]).
     pub solver: BTreeMap<String, Real>,
 }
 

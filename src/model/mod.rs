@@ -270,6 +270,9 @@ pub struct SolverSettings {
     pub reuse_factorisation: bool,
     /// Residual reduction per iteration below which a reused factorisation is kept.
     pub refactor_ratio: Real,
+    /// Start each step's Newton iteration from a linear extrapolation of the last two converged states (the
+    /// last step's increment scaled by the step-size ratio), except right after a schedule breakpoint.
+    pub extrapolate: bool,
 }
 
 impl Default for SolverSettings {
@@ -283,6 +286,7 @@ impl Default for SolverSettings {
             reuse_factorisation: true,
             refactor_ratio: 0.25,
             max_iterations: 25,
+            extrapolate: true,
         }
     }
 }

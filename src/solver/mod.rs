@@ -13,7 +13,7 @@ pub mod shape;
 pub mod simulation;
 pub mod state;
 
-pub use simulation::{NewtonReport, Observer, RunSummary, Simulation, StepReport};
+pub use simulation::{NewtonReport, Observer, RunSummary, Simulation, SolverTiming, StepReport};
 
 use crate::geometry::GeometryError;
 use crate::math::Real;

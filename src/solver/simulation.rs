@@ -24,6 +24,7 @@ use crate::material::{
 use crate::math::{Real, Vec3};
 use crate::model::{Model, ProbeLocation};
 use std::ops::ControlFlow;
+use std::time::Instant;
 
 /// What one Newton solve did.
 #[derive(Debug, Clone, PartialEq, Default)]
@@ -40,7 +41,6 @@ pub struct NewtonReport {
 
 /// An iteration counts as stagnant when its residual is above this fraction of the previous one.
 const STAGNATION_RATIO: Real = 0.5;
-
 
 /// One converged time step, as reported to observers.
 #[derive(Debug, Clone, PartialEq)]
@@ -74,6 +74,56 @@ pub struct RunSummary {
     pub time: Real,
     /// True when an observer asked to stop before the end.
     pub stopped: bool,
+}
+
+/// Where the solver's wall time went, with counts (DESIGN §6): residual assemblies, tangent assemblies,
+/// factorisations, solves and the per-step material work (history stresses before, internal-variable update
+/// after a step). Counts include the work of abandoned attempts (cut steps, retried reuse).
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct SolverTiming {
+    /// Residual-only assemblies and their time [s].
+    pub residual: (usize, Real),
+    /// Residual-and-tangent assemblies and their time [s].
+    pub tangent: (usize, Real),
+    /// Numeric LU factorisations and their time [s].
+    pub factorisation: (usize, Real),
+    /// Solves with a factorisation (forward and back substitution) and their time [s].
+    pub solve: (usize, Real),
+    /// Step preparation (integrator coefficients, history stresses) and commits (internal variables) [s].
+    pub material: (usize, Real),
+}
+
+impl SolverTiming {
+    /// Adds one event that started at `start` to `slot`.
+    fn add(slot: &mut (usize, Real), start: Instant) {
+        slot.0 += 1;
+        slot.1 += start.elapsed().as_secs_f64();
+    }
+
+    /// Total of the timed parts [s].
+    pub fn total(&self) -> Real {
+        self.residual.1 + self.tangent.1 + self.factorisation.1 + self.solve.1 + self.material.1
+    }
+
+    /// The split as named entries: `<part>_s` (seconds) and `<part>_count`.
+    pub fn entries(&self) -> Vec<(String, Real)> {
+        let parts = [
+            ("residual", self.residual),
+            ("tangent", self.tangent),
+            ("factorisation", self.factorisation),
+            ("solve", self.solve),
+            ("material", self.material),
+        ];
+        parts
+            .iter()
+            .flat_map(|(name, (count, secs))| {
+                [
+                    (format!("{name}_s"), *secs),
+                    (format!("{name}_count"), *count as Real),
+                ]
+            })
+            .collect()
+    }
 }
 
 /// Receives the initial state and every converged step; may stop the run.
@@ -145,6 +195,12 @@ pub struct Simulation<'m> {
     gauge: Option<(Gauge, SparseSystem, Vec<Real>)>,
     /// Whether the gauge constraints apply to the step being solved.
     gauge_active: bool,
+    /// Where the time went so far.
+    timing: SolverTiming,
+    /// Sum of the increments applied in the step being solved (prediction and Newton corrections).
+    step_increment: Vec<Real>,
+    /// The last converged step's total increment and its size, for the next step's prediction.
+    last_increment: Option<(Vec<Real>, Real)>,
 }
 
 impl<'m> Simulation<'m> {
@@ -205,6 +261,9 @@ impl<'m> Simulation<'m> {
             ramps: vec![[None; 6]; model.nodes.len()],
             gauge: None,
             gauge_active: false,
+            timing: SolverTiming::default(),
+            step_increment: Vec::new(),
+            last_increment: None,
         })
     }
 
@@ -218,6 +277,7 @@ impl<'m> Simulation<'m> {
     /// coefficients of the design's integrator, the effective modulus `Ē` of `C̄ = S Ē` and, per collocation
     /// point, the history stresses from the converged strains at `t_n` (Ψ-terms of N/M_constitutive_disc).
     fn prepare_step(&mut self, t_n: Real, t_np1: Real) -> Result<(), SolverError> {
+        let start = Instant::now();
         let material = &self.model.material;
         let temperature = |t: Real| self.model.temperature.value(t);
         step_coefficients_into(
@@ -253,6 +313,7 @@ impl<'m> Simulation<'m> {
                 ));
             }
         }
+        SolverTiming::add(&mut self.timing.material, start);
         Ok(())
     }
 
@@ -354,6 +415,7 @@ impl<'m> Simulation<'m> {
 
     /// After a converged step: advances the Maxwell-branch strains and the converged total strains.
     fn commit_step(&mut self) {
+        let start = Instant::now();
         let branches = self.model.material.num_branches() > 0;
         for g in 0..self.disc.points.len() {
             let strain = point_strains(&self.disc, &self.state, g);
@@ -367,6 +429,41 @@ impl<'m> Simulation<'m> {
             }
             self.strain_n[g] = strain;
         }
+        // Counted with the step's preparation.
+        self.timing.material.1 += start.elapsed().as_secs_f64();
+    }
+
+    /// Assembles the residual (and with `with_tangent` the tangent) at the current state for time `t` and
+    /// returns the normalised residual norm: one piece of a Newton iteration, for benchmarks and diagnostics.
+    pub fn assemble(&mut self, t: Real, with_tangent: bool) -> Result<Real, SolverError> {
+        let actions = Actions::at(self.model, t, &self.ramps);
+        self.linearise(&actions, with_tangent)
+    }
+
+    /// Factorises the last assembled tangent and solves for the Newton increment of the last assembled
+    /// residual, which is returned (not applied): the linear-algebra part of a Newton iteration, for benchmarks
+    /// and diagnostics.
+    pub fn factor_and_solve(&mut self) -> Result<&[Real], SolverError> {
+        let (system, values) = match (&mut self.gauge, self.gauge_active) {
+            (Some((_, s, v)), true) => (s, &*v),
+            _ => (&mut self.system, &self.values),
+        };
+        let start = Instant::now();
+        system.factor(values)?;
+        SolverTiming::add(&mut self.timing.factorisation, start);
+        self.delta.resize(self.lin.residual.len(), 0.0);
+        for (d, r) in self.delta.iter_mut().zip(&self.lin.residual) {
+            *d = -r;
+        }
+        let start = Instant::now();
+        system.solve_in_place(&mut self.delta);
+        SolverTiming::add(&mut self.timing.solve, start);
+        Ok(&self.delta)
+    }
+
+    /// Where the solver's time went so far.
+    pub fn timing(&self) -> &SolverTiming {
+        &self.timing
     }
 
     /// The model.
@@ -437,6 +534,7 @@ impl<'m> Simulation<'m> {
     /// Assembles residual and tangent at the current state for time `t` and returns the normalised residual
     /// norm (largest over fields).
     fn linearise(&mut self, actions: &Actions, with_tangent: bool) -> Result<Real, SolverError> {
+        let start = Instant::now();
         let material = StepMaterial {
             modulus: self.modulus,
             history: &self.history,
@@ -459,6 +557,12 @@ impl<'m> Simulation<'m> {
             &mut self.lin,
             &mut sink,
         );
+        let slot = if with_tangent {
+            &mut self.timing.tangent
+        } else {
+            &mut self.timing.residual
+        };
+        SolverTiming::add(slot, start);
         let mut norm: Real = 0.0;
         for (r, s) in self.lin.residual.iter().zip(&self.lin.row_scale) {
             let x = (r / s).abs();
@@ -495,12 +599,18 @@ impl<'m> Simulation<'m> {
     fn newton(&mut self, t: Real, reuse: bool) -> Result<NewtonReport, NewtonFailure> {
         let actions = Actions::at(self.model, t, &self.ramps);
         let settings = &self.model.solver;
-        let (tol, max_iterations, ratio) = (settings.tolerance, settings.max_iterations, settings.refactor_ratio);
+        let (tol, max_iterations, ratio) = (
+            settings.tolerance,
+            settings.max_iterations,
+            settings.refactor_ratio,
+        );
         let mut report = NewtonReport::default();
         let mut last_increment = Real::INFINITY;
         let mut previous = Real::INFINITY;
         loop {
-            let r = self.linearise(&actions, false).map_err(NewtonFailure::Fatal)?;
+            let r = self
+                .linearise(&actions, false)
+                .map_err(NewtonFailure::Fatal)?;
             report.residuals.push(r);
             if !r.is_finite() {
                 return Err(NewtonFailure::NotConverged(report));
@@ -531,21 +641,26 @@ impl<'m> Simulation<'m> {
             // A reused factorisation is kept while it contracts the residual fast enough.
             let fresh_tangent = !reuse || !factored || r > ratio * previous;
             if fresh_tangent {
-                self.linearise(&actions, true).map_err(NewtonFailure::Fatal)?;
+                self.linearise(&actions, true)
+                    .map_err(NewtonFailure::Fatal)?;
             }
             let (system, values) = match (&mut self.gauge, self.gauge_active) {
                 (Some((_, s, v)), true) => (s, &*v),
                 _ => (&mut self.system, &self.values),
             };
             if fresh_tangent {
+                let start = Instant::now();
                 system.factor(values).map_err(NewtonFailure::Fatal)?;
+                SolverTiming::add(&mut self.timing.factorisation, start);
                 report.factorisations += 1;
             }
             self.delta.resize(self.lin.residual.len(), 0.0);
             for (d, r) in self.delta.iter_mut().zip(&self.lin.residual) {
                 *d = -r;
             }
+            let start = Instant::now();
             system.solve_in_place(&mut self.delta);
+            SolverTiming::add(&mut self.timing.solve, start);
             last_increment = self.increment_norm();
             report.increments.push(last_increment);
             report.iterations += 1;
@@ -553,8 +668,29 @@ impl<'m> Simulation<'m> {
                 return Err(NewtonFailure::NotConverged(report));
             }
             self.state.apply_increment(&self.disc, &self.delta);
+            self.step_increment.resize(self.delta.len(), 0.0);
+            for (a, d) in self.step_increment.iter_mut().zip(&self.delta) {
+                *a += d;
+            }
             previous = if fresh_tangent { Real::INFINITY } else { r };
         }
+    }
+
+    /// Predicts the state at `t` by extrapolating the last step's increment linearly in time (scaled by `dt`
+    /// over its size; the rotation part applied as one more multiplicative increment). Schedules are piecewise
+    /// linear, so the last step's rate is a good guess except across a breakpoint, after which there is no
+    /// prediction (see `run`).
+    fn predict(&mut self, dt: Real) {
+        self.step_increment.clear();
+        let n = self.disc.num_unknowns();
+        // (A step that needed no iteration left an empty increment: nothing to extrapolate.)
+        let Some((increment, h)) = self.last_increment.as_ref().filter(|(i, _)| i.len() >= n)
+        else {
+            return;
+        };
+        let scale = dt / h;
+        self.step_increment = increment[..n].iter().map(|d| d * scale).collect();
+        self.state.apply_increment(&self.disc, &self.step_increment);
     }
 
     /// Runs from the current time to the model's end time, reporting each converged step to `observer`.
@@ -591,6 +727,9 @@ impl<'m> Simulation<'m> {
             let captured = self.capture_releases(target);
             self.set_gauge(target)?;
             self.prepare_step(self.time, target)?;
+            if self.model.solver.extrapolate {
+                self.predict(dt);
+            }
             let reuse = self.model.solver.reuse_factorisation;
             let mut attempt = self.newton(target, reuse);
             if reuse && let Err(NewtonFailure::NotConverged(failed)) = &attempt {
@@ -599,6 +738,7 @@ impl<'m> Simulation<'m> {
                 observer.step_failed(target, dt, failed);
                 let factorisations = failed.factorisations;
                 self.state = saved.clone();
+                self.step_increment.clear();
                 attempt = self.newton(target, false);
                 if let Ok(newton) = &mut attempt {
                     newton.factorisations += factorisations;
@@ -607,6 +747,10 @@ impl<'m> Simulation<'m> {
             match attempt {
                 Ok(newton) => {
                     self.commit_step();
+                    // A schedule's rate changes at its breakpoints: no extrapolation across them.
+                    let at_break = breakpoints.iter().any(|&b| (b - target).abs() <= snap);
+                    let increment = std::mem::take(&mut self.step_increment);
+                    self.last_increment = (!at_break).then_some((increment, dt));
                     self.time = target;
                     self.step += 1;
                     summary.steps += 1;

@@ -1067,6 +1067,9 @@ fn solver_settings(s: Option<&SolverDto>) -> Result<SolverSettings> {
         if let Some(r) = s.reuse_factorisation {
             out.reuse_factorisation = r;
         }
+        if let Some(e) = s.extrapolate {
+            out.extrapolate = e;
+        }
     }
     Ok(out)
 }

@@ -592,6 +592,9 @@ pub struct SolverDto {
     /// Reuse the tangent's factorisation across iterations and steps (default true).
     #[serde(default)]
     pub reuse_factorisation: Option<bool>,
+    /// Start each step from the previous step's increment, scaled to the step size (default true).
+    #[serde(default)]
+    pub extrapolate: Option<bool>,
 }
 
 /// Outputs.
