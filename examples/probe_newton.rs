@@ -1,5 +1,4 @@
 use std::ops::ControlFlow;
-use stentkit::io::design::load_design;
 use stentkit::solver::{Observer, Simulation, StepReport};
 struct P(usize);
 impl Observer for P {
@@ -21,7 +20,14 @@ impl Observer for P {
 fn main() -> anyhow::Result<()> {
     let path = std::env::args().nth(1).unwrap();
     let every: usize = std::env::args().nth(2).unwrap().parse()?;
-    let design = load_design(std::path::Path::new(&path))?;
+    let end: Option<f64> = std::env::args().nth(3).map(|s| s.parse()).transpose()?;
+    let text = std::fs::read_to_string(&path)?;
+    let overrides = stentkit::io::design::DesignOverrides {
+        end_time: end,
+        ..Default::default()
+    };
+    let design =
+        stentkit::io::design::parse_design_with(&text, std::path::Path::new(&path), &overrides)?;
     let mut sim = Simulation::new(&design.model)?;
     let s = sim.run(&mut P(every))?;
     println!("{s:?}\n{:?}", sim.timing());

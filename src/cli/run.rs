@@ -19,7 +19,9 @@ use crate::io::history::HistoryWriter;
 use crate::io::mcap::{McapRecorder, RunInfo};
 use crate::io::run_charts::RunCharts;
 use crate::io::snapshots::SnapshotWriter;
-use crate::io::summary::{Files, FinalState, RunStatus, RunSummaryFile, Timing, UnitsSummary};
+use crate::io::summary::{
+    Files, FinalState, RunStatus, RunSummaryFile, Timing, UnitsSummary, peak_memory_mib,
+};
 use crate::math::Real;
 use crate::solver::{NewtonReport, Observer, Simulation, StepReport};
 use anyhow::{Context, bail};
@@ -424,6 +426,7 @@ fn run_in(
         status,
         error,
         wall_time_s: wall,
+        peak_memory_mib: peak_memory_mib(),
         timing: Timing {
             setup_s: setup.as_secs_f64(),
             run_s: run_time.as_secs_f64(),
@@ -484,7 +487,7 @@ fn run_in(
         )));
     }
     println!(
-        "{}: {} steps to t = {} s, {} Newton iterations ({:.2} per step), {} factorisations, {} step cuts, {} snapshots, run.mcap {}, wall time {wall:.2} s → {}",
+        "{}: {} steps to t = {} s, {} Newton iterations ({:.2} per step), {} factorisations, {} step cuts, {} snapshots, run.mcap {}, wall time {wall:.2} s, peak memory {} → {}",
         model.name,
         totals.steps,
         totals.time,
@@ -494,6 +497,9 @@ fn run_in(
         totals.cuts,
         summary.snapshots.len(),
         human_bytes(mcap_bytes),
+        summary
+            .peak_memory_mib
+            .map_or("unknown".to_string(), |m| format!("{m:.0} MiB")),
         dir.display()
     );
     Ok(())

@@ -181,6 +181,8 @@ pub struct RunSummaryFile {
     pub error: Option<String>,
     /// Wall time of the whole command [s].
     pub wall_time_s: Real,
+    /// Peak resident memory of the process [MiB] (Linux `VmHWM`; absent elsewhere).
+    pub peak_memory_mib: Option<Real>,
     /// Its split.
     pub timing: Timing,
     /// Converged steps.
@@ -228,4 +230,13 @@ impl RunSummaryFile {
         text.push('\n');
         std::fs::write(path, text)
     }
+}
+
+/// Peak resident memory of this process so far [MiB]: `VmHWM` of `/proc/self/status` (Linux); `None` where that
+/// is not available.
+pub fn peak_memory_mib() -> Option<Real> {
+    let status = std::fs::read_to_string("/proc/self/status").ok()?;
+    let line = status.lines().find(|l| l.starts_with("VmHWM:"))?;
+    let kib: Real = line.split_whitespace().nth(1)?.parse().ok()?;
+    Some(kib / 1024.0)
 }

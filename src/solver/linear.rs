@@ -1,4 +1,7 @@
-//! The global sparse linear system (faer): the compressed-column pattern and the symbolic LU analysis once per
+//! The global linear system: [`LinearSystem`] chooses between the block-bordered solver of [`super::block`]
+//! and the general sparse LU [`SparseSystem`].
+//!
+//! The general sparse linear system (faer): the compressed-column pattern and the symbolic LU analysis once per
 //! pattern, then a numeric LU per Newton iteration into reused storage and scratch (faer's low-level
 //! `factorize_numeric_lu`, no allocation once warm), and solves.
 //!
@@ -6,7 +9,9 @@
 //! entry to its slot in the compressed columns once, so refilling the values is one pass with no sorting.
 
 use super::SolverError;
+use super::block::BlockSystem;
 use crate::math::Real;
+use crate::model::LinearMethod;
 use faer::dyn_stack::{MemBuffer, MemStack, StackReq};
 use faer::sparse::linalg::LuError;
 use faer::sparse::linalg::lu::{LuRef, NumericLu, SymbolicLu, factorize_symbolic_lu};
@@ -163,5 +168,104 @@ impl SparseSystem {
         let rhs = MatMut::from_column_major_slice_mut(rhs, n, 1);
         let stack = MemStack::new(&mut self.solve_scratch);
         lu.solve_in_place_with_conj(Conj::No, rhs, Par::Seq, stack);
+    }
+}
+
+/// The Newton systems' solver: the block-bordered solver ([`BlockSystem`]) when the design asks for it and the
+/// pattern allows, with the general sparse LU as its fallback (a patch interior singular on its own) and as
+/// the alternative the design can choose (`solver: {linear: sparse-lu}`).
+pub struct LinearSystem {
+    sparse: SparseSystem,
+    block: Option<BlockSystem>,
+    /// The last factorisation is the sparse LU's although a block solver exists.
+    fallback: bool,
+}
+
+impl std::fmt::Debug for LinearSystem {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("LinearSystem")
+            .field("sparse", &self.sparse)
+            .field("block", &self.block)
+            .finish()
+    }
+}
+
+impl LinearSystem {
+    /// Analyses the pattern (see [`SparseSystem::new`]) for `method`; `patches` lists each patch's first
+    /// control point and count (see [`BlockSystem::new`]).
+    pub fn new(
+        n: usize,
+        entries: &[(usize, usize)],
+        patches: &[(usize, usize)],
+        method: LinearMethod,
+    ) -> Result<Self, SolverError> {
+        let block = match method {
+            LinearMethod::Block => BlockSystem::new(n, entries, patches)?,
+            LinearMethod::SparseLu => None,
+        };
+        Ok(Self {
+            sparse: SparseSystem::new(n, entries)?,
+            block,
+            fallback: false,
+        })
+    }
+
+    /// The solver that factorised last: `"block"` or `"sparse-lu"`.
+    pub fn method(&self) -> &'static str {
+        if self.block.is_some() && !self.fallback {
+            "block"
+        } else {
+            "sparse-lu"
+        }
+    }
+
+    /// The general sparse system (size, pattern).
+    pub fn sparse(&self) -> &SparseSystem {
+        &self.sparse
+    }
+
+    /// Number of unknowns.
+    pub fn size(&self) -> usize {
+        self.sparse.size()
+    }
+
+    /// Forgets the factorisation (it belonged to a state that was abandoned).
+    pub fn invalidate(&mut self) {
+        self.sparse.invalidate();
+        if let Some(b) = &mut self.block {
+            b.invalidate();
+        }
+    }
+
+    /// True when a factorisation is available for solves.
+    pub fn is_factored(&self) -> bool {
+        match &self.block {
+            Some(b) if !self.fallback => b.is_factored(),
+            _ => self.sparse.is_factored(),
+        }
+    }
+
+    /// Factorises the matrix whose pushed entries are `entry_values`; the sparse LU takes over a
+    /// factorisation the block solver cannot do.
+    pub fn factor(&mut self, entry_values: &[Real]) -> Result<(), SolverError> {
+        if let Some(b) = &mut self.block {
+            match b.factor(entry_values) {
+                Ok(()) => {
+                    self.fallback = false;
+                    return Ok(());
+                }
+                Err(SolverError::Singular { .. }) => self.fallback = true,
+                Err(e) => return Err(e),
+            }
+        }
+        self.sparse.factor(entry_values)
+    }
+
+    /// Solves `A x = b` in place with the last factorisation.
+    pub fn solve_in_place(&mut self, rhs: &mut [Real]) {
+        match &mut self.block {
+            Some(b) if !self.fallback => b.solve_in_place(rhs),
+            _ => self.sparse.solve_in_place(rhs),
+        }
     }
 }

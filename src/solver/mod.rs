@@ -6,6 +6,7 @@
 //! and reports every converged step to an [`Observer`] — the engine reports, observers record.
 
 pub mod assembly;
+pub mod block;
 pub mod discretisation;
 pub mod gauge;
 pub mod linear;

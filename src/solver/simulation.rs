@@ -15,7 +15,7 @@ use super::assembly::{
 };
 use super::discretisation::Discretisation;
 use super::gauge::Gauge;
-use super::linear::SparseSystem;
+use super::linear::LinearSystem;
 use super::state::State;
 use crate::material::{
     BranchHistory, ReducedTimeQuadrature, SectionStrains, StepCoefficients, history_stress,
@@ -41,6 +41,21 @@ pub struct NewtonReport {
 
 /// An iteration counts as stagnant when its residual is above this fraction of the previous one.
 const STAGNATION_RATIO: Real = 0.5;
+
+/// The error left after the last of a Newton iteration's increments `Δ_1 … Δ_k` (normalised norms): with the
+/// contraction `θ = ‖Δ_k‖ / ‖Δ_{k−1}‖ < 1` it is at most `θ / (1 − θ) ‖Δ_k‖` (the stopping criterion of
+/// simplified Newton iterations, Hairer & Wanner, *Solving ODEs II*, §IV.8, Eq. 8.10), otherwise `‖Δ_k‖`
+/// itself (the first iteration, or no contraction).
+fn remaining_error(increments: &[Real]) -> Real {
+    match increments {
+        [.., previous, last] if last < previous => {
+            let theta = last / previous;
+            last.min(theta / (1.0 - theta) * last)
+        }
+        [.., last] => *last,
+        [] => Real::INFINITY,
+    }
+}
 
 /// One converged time step, as reported to observers.
 #[derive(Debug, Clone, PartialEq)]
@@ -126,6 +141,11 @@ impl SolverTiming {
     }
 }
 
+/// Each patch's first control point and count, for the block solver.
+fn patch_ranges(disc: &Discretisation) -> Vec<(usize, usize)> {
+    disc.patches.iter().map(|r| (r.offset, r.n)).collect()
+}
+
 /// Receives the initial state and every converged step; may stop the run.
 pub trait Observer {
     /// Called once with the initial state (step 0).
@@ -166,7 +186,7 @@ pub struct Simulation<'m> {
     model: &'m Model,
     disc: Discretisation,
     assembler: Assembler,
-    system: SparseSystem,
+    system: LinearSystem,
     state: State,
     time: Real,
     step: usize,
@@ -192,7 +212,7 @@ pub struct Simulation<'m> {
     /// Per node and local component: the release ramp, once the component has been released.
     ramps: Vec<[Option<ReleaseRamp>; 6]>,
     /// Gauge constraints after a programme's release, with their extended system and entry values.
-    gauge: Option<(Gauge, SparseSystem, Vec<Real>)>,
+    gauge: Option<(Gauge, LinearSystem, Vec<Real>)>,
     /// Whether the gauge constraints apply to the step being solved.
     gauge_active: bool,
     /// Where the time went so far.
@@ -225,7 +245,12 @@ impl<'m> Simulation<'m> {
             &mut lin,
             &mut Sink::Pattern(&mut pattern),
         );
-        let system = SparseSystem::new(disc.num_unknowns(), &pattern)?;
+        let system = LinearSystem::new(
+            disc.num_unknowns(),
+            &pattern,
+            &patch_ranges(&disc),
+            model.solver.linear,
+        )?;
         let values = vec![0.0; pattern.len()];
         let control_length = disc
             .patches
@@ -398,7 +423,12 @@ impl<'m> Simulation<'m> {
                     &mut lin,
                     &mut Sink::Pattern(&mut pattern),
                 );
-                let system = SparseSystem::new(self.disc.num_unknowns() + gauge.len(), &pattern)?;
+                let system = LinearSystem::new(
+                    self.disc.num_unknowns() + gauge.len(),
+                    &pattern,
+                    &patch_ranges(&self.disc),
+                    self.model.solver.linear,
+                )?;
                 let values = vec![0.0; pattern.len()];
                 self.gauge = Some((gauge, system, values));
             }
@@ -486,8 +516,8 @@ impl<'m> Simulation<'m> {
         self.time
     }
 
-    /// The sparse system (size, pattern).
-    pub fn system(&self) -> &SparseSystem {
+    /// The linear system (solver, size, pattern).
+    pub fn system(&self) -> &LinearSystem {
         &self.system
     }
 
@@ -605,7 +635,6 @@ impl<'m> Simulation<'m> {
             settings.refactor_ratio,
         );
         let mut report = NewtonReport::default();
-        let mut last_increment = Real::INFINITY;
         let mut previous = Real::INFINITY;
         loop {
             let r = self
@@ -626,7 +655,7 @@ impl<'m> Simulation<'m> {
                 // it many-fold).
                 let n = report.residuals.len();
                 let stagnant = n >= 3 && r > STAGNATION_RATIO * report.residuals[n - 2];
-                (small && last_increment <= tol) || (r <= tol && stagnant)
+                (small && remaining_error(&report.increments) <= tol) || (r <= tol && stagnant)
             };
             if converged {
                 return Ok(report);
@@ -661,10 +690,10 @@ impl<'m> Simulation<'m> {
             let start = Instant::now();
             system.solve_in_place(&mut self.delta);
             SolverTiming::add(&mut self.timing.solve, start);
-            last_increment = self.increment_norm();
-            report.increments.push(last_increment);
+            let increment = self.increment_norm();
+            report.increments.push(increment);
             report.iterations += 1;
-            if !last_increment.is_finite() {
+            if !increment.is_finite() {
                 return Err(NewtonFailure::NotConverged(report));
             }
             self.state.apply_increment(&self.disc, &self.delta);

@@ -231,6 +231,14 @@ fn rod_run_writes_the_run_folder() {
     assert!(s["newton_iterations"].as_u64().expect("iterations") >= 10);
     assert!(s["wall_time_s"].as_f64().expect("wall time") > 0.0);
     assert!(s["timing"]["recording"]["mcap"].as_f64().is_some());
+    // The solver's split counts what the run did: one tangent assembly per factorisation, and at least one solve
+    // per converged iteration (abandoned attempts count too).
+    let solver = &s["timing"]["solver"];
+    let solves = solver["solve_count"].as_f64().expect("count");
+    assert!(solves >= s["newton_iterations"].as_f64().expect("iterations"));
+    assert_eq!(solver["factorisation_count"], solver["tangent_count"]);
+    assert!(solver["factorisation_s"].as_f64().expect("seconds") > 0.0);
+    assert!(s["peak_memory_mib"].as_f64().expect("Linux VmHWM") > 1.0);
     assert_eq!(s["final_time"], 1.0);
     // Default: about 20 snapshots, here every step (⌈10/20⌉ = 1).
     assert_eq!(s["snapshots"].as_array().expect("list").len(), 11);

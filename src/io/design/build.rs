@@ -1070,6 +1070,12 @@ fn solver_settings(s: Option<&SolverDto>) -> Result<SolverSettings> {
         if let Some(e) = s.extrapolate {
             out.extrapolate = e;
         }
+        if let Some(l) = s.linear {
+            out.linear = match l {
+                LinearDto::Block => LinearMethod::Block,
+                LinearDto::SparseLu => LinearMethod::SparseLu,
+            };
+        }
     }
     Ok(out)
 }

@@ -592,9 +592,22 @@ pub struct SolverDto {
     /// Reuse the tangent's factorisation across iterations and steps (default true).
     #[serde(default)]
     pub reuse_factorisation: Option<bool>,
-    /// Start each step from the previous step's increment, scaled to the step size (default true).
+    /// Start each step from the previous step's increment, scaled to the step size (default false).
     #[serde(default)]
     pub extrapolate: Option<bool>,
+    /// Linear solver: `block` (banded per patch + Schur complement on the patch ends, default) or `sparse-lu`.
+    #[serde(default)]
+    pub linear: Option<LinearDto>,
+}
+
+/// Linear solver names.
+#[derive(Debug, Clone, Copy, Deserialize, JsonSchema)]
+#[serde(rename_all = "kebab-case")]
+pub enum LinearDto {
+    /// Banded LU per patch and a sparse LU of the Schur complement on the patch ends.
+    Block,
+    /// General sparse LU of the whole system.
+    SparseLu,
 }
 
 /// Outputs.
