@@ -23,6 +23,7 @@ use crate::material::{
 };
 use crate::math::{Real, Vec3};
 use crate::model::{Model, ProbeLocation};
+use rayon::prelude::*;
 use std::ops::ControlFlow;
 use std::time::Instant;
 
@@ -316,17 +317,23 @@ impl<'m> Simulation<'m> {
         )?;
         self.modulus = self.coeffs.effective_modulus(material.prony());
         if material.num_branches() > 0 {
-            for (g, point) in self.disc.points.iter().enumerate() {
-                let shape = &self.disc.shapes[point.shape];
-                let h = history_stress(
-                    material.prony(),
-                    shape,
-                    &self.coeffs,
-                    &self.strain_n[g],
-                    self.branches.point(g),
-                );
-                self.history[g] = [h.force, h.force_ds, h.moment, h.moment_ds];
-            }
+            // Per collocation point and independent: in parallel.
+            let (disc, coeffs, strain_n, branches) =
+                (&self.disc, &self.coeffs, &self.strain_n, &self.branches);
+            self.history
+                .par_iter_mut()
+                .enumerate()
+                .for_each(|(g, history)| {
+                    let shape = &disc.shapes[disc.points[g].shape];
+                    let h = history_stress(
+                        material.prony(),
+                        shape,
+                        coeffs,
+                        &strain_n[g],
+                        branches.point(g),
+                    );
+                    *history = [h.force, h.force_ds, h.moment, h.moment_ds];
+                });
         }
         if !self.freeze_reported && material.is_frozen(temperature(t_np1)) {
             self.freeze_reported = true;
@@ -446,18 +453,24 @@ impl<'m> Simulation<'m> {
     /// After a converged step: advances the Maxwell-branch strains and the converged total strains.
     fn commit_step(&mut self) {
         let start = Instant::now();
-        let branches = self.model.material.num_branches() > 0;
-        for g in 0..self.disc.points.len() {
-            let strain = point_strains(&self.disc, &self.state, g);
-            if branches {
-                update_branch_strains(
-                    &self.coeffs,
-                    &strain,
-                    &self.strain_n[g],
-                    self.branches.point_mut(g),
-                );
-            }
-            self.strain_n[g] = strain;
+        let (disc, state, coeffs) = (&self.disc, &self.state, &self.coeffs);
+        // Per collocation point and independent: in parallel.
+        match self.model.material.num_branches() {
+            0 => self
+                .strain_n
+                .par_iter_mut()
+                .enumerate()
+                .for_each(|(g, strain_n)| *strain_n = point_strains(disc, state, g)),
+            branches => self
+                .strain_n
+                .par_iter_mut()
+                .zip(self.branches.as_mut_slice().par_chunks_mut(branches))
+                .enumerate()
+                .for_each(|(g, (strain_n, point_branches))| {
+                    let strain = point_strains(disc, state, g);
+                    update_branch_strains(coeffs, &strain, strain_n, point_branches);
+                    *strain_n = strain;
+                }),
         }
         // Counted with the step's preparation.
         self.timing.material.1 += start.elapsed().as_secs_f64();
