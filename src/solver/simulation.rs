@@ -36,11 +36,13 @@ pub struct NewtonReport {
     pub increments: Vec<Real>,
     /// LU factorisations performed (fewer than `iterations` when a factorisation was reused).
     pub factorisations: usize,
+    /// Where a NaN or infinity first appeared (the equation of the residual, or the patches and unknown of the
+    /// increment), if one did; the iteration stops there.
+    pub non_finite: Option<String>,
 }
 
 /// An iteration counts as stagnant when its residual is above this fraction of the previous one.
 const STAGNATION_RATIO: Real = 0.5;
-
 
 /// One converged time step, as reported to observers.
 #[derive(Debug, Clone, PartialEq)]
@@ -150,6 +152,34 @@ pub struct Simulation<'m> {
 impl<'m> Simulation<'m> {
     /// Discretises the model, builds the sparsity pattern and analyses it.
     pub fn new(model: &'m Model) -> Result<Self, SolverError> {
+        let free = super::diagnose::free_bodies(model);
+        if !free.is_empty() {
+            let parts = free
+                .iter()
+                .map(|b| {
+                    let names: Vec<String> = b
+                        .patches
+                        .iter()
+                        .map(|&k| format!("`{}`", model.patches[k].name))
+                        .collect();
+                    if names.len() == 1 {
+                        format!("patch {}", names[0])
+                    } else {
+                        format!("patches {}", names.join(", "))
+                    }
+                })
+                .collect();
+            let nodes = free
+                .iter()
+                .flat_map(|b| b.nodes.iter().map(|&k| model.nodes[k].name.clone()))
+                .collect();
+            let free_patches: usize = free.iter().map(|b| b.patches.len()).sum();
+            return Err(SolverError::FreeBody {
+                parts,
+                nodes,
+                rest_held: free_patches < model.patches.len(),
+            });
+        }
         let disc = Discretisation::new(model)?;
         let assembler = Assembler::new(model, &disc);
         let state = State::reference(&disc);
@@ -488,6 +518,48 @@ impl<'m> Simulation<'m> {
         }
     }
 
+    /// Where the residual in `self.lin` is not finite, after `iteration` Newton iterations: its first such
+    /// equation, and how many there are.
+    fn non_finite_residual(&self, iteration: usize) -> String {
+        let bad: Vec<usize> = self
+            .lin
+            .residual
+            .iter()
+            .zip(&self.lin.row_scale)
+            .enumerate()
+            .filter(|(_, (r, s))| !(*r / *s).is_finite())
+            .map(|(i, _)| i)
+            .collect();
+        match bad.first() {
+            Some(&row) => format!(
+                "the residual became non-finite after {iteration} iterations, first in the equation of {} ({} non-finite equations in all)",
+                super::diagnose::describe_row(self.model, &self.disc, row),
+                bad.len()
+            ),
+            None => format!("the residual became non-finite after {iteration} iterations"),
+        }
+    }
+
+    /// Where the Newton increment in `self.delta` is not finite (at iteration `iteration`, 1-based): the patches
+    /// and the first unknown. A singular tangent (a part free to move as a rigid body) gives this.
+    fn non_finite_increment(&self, iteration: usize) -> String {
+        let patches = super::diagnose::non_finite_patches(self.model, &self.disc, &self.delta);
+        let first = self
+            .delta
+            .iter()
+            .position(|d| !d.is_finite())
+            .map(|c| super::diagnose::describe_unknown(self.model, &self.disc, c))
+            .unwrap_or_default();
+        format!(
+            "the Newton increment of iteration {iteration} is not finite in {}, first at {first}: the tangent is singular or nearly so there (a part free to move as a rigid body, or a load far beyond the structure's strength)",
+            if patches.is_empty() {
+                "the gauge multipliers".to_string()
+            } else {
+                patches.join(", ")
+            }
+        )
+    }
+
     /// Newton's method at time `t` from the current state (modified in place). With `reuse`, the last
     /// factorisation of the tangent (from an earlier iteration or step) is kept while each iteration reduces the
     /// normalised residual at least by the factor `refactor_ratio`; otherwise the tangent is assembled and
@@ -495,14 +567,21 @@ impl<'m> Simulation<'m> {
     fn newton(&mut self, t: Real, reuse: bool) -> Result<NewtonReport, NewtonFailure> {
         let actions = Actions::at(self.model, t, &self.ramps);
         let settings = &self.model.solver;
-        let (tol, max_iterations, ratio) = (settings.tolerance, settings.max_iterations, settings.refactor_ratio);
+        let (tol, max_iterations, ratio) = (
+            settings.tolerance,
+            settings.max_iterations,
+            settings.refactor_ratio,
+        );
         let mut report = NewtonReport::default();
         let mut last_increment = Real::INFINITY;
         let mut previous = Real::INFINITY;
         loop {
-            let r = self.linearise(&actions, false).map_err(NewtonFailure::Fatal)?;
+            let r = self
+                .linearise(&actions, false)
+                .map_err(NewtonFailure::Fatal)?;
             report.residuals.push(r);
             if !r.is_finite() {
+                report.non_finite = Some(self.non_finite_residual(report.iterations));
                 return Err(NewtonFailure::NotConverged(report));
             }
             let converged = if report.iterations == 0 {
@@ -531,14 +610,25 @@ impl<'m> Simulation<'m> {
             // A reused factorisation is kept while it contracts the residual fast enough.
             let fresh_tangent = !reuse || !factored || r > ratio * previous;
             if fresh_tangent {
-                self.linearise(&actions, true).map_err(NewtonFailure::Fatal)?;
+                self.linearise(&actions, true)
+                    .map_err(NewtonFailure::Fatal)?;
             }
             let (system, values) = match (&mut self.gauge, self.gauge_active) {
                 (Some((_, s, v)), true) => (s, &*v),
                 _ => (&mut self.system, &self.values),
             };
             if fresh_tangent {
-                system.factor(values).map_err(NewtonFailure::Fatal)?;
+                if let Err(e) = system.factor(values) {
+                    return Err(NewtonFailure::Fatal(match e {
+                        SolverError::Singular { column, .. } => SolverError::Singular {
+                            column,
+                            location: super::diagnose::describe_unknown(
+                                self.model, &self.disc, column,
+                            ),
+                        },
+                        e => e,
+                    }));
+                }
                 report.factorisations += 1;
             }
             self.delta.resize(self.lin.residual.len(), 0.0);
@@ -550,6 +640,7 @@ impl<'m> Simulation<'m> {
             report.increments.push(last_increment);
             report.iterations += 1;
             if !last_increment.is_finite() {
+                report.non_finite = Some(self.non_finite_increment(report.iterations));
                 return Err(NewtonFailure::NotConverged(report));
             }
             self.state.apply_increment(&self.disc, &self.delta);
@@ -652,6 +743,7 @@ impl<'m> Simulation<'m> {
                             dt,
                             iterations: newton.iterations,
                             residuals: newton.residuals,
+                            non_finite: newton.non_finite,
                         });
                     }
                     h = (dt / 2.0).max(min_step);

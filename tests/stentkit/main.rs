@@ -6,6 +6,7 @@ mod common;
 mod cli;
 mod design_errors;
 mod designs;
+mod fuzz;
 mod mesh;
 mod outputs;
 mod solver;

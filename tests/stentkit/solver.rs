@@ -44,7 +44,10 @@ fn bend45_text(p: usize, n: usize, steps: usize) -> String {
 #[test]
 fn newton_converges_quadratically() {
     // Newton's method proper: a factorisation per iteration (the default reuses it while it contracts).
-    let text = format!("{}\nsolver: {{reuse_factorisation: false}}\n", bend45_text(6, 20, 50));
+    let text = format!(
+        "{}\nsolver: {{reuse_factorisation: false}}\n",
+        bend45_text(6, 20, 50)
+    );
     let model = model_from_text(&text, "bend45_newton.yaml");
     let (_, rec) = solve(&model);
     let pre_round_off = 1e-9;

@@ -150,15 +150,6 @@ pub fn build(
     let time = time_settings(&dto.time)?;
     let solver = solver_settings(dto.solver.as_ref())?;
     let probes = probes(dto, &patches, &nodes)?;
-    let any_prescribed = nodes.iter().any(|n| {
-        n.conditions
-            .components
-            .iter()
-            .any(|c| matches!(c, Component::Prescribed { .. }))
-    });
-    if !any_prescribed {
-        warnings.push("no component of any node is prescribed: rigid-body motion is unconstrained and the tangent will be singular".to_string());
-    }
     let output = output_settings(dto.output.as_ref(), &time)?;
     let record_times = output
         .snapshots
@@ -185,6 +176,20 @@ pub fn build(
         symmetry_planes,
         record_times,
     };
+    // A part no condition holds can move as a rigid body: `run` refuses it (the solver's check), `check` warns.
+    for body in crate::solver::diagnose::free_bodies(&model) {
+        let names: Vec<String> = body
+            .patches
+            .iter()
+            .map(|&k| format!("`{}`", model.patches[k].name))
+            .collect();
+        warnings.push(format!(
+            "no component of any node of patch{} {} is prescribed: {} free to move as a rigid body, the tangent is singular and `run` will refuse the design",
+            if names.len() == 1 { "" } else { "es" },
+            names.join(", "),
+            if names.len() == 1 { "it is" } else { "they are" }
+        ));
+    }
     Ok((model, output, warnings))
 }
 
