@@ -275,6 +275,29 @@ fn unmutated_designs_are_accepted() {
     }
 }
 
+/// Mutations that once panicked, kept as fixed cases: `(design, line fragment, replacement)`.
+const REGRESSIONS: &[(&str, &str, &str)] = &[
+    // A crown rotation of 1e308° lost all precision in the angles: a bridge found no facing trough and the
+    // generator panicked (`retained trough`). Rotations are now reduced modulo 360°, and a crest facing no
+    // trough is an error.
+    ("straight_stent.yaml", "rotation_deg: 90", "rotation_deg: 1e308"),
+    ("straight_stent.yaml", "rotation_deg: 90", "rotation_deg: 1e17"),
+];
+
+#[test]
+fn mutations_that_once_panicked_are_handled() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("designs");
+    for (file, from, to) in REGRESSIONS {
+        let path = root.join(file);
+        let text = std::fs::read_to_string(&path).expect("design");
+        assert!(text.contains(from), "{file}: `{from}`");
+        let mutated = text.replacen(from, to, 1);
+        if let Err(why) = check(&mutated, &path) {
+            panic!("{file} with `{to}`: {why}");
+        }
+    }
+}
+
 #[test]
 fn mutated_designs_never_panic_and_every_rejection_names_the_file() {
     let sources = sources();
