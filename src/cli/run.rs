@@ -529,8 +529,8 @@ fn failure_report(failure: &FailureReport, summary: &RunSummaryFile) -> String {
         }
         _ => lines.push(format!("  {} ({})", failure.message, failure.kind)),
     }
-    if let Some(w) = &failure.non_finite {
-        lines.push(format!("  non-finite: {w}"));
+    if let Some(w) = &failure.diagnosis {
+        lines.push(format!("  diagnosis: {w}"));
     }
     let snapshot = summary
         .snapshots

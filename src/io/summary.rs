@@ -44,9 +44,10 @@ pub struct FailureReport {
     pub iterations: Option<usize>,
     /// Normalised residual at each assembly of the last attempt (`null` where it was not finite).
     pub residuals: Vec<Real>,
-    /// Where a NaN or infinity first appeared, if one did.
+    /// Why the last attempt was abandoned at once, if it was: where a NaN or infinity first appeared, or where
+    /// an increment too large for a regular tangent was largest.
     #[serde(skip_serializing_if = "Option::is_none")]
-    pub non_finite: Option<String>,
+    pub diagnosis: Option<String>,
     /// The last converged step (0: the initial state), whose state the outputs end with.
     pub last_converged_step: usize,
     /// Its time [s].
@@ -74,7 +75,7 @@ impl FailureReport {
             dt: None,
             iterations: None,
             residuals: Vec::new(),
-            non_finite: None,
+            diagnosis: None,
             last_converged_step: step,
             last_converged_time: time,
             message: error.to_string(),
@@ -85,7 +86,7 @@ impl FailureReport {
             dt,
             iterations,
             residuals,
-            non_finite,
+            diagnosis,
         } = error
         {
             report.time = Some(*time);
@@ -93,7 +94,7 @@ impl FailureReport {
             report.dt = Some(*dt);
             report.iterations = Some(*iterations);
             report.residuals = residuals.clone();
-            report.non_finite = non_finite.clone();
+            report.diagnosis = diagnosis.clone();
         }
         report
     }

@@ -64,7 +64,7 @@ pub enum SolverError {
     /// Newton failed even at the smallest allowed step.
     #[error(
         "no convergence at t = {time} (step {step}, dt = {dt:.3e} ≤ min_step): after {iterations} Newton iterations the normalised residuals were {residuals:?}{}",
-        non_finite.as_ref().map(|w| format!("; {w}")).unwrap_or_default()
+        diagnosis.as_ref().map(|w| format!("; {w}")).unwrap_or_default()
     )]
     StepFailed {
         /// Time the step tried to reach.
@@ -77,8 +77,9 @@ pub enum SolverError {
         iterations: usize,
         /// Normalised residual norm at each iteration of the last attempt.
         residuals: Vec<Real>,
-        /// Where a NaN or infinity first appeared in the last attempt, if one did.
-        non_finite: Option<String>,
+        /// Why the last attempt was abandoned at once, if it was: where a NaN or infinity first appeared, or
+        /// where an increment too large for a regular tangent was largest.
+        diagnosis: Option<String>,
     },
 }
 

@@ -36,10 +36,17 @@ pub struct NewtonReport {
     pub increments: Vec<Real>,
     /// LU factorisations performed (fewer than `iterations` when a factorisation was reused).
     pub factorisations: usize,
-    /// Where a NaN or infinity first appeared (the equation of the residual, or the patches and unknown of the
-    /// increment), if one did; the iteration stops there.
-    pub non_finite: Option<String>,
+    /// Why the iteration was abandoned at once, if it was: where a NaN or infinity first appeared (the equation
+    /// of the residual, or the patches and unknown of the increment), or where an increment so large that the
+    /// tangent must be (nearly) singular is largest.
+    pub diagnosis: Option<String>,
 }
+
+/// A normalised Newton increment above this (a translation of 10⁸ patch lengths, a rotation of 10⁸ rad) never
+/// leads to convergence: it comes from a singular or nearly singular tangent (a part free to move as a rigid
+/// body) or from a load far beyond the structure's strength. The iteration stops there and names where the
+/// increment is largest.
+const SINGULAR_INCREMENT: Real = 1e8;
 
 /// An iteration counts as stagnant when its residual is above this fraction of the previous one.
 const STAGNATION_RATIO: Real = 0.5;
@@ -560,6 +567,28 @@ impl<'m> Simulation<'m> {
         )
     }
 
+    /// Where the (finite) Newton increment in `self.delta`, of normalised size `norm`, is largest.
+    fn huge_increment(&self, iteration: usize, norm: Real) -> String {
+        let n = self.disc.num_unknowns();
+        let largest = self.delta[..n]
+            .iter()
+            .enumerate()
+            .map(|(c, d)| {
+                let scale = if c % 6 < 3 {
+                    self.control_length[c / 6]
+                } else {
+                    1.0
+                };
+                (c, (d / scale).abs())
+            })
+            .max_by(|a, b| a.1.total_cmp(&b.1))
+            .map_or(0, |(c, _)| c);
+        format!(
+            "the Newton increment of iteration {iteration} is {norm:.3e} (normalised), largest at {}: Newton is diverging from a singular or nearly singular tangent (a part held too weakly to stop a rigid rotation or translation?) or from a load far beyond what the structure carries",
+            super::diagnose::describe_unknown(self.model, &self.disc, largest)
+        )
+    }
+
     /// Newton's method at time `t` from the current state (modified in place). With `reuse`, the last
     /// factorisation of the tangent (from an earlier iteration or step) is kept while each iteration reduces the
     /// normalised residual at least by the factor `refactor_ratio`; otherwise the tangent is assembled and
@@ -581,7 +610,7 @@ impl<'m> Simulation<'m> {
                 .map_err(NewtonFailure::Fatal)?;
             report.residuals.push(r);
             if !r.is_finite() {
-                report.non_finite = Some(self.non_finite_residual(report.iterations));
+                report.diagnosis = Some(self.non_finite_residual(report.iterations));
                 return Err(NewtonFailure::NotConverged(report));
             }
             let converged = if report.iterations == 0 {
@@ -640,7 +669,11 @@ impl<'m> Simulation<'m> {
             report.increments.push(last_increment);
             report.iterations += 1;
             if !last_increment.is_finite() {
-                report.non_finite = Some(self.non_finite_increment(report.iterations));
+                report.diagnosis = Some(self.non_finite_increment(report.iterations));
+                return Err(NewtonFailure::NotConverged(report));
+            }
+            if last_increment > SINGULAR_INCREMENT {
+                report.diagnosis = Some(self.huge_increment(report.iterations, last_increment));
                 return Err(NewtonFailure::NotConverged(report));
             }
             self.state.apply_increment(&self.disc, &self.delta);
@@ -743,7 +776,7 @@ impl<'m> Simulation<'m> {
                             dt,
                             iterations: newton.iterations,
                             residuals: newton.residuals,
-                            non_finite: newton.non_finite,
+                            diagnosis: newton.diagnosis,
                         });
                     }
                     h = (dt / 2.0).max(min_step);

@@ -280,8 +280,16 @@ const REGRESSIONS: &[(&str, &str, &str)] = &[
     // A crown rotation of 1e308° lost all precision in the angles: a bridge found no facing trough and the
     // generator panicked (`retained trough`). Rotations are now reduced modulo 360°, and a crest facing no
     // trough is an error.
-    ("straight_stent.yaml", "rotation_deg: 90", "rotation_deg: 1e308"),
-    ("straight_stent.yaml", "rotation_deg: 90", "rotation_deg: 1e17"),
+    (
+        "straight_stent.yaml",
+        "rotation_deg: 90",
+        "rotation_deg: 1e308",
+    ),
+    (
+        "straight_stent.yaml",
+        "rotation_deg: 90",
+        "rotation_deg: 1e17",
+    ),
 ];
 
 #[test]

@@ -9,6 +9,7 @@ mod designs;
 mod fuzz;
 mod mesh;
 mod outputs;
+mod reliability;
 mod solver;
 mod stent;
 mod viscoelastic;
