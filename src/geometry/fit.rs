@@ -377,6 +377,6 @@ mod tests {
         let (rf, tf) = best_fit_rigid(&from, &to, &weights).expect("fit");
         assert!((rf - r).abs().max() < 1e-12);
         assert!((tf - t).norm() < 1e-12);
-        assert!(best_fit_rigid(&from, &to, &vec![0.0; 9]).is_none());
+        assert!(best_fit_rigid(&from, &to, &[0.0; 9]).is_none());
     }
 }

@@ -745,7 +745,7 @@ pub fn programme(
                 .temporary_node_positions(geometry, &temporary)
                 .map_err(geometry_issue)?;
             let positions = if t.align.unwrap_or(true) {
-                align_temporary(geometry, &positions, &set).ok_or_else(|| {
+                align_temporary(geometry, &positions, set).ok_or_else(|| {
                     issue(
                         format!("{tpath}.align"),
                         "the driven nodes do not define a rigid placement",
