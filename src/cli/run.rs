@@ -20,7 +20,8 @@ use crate::io::mcap::{McapRecorder, RunInfo};
 use crate::io::run_charts::RunCharts;
 use crate::io::snapshots::SnapshotWriter;
 use crate::io::summary::{
-    Files, FinalState, RunStatus, RunSummaryFile, Timing, UnitsSummary, peak_memory_mib,
+    FailureReport, Files, FinalState, RunStatus, RunSummaryFile, Timing, UnitsSummary,
+    peak_memory_mib,
 };
 use crate::math::Real;
 use crate::solver::{NewtonReport, Observer, Simulation, StepReport};
@@ -425,6 +426,10 @@ fn run_in(
         units: UnitsSummary::of(model),
         status,
         error,
+        failure: result
+            .as_ref()
+            .err()
+            .map(|e| FailureReport::of(e, totals.steps, sim.time())),
         wall_time_s: wall,
         peak_memory_mib: peak_memory_mib(),
         timing: Timing {
@@ -459,6 +464,9 @@ fn run_in(
         warnings: design.warnings.clone(),
         notices: sim.notices().to_vec(),
     };
+    if let Some(failure) = &summary.failure {
+        eprintln!("{}", failure_report(failure, &summary));
+    }
     let summary_path = dir.join("summary.json");
     summary
         .write(&summary_path)
@@ -503,6 +511,44 @@ fn run_in(
         dir.display()
     );
     Ok(())
+}
+
+/// The failure report printed by a failed run (the same facts are in summary.json under `failure`).
+fn failure_report(failure: &FailureReport, summary: &RunSummaryFile) -> String {
+    let mut lines = vec!["failure report:".to_string()];
+    match (failure.step, failure.time, failure.dt, failure.iterations) {
+        (Some(step), Some(time), Some(dt), Some(iterations)) => {
+            lines.push(format!(
+                "  step {step} to t = {} s failed at the smallest step, dt = {dt:.3e} s",
+                short_time(time)
+            ));
+            let residuals: Vec<String> = failure
+                .residuals
+                .iter()
+                .map(|r| format!("{r:.3e}"))
+                .collect();
+            lines.push(format!(
+                "  Newton: {iterations} iterations, normalised residuals [{}]",
+                residuals.join(", ")
+            ));
+        }
+        _ => lines.push(format!("  {} ({})", failure.message, failure.kind)),
+    }
+    if let Some(w) = &failure.diagnosis {
+        lines.push(format!("  diagnosis: {w}"));
+    }
+    let snapshot = summary
+        .snapshots
+        .last()
+        .filter(|s| s.step == failure.last_converged_step)
+        .map(|s| format!(", snapshot {}", s.stl))
+        .unwrap_or_default();
+    lines.push(format!(
+        "  last converged: step {}, t = {} s (history.csv and run.mcap end there{snapshot})",
+        failure.last_converged_step,
+        short_time(failure.last_converged_time)
+    ));
+    lines.join("\n")
 }
 
 /// A time for messages: at most 9 decimals, trailing zeros dropped (`0.1`, not `0.10000000000000005`).

@@ -1038,8 +1038,20 @@ impl StentSpec {
                     debug_assert!(
                         j % 2 == 1 && same_angle(a, phase(k + 1) + half_wave * j as Real)
                     );
-                    let start = node_index[k][2 * c].expect("retained crest");
-                    let end = node_index[k + 1][j].expect("retained trough");
+                    // A rotation so large that angles lost their precision (found by fuzzing the designs:
+                    // `rotation_deg: 1e308`) can leave a crest facing no retained trough: an error, not a panic.
+                    let (Some(start), Some(end)) = (node_index[k][2 * c], node_index[k + 1][j])
+                    else {
+                        return Err(invalid(
+                            "rotation",
+                            format!(
+                                "the bridge from crown {} at ϑ = {:.6} rad finds no trough of crown {} facing it; give a rotation in degrees within (−360, 360)",
+                                k + 1,
+                                a,
+                                k + 2
+                            ),
+                        ));
+                    };
                     let in_plane = plane_of(a);
                     let offset = match b.shape {
                         BridgeShape::Straight => Offset::None,

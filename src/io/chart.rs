@@ -211,10 +211,10 @@ pub fn render_svg(chart: &LineChart) -> Result<String, ChartError> {
     Ok(svg)
 }
 
-/// Renders the chart and writes it to `path`.
+/// Renders the chart and writes it to `path`, atomically (no partial SVG is ever visible).
 pub fn write_svg(chart: &LineChart, path: &Path) -> Result<(), ChartError> {
     let svg = render_svg(chart)?;
-    std::fs::write(path, svg).map_err(|source| ChartError::Io {
+    super::stl::write_bytes_atomically(path, svg.as_bytes()).map_err(|source| ChartError::Io {
         path: path.to_path_buf(),
         source,
     })

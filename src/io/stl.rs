@@ -231,6 +231,18 @@ pub(crate) fn check_writable(mesh: &TriangleMesh, single_precision: bool) -> io:
 /// Distinguishes temporary files of concurrent writes from one process.
 static TEMPORARY_COUNTER: AtomicU64 = AtomicU64::new(0);
 
+/// Writes `bytes` to `path` atomically, as the mesh writers do: a temporary file in the same folder, synced,
+/// then renamed over the target, so that a reader (or a run interrupted while writing) never sees a partial
+/// file. Used for `summary.json` and the charts.
+///
+/// # Errors
+/// The I/O error of creating, writing, syncing or renaming the temporary file; the target is then unchanged.
+pub fn write_bytes_atomically(path: &Path, bytes: &[u8]) -> io::Result<()> {
+    write_atomically(path, |w| w.write_all(bytes)).map_err(|e| match e {
+        MeshIoError::Write { source, .. } | MeshIoError::Read { source, .. } => source,
+    })
+}
+
 /// Writes a file atomically: `write` fills a temporary file `.<name>.<pid>.<n>.tmp` in the target's
 /// directory, which is then flushed, synced to disk and renamed over `path` (an atomic replacement on
 /// POSIX and Windows file systems). On any error the temporary file is removed and the target is untouched.

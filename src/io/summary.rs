@@ -24,6 +24,82 @@ pub enum RunStatus {
     Interrupted,
 }
 
+/// Where and how the solver failed (`status: failed`), and the last converged state the run folder holds.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct FailureReport {
+    /// What failed: `no_convergence` (Newton failed at the smallest step), `free_body`, `singular_tangent`,
+    /// `geometry`, `material` or `linear_solver`.
+    pub kind: String,
+    /// Time the failing step tried to reach [s] (no convergence only).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub time: Option<Real>,
+    /// Number of the failing step, 1-based (no convergence only).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub step: Option<usize>,
+    /// Step size of the last attempt [s] (no convergence only).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub dt: Option<Real>,
+    /// Newton iterations of the last attempt (no convergence only).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub iterations: Option<usize>,
+    /// Normalised residual at each assembly of the last attempt (`null` where it was not finite).
+    pub residuals: Vec<Real>,
+    /// Why the last attempt was abandoned at once, if it was: where a NaN or infinity first appeared, or where
+    /// an increment too large for a regular tangent was largest.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub diagnosis: Option<String>,
+    /// The last converged step (0: the initial state), whose state the outputs end with.
+    pub last_converged_step: usize,
+    /// Its time [s].
+    pub last_converged_time: Real,
+    /// The solver's message.
+    pub message: String,
+}
+
+impl FailureReport {
+    /// The report of `error`, the run having converged up to `step` at `time`.
+    pub fn of(error: &crate::solver::SolverError, step: usize, time: Real) -> Self {
+        use crate::solver::SolverError as E;
+        let mut report = Self {
+            kind: match error {
+                E::StepFailed { .. } => "no_convergence",
+                E::FreeBody { .. } => "free_body",
+                E::Singular { .. } => "singular_tangent",
+                E::Geometry { .. } => "geometry",
+                E::Material(_) => "material",
+                E::Linear(_) => "linear_solver",
+            }
+            .into(),
+            time: None,
+            step: None,
+            dt: None,
+            iterations: None,
+            residuals: Vec::new(),
+            diagnosis: None,
+            last_converged_step: step,
+            last_converged_time: time,
+            message: error.to_string(),
+        };
+        if let E::StepFailed {
+            time,
+            step,
+            dt,
+            iterations,
+            residuals,
+            diagnosis,
+        } = error
+        {
+            report.time = Some(*time);
+            report.step = Some(*step);
+            report.dt = Some(*dt);
+            report.iterations = Some(*iterations);
+            report.residuals = residuals.clone();
+            report.diagnosis = diagnosis.clone();
+        }
+        report
+    }
+}
+
 /// The unit system of every number in the run folder.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct UnitsSummary {
@@ -179,6 +255,9 @@ pub struct RunSummaryFile {
     /// Why it stopped or failed.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub error: Option<String>,
+    /// The failure report of a run whose solver failed.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub failure: Option<FailureReport>,
     /// Wall time of the whole command [s].
     pub wall_time_s: Real,
     /// Peak resident memory of the process [MiB] (Linux `VmHWM`; absent elsewhere).
@@ -221,14 +300,15 @@ pub struct RunSummaryFile {
 }
 
 impl RunSummaryFile {
-    /// Writes the summary as pretty-printed JSON.
+    /// Writes the summary as pretty-printed JSON, atomically (a temporary file renamed over the target), so
+    /// that a reader never sees a partial summary.
     ///
     /// # Errors
     /// The I/O error when the file cannot be written.
     pub fn write(&self, path: &Path) -> std::io::Result<()> {
         let mut text = serde_json::to_string_pretty(self).map_err(std::io::Error::other)?;
         text.push('\n');
-        std::fs::write(path, text)
+        super::stl::write_bytes_atomically(path, text.as_bytes())
     }
 }
 

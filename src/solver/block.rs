@@ -61,8 +61,8 @@ impl BandLu {
         j * self.ld() + self.kl + self.ku + i - j
     }
 
-    /// In-place LU with partial pivoting (LAPACK `dgbtf2`). `false` when a column has no non-zero pivot.
-    fn factor(&mut self) -> bool {
+    /// In-place LU with partial pivoting (LAPACK `dgbtf2`). `Err(j)` when column `j` has no non-zero pivot.
+    fn factor(&mut self) -> Result<(), usize> {
         let (m, kl, ku, ld) = (self.m, self.kl, self.ku, self.ld());
         let kv = kl + ku;
         let ab = &mut self.ab;
@@ -81,7 +81,7 @@ impl BandLu {
             }
             self.pivots[j] = j + jp;
             if best == 0.0 || !best.is_finite() {
-                return false;
+                return Err(j);
             }
             ju = ju.max((j + ku + jp).min(m - 1));
             if jp != 0 {
@@ -109,7 +109,7 @@ impl BandLu {
                 }
             }
         }
-        true
+        Ok(())
     }
 
     /// Solves `A x = b` in place for one right-hand side: [`Self::solve`] with both triangles as contiguous
@@ -451,10 +451,9 @@ impl BlockSystem {
             .patches
             .par_iter_mut()
             .zip(chunks)
-            .enumerate()
-            .find_map_any(|(k, (block, out))| {
-                if !block.lu.factor() {
-                    return Some(k);
+            .find_map_any(|(block, out)| {
+                if let Err(j) = block.lu.factor() {
+                    return Some(block.start + j);
                 }
                 block.lu.solve(&mut block.x, END_COLUMNS);
                 out.fill(0.0);
@@ -474,12 +473,20 @@ impl BlockSystem {
                 }
                 None
             });
-        if let Some(k) = failed {
+        if let Some(column) = failed {
             return Err(SolverError::Singular {
-                index: self.patches[k].start,
+                column,
+                location: String::new(),
             });
         }
-        self.schur.factor(&self.schur_values)?;
+        self.schur.factor(&self.schur_values).map_err(|e| match e {
+            // The Schur complement's unknowns are the border's.
+            SolverError::Singular { column, location } => SolverError::Singular {
+                column: self.border.get(column).copied().unwrap_or(column),
+                location,
+            },
+            e => e,
+        })?;
         self.factored = true;
         Ok(())
     }
@@ -561,7 +568,7 @@ mod tests {
         let mut b: Vec<Real> = (0..m)
             .map(|i| (0..m).map(|j| dense[i * m + j] * x[j]).sum())
             .collect();
-        assert!(lu.factor());
+        assert_eq!(lu.factor(), Ok(()));
         let mut wide: Vec<Real> = b.iter().flat_map(|&v| [v, 2.0 * v]).collect();
         lu.solve_vector(&mut b);
         lu.solve(&mut wide, 2);

@@ -155,7 +155,15 @@ impl SparseSystem {
                 self.factored = true;
                 Ok(())
             }
-            Err(LuError::SymbolicSingular { index }) => Err(SolverError::Singular { index }),
+            Err(LuError::SymbolicSingular { index }) => {
+                // `index` is the elimination step; the column permutation names the unknown.
+                let (forward, _) = self.symbolic.col_perm().arrays();
+                let column = forward.get(index).copied().unwrap_or(index);
+                Err(SolverError::Singular {
+                    column,
+                    location: String::new(),
+                })
+            }
             Err(LuError::Generic(e)) => Err(SolverError::Linear(format!("numeric LU: {e:?}"))),
         }
     }

@@ -7,6 +7,7 @@
 
 pub mod assembly;
 pub mod block;
+pub mod diagnose;
 pub mod discretisation;
 pub mod gauge;
 pub mod linear;
@@ -36,17 +37,35 @@ pub enum SolverError {
     /// The sparse linear algebra failed for a reason other than singularity.
     #[error("linear solver: {0}")]
     Linear(String),
-    /// The tangent is singular (no pivot at the given elimination step).
+    /// The tangent is structurally singular: no pivot for an unknown.
     #[error(
-        "the tangent matrix is singular (no pivot at elimination step {index}): is some patch or node free to move as a rigid body?"
+        "the tangent matrix is singular: no pivot for unknown {column}{}: is that patch or node free to move as a rigid body?",
+        if location.is_empty() { String::new() } else { format!(" ({location})") }
     )]
     Singular {
-        /// Elimination step without a pivot.
-        index: usize,
+        /// The unknown (column of the tangent) without a pivot.
+        column: usize,
+        /// Where that unknown is (patch, control point, field), when known.
+        location: String,
+    },
+    /// Parts of the model are held by no condition: each can move as a rigid body and the tangent is singular.
+    #[error(
+        "{} held by no condition: {} free to move as a rigid body and the tangent would be singular; prescribe a component (e.g. `clamp: true`) at one of {} nodes ({}){}",
+        list(parts), if parts.len() == 1 { "it is" } else { "they are" }, if parts.len() == 1 { "its" } else { "their" },
+        nodes.join(", "), if *rest_held { if parts.len() == 1 { ", or join it to the rest" } else { ", or join them to the rest" } } else { "" }
+    )]
+    FreeBody {
+        /// Each free part, described by its patches (`patches `a`, `b``).
+        parts: Vec<String>,
+        /// The names of the free parts' nodes.
+        nodes: Vec<String>,
+        /// Whether the rest of the model is held (joining the free parts to it is then a remedy).
+        rest_held: bool,
     },
     /// Newton failed even at the smallest allowed step.
     #[error(
-        "no convergence at t = {time} (step {step}, dt = {dt:.3e} ≤ min_step): after {iterations} Newton iterations the normalised residuals were {residuals:?}"
+        "no convergence at t = {time} (step {step}, dt = {dt:.3e} ≤ min_step): after {iterations} Newton iterations the normalised residuals were {residuals:?}{}",
+        diagnosis.as_ref().map(|w| format!("; {w}")).unwrap_or_default()
     )]
     StepFailed {
         /// Time the step tried to reach.
@@ -59,7 +78,19 @@ pub enum SolverError {
         iterations: usize,
         /// Normalised residual norm at each iteration of the last attempt.
         residuals: Vec<Real>,
+        /// Why the last attempt was abandoned at once, if it was: where a NaN or infinity first appeared, or
+        /// where an increment too large for a regular tangent was largest.
+        diagnosis: Option<String>,
     },
+}
+
+/// `a`, `a and b`, `a, b and c`.
+fn list(items: &[String]) -> String {
+    match items {
+        [] => String::new(),
+        [one] => one.clone(),
+        [init @ .., last] => format!("{} and {last}", init.join(", ")),
+    }
 }
 
 #[cfg(test)]

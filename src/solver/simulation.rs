@@ -38,7 +38,17 @@ pub struct NewtonReport {
     pub increments: Vec<Real>,
     /// LU factorisations performed (fewer than `iterations` when a factorisation was reused).
     pub factorisations: usize,
+    /// Why the iteration was abandoned at once, if it was: where a NaN or infinity first appeared (the equation
+    /// of the residual, or the patches and unknown of the increment), or where an increment so large that the
+    /// tangent must be (nearly) singular is largest.
+    pub diagnosis: Option<String>,
 }
+
+/// A normalised Newton increment above this (a translation of 10⁸ patch lengths, a rotation of 10⁸ rad) never
+/// leads to convergence: it comes from a singular or nearly singular tangent (a part free to move as a rigid
+/// body) or from a load far beyond the structure's strength. The iteration stops there and names where the
+/// increment is largest.
+const SINGULAR_INCREMENT: Real = 1e8;
 
 /// An iteration counts as stagnant when its residual is above this fraction of the previous one.
 const STAGNATION_RATIO: Real = 0.5;
@@ -227,6 +237,34 @@ pub struct Simulation<'m> {
 impl<'m> Simulation<'m> {
     /// Discretises the model, builds the sparsity pattern and analyses it.
     pub fn new(model: &'m Model) -> Result<Self, SolverError> {
+        let free = super::diagnose::free_bodies(model);
+        if !free.is_empty() {
+            let parts = free
+                .iter()
+                .map(|b| {
+                    let names: Vec<String> = b
+                        .patches
+                        .iter()
+                        .map(|&k| format!("`{}`", model.patches[k].name))
+                        .collect();
+                    if names.len() == 1 {
+                        format!("patch {}", names[0])
+                    } else {
+                        format!("patches {}", names.join(", "))
+                    }
+                })
+                .collect();
+            let nodes = free
+                .iter()
+                .flat_map(|b| b.nodes.iter().map(|&k| model.nodes[k].name.clone()))
+                .collect();
+            let free_patches: usize = free.iter().map(|b| b.patches.len()).sum();
+            return Err(SolverError::FreeBody {
+                parts,
+                nodes,
+                rest_held: free_patches < model.patches.len(),
+            });
+        }
         let disc = Discretisation::new(model)?;
         let assembler = Assembler::new(model, &disc);
         let state = State::reference(&disc);
@@ -635,6 +673,70 @@ impl<'m> Simulation<'m> {
         }
     }
 
+    /// Where the residual in `self.lin` is not finite, after `iteration` Newton iterations: its first such
+    /// equation, and how many there are.
+    fn non_finite_residual(&self, iteration: usize) -> String {
+        let bad: Vec<usize> = self
+            .lin
+            .residual
+            .iter()
+            .zip(&self.lin.row_scale)
+            .enumerate()
+            .filter(|(_, (r, s))| !(*r / *s).is_finite())
+            .map(|(i, _)| i)
+            .collect();
+        match bad.first() {
+            Some(&row) => format!(
+                "the residual became non-finite after {iteration} iterations, first in the equation of {} ({} non-finite equations in all)",
+                super::diagnose::describe_row(self.model, &self.disc, row),
+                bad.len()
+            ),
+            None => format!("the residual became non-finite after {iteration} iterations"),
+        }
+    }
+
+    /// Where the Newton increment in `self.delta` is not finite (at iteration `iteration`, 1-based): the patches
+    /// and the first unknown. A singular tangent (a part free to move as a rigid body) gives this.
+    fn non_finite_increment(&self, iteration: usize) -> String {
+        let patches = super::diagnose::non_finite_patches(self.model, &self.disc, &self.delta);
+        let first = self
+            .delta
+            .iter()
+            .position(|d| !d.is_finite())
+            .map(|c| super::diagnose::describe_unknown(self.model, &self.disc, c))
+            .unwrap_or_default();
+        format!(
+            "the Newton increment of iteration {iteration} is not finite in {}, first at {first}: the tangent is singular or nearly so there (a part free to move as a rigid body, or a load far beyond the structure's strength)",
+            if patches.is_empty() {
+                "the gauge multipliers".to_string()
+            } else {
+                patches.join(", ")
+            }
+        )
+    }
+
+    /// Where the (finite) Newton increment in `self.delta`, of normalised size `norm`, is largest.
+    fn huge_increment(&self, iteration: usize, norm: Real) -> String {
+        let n = self.disc.num_unknowns();
+        let largest = self.delta[..n]
+            .iter()
+            .enumerate()
+            .map(|(c, d)| {
+                let scale = if c % 6 < 3 {
+                    self.control_length[c / 6]
+                } else {
+                    1.0
+                };
+                (c, (d / scale).abs())
+            })
+            .max_by(|a, b| a.1.total_cmp(&b.1))
+            .map_or(0, |(c, _)| c);
+        format!(
+            "the Newton increment of iteration {iteration} is {norm:.3e} (normalised), largest at {}: Newton is diverging from a singular or nearly singular tangent (a part held too weakly to stop a rigid rotation or translation?) or from a load far beyond what the structure carries",
+            super::diagnose::describe_unknown(self.model, &self.disc, largest)
+        )
+    }
+
     /// Newton's method at time `t` from the current state (modified in place). With `reuse`, the last
     /// factorisation of the tangent (from an earlier iteration or step) is kept while each iteration reduces the
     /// normalised residual at least by the factor `refactor_ratio`; otherwise the tangent is assembled and
@@ -655,6 +757,7 @@ impl<'m> Simulation<'m> {
                 .map_err(NewtonFailure::Fatal)?;
             report.residuals.push(r);
             if !r.is_finite() {
+                report.diagnosis = Some(self.non_finite_residual(report.iterations));
                 return Err(NewtonFailure::NotConverged(report));
             }
             let converged = if report.iterations == 0 {
@@ -692,7 +795,17 @@ impl<'m> Simulation<'m> {
             };
             if fresh_tangent {
                 let start = Instant::now();
-                system.factor(values).map_err(NewtonFailure::Fatal)?;
+                if let Err(e) = system.factor(values) {
+                    return Err(NewtonFailure::Fatal(match e {
+                        SolverError::Singular { column, .. } => SolverError::Singular {
+                            column,
+                            location: super::diagnose::describe_unknown(
+                                self.model, &self.disc, column,
+                            ),
+                        },
+                        e => e,
+                    }));
+                }
                 SolverTiming::add(&mut self.timing.factorisation, start);
                 report.factorisations += 1;
             }
@@ -707,6 +820,11 @@ impl<'m> Simulation<'m> {
             report.increments.push(increment);
             report.iterations += 1;
             if !increment.is_finite() {
+                report.diagnosis = Some(self.non_finite_increment(report.iterations));
+                return Err(NewtonFailure::NotConverged(report));
+            }
+            if increment > SINGULAR_INCREMENT {
+                report.diagnosis = Some(self.huge_increment(report.iterations, increment));
                 return Err(NewtonFailure::NotConverged(report));
             }
             self.state.apply_increment(&self.disc, &self.delta);
@@ -838,6 +956,7 @@ impl<'m> Simulation<'m> {
                             dt,
                             iterations: newton.iterations,
                             residuals: newton.residuals,
+                            diagnosis: newton.diagnosis,
                         });
                     }
                     h = (dt / 2.0).max(min_step);

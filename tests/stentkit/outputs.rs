@@ -180,6 +180,29 @@ fn check_recording(dir: &Path, design_file: &Path) -> Recording {
     rec
 }
 
+/// Checks that history.csv holds the initial state and `steps` converged steps, every row complete (as many
+/// numbers as the header has columns), the last at `final_time`.
+fn check_history(dir: &Path, steps: usize, final_time: Real) {
+    let history = std::fs::read_to_string(dir.join("history.csv")).expect("history.csv");
+    assert!(history.ends_with('\n'), "the last row is complete");
+    let mut lines = history.lines();
+    let columns = lines.next().expect("header").split(',').count();
+    let rows: Vec<Vec<f64>> = lines
+        .map(|l| {
+            l.split(',')
+                .map(|v| v.parse().unwrap_or_else(|_| panic!("number in `{l}`")))
+                .collect()
+        })
+        .collect();
+    assert_eq!(rows.len(), steps + 1, "the initial state and every step");
+    assert!(rows.iter().all(|r| r.len() == columns));
+    let last = rows.last().expect("rows")[0];
+    assert!(
+        (last - final_time).abs() <= 1e-9 * final_time.abs().max(1.0),
+        "{last} vs {final_time}"
+    );
+}
+
 /// Reads every snapshot STL back (vertices merged by their f32 coordinates) and checks it closed with a
 /// positive volume equal to the reported one; returns the meshes' (volume, triangles) per snapshot.
 fn check_snapshots(dir: &Path) -> Vec<(Real, usize)> {
@@ -506,6 +529,14 @@ fn failed_run_leaves_every_file_valid() {
         stderr.contains("the run stopped at t = 0.3") && !stderr.contains("panicked"),
         "{stderr}"
     );
+    // The failure report, printed and in the summary: time, step, step size, iterations, residual history and
+    // the last converged state.
+    assert!(
+        stderr.contains("failure report:")
+            && stderr.contains("step 4 to t = 0.4 s failed at the smallest step")
+            && stderr.contains("last converged: step 3, t = 0.3 s"),
+        "{stderr}"
+    );
     let s = summary(&dir);
     assert_eq!(s["status"], "failed");
     assert!(
@@ -515,6 +546,29 @@ fn failed_run_leaves_every_file_valid() {
             .contains("no convergence")
     );
     assert_eq!(s["steps"], 3);
+    let failure = &s["failure"];
+    assert_eq!(failure["kind"], "no_convergence");
+    assert_eq!(failure["step"], 4);
+    assert!((failure["time"].as_f64().expect("time") - 0.4).abs() < 1e-12);
+    assert!((failure["dt"].as_f64().expect("dt") - 0.1).abs() < 1e-12);
+    let iterations = failure["iterations"].as_u64().expect("iterations") as usize;
+    let residuals = failure["residuals"].as_array().expect("residuals");
+    // One residual per assembly: after each increment, and before the first; an attempt abandoned on its
+    // increment ends without the last one.
+    assert!(
+        (iterations.max(1)..=iterations + 1).contains(&residuals.len()),
+        "{iterations} iterations, {residuals:?}"
+    );
+    assert!(
+        failure["diagnosis"]
+            .as_str()
+            .expect("diagnosis")
+            .contains("patch `bend`"),
+        "{failure}"
+    );
+    assert_eq!(failure["last_converged_step"], 3);
+    assert!((failure["last_converged_time"].as_f64().expect("time") - 0.3).abs() < 1e-12);
+    check_history(&dir, 3, 0.3);
     let steps: Vec<u64> = s["snapshots"]
         .as_array()
         .expect("list")
@@ -565,8 +619,28 @@ fn interrupted_run_leaves_every_file_valid() {
     assert!(stderr.contains("interrupted at t = "), "{stderr}");
     let s = summary(&dir);
     assert_eq!(s["status"], "interrupted");
+    assert!(
+        s.get("failure").is_none(),
+        "an interruption is not a failure"
+    );
     let steps = s["steps"].as_u64().expect("steps");
     assert!((3..1300).contains(&steps), "{steps} steps");
+    check_history(
+        &dir,
+        steps as usize,
+        s["final_time"].as_f64().expect("final time"),
+    );
+    // No temporary file of an atomic write is left behind.
+    for folder in [dir.clone(), dir.join("snapshots"), dir.join("charts")] {
+        for entry in std::fs::read_dir(&folder).expect("folder") {
+            let name = entry.expect("entry").file_name();
+            assert!(
+                !name.to_string_lossy().ends_with(".tmp"),
+                "{}: {name:?}",
+                folder.display()
+            );
+        }
+    }
     let last = s["snapshots"]
         .as_array()
         .expect("list")

@@ -79,6 +79,8 @@ pub fn build(
     };
     let (material, integrator) = material(&dto.material)?;
     let (section, shear_factor) = section(&dto.section)?;
+    // Before any geometry is generated: a size that would exhaust memory is refused with an estimate.
+    check_size(dto, &time_settings(&dto.time)?)?;
     let mut sections = vec![section];
     // A generated stent's patches and nodes come first; its node sets index the model's nodes.
     let stent = match &dto.stent {
@@ -148,15 +150,6 @@ pub fn build(
     let time = time_settings(&dto.time)?;
     let solver = solver_settings(dto.solver.as_ref())?;
     let probes = probes(dto, &patches, &nodes)?;
-    let any_prescribed = nodes.iter().any(|n| {
-        n.conditions
-            .components
-            .iter()
-            .any(|c| matches!(c, Component::Prescribed { .. }))
-    });
-    if !any_prescribed {
-        warnings.push("no component of any node is prescribed: rigid-body motion is unconstrained and the tangent will be singular".to_string());
-    }
     let output = output_settings(dto.output.as_ref(), &time)?;
     let record_times = output
         .snapshots
@@ -183,7 +176,198 @@ pub fn build(
         symmetry_planes,
         record_times,
     };
+    // A part no condition holds can move as a rigid body: `run` refuses it (the solver's check), `check` warns.
+    for body in crate::solver::diagnose::free_bodies(&model) {
+        let names: Vec<String> = body
+            .patches
+            .iter()
+            .map(|&k| format!("`{}`", model.patches[k].name))
+            .collect();
+        warnings.push(format!(
+            "no component of any node of patch{} {} is prescribed: {} free to move as a rigid body, the tangent is singular and `run` will refuse the design",
+            if names.len() == 1 { "" } else { "es" },
+            names.join(", "),
+            if names.len() == 1 { "it is" } else { "they are" }
+        ));
+    }
     Ok((model, output, warnings))
+}
+
+/// Memory a design may need before it is refused [bytes]: 8 GB. The estimate ([`estimated_memory`]) is
+/// checked before any geometry is generated, so that a typo (`n: 100000000`, `step: 1e-12`) gets an error
+/// naming the field and the estimate instead of exhausting the machine. The paper's curved stent needs about
+/// 0.1 GB; 8 GB leaves two orders of magnitude for refined studies while staying below the memory of a
+/// typical workstation.
+pub const MEMORY_LIMIT_BYTES: Real = 8e9;
+
+/// Estimated bytes per control point of degree `p` with `branches` Maxwell branches: the tangent's entries
+/// (6 rows × 6(p+1) columns, each with its pattern, slot and value: ~48 bytes) and its LU factors (banded
+/// fill of about twice the entries, value and index: ~16 bytes each), plus the state and the history at the
+/// collocation point (strains and their s-derivatives per branch, ~200 bytes each) and ~1 kB of basis
+/// tables and state.
+fn bytes_per_control_point(p: usize, branches: usize) -> Real {
+    let width = 36.0 * (p as Real + 1.0);
+    width * 48.0 + 2.0 * width * 16.0 + 200.0 * branches as Real + 1000.0
+}
+
+/// Estimated bytes kept per time step (the chart and summary samples with the probes' displacements and the
+/// residual history), with `probes` probes.
+fn bytes_per_step(probes: usize) -> Real {
+    512.0 + 24.0 * probes as Real
+}
+
+/// The contributions to the memory a design needs, each with the field that sets it: `(field path, what,
+/// bytes)`. Computed from the deserialised design alone (degree and size of every patch, the stent's patch
+/// count, the number of nominal steps, the snapshot mesh size), in floating point so that absurd sizes do not
+/// overflow.
+pub fn estimated_memory(dto: &DesignDto, time: &TimeSettings) -> Vec<(String, String, Real)> {
+    let branches = dto.material.prony.len();
+    let mesh = dto.mesh.as_ref();
+    // (path, what, bytes, patches)
+    let mut terms: Vec<(String, String, Real, Real)> = Vec::new();
+    let mut patches: Real = 0.0;
+    for (k, pd) in dto.patches.iter().enumerate() {
+        let (Some(p), Some(n)) = (
+            pd.p.or(mesh.and_then(|m| m.p)),
+            pd.n.or(mesh.and_then(|m| m.n)),
+        ) else {
+            continue;
+        };
+        let path = if pd.n.is_some() {
+            format!("patches[{k}].n")
+        } else {
+            "mesh.n".to_string()
+        };
+        patches += 1.0;
+        terms.push((
+            path,
+            format!("patch `{}` ({n} control points, p = {p})", pd.name),
+            n as Real * bytes_per_control_point(p, branches),
+            1.0,
+        ));
+    }
+    if let Some(s) = &dto.stent {
+        let sector = match s.symmetry {
+            _ if s.full_model => 1.0,
+            None | Some(stent::SymmetryDto::None) => 1.0,
+            Some(stent::SymmetryDto::Half) => 2.0,
+            Some(stent::SymmetryDto::Quarter) => 4.0,
+        };
+        let (crowns, peaks) = (s.crowns as Real, s.peaks as Real);
+        let every = s
+            .bridges
+            .as_ref()
+            .map_or(0.0, |b| 1.0 / b.every.unwrap_or(1).max(1) as Real);
+        let pick = |own: Option<&MeshDto>| {
+            let p = own.and_then(|m| m.p).or(mesh.and_then(|m| m.p));
+            let n = own.and_then(|m| m.n).or(mesh.and_then(|m| m.n));
+            p.zip(n)
+        };
+        let crown_patches = crowns * 2.0 * peaks / sector;
+        let bridge_patches = (crowns - 1.0).max(0.0) * peaks * every / sector;
+        patches += crown_patches + bridge_patches;
+        for (count, pn, what) in [
+            (crown_patches, pick(s.crown_mesh.as_ref()), "crown wires"),
+            (bridge_patches, pick(s.bridge_mesh.as_ref()), "bridges"),
+        ] {
+            if let Some((p, n)) = pn
+                && count > 0.0
+            {
+                let path = if crowns * peaks > 1e4 {
+                    "stent.crowns"
+                } else if what == "bridges" && s.bridge_mesh.is_some() {
+                    "stent.bridge_mesh.n"
+                } else if what == "crown wires" && s.crown_mesh.is_some() {
+                    "stent.crown_mesh.n"
+                } else {
+                    "mesh.n"
+                };
+                terms.push((
+                    path.to_string(),
+                    format!("about {count:.0} stent {what} of {n} control points (p = {p})"),
+                    count * n as Real * bytes_per_control_point(p, branches),
+                    count,
+                ));
+            }
+        }
+    }
+    let patch_terms = terms.len();
+    let probes = dto.output.as_ref().map_or(0, |o| o.probes.len());
+    let steps = time.end / time.step;
+    terms.push((
+        "time.step".to_string(),
+        format!("{steps:.3e} time steps"),
+        steps * bytes_per_step(probes),
+        0.0,
+    ));
+    // Snapshot meshes: up to four mirrored copies of every patch; a vertex (24 bytes) and two triangles
+    // (24 bytes) per ring segment. Charged to `rings` or `segments` when the design sets them, otherwise to
+    // the patches themselves.
+    let snapshots = dto.output.as_ref().and_then(|o| o.snapshots.as_ref());
+    let segments = snapshots.and_then(|s| s.segments);
+    let rings = snapshots.and_then(|s| s.rings);
+    let per_patch = 4.0
+        * rings.unwrap_or(super::SnapshotSettings::DEFAULT_RINGS) as Real
+        * segments.unwrap_or(super::SnapshotSettings::DEFAULT_SEGMENTS) as Real
+        * 48.0;
+    match (rings, segments) {
+        (None, None) => {
+            for term in &mut terms[..patch_terms] {
+                term.2 += term.3 * per_patch;
+            }
+        }
+        (r, s) => {
+            let path = if r.unwrap_or(0) >= s.unwrap_or(0) {
+                "output.snapshots.rings"
+            } else {
+                "output.snapshots.segments"
+            };
+            terms.push((
+                path.to_string(),
+                "snapshot meshes".to_string(),
+                patches * per_patch,
+                0.0,
+            ));
+        }
+    }
+    terms
+        .into_iter()
+        .map(|(path, what, bytes, _)| (path, what, bytes))
+        .collect()
+}
+
+/// `1.2 GB`-style size.
+fn human_bytes(bytes: Real) -> String {
+    if bytes >= 1e15 {
+        format!("{bytes:.1e} bytes")
+    } else if bytes >= 1e12 {
+        format!("{:.0} TB", bytes / 1e12)
+    } else if bytes >= 1e9 {
+        format!("{:.1} GB", bytes / 1e9)
+    } else {
+        format!("{:.0} MB", bytes / 1e6)
+    }
+}
+
+/// Refuses a design whose [`estimated_memory`] exceeds [`MEMORY_LIMIT_BYTES`], naming the field of the largest
+/// contribution.
+fn check_size(dto: &DesignDto, time: &TimeSettings) -> Result<()> {
+    let terms = estimated_memory(dto, time);
+    let total: Real = terms.iter().map(|t| t.2).sum();
+    if total.is_nan() || total > MEMORY_LIMIT_BYTES {
+        if let Some((path, what, bytes)) = terms.iter().max_by(|a, b| a.2.total_cmp(&b.2)) {
+            return Err(issue(
+                path,
+                format!(
+                    "this design would need about {} of memory ({what}: {}), more than stentkit's limit of {}: reduce it",
+                    human_bytes(total),
+                    human_bytes(*bytes),
+                    human_bytes(MEMORY_LIMIT_BYTES)
+                ),
+            ));
+        }
+    }
+    Ok(())
 }
 
 /// The `output:` block's snapshot and recording settings, with their defaults.

@@ -433,10 +433,12 @@ pub fn spec(dto: &StentDto) -> Result<StentSpec> {
         },
         crowns: dto.crowns,
         spacing: dto.spacing.map(|d| d.0),
+        // Reduced to (−360°, 360°): whole turns do not change the device, and angles of the size of the largest
+        // finite numbers have lost their precision.
         rotation: dto
             .rotation_deg
             .map_or(std::f64::consts::PI / dto.peaks.max(1) as Real, |r| {
-                r.0.to_radians()
+                (r.0 % 360.0).to_radians()
             }),
         bridges: dto.bridges.as_ref().map(bridges).transpose()?,
         centreline: centreline(&dto.centreline, "stent.centreline")?,

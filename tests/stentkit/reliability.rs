@@ -1,0 +1,159 @@
+//! Numerical failures named in the designer's terms (issue 7): a NaN or infinity is caught in the equation
+//! where it first appears; a tangent made singular by a part that can move as a rigid body is refused with the
+//! free patch named, before any factorisation, or — for a part held too weakly — diagnosed from the increment it
+//! produces. (The failure report of a run and its run folder are checked end to end in `outputs`.)
+//!
+//! Every design here is the 45° bend (`designs/bend45.yaml`: one arc patch `bend` of 20 control points, clamped
+//! at node `root`, loaded at node `tip`), changed in one place.
+
+use std::path::Path;
+use std::process::Command;
+use stentkit::io::design::parse_design;
+use stentkit::solver::simulation::NoObserver;
+use stentkit::solver::{Simulation, SolverError};
+
+fn bend45() -> String {
+    std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join("designs/bend45.yaml"))
+        .expect("bend45")
+}
+
+/// `bend45` with `from` replaced by `to` (which must occur).
+fn variant(from: &str, to: &str) -> String {
+    let text = bend45();
+    assert!(text.contains(from), "`{from}` in bend45");
+    text.replacen(from, to, 1)
+}
+
+#[test]
+fn a_non_finite_residual_is_located_in_its_equation() {
+    // A modulus of 0.01 (E A = 0.01) and a tip force of 1e307 in a single step with no cutting: the force rows
+    // of node `tip` are scaled by E A, so their normalised residual overflows to infinity in the very first
+    // assembly — at the equation where the load enters, force equilibrium of `tip` along its third axis. The
+    // failure must say so (it would not if the location were lost, or a different row were blamed).
+    let text = variant("E_inf: 1.0e7", "E_inf: 1.0e-2")
+        .replace("[[0, 0], [1, 600]]", "1.0e307")
+        .replace("step: 0.1}", "step: 0.1, min_step: 0.1}");
+    let design = parse_design(&text, Path::new("overflow.yaml")).expect("a valid design");
+    let mut sim = Simulation::new(&design.model).expect("simulation");
+    let error = sim
+        .run(&mut NoObserver)
+        .expect_err("the step cannot converge");
+    let SolverError::StepFailed {
+        step,
+        iterations,
+        ref residuals,
+        ref diagnosis,
+        ..
+    } = error
+    else {
+        panic!("expected StepFailed, got {error}");
+    };
+    assert_eq!((step, iterations), (1, 0), "{error}");
+    assert_eq!(residuals.len(), 1);
+    assert!(residuals[0].is_infinite());
+    let diagnosis = diagnosis.as_deref().expect("a diagnosis");
+    assert!(
+        diagnosis.contains("residual became non-finite after 0 iterations")
+            && diagnosis.contains("node `tip`")
+            && diagnosis.contains("force equilibrium, component u3")
+            && diagnosis.contains("(1 non-finite equations in all)"),
+        "{diagnosis}"
+    );
+    assert!(error.to_string().contains(diagnosis), "{error}");
+}
+
+#[test]
+fn a_free_free_rod_is_refused_naming_its_patch_and_nodes() {
+    // No condition at all (the clamp removed): the rod can translate freely, so the tangent is singular
+    // whatever the load. `check` warns, the simulation refuses before factorising, naming the patch and the
+    // nodes where a condition would help.
+    let text = variant("  - {node: root, clamp: true}\n", "");
+    let design = parse_design(&text, Path::new("free.yaml")).expect("accepted with a warning");
+    assert!(
+        design
+            .warnings
+            .iter()
+            .any(|w| w.contains("patch `bend`") && w.contains("rigid body")),
+        "{:?}",
+        design.warnings
+    );
+    let error = Simulation::new(&design.model)
+        .err()
+        .expect("refused: a free body");
+    let message = error.to_string();
+    assert!(
+        matches!(error, SolverError::FreeBody { .. })
+            && message.contains("patch `bend` held by no condition")
+            && message.contains("(root, tip)")
+            && !message.contains("join it to the rest"),
+        "{message}"
+    );
+}
+
+#[test]
+fn a_patch_joined_to_nothing_is_named() {
+    // A second patch, `floating`, away from the clamped bend and joined to nothing: only it is free. The error
+    // names it and its end nodes, not the clamped `bend`.
+    let text = variant(
+        "nodes:\n",
+        "  - name: floating\n    line: {from: [50, 0, 0], to: [60, 0, 0]}\nnodes:\n",
+    );
+    let design = parse_design(&text, Path::new("floating.yaml")).expect("accepted with a warning");
+    let error = Simulation::new(&design.model)
+        .err()
+        .expect("refused: a free body");
+    let message = error.to_string();
+    assert!(
+        message.contains("patch `floating` held by no condition")
+            && message.contains("floating.start, floating.end")
+            && message.contains("join it to the rest")
+            && !message.contains("`bend`"),
+        "{message}"
+    );
+    // The same through the command line: a clear error, no panic, no LU message.
+    let dir = crate::outputs::test_outputs("floating_patch");
+    std::fs::create_dir_all(&dir).expect("folder");
+    let file = dir.join("floating.yaml");
+    std::fs::write(&file, &text).expect("design written");
+    let out = Command::new(env!("CARGO_BIN_EXE_stentkit"))
+        .args(["run", file.to_str().expect("path"), "-o"])
+        .arg(dir.join("run"))
+        .arg("--quiet")
+        .output()
+        .expect("stentkit runs");
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(!out.status.success());
+    assert!(
+        stderr.contains("patch `floating` held by no condition") && !stderr.contains("panicked"),
+        "{stderr}"
+    );
+}
+
+#[test]
+fn a_weakly_held_rod_gets_a_singular_tangent_diagnosis() {
+    // The root only pinned (translations held, rotations free): the free-body check passes (a component is
+    // prescribed) but the rod can still rotate rigidly about the pin, and the tip load has no equilibrium. The
+    // tangent is nearly singular: Newton's first increments are absurd. The run fails at the smallest step
+    // with a diagnosis naming the singular tangent and a control point of `bend`, instead of a bare residual
+    // list.
+    let text = variant(
+        "{node: root, clamp: true}",
+        "{node: root, displacement: [0, 0, 0]}",
+    );
+    let design = parse_design(&text, Path::new("pinned.yaml")).expect("a valid design");
+    let mut sim = Simulation::new(&design.model).expect("a component is prescribed");
+    let error = sim.run(&mut NoObserver).expect_err("no equilibrium");
+    let SolverError::StepFailed { ref diagnosis, .. } = error else {
+        panic!("expected StepFailed, got {error}");
+    };
+    let diagnosis = diagnosis.as_deref().expect("a diagnosis");
+    assert!(
+        diagnosis.contains("singular") && diagnosis.contains("patch `bend`, control point"),
+        "{diagnosis}"
+    );
+    assert_eq!(
+        sim.time(),
+        0.0,
+        "the last converged state is the initial one"
+    );
+}
