@@ -193,17 +193,15 @@ impl BandLu {
     }
 }
 
-/// Where one pushed entry goes.
-#[derive(Debug, Clone, Copy)]
-enum Slot {
-    /// `A_II,k` at a band storage index.
-    Band { patch: usize, index: usize },
-    /// `A_IB,k`: interior row, end column (0..12), row-major in the patch's `X_k`.
-    Border { patch: usize, index: usize },
-    /// `A_BI,k`: entry `index` of the patch's coupling list.
-    Coupling { patch: usize, index: usize },
-    /// `A_BB`: entry `index` of the Schur complement's entries.
-    Corner { index: usize },
+/// Scatter list: `(pushed entry, destination index)` pairs (32-bit: half the memory traffic of `usize`).
+type Scatter = Vec<(u32, u32)>;
+
+/// Adds the pushed `values` listed in `scatter` into `out`.
+#[inline]
+fn scatter_add(scatter: &[(u32, u32)], values: &[Real], out: &mut [Real]) {
+    for &(e, i) in scatter {
+        out[i as usize] += values[e as usize];
+    }
 }
 
 /// One patch's blocks and factors.
@@ -225,12 +223,19 @@ struct PatchBlock {
     /// order), and per coupling entry the position of its row in this list.
     rows: Vec<usize>,
     row_of: Vec<usize>,
+    /// Where the pushed entries of `A_II,k` (band storage), `A_IB,k` (`x`) and `A_BI,k` (`coupling_values`) go.
+    band_in: Scatter,
+    border_in: Scatter,
+    coupling_in: Scatter,
 }
 
 /// The global system solved by banded patch LUs and a Schur complement on the patch ends.
 pub struct BlockSystem {
     n: usize,
-    slots: Vec<Slot>,
+    /// Pushed entries.
+    entries: usize,
+    /// Where the pushed entries of `A_BB` go in `schur_values`.
+    corner_in: Scatter,
     patches: Vec<PatchBlock>,
     /// Global index of each border unknown.
     border: Vec<usize>,
@@ -334,36 +339,39 @@ impl BlockSystem {
                 coupling_values: Vec::new(),
                 rows: Vec::new(),
                 row_of: Vec::new(),
+                band_in: Vec::new(),
+                border_in: Vec::new(),
+                coupling_in: Vec::new(),
             })
             .collect();
-        let mut slots = Vec::with_capacity(entries.len());
+        if entries.len() > u32::MAX as usize || n > u32::MAX as usize {
+            return Ok(None);
+        }
+        let mut corner_in = Vec::new();
         let mut schur_entries: Vec<(usize, usize)> = Vec::new();
-        for &(r, c) in entries {
-            let slot = match (interior[r], interior[c]) {
-                (Some((k, i)), Some((_, j))) => Slot::Band {
-                    patch: k,
-                    index: patch_blocks[k].lu.at(i, j),
-                },
-                (Some((k, i)), None) => Slot::Border {
-                    patch: k,
-                    index: i * END_COLUMNS + border_index[c] - patch_blocks[k].border,
-                },
+        for (e, &(r, c)) in entries.iter().enumerate() {
+            let e = e as u32;
+            match (interior[r], interior[c]) {
+                (Some((k, i)), Some((_, j))) => {
+                    let at = patch_blocks[k].lu.at(i, j) as u32;
+                    patch_blocks[k].band_in.push((e, at));
+                }
+                (Some((k, i)), None) => {
+                    let at = i * END_COLUMNS + border_index[c] - patch_blocks[k].border;
+                    patch_blocks[k].border_in.push((e, at as u32));
+                }
                 (None, Some((k, j))) => {
                     let block = &mut patch_blocks[k];
                     block.coupling.push((border_index[r], j));
-                    Slot::Coupling {
-                        patch: k,
-                        index: block.coupling.len() - 1,
-                    }
+                    block
+                        .coupling_in
+                        .push((e, (block.coupling.len() - 1) as u32));
                 }
                 (None, None) => {
                     schur_entries.push((border_index[r], border_index[c]));
-                    Slot::Corner {
-                        index: schur_entries.len() - 1,
-                    }
+                    corner_in.push((e, (schur_entries.len() - 1) as u32));
                 }
-            };
-            slots.push(slot);
+            }
         }
         let corner_entries = schur_entries.len();
         for block in &mut patch_blocks {
@@ -384,7 +392,8 @@ impl BlockSystem {
         let schur = SparseSystem::new(border.len(), &schur_entries)?;
         Ok(Some(Self {
             n,
-            slots,
+            entries: entries.len(),
+            corner_in,
             patches: patch_blocks,
             schur_values: vec![0.0; schur_entries.len()],
             corner_entries,
@@ -420,25 +429,14 @@ impl BlockSystem {
     pub fn factor(&mut self, entry_values: &[Real]) -> Result<(), SolverError> {
         assert_eq!(
             entry_values.len(),
-            self.slots.len(),
+            self.entries,
             "one value per pushed entry"
         );
         self.factored = false;
-        for block in &mut self.patches {
-            block.lu.ab.fill(0.0);
-            block.x.fill(0.0);
-            block.coupling_values.fill(0.0);
-        }
         self.schur_values[..self.corner_entries].fill(0.0);
-        for (slot, &v) in self.slots.iter().zip(entry_values) {
-            match *slot {
-                Slot::Band { patch, index } => self.patches[patch].lu.ab[index] += v,
-                Slot::Border { patch, index } => self.patches[patch].x[index] += v,
-                Slot::Coupling { patch, index } => self.patches[patch].coupling_values[index] += v,
-                Slot::Corner { index } => self.schur_values[index] += v,
-            }
-        }
-        // Per patch (in parallel): banded LU, X_k = A_II,k⁻¹ A_IB,k, and its block of −A_BI,k X_k.
+        scatter_add(&self.corner_in, entry_values, &mut self.schur_values);
+        // Per patch (in parallel): its blocks from the pushed entries, the banded LU, X_k = A_II,k⁻¹ A_IB,k, and
+        // its block of −A_BI,k X_k.
         let (_, products) = self.schur_values.split_at_mut(self.corner_entries);
         let mut chunks: Vec<&mut [Real]> = Vec::with_capacity(self.patches.len());
         let mut rest = products;
@@ -452,6 +450,12 @@ impl BlockSystem {
             .par_iter_mut()
             .zip(chunks)
             .find_map_any(|(block, out)| {
+                block.lu.ab.fill(0.0);
+                scatter_add(&block.band_in, entry_values, &mut block.lu.ab);
+                block.x.fill(0.0);
+                scatter_add(&block.border_in, entry_values, &mut block.x);
+                block.coupling_values.fill(0.0);
+                scatter_add(&block.coupling_in, entry_values, &mut block.coupling_values);
                 if let Err(j) = block.lu.factor() {
                     return Some(block.start + j);
                 }
