@@ -109,6 +109,9 @@ pub fn material_map(ratios: &[Real]) -> anyhow::Result<Vec<MaterialPoint>> {
     Ok(rows)
 }
 
+/// A temperature history [°C] as a function of time.
+type TemperatureHistory = Box<dyn Fn(Real) -> Real>;
+
 /// One run of the material map.
 pub fn material_point(
     scenario: MaterialScenario,
@@ -120,46 +123,45 @@ pub fn material_point(
         "h/τ must be positive, got {ratio}"
     );
     let (from, to) = COOLING_FROM_TO;
-    let (material, times, temperature): (Material, Vec<Real>, Box<dyn Fn(Real) -> Real>) =
-        match scenario {
-            MaterialScenario::JumpHold => {
-                let prony = Prony::try_new(
-                    1.0,
-                    vec![PronyBranch {
-                        modulus: 1.0,
-                        tau_g: 1.0,
-                    }],
-                )?;
-                let times = (0..=HOLD_STEPS).map(|k| k as Real * ratio).collect();
-                (
-                    Material::try_new(prony, 0.3, None)?,
-                    times,
-                    Box::new(|_| 20.0),
-                )
-            }
-            MaterialScenario::JumpCool => {
-                let wlf = Wlf::van_manen_2021();
-                // τ(90 °C) = τ_G / a(90 °C) = h / ratio.
-                let tau_g = wlf.rate_factor(from) * COOLING_STEP / ratio;
-                let prony = Prony::try_new(
-                    1.0,
-                    vec![PronyBranch {
-                        modulus: 1.0,
-                        tau_g,
-                    }],
-                )?;
-                let hot = HOT_STEPS as Real * COOLING_STEP;
-                let cooling = (from - to) / COOLING_RATE;
-                let steps = HOT_STEPS + (cooling / COOLING_STEP).ceil() as usize;
-                let times = (0..=steps).map(|k| k as Real * COOLING_STEP).collect();
-                let temperature = move |t: Real| (from - COOLING_RATE * (t - hot).max(0.0)).max(to);
-                (
-                    Material::try_new(prony, 0.3, Some(wlf))?,
-                    times,
-                    Box::new(temperature),
-                )
-            }
-        };
+    let (material, times, temperature): (Material, Vec<Real>, TemperatureHistory) = match scenario {
+        MaterialScenario::JumpHold => {
+            let prony = Prony::try_new(
+                1.0,
+                vec![PronyBranch {
+                    modulus: 1.0,
+                    tau_g: 1.0,
+                }],
+            )?;
+            let times = (0..=HOLD_STEPS).map(|k| k as Real * ratio).collect();
+            (
+                Material::try_new(prony, 0.3, None)?,
+                times,
+                Box::new(|_| 20.0),
+            )
+        }
+        MaterialScenario::JumpCool => {
+            let wlf = Wlf::van_manen_2021();
+            // τ(90 °C) = τ_G / a(90 °C) = h / ratio.
+            let tau_g = wlf.rate_factor(from) * COOLING_STEP / ratio;
+            let prony = Prony::try_new(
+                1.0,
+                vec![PronyBranch {
+                    modulus: 1.0,
+                    tau_g,
+                }],
+            )?;
+            let hot = HOT_STEPS as Real * COOLING_STEP;
+            let cooling = (from - to) / COOLING_RATE;
+            let steps = HOT_STEPS + (cooling / COOLING_STEP).ceil() as usize;
+            let times = (0..=steps).map(|k| k as Real * COOLING_STEP).collect();
+            let temperature = move |t: Real| (from - COOLING_RATE * (t - hot).max(0.0)).max(to);
+            (
+                Material::try_new(prony, 0.3, Some(wlf))?,
+                times,
+                Box::new(temperature),
+            )
+        }
+    };
     let stress = simulate_strain_history(&material, integrator, &times, &|_| 1.0, &*temperature)?;
     // Exact branch stress E₁ exp(−ξ/τ_G) for a held unit strain, ξ by fine composite Gauss quadrature.
     let fine = ReducedTimeQuadrature {
@@ -797,24 +799,15 @@ pub fn stability(
         summary.push_str(&material_summary(&rows));
         progress("material map done");
     }
-    let maps: [(
-        &str,
-        Box<dyn Fn(&mut dyn FnMut(&str)) -> anyhow::Result<SolverMap>>,
-    ); 3] = [
-        ("bend45", Box::new(|p| bend45_map(&study.load_steps, p))),
-        ("heating", Box::new(|p| heating_map(&study.heating, p))),
-        ("release", Box::new(|p| release_map(&study.release, p))),
-    ];
-    for (name, run) in maps {
-        let empty = match name {
-            "bend45" => study.load_steps.is_empty(),
-            "heating" => study.heating.is_empty(),
-            _ => study.release.is_empty(),
+    for name in ["bend45", "heating", "release"] {
+        let map = match name {
+            "bend45" if !study.load_steps.is_empty() => {
+                bend45_map(&study.load_steps, &mut progress)?
+            }
+            "heating" if !study.heating.is_empty() => heating_map(&study.heating, &mut progress)?,
+            "release" if !study.release.is_empty() => release_map(&study.release, &mut progress)?,
+            _ => continue,
         };
-        if empty {
-            continue;
-        }
-        let map = run(&mut progress)?;
         let (header, chart, text) = match name {
             "bend45" => (
                 "elastic 45-degree bend (designs/bend45.yaml), tip force 600 in equal load steps",
