@@ -10,4 +10,5 @@ mod mesh;
 mod outputs;
 mod solver;
 mod stent;
+mod studies;
 mod viscoelastic;
