@@ -36,7 +36,7 @@ pub struct ConvergencePoint {
     pub unknowns: usize,
     /// Relative displacement error against the reference.
     pub error: Real,
-    /// Wall time of the run [s].
+    /// Wall time of the run \[s\].
     pub wall: Real,
     /// Newton iterations of the run.
     pub iterations: usize,
@@ -45,9 +45,9 @@ pub struct ConvergencePoint {
 /// A finished run sampled on the study grid.
 #[derive(Debug, Clone, PartialEq)]
 pub struct SampledRun {
-    /// Displacements at `samples` equally spaced parameters per patch, patch by patch [length].
+    /// Displacements at `samples` equally spaced parameters per patch, patch by patch \[length\].
     pub grid: Vec<Vec3>,
-    /// Wall time of the run (discretisation, analysis and time stepping) [s].
+    /// Wall time of the run (discretisation, analysis and time stepping) \[s\].
     pub wall: Real,
     /// The solver's totals (steps, Newton iterations, cuts, factorisations).
     pub summary: RunSummary,
@@ -177,7 +177,7 @@ pub struct ConvergenceStudy {
     pub degrees: Vec<usize>,
     /// Control points per patch to run (values `≤ p` are skipped for that `p`).
     pub points: Vec<usize>,
-    /// Time at which errors are measured [time].
+    /// Time at which errors are measured \[time\].
     pub time: Real,
     /// Reference `(p, n)`.
     pub reference: (usize, usize),

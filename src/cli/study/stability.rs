@@ -45,11 +45,11 @@ pub const INTEGRATORS: [Integrator; 3] = [
 pub const HOLD_STEPS: usize = 40;
 /// Steps at 90 °C before the cooling starts.
 pub const HOT_STEPS: usize = 5;
-/// Step of the cooling scenario [s] (the paper's).
+/// Step of the cooling scenario \[s\] (the paper's).
 pub const COOLING_STEP: Real = 1e-3;
-/// Cooling rate [K/s] (the paper's cantilever).
+/// Cooling rate \[K/s\] (the paper's cantilever).
 pub const COOLING_RATE: Real = 58.5;
-/// Hot and final temperatures of the cooling scenario [°C] (the final one is below PLA's `Tg − C2 = 21.57 °C`).
+/// Hot and final temperatures of the cooling scenario \[°C\] (the final one is below PLA's `Tg − C2 = 21.57 °C`).
 pub const COOLING_FROM_TO: (Real, Real) = (90.0, 20.0);
 /// Branch stresses below this fraction of the jump's `E₁ Δε` are round-off, not ringing: the update
 /// coefficients `β + γ + δ` sum to 1 only to a few ulps, so a relaxed branch hovers at `±1e-16`.
@@ -84,15 +84,15 @@ pub struct MaterialPoint {
     pub scenario: MaterialScenario,
     /// The integrator.
     pub integrator: Integrator,
-    /// `h/τ` (at 90 °C for the cooling scenario) [-].
+    /// `h/τ` (at 90 °C for the cooling scenario) \[-\].
     pub ratio: Real,
-    /// Largest `|σ_α − σ_α,exact|` over the steps after the jump, over `E₁ Δε` [-].
+    /// Largest `|σ_α − σ_α,exact|` over the steps after the jump, over `E₁ Δε` \[-\].
     pub amplitude: Real,
     /// Sign changes of the computed branch stress beyond [`NOISE_FLOOR`] (the exact one never changes sign).
     pub sign_changes: usize,
-    /// Branch stress at the last step over `E₁ Δε` (the frozen-in stress after cooling) [-].
+    /// Branch stress at the last step over `E₁ Δε` (the frozen-in stress after cooling) \[-\].
     pub last: Real,
-    /// The exact value of `last` [-].
+    /// The exact value of `last` \[-\].
     pub last_exact: Real,
 }
 
@@ -109,7 +109,7 @@ pub fn material_map(ratios: &[Real]) -> anyhow::Result<Vec<MaterialPoint>> {
     Ok(rows)
 }
 
-/// A temperature history [°C] as a function of time.
+/// A temperature history \[°C\] as a function of time.
 type TemperatureHistory = Box<dyn Fn(Real) -> Real>;
 
 /// One run of the material map.
@@ -204,7 +204,7 @@ pub fn material_point(
 pub struct NewtonRun {
     /// The run reached its end time.
     pub completed: bool,
-    /// Time reached [time].
+    /// Time reached \[time\].
     pub time: Real,
     /// Converged steps.
     pub steps: usize,
@@ -217,11 +217,11 @@ pub struct NewtonRun {
     pub cuts: usize,
     /// Failed Newton attempts (cuts, plus retries without the reused factorisation).
     pub failed_attempts: usize,
-    /// Target times of the failed attempts [time].
+    /// Target times of the failed attempts \[time\].
     pub failure_times: Vec<Real>,
-    /// Smallest step taken or attempted [time].
+    /// Smallest step taken or attempted \[time\].
     pub smallest_step: Real,
-    /// Wall time [s].
+    /// Wall time \[s\].
     pub wall: Real,
     /// Why the run stopped early.
     pub failure: Option<String>,
@@ -356,9 +356,9 @@ pub fn bend45_map(
     })
 }
 
-/// Temperature change of the arch's heating [K] (31.5 → 90 °C).
+/// Temperature change of the arch's heating \[K\] (31.5 → 90 °C).
 const ARCH_HEATING: Real = 58.5;
-/// The arch's load ramp and end time [s].
+/// The arch's load ramp and end time \[s\].
 const ARCH_END: Real = 5.0;
 
 /// The arch heated over `duration` (loads still ramp over 5 s) with step `h`: `(duration [s], h [s])` pairs.
@@ -402,9 +402,9 @@ pub fn heating_map(
     })
 }
 
-/// Release time of the straight stent [s].
+/// Release time of the straight stent \[s\].
 const RELEASE: Real = 1.75;
-/// End of the release runs [s].
+/// End of the release runs \[s\].
 const RELEASE_END: Real = 2.0;
 
 /// A two-crown straight stent run to 2 s (released at 1.75 s) with step `h`, release ramp `ramp` and `n`

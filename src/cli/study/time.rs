@@ -27,7 +27,7 @@ pub enum TimeReference {
     Auto,
     /// The design's own `time.step` and integrator.
     Design,
-    /// The exponential integrator with this step [time].
+    /// The exponential integrator with this step \[time\].
     Step(Real),
 }
 
@@ -36,9 +36,9 @@ pub enum TimeReference {
 pub struct TimeStudy {
     /// Integrators to compare.
     pub integrators: Vec<Integrator>,
-    /// Nominal time steps `h` [time].
+    /// Nominal time steps `h` \[time\].
     pub steps: Vec<Real>,
-    /// Time at which errors are measured (the runs end there) [time].
+    /// Time at which errors are measured (the runs end there) \[time\].
     pub time: Real,
     /// The reference run.
     pub reference: TimeReference,
@@ -51,11 +51,11 @@ pub struct TimeStudy {
 pub struct TimePoint {
     /// The integrator.
     pub integrator: Integrator,
-    /// Nominal step `h` [time].
+    /// Nominal step `h` \[time\].
     pub step: Real,
     /// Relative displacement error at the study time, or why the run failed.
     pub error: Result<Real, String>,
-    /// Wall time of the run [s].
+    /// Wall time of the run \[s\].
     pub wall: Real,
     /// Converged time steps.
     pub steps: usize,
