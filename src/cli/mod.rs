@@ -51,7 +51,7 @@ pub enum Command {
         #[arg(short, long)]
         verbose: bool,
     },
-    /// Accuracy against cost: convergence studies.
+    /// Accuracy against cost: convergence in p × n, error against time step per integrator, stability map.
     ///
     /// Example: stentkit study convergence designs/circular_arch.yaml --time 3 -o runs/arch_convergence
     #[command(subcommand)]
@@ -111,6 +111,54 @@ pub enum StudyCommand {
         #[arg(long, default_value_t = 9)]
         samples: usize,
     },
+    /// Time-step sweep per integrator: displacement error at time T against a self-converged run, and wall
+    /// time (CSV, error_vs_h.svg, error_vs_time.svg); prints the observed order of each integrator.
+    ///
+    /// Example: stentkit study time designs/cantilever_morphing.yaml --time 1 --steps 0.02,0.01,0.005 -o runs/cantilever_time
+    Time {
+        /// The design file (YAML).
+        design: PathBuf,
+        /// Output folder.
+        #[arg(short, long)]
+        output: PathBuf,
+        /// Time at which the error is measured; the runs end there (default: the design's end time).
+        #[arg(long)]
+        time: Option<f64>,
+        /// Nominal time steps h.
+        #[arg(long, value_delimiter = ',', default_value = "0.04,0.02,0.01,0.005")]
+        steps: Vec<f64>,
+        /// Integrators to compare.
+        #[arg(
+            long,
+            value_delimiter = ',',
+            default_value = "trapezoidal,backward-euler,exponential"
+        )]
+        integrators: Vec<String>,
+        /// Reference run: `auto` (exponential integrator, smallest h halved), `design` (the design's own step
+        /// and integrator) or a step (exponential integrator with that step).
+        #[arg(long, default_value = "auto")]
+        reference: String,
+        /// Sampling points per patch.
+        #[arg(long, default_value_t = 9)]
+        samples: usize,
+    },
+    /// Stability map: where each integrator rings (h/τ on one Maxwell branch, held and cooled) and where
+    /// Newton needs step cuts or fails (load steps of the 45° bend, heating per step of the loaded arch, the
+    /// release snap of a two-crown stent). Writes a CSV and an SVG per map and stability.md.
+    ///
+    /// Example: stentkit study stability -o runs/stability
+    Stability {
+        /// Output folder.
+        #[arg(short, long)]
+        output: PathBuf,
+        /// Maps to draw: any of material, bend45, heating, release.
+        #[arg(
+            long,
+            value_delimiter = ',',
+            default_value = "material,bend45,heating,release"
+        )]
+        maps: Vec<String>,
+    },
 }
 
 /// Runs the command line and returns the process exit code.
@@ -143,6 +191,24 @@ pub fn main() -> ExitCode {
             reference,
             samples,
         }) => study_convergence(&design, &output, degrees, points, time, reference, samples),
+        Command::Study(StudyCommand::Time {
+            design,
+            output,
+            time,
+            steps,
+            integrators,
+            reference,
+            samples,
+        }) => study_time(
+            &design,
+            &output,
+            time,
+            steps,
+            &integrators,
+            &reference,
+            samples,
+        ),
+        Command::Study(StudyCommand::Stability { output, maps }) => study_stability(&output, &maps),
         Command::Mesh {
             design,
             output,
@@ -206,5 +272,98 @@ fn study_convergence(
         rows.len(),
         csv.display()
     );
+    Ok(())
+}
+
+fn study_time(
+    design: &std::path::Path,
+    output: &std::path::Path,
+    time: Option<f64>,
+    steps: Vec<f64>,
+    integrators: &[String],
+    reference: &str,
+    samples: usize,
+) -> anyhow::Result<()> {
+    use anyhow::Context;
+    use study::time::{TimeReference, TimeStudy, parse_integrator};
+    let text = std::fs::read_to_string(design)
+        .with_context(|| format!("cannot read {}", design.display()))?;
+    let model = crate::io::design::parse_design(&text, design)?.model;
+    let integrators = integrators
+        .iter()
+        .map(|name| parse_integrator(name).map_err(anyhow::Error::msg))
+        .collect::<anyhow::Result<Vec<_>>>()?;
+    let reference = match reference {
+        "auto" => TimeReference::Auto,
+        "design" => TimeReference::Design,
+        h => TimeReference::Step(h.parse().with_context(|| {
+            format!("--reference takes auto, design or a time step, not `{h}`")
+        })?),
+    };
+    let study = TimeStudy {
+        integrators,
+        steps,
+        time: time.unwrap_or(model.time.end),
+        reference,
+        samples,
+    };
+    std::fs::create_dir_all(output)
+        .with_context(|| format!("cannot create {}", output.display()))?;
+    let result = study::time::time_study(&text, design, &study, |line| eprintln!("  {line}"))?;
+    let csv = output.join("time_steps.csv");
+    std::fs::write(&csv, study::time::time_csv(&result, &study, &model.name))
+        .with_context(|| format!("cannot write {}", csv.display()))?;
+    let [by_h, by_time] = study::time::time_charts(&result, &study, &model.name);
+    crate::io::chart::write_svg(&by_h, &output.join("error_vs_h.svg"))?;
+    crate::io::chart::write_svg(&by_time, &output.join("error_vs_time.svg"))?;
+    println!(
+        "{}: errors at t = {} against {}",
+        model.name, study.time, result.reference
+    );
+    for (integrator, order) in &result.orders {
+        match order {
+            Some(q) => println!("  {:<15} observed order {q:.2}", integrator.name()),
+            None => println!(
+                "  {:<15} observed order n/a (fewer than two runs with an error)",
+                integrator.name()
+            ),
+        }
+    }
+    println!(
+        "{} runs → {} (and error_vs_h.svg, error_vs_time.svg)",
+        result.rows.len(),
+        csv.display()
+    );
+    Ok(())
+}
+
+fn study_stability(output: &std::path::Path, maps: &[String]) -> anyhow::Result<()> {
+    use anyhow::Context;
+    use study::stability::{StabilityStudy, stability};
+    for m in maps {
+        anyhow::ensure!(
+            ["material", "bend45", "heating", "release"].contains(&m.as_str()),
+            "unknown map `{m}` (material, bend45, heating, release)"
+        );
+    }
+    let mut study = StabilityStudy::default();
+    let wanted = |name: &str| maps.iter().any(|m| m == name);
+    if !wanted("material") {
+        study.ratios.clear();
+    }
+    if !wanted("bend45") {
+        study.load_steps.clear();
+    }
+    if !wanted("heating") {
+        study.heating.clear();
+    }
+    if !wanted("release") {
+        study.release.clear();
+    }
+    std::fs::create_dir_all(output)
+        .with_context(|| format!("cannot create {}", output.display()))?;
+    let summary = stability(&study, output, |line| eprintln!("  {line}"))?;
+    println!("{summary}");
+    println!("→ {}", output.join("stability.md").display());
     Ok(())
 }

@@ -12,3 +12,4 @@ pub mod snapshots;
 pub mod state;
 pub mod stl;
 pub mod summary;
+pub mod yaml_edit;

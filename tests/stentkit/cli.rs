@@ -203,6 +203,8 @@ fn every_subcommand_help_has_an_example() {
         &["schema"],
         &["study"],
         &["study", "convergence"],
+        &["study", "time"],
+        &["study", "stability"],
     ] {
         let mut args = command.to_vec();
         args.push("--help");

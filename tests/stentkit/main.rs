@@ -12,4 +12,5 @@ mod outputs;
 mod reliability;
 mod solver;
 mod stent;
+mod studies;
 mod viscoelastic;

@@ -1,0 +1,267 @@
+//! `stentkit study time`: error against the time step `h` for each internal-variable integrator (DESIGN §6).
+//!
+//! Every integrator asked for (trapezoidal, backward Euler, exponential) runs the design with every step `h`
+//! asked for, up to a time `T`; the displacement on the study grid at `T` is compared with a self-converged
+//! reference run (by default the exponential integrator with the smallest `h` halved again; or the design's own
+//! step and integrator; or the exponential integrator at a given step), with the error measure of the
+//! convergence study: `‖u_ref − u_h‖ / ‖u_ref‖` over the grid. The observed order per integrator is the
+//! least-squares slope of `log err` against `log h`. Steps are nominal: the solver lands on every schedule
+//! breakpoint and may cut a step, so a run's steps are `≤ h`.
+
+use super::{
+    ErrorChartLabels, ErrorCurve, error_charts, fit_log_slope, relative_error, sample_run,
+};
+use crate::io::chart::LineChart;
+use crate::io::design::DesignOverrides;
+use crate::io::design::dto::IntegratorDto;
+use crate::material::Integrator;
+use crate::math::Real;
+use anyhow::Context;
+use std::fmt::Write as _;
+use std::path::Path;
+
+/// Which run the errors of a time-step study are measured against.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum TimeReference {
+    /// The exponential integrator with the smallest step of the study halved.
+    Auto,
+    /// The design's own `time.step` and integrator.
+    Design,
+    /// The exponential integrator with this step \[time\].
+    Step(Real),
+}
+
+/// Settings of a time-step study.
+#[derive(Debug, Clone, PartialEq)]
+pub struct TimeStudy {
+    /// Integrators to compare.
+    pub integrators: Vec<Integrator>,
+    /// Nominal time steps `h` \[time\].
+    pub steps: Vec<Real>,
+    /// Time at which errors are measured (the runs end there) \[time\].
+    pub time: Real,
+    /// The reference run.
+    pub reference: TimeReference,
+    /// Sampling points per patch.
+    pub samples: usize,
+}
+
+/// One run of a time-step study.
+#[derive(Debug, Clone, PartialEq)]
+pub struct TimePoint {
+    /// The integrator.
+    pub integrator: Integrator,
+    /// Nominal step `h` \[time\].
+    pub step: Real,
+    /// Relative displacement error at the study time, or why the run failed.
+    pub error: Result<Real, String>,
+    /// Wall time of the run \[s\].
+    pub wall: Real,
+    /// Converged time steps.
+    pub steps: usize,
+    /// Newton iterations.
+    pub iterations: usize,
+    /// Step cuts.
+    pub cuts: usize,
+}
+
+/// The result of a time-step study.
+#[derive(Debug, Clone, PartialEq)]
+pub struct TimeStudyResult {
+    /// Every run, integrator by integrator, steps in the given order.
+    pub rows: Vec<TimePoint>,
+    /// What the reference run was, in words (for the CSV header, chart titles and the terminal).
+    pub reference: String,
+    /// Observed order per integrator (least-squares slope of `log err` against `log h`), `None` when fewer than
+    /// two runs have a positive error.
+    pub orders: Vec<(Integrator, Option<Real>)>,
+}
+
+/// The design-file spelling of an integrator, as an override.
+fn dto(integrator: Integrator) -> IntegratorDto {
+    match integrator {
+        Integrator::Trapezoidal => IntegratorDto::Trapezoidal,
+        Integrator::BackwardEuler => IntegratorDto::BackwardEuler,
+        Integrator::Exponential => IntegratorDto::Exponential,
+    }
+}
+
+/// Parses an integrator's design-file name (`trapezoidal`, `backward-euler`, `exponential`).
+pub fn parse_integrator(name: &str) -> Result<Integrator, String> {
+    [
+        Integrator::Trapezoidal,
+        Integrator::BackwardEuler,
+        Integrator::Exponential,
+    ]
+    .into_iter()
+    .find(|i| i.name() == name)
+    .ok_or_else(|| {
+        format!("unknown integrator `{name}` (trapezoidal, backward-euler or exponential)")
+    })
+}
+
+/// Runs the study; `progress` is told about each finished run.
+pub fn time_study(
+    text: &str,
+    path: &Path,
+    study: &TimeStudy,
+    mut progress: impl FnMut(&str),
+) -> anyhow::Result<TimeStudyResult> {
+    let smallest = study.steps.iter().copied().fold(Real::INFINITY, Real::min);
+    anyhow::ensure!(
+        smallest.is_finite() && smallest > 0.0,
+        "the steps must be positive numbers"
+    );
+    let mut reference_overrides = DesignOverrides {
+        end_time: Some(study.time),
+        ..DesignOverrides::default()
+    };
+    let reference = match study.reference {
+        TimeReference::Auto | TimeReference::Step(_) => {
+            let (h, why) = match study.reference {
+                TimeReference::Step(h) => (h, "given"),
+                _ => (smallest / 2.0, "the smallest h halved"),
+            };
+            reference_overrides.step = Some(h);
+            reference_overrides.integrator = Some(IntegratorDto::Exponential);
+            format!("exponential integrator, h = {h:e} ({why})")
+        }
+        TimeReference::Design => "the design's own time step and integrator".to_string(),
+    };
+    let reference_run =
+        sample_run(text, path, &reference_overrides, study.samples).context("reference run")?;
+    progress(&format!(
+        "reference ({reference}): {} steps, {:.2} s",
+        reference_run.summary.steps, reference_run.wall
+    ));
+    let mut rows = Vec::new();
+    for &integrator in &study.integrators {
+        for &step in &study.steps {
+            let overrides = DesignOverrides {
+                end_time: Some(study.time),
+                step: Some(step),
+                integrator: Some(dto(integrator)),
+                ..DesignOverrides::default()
+            };
+            let row = match sample_run(text, path, &overrides, study.samples) {
+                Ok(run) => TimePoint {
+                    integrator,
+                    step,
+                    error: Ok(relative_error(&run.grid, &reference_run.grid)),
+                    wall: run.wall,
+                    steps: run.summary.steps,
+                    iterations: run.summary.iterations,
+                    cuts: run.summary.cuts,
+                },
+                Err(e) => TimePoint {
+                    integrator,
+                    step,
+                    error: Err(format!("{e:#}")),
+                    wall: 0.0,
+                    steps: 0,
+                    iterations: 0,
+                    cuts: 0,
+                },
+            };
+            progress(&match &row.error {
+                Ok(e) => format!(
+                    "{} h = {step:e}: error {e:.3e}, {} steps, {} cuts, {:.2} s",
+                    integrator.name(),
+                    row.steps,
+                    row.cuts,
+                    row.wall
+                ),
+                Err(e) => format!("{} h = {step:e}: failed: {e}", integrator.name()),
+            });
+            rows.push(row);
+        }
+    }
+    let orders = study
+        .integrators
+        .iter()
+        .map(|&i| (i, fit_log_slope(&error_points(&rows, i))))
+        .collect();
+    Ok(TimeStudyResult {
+        rows,
+        reference,
+        orders,
+    })
+}
+
+/// `(h, error)` of the successful runs of one integrator.
+fn error_points(rows: &[TimePoint], integrator: Integrator) -> Vec<(Real, Real)> {
+    rows.iter()
+        .filter(|r| r.integrator == integrator)
+        .filter_map(|r| r.error.as_ref().ok().map(|e| (r.step, *e)))
+        .collect()
+}
+
+/// The rows as CSV, with a comment header naming the design, the study time and the reference run; failed
+/// runs have an empty error and their message in the last column.
+pub fn time_csv(result: &TimeStudyResult, study: &TimeStudy, design: &str) -> String {
+    let mut s = String::new();
+    let _ = writeln!(
+        s,
+        "# time-step study of {design}: displacement error at t = {} on {} points per patch against a reference run: {}",
+        study.time, study.samples, result.reference
+    );
+    for (integrator, order) in &result.orders {
+        let _ = writeln!(
+            s,
+            "# observed order of {}: {}",
+            integrator.name(),
+            order.map_or("n/a".to_string(), |q| format!("{q:.2}"))
+        );
+    }
+    let _ = writeln!(
+        s,
+        "integrator,h,error,wall_s,steps,newton_iterations,cuts,failure"
+    );
+    for r in &result.rows {
+        let (error, failure) = match &r.error {
+            Ok(e) => (format!("{e:.6e}"), String::new()),
+            Err(m) => (String::new(), m.replace(['\n', ','], " ")),
+        };
+        let _ = writeln!(
+            s,
+            "{},{:e},{error},{:.4},{},{},{},{failure}",
+            r.integrator.name(),
+            r.step,
+            r.wall,
+            r.steps,
+            r.iterations,
+            r.cuts
+        );
+    }
+    s
+}
+
+/// The two charts of a time-step study: error against `h` and error against wall time, one series per
+/// integrator (labelled with its observed order), on log–log axes; the titles name the reference.
+pub fn time_charts(result: &TimeStudyResult, study: &TimeStudy, design: &str) -> [LineChart; 2] {
+    let curves: Vec<ErrorCurve> = result
+        .orders
+        .iter()
+        .map(|(integrator, order)| ErrorCurve {
+            label: match order {
+                Some(q) => format!("{} (order {q:.2})", integrator.name()),
+                None => integrator.name().to_string(),
+            },
+            runs: result
+                .rows
+                .iter()
+                .filter(|r| r.integrator == *integrator)
+                .filter_map(|r| r.error.as_ref().ok().map(|e| (r.step, *e, r.wall)))
+                .collect(),
+        })
+        .collect();
+    let against = format!("at t = {}, against {}", study.time, result.reference);
+    error_charts(
+        &curves,
+        &ErrorChartLabels {
+            by_parameter: format!("{design}: error vs time step ({against})"),
+            by_time: format!("{design}: work-precision over h ({against})"),
+            parameter: "time step h [time]".into(),
+        },
+    )
+}
