@@ -453,8 +453,12 @@ impl McapRecorder {
         };
         let mut writer = ::mcap::WriteOptions::new()
             .compression(Some(::mcap::Compression::Zstd))
-            // The solver has the cores; compress on the calling thread.
-            .compression_threads(0)
+            // zstd level 1 with one background thread, measured against the default level on the calling
+            // thread: the straight stent's recording 1.5 s → 1.05 s and 16.5 → 16.3 MB (level 1 compresses
+            // these JSON messages no worse), the curved stent's run 63.0 → 59.0 s (the thread overlaps the
+            // solver's sequential parts).
+            .compression_level(1)
+            .compression_threads(1)
             .profile("")
             .library(format!("stentkit {} (mcap crate)", info.version))
             .create(BufWriter::new(file))
