@@ -34,6 +34,7 @@ use crate::material::SectionStrains;
 use crate::math::so3::{hat, log};
 use crate::math::{Mat3, Real, Rot3, Vec3};
 use crate::model::{Component, Model};
+use rayon::prelude::*;
 
 /// Receives the tangent's entries in a fixed order: first to record the sparsity pattern, then to fill values.
 pub enum Sink<'a> {
@@ -207,6 +208,14 @@ pub struct Assembler {
     modulus_scale: Real,
     /// Length of each patch [length].
     patch_length: Vec<Real>,
+    /// Tangent entries pushed by each collocation point's interior equations (zero at patch ends), and their
+    /// total: the interior points come first in the push order, so point `g`'s entries are a known slice.
+    interior_entries: Vec<usize>,
+}
+
+/// Tangent entries pushed by one interior collocation point: four 3×3 blocks per control point of its basis.
+fn interior_entry_count(point: &CollocationPoint) -> usize {
+    4 * 9 * point.basis.len()
 }
 
 /// Tangent and residual of one Newton iteration, and the row scales of the residual.
@@ -262,10 +271,23 @@ impl Assembler {
             .iter()
             .map(|p| curve_length(&p.curve))
             .collect();
+        let interior_entries = disc
+            .points
+            .iter()
+            .enumerate()
+            .map(|(g, point)| {
+                if disc.is_end(g) {
+                    0
+                } else {
+                    interior_entry_count(point)
+                }
+            })
+            .collect();
         Self {
             nodes,
             modulus_scale,
             patch_length,
+            interior_entries,
         }
     }
 
@@ -287,12 +309,53 @@ impl Assembler {
         let m = gauge.map_or(0, Gauge::len);
         lin.residual.resize(n + m, 0.0);
         lin.row_scale.resize(n + m, 1.0);
-        // Interior points.
-        for (g, point) in disc.points.iter().enumerate() {
-            if disc.is_end(g) {
-                continue;
+        // Interior points: independent (each owns its six rows and a known slice of the tangent's entries), so
+        // the tangent is assembled in parallel; the residual alone is too cheap per point to gain from it
+        // (measured on the curved stent: tangent 0.81 → 0.60 s, residual 0.29 → 0.44 s over 0.5 s of the run).
+        if let Sink::Values { values, next } = sink {
+            let total: usize = self.interior_entries.iter().sum();
+            *next = total;
+            let mut entries = &mut values[..total];
+            let mut tasks = Vec::with_capacity(disc.points.len());
+            for ((g, residual), scale) in lin.residual[..n]
+                .chunks_mut(6)
+                .enumerate()
+                .zip(lin.row_scale[..n].chunks_mut(6))
+            {
+                let (head, tail) =
+                    std::mem::take(&mut entries).split_at_mut(self.interior_entries[g]);
+                entries = tail;
+                if !disc.is_end(g) {
+                    tasks.push((g, residual, scale, head));
+                }
             }
-            self.interior(disc, state, material, actions, g, point, lin, sink);
+            tasks
+                .into_par_iter()
+                .for_each(|(g, residual, scale, values)| {
+                    let mut sink = Sink::Values { values, next: 0 };
+                    let point = &disc.points[g];
+                    self.interior(
+                        disc, state, material, actions, g, point, residual, scale, &mut sink,
+                    );
+                    if let Sink::Values { values, next } = sink {
+                        debug_assert_eq!(
+                            next,
+                            values.len(),
+                            "interior_entry_count matches the pushes"
+                        );
+                    }
+                });
+        } else {
+            for (g, point) in disc.points.iter().enumerate() {
+                if !disc.is_end(g) {
+                    let rows = 6 * g..6 * g + 6;
+                    let (residual, scale) =
+                        (&mut lin.residual[rows.clone()], &mut lin.row_scale[rows]);
+                    self.interior(
+                        disc, state, material, actions, g, point, residual, scale, sink,
+                    );
+                }
+            }
         }
         // Node rows.
         for (k, node) in self.nodes.iter().enumerate() {
@@ -396,7 +459,8 @@ impl Assembler {
         actions: &Actions,
         g: usize,
         point: &CollocationPoint,
-        lin: &mut Linearisation,
+        residual: &mut [Real],
+        row_scale: &mut [Real],
         sink: &mut Sink<'_>,
     ) {
         let (CN, CM) = self.section(disc, point, material.modulus);
@@ -419,14 +483,14 @@ impl Assembler {
         let F = K.cross(&N) + N_s + nbar;
         let T = K.cross(&M) + M_s + k.gamma.cross(&N) + mbar;
         let row = 6 * g;
-        lin.residual[row..row + 3].copy_from_slice(F.as_slice());
-        lin.residual[row + 3..row + 6].copy_from_slice(T.as_slice());
+        residual[..3].copy_from_slice(F.as_slice());
+        residual[3..6].copy_from_slice(T.as_slice());
         let length = self.patch_length[point.patch];
         let shape = &disc.shapes[point.shape];
         let force_scale = self.modulus_scale * shape.force.x / length;
         let moment_scale = self.modulus_scale * shape.moment.y / (length * length);
-        lin.row_scale[row..row + 3].fill(force_scale);
-        lin.row_scale[row + 3..row + 6].fill(moment_scale);
+        row_scale[..3].fill(force_scale);
+        row_scale[3..6].fill(moment_scale);
         if matches!(sink, Sink::Discard) {
             return;
         }
