@@ -16,7 +16,7 @@ struct Trace(usize);
 
 impl Observer for Trace {
     fn step(&mut self, _: &Simulation<'_>, r: &StepReport) -> ControlFlow<()> {
-        if r.step % self.0 == 0 {
+        if r.step.is_multiple_of(self.0) {
             let list = |v: &[f64]| {
                 v.iter()
                     .map(|x| format!("{x:.1e}"))

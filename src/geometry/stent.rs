@@ -798,7 +798,7 @@ impl StentSpec {
         match (self.symmetry, axis) {
             (Symmetry::None, _) => Ok(()),
             (Symmetry::Quarter, Axis::Straight { .. }) => {
-                if self.crown.peaks % 2 != 0 {
+                if !self.crown.peaks.is_multiple_of(2) {
                     return Err(invalid(
                         "symmetry",
                         format!(

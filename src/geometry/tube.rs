@@ -357,33 +357,33 @@ impl TriangleMesh {
                 })
             })
         };
-        if boundary > 0 {
-            if let Some((triangle, edge, _)) = first_edge(&|e| uses(e) == 1) {
-                return Err(MeshDefect::BoundaryEdge {
-                    edge,
-                    triangle,
-                    count: boundary,
-                });
-            }
+        if boundary > 0
+            && let Some((triangle, edge, _)) = first_edge(&|e| uses(e) == 1)
+        {
+            return Err(MeshDefect::BoundaryEdge {
+                edge,
+                triangle,
+                count: boundary,
+            });
         }
-        if non_manifold > 0 {
-            if let Some((triangle, edge, e)) = first_edge(&|e| uses(e) > 2) {
-                return Err(MeshDefect::NonManifoldEdge {
-                    edge,
-                    triangle,
-                    triangles: uses(&e),
-                    count: non_manifold,
-                });
-            }
+        if non_manifold > 0
+            && let Some((triangle, edge, e)) = first_edge(&|e| uses(e) > 2)
+        {
+            return Err(MeshDefect::NonManifoldEdge {
+                edge,
+                triangle,
+                triangles: uses(&e),
+                count: non_manifold,
+            });
         }
-        if misoriented > 0 {
-            if let Some((_, edge, e)) = first_edge(&|e| uses(e) == 2 && e.forward != 1) {
-                return Err(MeshDefect::InconsistentOrientation {
-                    edge,
-                    triangles: e.first,
-                    count: misoriented,
-                });
-            }
+        if misoriented > 0
+            && let Some((_, edge, e)) = first_edge(&|e| uses(e) == 2 && e.forward != 1)
+        {
+            return Err(MeshDefect::InconsistentOrientation {
+                edge,
+                triangles: e.first,
+                count: misoriented,
+            });
         }
         // 4. Unused vertices.
         let mut used = vec![false; vertex_count];

@@ -27,7 +27,7 @@ pub fn decimation(n: usize, target: usize) -> Vec<usize> {
     }
     let k = (((n - 1) as Real / (target - 1) as Real).round() as usize).max(1);
     let mut out: Vec<usize> = (0..n).step_by(k).collect();
-    if (n - 1) % k != 0 {
+    if !(n - 1).is_multiple_of(k) {
         out.push(n - 1);
     }
     out

@@ -43,7 +43,7 @@ impl SnapshotSchedule {
     /// requested time (which is the step landing on it).
     pub fn is_due(&self, step: usize, previous: Real, time: Real) -> bool {
         step == 0
-            || (self.every > 0 && step % self.every == 0)
+            || (self.every > 0 && step.is_multiple_of(self.every))
             || time >= self.end - self.snap
             || self
                 .times

@@ -711,7 +711,7 @@ mod tests {
             let p = c.degree();
             let mut x: Vec<Real> = ts.iter().map(|t| lo + t * (hi - lo)).collect();
             x.push(x[0]);
-            if let Some(&b) = c.knots().breakpoints().get(1) { if b < hi { x.push(b); } }
+            if let Some(&b) = c.knots().breakpoints().get(1) && b < hi { x.push(b); }
             x.sort_by(Real::total_cmp);
             // Drop values that would exceed multiplicity p.
             let mut kept: Vec<Real> = Vec::new();

@@ -112,81 +112,45 @@ impl BandLu {
         Ok(())
     }
 
-    /// Solves `A x = b` in place for one right-hand side: [`Self::solve`] with both triangles as contiguous
-    /// `axpy`s over the band columns.
-    fn solve_vector(&self, b: &mut [Real]) {
+    /// Solves `A X = B` in place for `B` with `W` columns stored row-major (`b[i * W + q]`), LAPACK `dgbtrs`:
+    /// row interchanges and the unit lower triangle column by column, then the upper triangle (bandwidth
+    /// `kl + ku`) backwards, each column an `axpy` of `W`-wide rows (`W` fixed so the inner loops unroll; one
+    /// right-hand side is the plain vector `axpy`).
+    fn solve<const W: usize>(&self, b: &mut [Real]) {
         let (m, kl, ld) = (self.m, self.kl, self.ld());
         let kv = kl + self.ku;
         for j in 0..m.saturating_sub(1) {
             let lm = kl.min(m - 1 - j);
             let p = self.pivots[j];
             if p != j {
-                b.swap(p, j);
-            }
-            let bj = b[j];
-            if bj != 0.0 {
-                let col = j * ld + kv;
-                for (t, l) in b[j + 1..=j + lm]
-                    .iter_mut()
-                    .zip(&self.ab[col + 1..=col + lm])
-                {
-                    *t -= l * bj;
-                }
-            }
-        }
-        for j in (0..m).rev() {
-            let col = j * ld + kv;
-            let bj = b[j] / self.ab[col];
-            b[j] = bj;
-            let len = kv.min(j);
-            if bj != 0.0 {
-                for (t, u) in b[j - len..j].iter_mut().zip(&self.ab[col - len..col]) {
-                    *t -= u * bj;
-                }
-            }
-        }
-    }
-
-    /// Solves `A X = B` in place for `B` with `w` columns stored row-major (`b[i * w + q]`), LAPACK `dgbtrs`.
-    fn solve(&self, b: &mut [Real], w: usize) {
-        let (m, kl, ld) = (self.m, self.kl, self.ld());
-        let kv = kl + self.ku;
-        // L: row interchanges and unit lower triangle, column by column.
-        for j in 0..m.saturating_sub(1) {
-            let lm = kl.min(m - 1 - j);
-            let p = self.pivots[j];
-            if p != j {
-                for q in 0..w {
-                    b.swap(p * w + q, j * w + q);
+                for q in 0..W {
+                    b.swap(p * W + q, j * W + q);
                 }
             }
             let col = j * ld + kv;
-            let (head, tail) = b.split_at_mut((j + 1) * w);
-            let bj = &head[j * w..];
-            for i in 1..=lm {
-                let l = self.ab[col + i];
-                if l != 0.0 {
-                    for (t, s) in tail[(i - 1) * w..i * w].iter_mut().zip(bj) {
-                        *t -= l * s;
-                    }
+            let (head, tail) = b.split_at_mut((j + 1) * W);
+            let bj: [Real; W] = std::array::from_fn(|q| head[j * W + q]);
+            let (rows, _) = tail[..lm * W].as_chunks_mut::<W>();
+            for (t, l) in rows.iter_mut().zip(&self.ab[col + 1..=col + lm]) {
+                for q in 0..W {
+                    t[q] -= l * bj[q];
                 }
             }
         }
-        // U: upper triangle of bandwidth kl + ku, backwards.
         for j in (0..m).rev() {
             let col = j * ld + kv;
             let inv = 1.0 / self.ab[col];
-            let (head, tail) = b.split_at_mut(j * w);
-            let bj = &mut tail[..w];
+            let (head, tail) = b.split_at_mut(j * W);
+            let bj = &mut tail[..W];
             for v in bj.iter_mut() {
                 *v *= inv;
             }
-            for i in 1..=kv.min(j) {
-                let u = self.ab[col - i];
-                if u != 0.0 {
-                    for (t, s) in head[(j - i) * w..(j - i + 1) * w].iter_mut().zip(bj.iter()) {
-                        *t -= u * s;
-                    }
+            let len = kv.min(j);
+            let bj: [Real; W] = std::array::from_fn(|q| bj[q]);
+            let (rows, _) = head[(j - len) * W..].as_chunks_mut::<W>();
+            for (t, u) in rows.iter_mut().zip(&self.ab[col - len..col]) {
+                for q in 0..W {
+                    t[q] -= u * bj[q];
                 }
             }
         }
@@ -207,10 +171,8 @@ fn scatter_add(scatter: &[(u32, u32)], values: &[Real], out: &mut [Real]) {
 /// One patch's blocks and factors.
 #[derive(Debug, Clone)]
 struct PatchBlock {
-    /// First global unknown of the interior.
+    /// First global unknown of the interior (its `lu.m` unknowns follow).
     start: usize,
-    /// Interior unknowns `m`.
-    m: usize,
     /// Border index of the patch's first end column (its 12 end columns are consecutive there).
     border: usize,
     lu: BandLu,
@@ -219,9 +181,9 @@ struct PatchBlock {
     /// `A_BI,k` as `(border row, interior column)` with values.
     coupling: Vec<(usize, usize)>,
     coupling_values: Vec<Real>,
-    /// Distinct border rows of `coupling` (its block of the Schur complement has 12 entries per row, in this
-    /// order), and per coupling entry the position of its row in this list.
-    rows: Vec<usize>,
+    /// Distinct border rows of `coupling` (its block of the Schur complement has 12 entries per row, in
+    /// ascending row order), and per coupling entry the position of its row among them.
+    rows: usize,
     row_of: Vec<usize>,
     /// Where the pushed entries of `A_II,k` (band storage), `A_IB,k` (`x`) and `A_BI,k` (`coupling_values`) go.
     band_in: Scatter,
@@ -331,13 +293,12 @@ impl BlockSystem {
             .enumerate()
             .map(|(k, &(start, m, offset))| PatchBlock {
                 start,
-                m,
                 border: offset,
                 lu: BandLu::new(m, kl[k], ku[k]),
                 x: vec![0.0; m * END_COLUMNS],
                 coupling: Vec::new(),
                 coupling_values: Vec::new(),
-                rows: Vec::new(),
+                rows: 0,
                 row_of: Vec::new(),
                 band_in: Vec::new(),
                 border_in: Vec::new(),
@@ -387,7 +348,7 @@ impl BlockSystem {
             for &r in &rows {
                 schur_entries.extend((0..END_COLUMNS).map(|q| (r, block.border + q)));
             }
-            block.rows = rows;
+            block.rows = rows.len();
         }
         let schur = SparseSystem::new(border.len(), &schur_entries)?;
         Ok(Some(Self {
@@ -402,16 +363,6 @@ impl BlockSystem {
             schur,
             factored: false,
         }))
-    }
-
-    /// Number of unknowns.
-    pub fn size(&self) -> usize {
-        self.n
-    }
-
-    /// Unknowns on the border (patch ends and extra unknowns): the size of the Schur complement.
-    pub fn border_size(&self) -> usize {
-        self.border.len()
     }
 
     /// Forgets the factorisation.
@@ -441,7 +392,7 @@ impl BlockSystem {
         let mut chunks: Vec<&mut [Real]> = Vec::with_capacity(self.patches.len());
         let mut rest = products;
         for block in &self.patches {
-            let (head, tail) = rest.split_at_mut(block.rows.len() * END_COLUMNS);
+            let (head, tail) = rest.split_at_mut(block.rows * END_COLUMNS);
             chunks.push(head);
             rest = tail;
         }
@@ -459,7 +410,7 @@ impl BlockSystem {
                 if let Err(j) = block.lu.factor() {
                     return Some(block.start + j);
                 }
-                block.lu.solve(&mut block.x, END_COLUMNS);
+                block.lu.solve::<END_COLUMNS>(&mut block.x);
                 out.fill(0.0);
                 for ((&(_, j), &a), &row) in block
                     .coupling
@@ -505,16 +456,16 @@ impl BlockSystem {
             let mut at = 0;
             for block in &self.patches {
                 let (_, tail) = rest.split_at_mut(block.start - at);
-                let (interior, tail) = tail.split_at_mut(block.m);
+                let (interior, tail) = tail.split_at_mut(block.lu.m);
                 slices.push(interior);
                 rest = tail;
-                at = block.start + block.m;
+                at = block.start + block.lu.m;
             }
         }
         self.patches
             .par_iter()
             .zip(slices.par_iter_mut())
-            .for_each(|(block, y)| block.lu.solve_vector(y));
+            .for_each(|(block, y)| block.lu.solve::<1>(y));
         // b_B − Σ_k A_BI,k y_k, then x_B = S⁻¹ (…).
         for (b, &g) in self.border_rhs.iter_mut().zip(&self.border) {
             *b = rhs[g];
@@ -532,7 +483,7 @@ impl BlockSystem {
         // x_I,k = y_k − X_k x_B,k.
         for block in &self.patches {
             let xb = &self.border_rhs[block.border..block.border + END_COLUMNS];
-            let y = &mut rhs[block.start..block.start + block.m];
+            let y = &mut rhs[block.start..block.start + block.lu.m];
             for (i, yi) in y.iter_mut().enumerate() {
                 let row = &block.x[i * END_COLUMNS..(i + 1) * END_COLUMNS];
                 *yi -= row.iter().zip(xb).map(|(a, b)| a * b).sum::<Real>();
@@ -574,8 +525,8 @@ mod tests {
             .collect();
         assert_eq!(lu.factor(), Ok(()));
         let mut wide: Vec<Real> = b.iter().flat_map(|&v| [v, 2.0 * v]).collect();
-        lu.solve_vector(&mut b);
-        lu.solve(&mut wide, 2);
+        lu.solve::<1>(&mut b);
+        lu.solve::<2>(&mut wide);
         for (i, v) in b.iter().enumerate() {
             assert!((wide[2 * i] - v).abs() < 1e-12 && (wide[2 * i + 1] - 2.0 * v).abs() < 1e-12);
         }

@@ -227,11 +227,6 @@ impl LinearSystem {
         }
     }
 
-    /// The general sparse system (size, pattern).
-    pub fn sparse(&self) -> &SparseSystem {
-        &self.sparse
-    }
-
     /// Number of unknowns.
     pub fn size(&self) -> usize {
         self.sparse.size()

@@ -126,11 +126,6 @@ impl SolverTiming {
         slot.1 += start.elapsed().as_secs_f64();
     }
 
-    /// Total of the timed parts [s].
-    pub fn total(&self) -> Real {
-        self.residual.1 + self.tangent.1 + self.factorisation.1 + self.solve.1 + self.material.1
-    }
-
     /// The split as named entries: `<part>_s` (seconds) and `<part>_count`.
     pub fn entries(&self) -> Vec<(String, Real)> {
         let parts = [

@@ -87,7 +87,7 @@ fn run(p: usize, n: usize) -> Run {
 /// The known rate of IGA collocation at Greville points in the number of points: p for even p, p − 1 for
 /// odd p (Auricchio, Beirão da Veiga, Hughes, Reali & Sangalli 2010, M3AS 20; paper Fig. conv_circ).
 fn expected_rate(p: usize) -> Real {
-    if p % 2 == 0 {
+    if p.is_multiple_of(2) {
         p as Real
     } else {
         (p - 1) as Real

@@ -354,18 +354,18 @@ fn human_bytes(bytes: Real) -> String {
 fn check_size(dto: &DesignDto, time: &TimeSettings) -> Result<()> {
     let terms = estimated_memory(dto, time);
     let total: Real = terms.iter().map(|t| t.2).sum();
-    if total.is_nan() || total > MEMORY_LIMIT_BYTES {
-        if let Some((path, what, bytes)) = terms.iter().max_by(|a, b| a.2.total_cmp(&b.2)) {
-            return Err(issue(
-                path,
-                format!(
-                    "this design would need about {} of memory ({what}: {}), more than stentkit's limit of {}: reduce it",
-                    human_bytes(total),
-                    human_bytes(*bytes),
-                    human_bytes(MEMORY_LIMIT_BYTES)
-                ),
-            ));
-        }
+    if (total.is_nan() || total > MEMORY_LIMIT_BYTES)
+        && let Some((path, what, bytes)) = terms.iter().max_by(|a, b| a.2.total_cmp(&b.2))
+    {
+        return Err(issue(
+            path,
+            format!(
+                "this design would need about {} of memory ({what}: {}), more than stentkit's limit of {}: reduce it",
+                human_bytes(total),
+                human_bytes(*bytes),
+                human_bytes(MEMORY_LIMIT_BYTES)
+            ),
+        ));
     }
     Ok(())
 }
