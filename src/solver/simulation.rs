@@ -520,21 +520,44 @@ impl<'m> Simulation<'m> {
     /// residual, which is returned (not applied): the linear-algebra part of a Newton iteration, for benchmarks
     /// and diagnostics.
     pub fn factor_and_solve(&mut self) -> Result<&[Real], SolverError> {
-        let (system, values) = match (&mut self.gauge, self.gauge_active) {
+        self.factor_tangent()?;
+        self.solve_increment();
+        Ok(&self.delta)
+    }
+
+    /// The system that the step being solved uses (with the gauge constraints or without) and its entries.
+    fn active_system(&mut self) -> (&mut LinearSystem, &[Real]) {
+        match (&mut self.gauge, self.gauge_active) {
             (Some((_, s, v)), true) => (s, &*v),
             _ => (&mut self.system, &self.values),
-        };
-        let start = Instant::now();
-        system.factor(values)?;
-        SolverTiming::add(&mut self.timing.factorisation, start);
-        self.delta.resize(self.lin.residual.len(), 0.0);
-        for (d, r) in self.delta.iter_mut().zip(&self.lin.residual) {
-            *d = -r;
         }
+    }
+
+    /// Factorises the last assembled tangent; a singular one names where its pivotless unknown is.
+    fn factor_tangent(&mut self) -> Result<(), SolverError> {
         let start = Instant::now();
-        system.solve_in_place(&mut self.delta);
+        let (system, values) = self.active_system();
+        system.factor(values).map_err(|e| match e {
+            SolverError::Singular { column, .. } => SolverError::Singular {
+                column,
+                location: super::diagnose::describe_unknown(self.model, &self.disc, column),
+            },
+            e => e,
+        })?;
+        SolverTiming::add(&mut self.timing.factorisation, start);
+        Ok(())
+    }
+
+    /// Solves for the Newton increment `δ = −K⁻¹ r` of the last assembled residual with the last factorisation,
+    /// into `self.delta`.
+    fn solve_increment(&mut self) {
+        let start = Instant::now();
+        let mut delta = std::mem::take(&mut self.delta);
+        delta.clear();
+        delta.extend(self.lin.residual.iter().map(|r| -r));
+        self.active_system().0.solve_in_place(&mut delta);
+        self.delta = delta;
         SolverTiming::add(&mut self.timing.solve, start);
-        Ok(&self.delta)
     }
 
     /// Where the solver's time went so far.
@@ -774,43 +797,16 @@ impl<'m> Simulation<'m> {
             if report.iterations >= max_iterations {
                 return Err(NewtonFailure::NotConverged(report));
             }
-            let factored = match (&self.gauge, self.gauge_active) {
-                (Some((_, s, _)), true) => s.is_factored(),
-                _ => self.system.is_factored(),
-            };
+            let factored = self.active_system().0.is_factored();
             // A reused factorisation is kept while it contracts the residual fast enough.
             let fresh_tangent = !reuse || !factored || r > ratio * previous;
             if fresh_tangent {
                 self.linearise(&actions, true)
                     .map_err(NewtonFailure::Fatal)?;
-            }
-            let (system, values) = match (&mut self.gauge, self.gauge_active) {
-                (Some((_, s, v)), true) => (s, &*v),
-                _ => (&mut self.system, &self.values),
-            };
-            if fresh_tangent {
-                let start = Instant::now();
-                if let Err(e) = system.factor(values) {
-                    return Err(NewtonFailure::Fatal(match e {
-                        SolverError::Singular { column, .. } => SolverError::Singular {
-                            column,
-                            location: super::diagnose::describe_unknown(
-                                self.model, &self.disc, column,
-                            ),
-                        },
-                        e => e,
-                    }));
-                }
-                SolverTiming::add(&mut self.timing.factorisation, start);
+                self.factor_tangent().map_err(NewtonFailure::Fatal)?;
                 report.factorisations += 1;
             }
-            self.delta.resize(self.lin.residual.len(), 0.0);
-            for (d, r) in self.delta.iter_mut().zip(&self.lin.residual) {
-                *d = -r;
-            }
-            let start = Instant::now();
-            system.solve_in_place(&mut self.delta);
-            SolverTiming::add(&mut self.timing.solve, start);
+            self.solve_increment();
             let increment = self.increment_norm();
             report.increments.push(increment);
             report.iterations += 1;
@@ -823,9 +819,11 @@ impl<'m> Simulation<'m> {
                 return Err(NewtonFailure::NotConverged(report));
             }
             self.state.apply_increment(&self.disc, &self.delta);
-            self.step_increment.resize(self.delta.len(), 0.0);
-            for (a, d) in self.step_increment.iter_mut().zip(&self.delta) {
-                *a += d;
+            if self.model.solver.extrapolate {
+                self.step_increment.resize(self.delta.len(), 0.0);
+                for (a, d) in self.step_increment.iter_mut().zip(&self.delta) {
+                    *a += d;
+                }
             }
             previous = if fresh_tangent { Real::INFINITY } else { r };
         }
@@ -844,7 +842,8 @@ impl<'m> Simulation<'m> {
             return;
         };
         let scale = dt / h;
-        self.step_increment = increment[..n].iter().map(|d| d * scale).collect();
+        self.step_increment
+            .extend(increment[..n].iter().map(|d| d * scale));
         self.state.apply_increment(&self.disc, &self.step_increment);
     }
 
