@@ -211,6 +211,7 @@ pub struct Assembler {
     /// Tangent entries pushed by each collocation point's interior equations (zero at patch ends), and their
     /// total: the interior points come first in the push order, so point `g`'s entries are a known slice.
     interior_entries: Vec<usize>,
+    interior_total: usize,
 }
 
 /// Tangent entries pushed by one interior collocation point: four 3×3 blocks per control point of its basis.
@@ -271,7 +272,7 @@ impl Assembler {
             .iter()
             .map(|p| curve_length(&p.curve))
             .collect();
-        let interior_entries = disc
+        let interior_entries: Vec<usize> = disc
             .points
             .iter()
             .enumerate()
@@ -287,6 +288,7 @@ impl Assembler {
             nodes,
             modulus_scale,
             patch_length,
+            interior_total: interior_entries.iter().sum(),
             interior_entries,
         }
     }
@@ -313,9 +315,8 @@ impl Assembler {
         // the tangent is assembled in parallel; the residual alone is too cheap per point to gain from it
         // (measured on the curved stent: tangent 0.81 → 0.60 s, residual 0.29 → 0.44 s over 0.5 s of the run).
         if let Sink::Values { values, next } = sink {
-            let total: usize = self.interior_entries.iter().sum();
-            *next = total;
-            let mut entries = &mut values[..total];
+            *next = self.interior_total;
+            let mut entries = &mut values[..self.interior_total];
             let mut tasks = Vec::with_capacity(disc.points.len());
             for ((g, residual), scale) in lin.residual[..n]
                 .chunks_mut(6)
