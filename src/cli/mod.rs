@@ -3,8 +3,11 @@
 //! and `schema` (the JSON Schema of the design format). The only module that uses `anyhow` and prints.
 
 pub mod check;
+pub mod disk;
 pub mod mesh;
+pub mod repair;
 pub mod run;
+pub mod signals;
 pub mod study;
 
 use clap::{Parser, Subcommand};
@@ -13,7 +16,14 @@ use std::process::ExitCode;
 
 /// stentkit — design, simulate and export 4D-printed shape-memory-polymer rod devices.
 #[derive(Debug, Parser)]
-#[command(name = "stentkit", version, about, long_about = None)]
+#[command(
+    name = "stentkit",
+    version,
+    about,
+    long_about = None,
+    after_help = "Exit status: 0 completed, 1 failed (solver, output, folder in use), 2 bad input (design, \
+                  arguments, folder or size refused; nothing ran), 130 interrupted by SIGINT, SIGTERM or SIGHUP."
+)]
 pub struct Cli {
     /// What to do.
     #[command(subcommand)]
@@ -34,6 +44,10 @@ pub enum Command {
     /// Simulate a design and write the run folder: history.csv, summary.json, snapshots/ (STL and OBJ of the
     /// full device), run.mcap (open it in Foxglove) and charts/ (SVG).
     ///
+    /// SIGINT (Ctrl-C), SIGTERM and SIGHUP stop the run at the next Newton iteration and finish every file; a
+    /// second signal skips the final snapshot and charts; a third quits at once (then `stentkit repair`).
+    /// Exit status: 0 completed, 1 failed, 2 bad input, 130 interrupted.
+    ///
     /// Example: stentkit run designs/straight_stent.yaml -o runs/straight_stent
     Run {
         /// The design file (YAML).
@@ -41,7 +55,8 @@ pub enum Command {
         /// Run folder (default: runs/<design name>).
         #[arg(short, long)]
         output: Option<PathBuf>,
-        /// Overwrite a non-empty run folder.
+        /// Replace an earlier run in the run folder: only the files that run wrote (its manifest lists them) are
+        /// removed. A folder that is not a run folder is never used.
         #[arg(long)]
         force: bool,
         /// No progress bar (it is also hidden when stderr is not a terminal); the summary line is printed.
@@ -50,6 +65,15 @@ pub enum Command {
         /// Report every failed Newton attempt (before the step is cut).
         #[arg(short, long)]
         verbose: bool,
+    },
+    /// Make the folder of a run that was killed (SIGKILL, power loss, crash) whole: cut history.csv back to its
+    /// last complete row, finish run.mcap after its last complete chunk, remove unfinished temporaries, and mark
+    /// summary.json `killed`. A folder whose run is still going is refused.
+    ///
+    /// Example: stentkit repair runs/straight_stent
+    Repair {
+        /// The run folder.
+        run_dir: PathBuf,
     },
     /// Accuracy against cost: convergence in p × n, error against time step per integrator, stability map.
     ///
@@ -161,6 +185,73 @@ pub enum StudyCommand {
     },
 }
 
+/// Exit status of a command that failed: the solver failed, an output could not be written, the run folder is
+/// in use.
+pub const EXIT_FAILED: u8 = 1;
+/// Exit status of bad input: a design refused (file, line, column and field named), a bad argument, a run folder
+/// refused, a design too large for the memory or the disk. Nothing was run.
+pub const EXIT_BAD_INPUT: u8 = 2;
+/// Exit status of a run interrupted by SIGINT, SIGTERM or SIGHUP (128 + SIGINT, the shells' convention).
+pub const EXIT_INTERRUPTED: u8 = 130;
+
+/// Input refused before anything ran (exit status [`EXIT_BAD_INPUT`]).
+#[derive(Debug, thiserror::Error)]
+#[error("{0}")]
+pub struct BadInput(pub String);
+
+/// A run stopped by a signal (exit status [`EXIT_INTERRUPTED`]).
+#[derive(Debug, thiserror::Error)]
+#[error("{0}")]
+pub struct Interrupted(pub String);
+
+/// The exit status of a command that ended with `error`.
+pub fn exit_code(error: &anyhow::Error) -> u8 {
+    use crate::io::design::DesignError;
+    use crate::io::run_folder::RunFolderError;
+    for cause in error.chain() {
+        if cause.is::<Interrupted>() {
+            return EXIT_INTERRUPTED;
+        }
+        if cause.is::<BadInput>()
+            || cause.is::<DesignError>()
+            || matches!(
+                cause.downcast_ref::<RunFolderError>(),
+                Some(RunFolderError::Refused { .. })
+            )
+        {
+            return EXIT_BAD_INPUT;
+        }
+    }
+    EXIT_FAILED
+}
+
+/// An error's message followed by its causes, each said once: a cause whose text the message already holds
+/// (an error that prints its source and also returns it, as many libraries' errors do) is not repeated.
+pub fn error_text(error: &anyhow::Error) -> String {
+    let mut text = String::new();
+    for cause in error.chain() {
+        let s = cause.to_string();
+        if text.contains(&s) {
+            continue;
+        }
+        if !text.is_empty() {
+            text.push_str(": ");
+        }
+        text.push_str(&s);
+    }
+    text
+}
+
+/// A time for messages: at most 9 decimals, trailing zeros dropped (`0.1`, not `0.10000000000000005`).
+pub fn short_time(t: crate::math::Real) -> String {
+    // Far from the seconds a run spans (1e300 after a typo), fixed-point would print hundreds of digits.
+    if !(1e-9..1e9).contains(&t.abs()) && t != 0.0 {
+        return crate::math::Short(t).to_string();
+    }
+    let s = format!("{t:.9}");
+    s.trim_end_matches('0').trim_end_matches('.').to_string()
+}
+
 /// Runs the command line and returns the process exit code.
 pub fn main() -> ExitCode {
     let cli = Cli::parse();
@@ -182,6 +273,7 @@ pub fn main() -> ExitCode {
             },
         ),
         Command::Schema => schema(),
+        Command::Repair { run_dir } => repair::run(&run_dir),
         Command::Study(StudyCommand::Convergence {
             design,
             output,
@@ -219,8 +311,8 @@ pub fn main() -> ExitCode {
     match result {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
-            eprintln!("error: {e:#}");
-            ExitCode::FAILURE
+            eprintln!("error: {}", error_text(&e));
+            ExitCode::from(exit_code(&e))
         }
     }
 }

@@ -8,67 +8,44 @@
 //! DIR/charts/*.svg            histories (io::run_charts)
 //! ```
 //!
-//! The outputs are observers of the simulation, composed here with a progress bar (indicatif, on stderr,
-//! hidden when stderr is not a terminal or with `--quiet`). Every file is finished whether the run completes,
-//! fails, is interrupted (Ctrl-C stops it after the current step; a second Ctrl-C quits at once) or is
-//! stopped by an output error: the MCAP recording is closed, the last state gets a snapshot and the summary
-//! says where the run stopped.
+//! The folder is taken through [`crate::io::run_folder`] (refusals, lock, manifest, `--force`). The outputs
+//! are observers of the simulation, composed here with a progress bar (indicatif, on stderr, hidden when
+//! stderr is not a terminal or with `--quiet`). `summary.json` exists from the start (`"status": "running"`)
+//! and is rewritten every [`HEARTBEAT`] with the last converged step, when the recording's chunk is also
+//! closed, so that SIGKILL leaves a folder `stentkit repair` makes whole. Every file is finished whether the
+//! run completes, fails, is interrupted by a signal ([`super::signals`]: the step in progress is abandoned at
+//! its next Newton iteration) or is stopped by an output error (a full disk: the history is cut back to its
+//! last complete row, the recording salvaged up to its last complete chunk, and the error lists which files
+//! are complete): the last state gets a snapshot and the summary says where the run stopped.
 
+use super::signals;
+use super::{BadInput, Interrupted, error_text, short_time};
 use crate::io::design::{Design, load_design};
 use crate::io::history::HistoryWriter;
 use crate::io::mcap::{McapRecorder, RunInfo};
+use crate::io::mcap_salvage::{Salvage, salvage};
 use crate::io::run_charts::RunCharts;
+use crate::io::run_folder::{Manifest, RunFolder, RunFolderError};
 use crate::io::snapshots::SnapshotWriter;
 use crate::io::summary::{
-    FailureReport, Files, FinalState, RunStatus, RunSummaryFile, Timing, UnitsSummary,
-    peak_memory_mib,
+    FailureReport, FinalState, OutputState, RunStatus, RunSummaryFile, peak_memory_mib,
 };
-use crate::math::Real;
-use crate::solver::{NewtonReport, Observer, Simulation, StepReport};
-use anyhow::{Context, bail};
+use crate::math::{Real, Short};
+use crate::solver::{NewtonReport, Observer, Simulation, SolverError, StepReport};
+use anyhow::Context;
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
-use std::collections::BTreeMap;
 use std::ops::ControlFlow;
 use std::path::{Path, PathBuf};
-use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::{Duration, Instant};
 
-/// Set by the Ctrl-C handler: the run stops after the current step.
-static INTERRUPTED: AtomicBool = AtomicBool::new(false);
+/// How often a run rewrites `summary.json` with its last converged step and closes the recording's current
+/// chunk: what SIGKILL or a power loss can take is at most this much of the run (plus the step in progress).
+/// Each chunk boundary costs a little compression; every 2 s is far below a percent of the recording.
+const HEARTBEAT: Duration = Duration::from_secs(2);
 
-/// Installs the Ctrl-C handler: the first Ctrl-C asks the run to stop after the current step, a second one
-/// quits at once (exit status 130) without finishing the files.
-fn install_interrupt_handler() {
-    // Only fails if a handler is already installed (a second run in the same process): keep that one.
-    let _ = ctrlc::set_handler(|| {
-        if INTERRUPTED.swap(true, Ordering::SeqCst) {
-            std::process::exit(130);
-        }
-    });
-}
-
-/// Stops the run once Ctrl-C was pressed.
-struct Interrupt;
-
-impl Observer for Interrupt {
-    fn start(&mut self, _: &Simulation<'_>) -> ControlFlow<()> {
-        self.check()
-    }
-
-    fn step(&mut self, _: &Simulation<'_>, _: &StepReport) -> ControlFlow<()> {
-        self.check()
-    }
-}
-
-impl Interrupt {
-    fn check(&self) -> ControlFlow<()> {
-        if INTERRUPTED.load(Ordering::SeqCst) {
-            ControlFlow::Break(())
-        } else {
-            ControlFlow::Continue(())
-        }
-    }
-}
+/// Room kept free for finishing a run [bytes]: the summary (a few kB) and the charts (tens of kB each), written
+/// after a disk that filled up during the run (see [`RunFolder::reserve`]).
+const FINISHING_RESERVE: usize = 1 << 20;
 
 /// Positions of the progress bar over the run (simulated time is mapped onto them).
 const PROGRESS_RESOLUTION: u64 = 10_000;
@@ -148,113 +125,163 @@ impl Observer for Progress {
     }
 }
 
-/// Forwards every report to several observers; stops when any asks to.
-struct Tee<'a>(Vec<&'a mut dyn Observer>);
+/// The outputs of a run, observing the simulation: history, snapshots, recording, charts, the progress bar,
+/// and the running summary with the recording's chunk flushes every [`HEARTBEAT`].
+struct Outputs {
+    history: HistoryWriter,
+    snapshots: SnapshotWriter,
+    recorder: McapRecorder,
+    charts: RunCharts,
+    progress: Progress,
+    /// Wall time spent in each output during the run, as named in [`Outputs::RECORDING`].
+    spent: [Duration; 4],
+    /// When the running summary was last written.
+    beat: Instant,
+    /// What the run did so far.
+    totals: crate::solver::RunSummary,
+}
 
-impl Observer for Tee<'_> {
-    fn start(&mut self, sim: &Simulation<'_>) -> ControlFlow<()> {
+impl Outputs {
+    /// Names of the outputs timed in `spent` (summary.json `timing.recording`).
+    const RECORDING: [&'static str; 4] = ["history", "snapshots", "mcap", "charts"];
+
+    /// Calls every output (all of them, even after one asked to stop) with the time spent in each.
+    fn observe(
+        &mut self,
+        mut call: impl FnMut(&mut dyn Observer) -> ControlFlow<()>,
+    ) -> ControlFlow<()> {
         let mut flow = ControlFlow::Continue(());
-        for o in &mut self.0 {
-            if o.start(sim).is_break() {
+        let outputs: [&mut dyn Observer; 4] = [
+            &mut self.history,
+            &mut self.snapshots,
+            &mut self.recorder,
+            &mut self.charts,
+        ];
+        for (output, spent) in outputs.into_iter().zip(&mut self.spent) {
+            let t = Instant::now();
+            if call(output).is_break() {
                 flow = ControlFlow::Break(());
             }
+            *spent += t.elapsed();
+        }
+        if call(&mut self.progress).is_break() || signals::stop_requested() {
+            flow = ControlFlow::Break(());
+        }
+        flow
+    }
+}
+
+/// The observer of a run: the outputs, and the running summary every [`HEARTBEAT`].
+struct RunObserver<'a> {
+    outputs: &'a mut Outputs,
+    summary: &'a mut SummaryFile,
+}
+
+impl RunObserver<'_> {
+    /// Every [`HEARTBEAT`]: closes the recording's chunk and rewrites the running summary.
+    fn heartbeat(&mut self, sim: &Simulation<'_>) -> ControlFlow<()> {
+        if self.outputs.beat.elapsed() < HEARTBEAT {
+            return ControlFlow::Continue(());
+        }
+        self.outputs.beat = Instant::now();
+        if let Err(e) = self.outputs.recorder.flush_chunk() {
+            self.summary.problem = Some(anyhow::Error::new(e));
+            return ControlFlow::Break(());
+        }
+        let outputs = &*self.outputs;
+        if let Err(e) = self.summary.write(|s| outputs.fill(s, sim)) {
+            self.summary.problem = Some(e);
+            return ControlFlow::Break(());
+        }
+        ControlFlow::Continue(())
+    }
+}
+
+impl Observer for RunObserver<'_> {
+    fn start(&mut self, sim: &Simulation<'_>) -> ControlFlow<()> {
+        let flow = self.outputs.observe(|o| o.start(sim));
+        self.outputs.beat = Instant::now() - HEARTBEAT;
+        if self.heartbeat(sim).is_break() {
+            return ControlFlow::Break(());
         }
         flow
     }
 
     fn step(&mut self, sim: &Simulation<'_>, report: &StepReport) -> ControlFlow<()> {
-        let mut flow = ControlFlow::Continue(());
-        for o in &mut self.0 {
-            if o.step(sim, report).is_break() {
-                flow = ControlFlow::Break(());
-            }
+        let totals = &mut self.outputs.totals;
+        totals.steps = report.step;
+        totals.iterations += report.newton.iterations;
+        totals.factorisations += report.newton.factorisations;
+        totals.cuts += report.cuts;
+        totals.time = report.time;
+        let flow = self.outputs.observe(|o| o.step(sim, report));
+        if self.heartbeat(sim).is_break() {
+            return ControlFlow::Break(());
         }
         flow
     }
 
     fn step_failed(&mut self, time: Real, dt: Real, newton: &NewtonReport) {
-        for o in &mut self.0 {
-            o.step_failed(time, dt, newton);
-        }
+        self.outputs.progress.step_failed(time, dt, newton);
+    }
+
+    fn interrupted(&self) -> bool {
+        signals::stop_requested()
     }
 }
 
-/// An observer and the wall time spent in it.
-struct Timed<'a, O: Observer> {
-    inner: &'a mut O,
-    spent: Duration,
-}
-
-impl<'a, O: Observer> Timed<'a, O> {
-    fn new(inner: &'a mut O) -> Self {
-        Self {
-            inner,
-            spent: Duration::ZERO,
-        }
+impl Outputs {
+    /// Puts what the run did so far into `s`: counts, the time reached, snapshots, the last state, notices and
+    /// the solver's time split.
+    fn fill(&self, s: &mut RunSummaryFile, sim: &Simulation<'_>) {
+        let t = &self.totals;
+        s.steps = t.steps;
+        s.newton_iterations = t.iterations;
+        s.iterations_per_step = t.iterations as Real / t.steps.max(1) as Real;
+        s.step_cuts = t.cuts;
+        s.final_time = sim.time();
+        s.snapshots = self.snapshots.snapshots().iter().map(Into::into).collect();
+        s.final_state = self
+            .charts
+            .samples()
+            .last()
+            .map(|x| FinalState::of(sim.model(), x));
+        s.notices = sim.notices().to_vec();
+        s.timing.solver = sim.timing().entries().into_iter().collect();
+        s.timing.recording = Self::RECORDING
+            .iter()
+            .zip(&self.spent)
+            .map(|(name, d)| (name.to_string(), d.as_secs_f64()))
+            .collect();
     }
 }
 
-impl<O: Observer> Observer for Timed<'_, O> {
-    fn start(&mut self, sim: &Simulation<'_>) -> ControlFlow<()> {
-        let t = Instant::now();
-        let flow = self.inner.start(sim);
-        self.spent += t.elapsed();
-        flow
-    }
+/// `summary.json` of a run: the summary so far, rewritten atomically whenever it changes.
+struct SummaryFile {
+    path: PathBuf,
+    summary: RunSummaryFile,
+    /// The command's start.
+    started: Instant,
+    /// The first problem met while the run went on (writing the summary or closing a chunk).
+    problem: Option<anyhow::Error>,
+}
 
-    fn step(&mut self, sim: &Simulation<'_>, report: &StepReport) -> ControlFlow<()> {
-        let t = Instant::now();
-        let flow = self.inner.step(sim, report);
-        self.spent += t.elapsed();
-        flow
-    }
-
-    fn step_failed(&mut self, time: Real, dt: Real, newton: &NewtonReport) {
-        self.inner.step_failed(time, dt, newton);
+impl SummaryFile {
+    /// Updates the summary with `update` (and the time, wall time and peak memory) and writes it.
+    fn write(&mut self, update: impl FnOnce(&mut RunSummaryFile)) -> anyhow::Result<()> {
+        update(&mut self.summary);
+        self.summary.updated = crate::io::run_folder::utc_timestamp(std::time::SystemTime::now());
+        self.summary.wall_time_s = self.started.elapsed().as_secs_f64();
+        self.summary.peak_memory_mib = peak_memory_mib();
+        self.summary
+            .write(&self.path)
+            .with_context(|| format!("cannot write {}", self.path.display()))
     }
 }
 
 /// The run folder for a design: `-o DIR` or `runs/<design name>`.
 fn run_dir(output: Option<PathBuf>, name: &str) -> PathBuf {
     output.unwrap_or_else(|| Path::new("runs").join(name))
-}
-
-/// Files and folders a run writes, relative to the run folder (removed first under `--force`).
-const OUTPUTS: [&str; 5] = [
-    "history.csv",
-    "summary.json",
-    "run.mcap",
-    SnapshotWriter::FOLDER,
-    RunCharts::FOLDER,
-];
-
-/// Makes `dir` ready for a run: refuses a non-empty folder without `force`; with it, removes the outputs of
-/// an earlier run (and nothing else).
-fn prepare_dir(dir: &Path, force: bool) -> anyhow::Result<()> {
-    let non_empty = dir.exists()
-        && std::fs::read_dir(dir)
-            .map(|mut d| d.next().is_some())
-            .unwrap_or(true);
-    if non_empty {
-        if !force {
-            bail!(
-                "{} exists and is not empty; pass --force to overwrite it",
-                dir.display()
-            );
-        }
-        for name in OUTPUTS {
-            let path = dir.join(name);
-            let removed = if path.is_dir() {
-                std::fs::remove_dir_all(&path)
-            } else if path.exists() {
-                std::fs::remove_file(&path)
-            } else {
-                Ok(())
-            };
-            removed.with_context(|| format!("cannot remove {}", path.display()))?;
-        }
-    }
-    std::fs::create_dir_all(dir).with_context(|| format!("cannot create {}", dir.display()))
 }
 
 /// The command line as typed, arguments with spaces quoted.
@@ -276,7 +303,7 @@ fn command_line() -> String {
 pub struct RunOptions {
     /// Run folder (default `runs/<design name>`).
     pub output: Option<PathBuf>,
-    /// Overwrite a non-empty run folder.
+    /// Replace an earlier run in the run folder (only the files it wrote are removed).
     pub force: bool,
     /// No progress bar and no start line.
     pub quiet: bool,
@@ -285,232 +312,499 @@ pub struct RunOptions {
 }
 
 /// Simulates the design and writes the run folder.
+///
+/// # Errors
+/// A [`BadInput`] or [`crate::io::design::DesignError`] for a design or folder refused before anything ran
+/// (exit status 2), [`Interrupted`] for a run stopped by a signal (130), anything else for a failed run (1).
 pub fn run(design_path: &Path, options: RunOptions) -> anyhow::Result<()> {
     let started = Instant::now();
+    signals::install();
     let design = load_design(design_path)?;
     for w in &design.warnings {
         eprintln!("warning: {w}");
     }
+    if signals::stop_requested() {
+        return Err(Interrupted(format!(
+            "{} while reading the design: nothing was written",
+            signals::first().unwrap_or("signal")
+        ))
+        .into());
+    }
     let dir = run_dir(options.output.clone(), &design.model.name);
-    prepare_dir(&dir, options.force)?;
-    run_in(&design, &dir, &options, started)
+    let mut folder = RunFolder::open(&dir, design_path, options.force).map_err(|e| match e {
+        RunFolderError::Refused { .. } => anyhow::Error::new(BadInput(e.to_string())),
+        e => e.into(),
+    })?;
+    super::disk::check_space(&design, &folder)?;
+    folder.clear_previous()?;
+    run_in(&design, &folder, &options, started)
 }
 
 fn run_in(
     design: &Design,
-    dir: &Path,
+    folder: &RunFolder,
     options: &RunOptions,
     started: Instant,
 ) -> anyhow::Result<()> {
     let model = &design.model;
-    let mut sim = Simulation::new(model)?;
-    if !options.quiet {
-        eprintln!(
-            "stentkit run: {} — {} patches, {} unknowns, {} steps of {} s to {} s → {}",
-            model.name,
-            model.patches.len(),
-            model.num_unknowns(),
-            model.num_time_steps(),
-            model.time.step,
-            model.time.end,
-            dir.display()
-        );
-    }
+    let dir = folder.dir();
+    let manifest = folder.manifest();
     let info = RunInfo {
         version: env!("CARGO_PKG_VERSION").to_string(),
         command_line: command_line(),
     };
-    let history_path = dir.join("history.csv");
-    let mut history = HistoryWriter::create(&history_path, &sim)
-        .with_context(|| format!("cannot write {}", history_path.display()))?;
-    let mut snapshots = SnapshotWriter::create(dir, &design.output.snapshots, model)?;
-    let mcap_path = dir.join("run.mcap");
-    let mut recorder = McapRecorder::create(&mcap_path, design, &info, &design.output.snapshots)?;
-    let mut charts = RunCharts::new(model);
-    let mut progress = Progress::new(model.time.end, options.quiet, options.verbose);
-    install_interrupt_handler();
-    let setup = started.elapsed();
+    manifest.claim(Path::new("summary.json"))?;
+    let mut summary = SummaryFile {
+        path: dir.join("summary.json"),
+        summary: RunSummaryFile::start(
+            model,
+            &design.path.display().to_string(),
+            &info.version,
+            &info.command_line,
+            design.warnings.clone(),
+        ),
+        started,
+        problem: None,
+    };
+    summary.write(|_| {})?;
+    let reserve = folder.reserve(FINISHING_RESERVE)?;
+    let setup = (|| -> anyhow::Result<_> {
+        let sim = Simulation::new(model)?;
+        if !options.quiet {
+            eprintln!(
+                "stentkit run: {} — {} patches, {} unknowns, {} steps of {} s to {} s → {}",
+                model.name,
+                model.patches.len(),
+                model.num_unknowns(),
+                model.num_time_steps(),
+                model.time.step,
+                model.time.end,
+                dir.display()
+            );
+        }
+        let outputs = create_outputs(design, folder, &info, &sim, options)?;
+        Ok((sim, outputs))
+    })();
+    let (mut sim, mut outputs) = match setup {
+        Ok(x) => x,
+        Err(e) => {
+            let failure = e
+                .downcast_ref::<SolverError>()
+                .map(|s| FailureReport::of(s, 0, 0.0));
+            let text = error_text(&e);
+            summary.write(|s| {
+                s.status = RunStatus::Failed;
+                s.error = Some(text);
+                s.failure = failure;
+            })?;
+            return Err(e);
+        }
+    };
+    if signals::stop_requested() {
+        return interrupted_in_setup(&mut summary, &mut outputs, &sim, started);
+    }
+    summary.summary.timing.setup_s = started.elapsed().as_secs_f64();
 
     let run_started = Instant::now();
-    let mut recording = BTreeMap::new();
-    let result = {
-        let mut history = Timed::new(&mut history);
-        let mut snapshots = Timed::new(&mut snapshots);
-        let mut recorder = Timed::new(&mut recorder);
-        let mut charts = Timed::new(&mut charts);
-        let result = sim.run(&mut Tee(vec![
-            &mut history,
-            &mut snapshots,
-            &mut recorder,
-            &mut charts,
-            &mut progress,
-            &mut Interrupt,
-        ]));
-        for (name, spent) in [
-            ("history", history.spent),
-            ("snapshots", snapshots.spent),
-            ("mcap", recorder.spent),
-            ("charts", charts.spent),
-        ] {
-            recording.insert(name.to_string(), spent.as_secs_f64());
-        }
-        result
-    };
-    let run_time = run_started.elapsed();
-    progress.bar.finish_and_clear();
-    progress.notices(&sim);
+    let result = sim.run(&mut RunObserver {
+        outputs: &mut outputs,
+        summary: &mut summary,
+    });
+    summary.summary.timing.run_s = run_started.elapsed().as_secs_f64();
+    outputs.progress.bar.finish_and_clear();
+    outputs.progress.notices(&sim);
 
-    // Finish every output, whatever happened; report the first problem afterwards.
     let finish_started = Instant::now();
-    let mut problems: Vec<anyhow::Error> = Vec::new();
-    if let Some(e) = history.take_error() {
-        problems.push(anyhow::Error::new(e).context(format!("writing {}", history_path.display())));
+    reserve.release();
+    let mut finished = finish(&mut outputs, &sim, dir, manifest);
+    if let Some(p) = summary.problem.take() {
+        finished.problems.insert(0, p);
     }
-    if let Some(e) = snapshots.take_error() {
-        problems.push(e.into());
-    }
-    if let Err(e) = snapshots.finish(&sim) {
-        problems.push(e.into());
-    }
-    if let Some(e) = recorder.take_error() {
-        problems.push(e.into());
-    }
-    let mcap_bytes = match recorder.finish(&sim) {
-        Ok(bytes) => bytes,
-        Err(e) => {
-            problems.push(e.into());
-            0
-        }
-    };
-    let chart_files = match charts.write(model, dir) {
-        Ok(files) => files,
-        Err(e) => {
-            problems.push(e.into());
-            Vec::new()
-        }
-    };
-    let finish = finish_started.elapsed();
+    summary.summary.timing.finish_s = finish_started.elapsed().as_secs_f64();
 
-    let interrupted = INTERRUPTED.load(Ordering::SeqCst);
-    let (status, error) = match (&result, problems.first()) {
-        (Err(e), _) => (RunStatus::Failed, Some(format!("{e}"))),
-        (Ok(s), None) if s.stopped && interrupted => (
+    let interrupted = signals::stop_requested();
+    let stopped = result.as_ref().is_ok_and(|s| s.stopped);
+    let first_problem = finished.problems.first().map(error_text);
+    let (status, error) = match (&result, first_problem) {
+        (Err(e), _) => (RunStatus::Failed, Some(e.to_string())),
+        (Ok(_), None) if stopped && interrupted => (
             RunStatus::Interrupted,
             Some(format!(
-                "interrupted (Ctrl-C) at t = {} s",
+                "interrupted by {} at t = {} s",
+                signals::first().unwrap_or("a signal"),
                 short_time(sim.time())
             )),
         ),
-        (Ok(s), Some(p)) if s.stopped => (RunStatus::Stopped, Some(format!("{p:#}"))),
-        (Ok(_), Some(p)) => (RunStatus::Completed, Some(format!("{p:#}"))),
-        (Ok(_), None) => (RunStatus::Completed, None),
+        (Ok(_), Some(p)) if stopped => (RunStatus::Stopped, Some(p)),
+        (Ok(_), p) => (RunStatus::Completed, p),
     };
-    let totals = result.as_ref().ok().cloned().unwrap_or_else(|| {
-        // The solver failed: count what the observers saw.
-        let samples = charts.samples();
-        crate::solver::RunSummary {
-            steps: samples.last().map_or(0, |s| s.step),
-            iterations: samples.iter().map(|s| s.iterations).sum(),
-            cuts: samples.iter().map(|s| s.cuts).sum(),
-            time: sim.time(),
-            stopped: true,
-            ..Default::default()
+    let failure = result
+        .as_ref()
+        .err()
+        .map(|e| FailureReport::of(e, outputs.totals.steps, sim.time()));
+    let mcap_bytes = finished.mcap_bytes;
+    let write = summary.write(|s| {
+        outputs.fill(s, &sim);
+        s.status = status;
+        s.error = error;
+        s.failure = failure;
+        s.files.mcap_bytes = mcap_bytes;
+        s.files.charts = finished
+            .charts
+            .iter()
+            .map(|p| p.display().to_string())
+            .collect();
+        if !finished.problems.is_empty() {
+            s.outputs = finished.states.clone();
         }
     });
-    let wall = started.elapsed().as_secs_f64();
-    let summary = RunSummaryFile {
-        design: model.name.clone(),
-        design_file: design.path.display().to_string(),
-        stentkit_version: info.version.clone(),
-        command_line: info.command_line.clone(),
-        units: UnitsSummary::of(model),
-        status,
-        error,
-        failure: result
-            .as_ref()
-            .err()
-            .map(|e| FailureReport::of(e, totals.steps, sim.time())),
-        wall_time_s: wall,
-        peak_memory_mib: peak_memory_mib(),
-        timing: Timing {
-            setup_s: setup.as_secs_f64(),
-            run_s: run_time.as_secs_f64(),
-            recording,
-            finish_s: finish.as_secs_f64(),
-            solver: sim.timing().entries().into_iter().collect(),
-        },
-        steps: totals.steps,
-        newton_iterations: totals.iterations,
-        iterations_per_step: totals.iterations as Real / totals.steps.max(1) as Real,
-        step_cuts: totals.cuts,
-        final_time: sim.time(),
-        end_time: model.time.end,
-        time_step: model.time.step,
-        patches: model.patches.len(),
-        collocation_points: model.num_collocation_points(),
-        unknowns: model.num_unknowns(),
-        symmetry_planes: model.symmetry_planes.len(),
-        snapshots: snapshots.snapshots().iter().map(Into::into).collect(),
-        files: Files {
-            history: "history.csv".into(),
-            mcap: "run.mcap".into(),
-            mcap_bytes,
-            charts: chart_files
-                .iter()
-                .map(|p| p.display().to_string())
-                .collect(),
-        },
-        final_state: charts.samples().last().map(|s| FinalState::of(model, s)),
-        warnings: design.warnings.clone(),
-        notices: sim.notices().to_vec(),
-    };
-    if let Some(failure) = &summary.failure {
-        eprintln!("{}", failure_report(failure, &summary));
+    if let Some(failure) = &summary.summary.failure {
+        eprintln!("{}", failure_report(failure, &summary.summary));
     }
-    let summary_path = dir.join("summary.json");
-    summary
-        .write(&summary_path)
-        .with_context(|| format!("cannot write {}", summary_path.display()))?;
+    if let Err(e) = write {
+        finished.states.push(OutputState {
+            file: "summary.json".into(),
+            complete: false,
+            state: format!("not updated (it says `running`): {}", error_text(&e)),
+        });
+        finished.problems.push(e);
+    }
 
-    let totals = result.with_context(|| {
+    let files = file_report(&finished);
+    let where_ = |what: &str| {
         format!(
-            "the run stopped at t = {} s; results up to there are in {}",
+            "{what} at t = {} s; results up to there are in {}",
             short_time(sim.time()),
-            dir.display()
+            dir.display(),
         )
-    })?;
-    if totals.stopped && interrupted {
-        bail!(
-            "interrupted at t = {} s after {} steps; results up to there are in {}",
-            short_time(sim.time()),
-            totals.steps,
-            dir.display()
-        );
+    };
+    if !files.is_empty() && (result.is_err() || (stopped && interrupted)) {
+        eprintln!("{}", files.trim_start_matches("; "));
     }
-    if let Some(problem) = problems.into_iter().next() {
-        return Err(problem.context(format!(
-            "the run stopped at t = {} s; results up to there are in {}",
-            short_time(sim.time()),
-            dir.display()
-        )));
+    if let Err(e) = result {
+        return Err(anyhow::Error::new(e).context(where_("the run failed")));
     }
+    if stopped && interrupted {
+        return Err(Interrupted(where_(&format!(
+            "interrupted by {} after {} steps",
+            signals::first().unwrap_or("a signal"),
+            outputs.totals.steps
+        )))
+        .into());
+    }
+    if let Some(problem) = finished.problems.first() {
+        // The cause first, then where the run stopped and which files are complete.
+        return Err(anyhow::anyhow!(
+            "{}; {}{files}",
+            error_text(problem),
+            where_(if stopped {
+                "the run stopped"
+            } else {
+                "the run ended"
+            })
+        ));
+    }
+    let totals = &outputs.totals;
     println!(
-        "{}: {} steps to t = {} s, {} Newton iterations ({:.2} per step), {} factorisations, {} step cuts, {} snapshots, run.mcap {}, wall time {wall:.2} s, peak memory {} → {}",
+        "{}: {} steps to t = {} s, {} Newton iterations ({:.2} per step), {} factorisations, {} step cuts, {} snapshots, run.mcap {}, wall time {:.2} s, peak memory {} → {}",
         model.name,
         totals.steps,
-        totals.time,
+        Short(totals.time),
         totals.iterations,
         totals.iterations as f64 / totals.steps.max(1) as f64,
         totals.factorisations,
         totals.cuts,
-        summary.snapshots.len(),
+        summary.summary.snapshots.len(),
         human_bytes(mcap_bytes),
+        summary.summary.wall_time_s,
         summary
+            .summary
             .peak_memory_mib
             .map_or("unknown".to_string(), |m| format!("{m:.0} MiB")),
         dir.display()
     );
     Ok(())
+}
+
+/// Creates the writers of the run folder, each file listed in the manifest first.
+fn create_outputs(
+    design: &Design,
+    folder: &RunFolder,
+    info: &RunInfo,
+    sim: &Simulation<'_>,
+    options: &RunOptions,
+) -> anyhow::Result<Outputs> {
+    let model = &design.model;
+    let dir = folder.dir();
+    let manifest = folder.manifest();
+    manifest.claim(Path::new("history.csv"))?;
+    let history_path = dir.join("history.csv");
+    let history = HistoryWriter::create(&history_path, sim)
+        .with_context(|| format!("cannot write {}", history_path.display()))?;
+    let snapshots = SnapshotWriter::create(dir, &design.output.snapshots, model)?
+        .with_manifest(manifest.clone());
+    manifest.claim(Path::new("run.mcap"))?;
+    let recorder = McapRecorder::create(
+        &dir.join("run.mcap"),
+        design,
+        info,
+        &design.output.snapshots,
+    )?;
+    Ok(Outputs {
+        history,
+        snapshots,
+        recorder,
+        charts: RunCharts::new(model),
+        progress: Progress::new(model.time.end, options.quiet, options.verbose),
+        spent: [Duration::ZERO; 4],
+        beat: Instant::now(),
+        totals: crate::solver::RunSummary::default(),
+    })
+}
+
+/// A signal arrived while the run was set up: the (empty) outputs are closed and the summary says so.
+fn interrupted_in_setup(
+    summary: &mut SummaryFile,
+    outputs: &mut Outputs,
+    sim: &Simulation<'_>,
+    started: Instant,
+) -> anyhow::Result<()> {
+    let _ = outputs.recorder.close();
+    let message = format!(
+        "interrupted by {} during setup, before the first step",
+        signals::first().unwrap_or("a signal")
+    );
+    let text = message.clone();
+    summary.write(|s| {
+        outputs.fill(s, sim);
+        s.status = RunStatus::Interrupted;
+        s.error = Some(text);
+        s.timing.setup_s = started.elapsed().as_secs_f64();
+    })?;
+    Err(Interrupted(message).into())
+}
+
+/// What finishing the outputs did.
+struct Finished {
+    /// Every problem met, the first one first.
+    problems: Vec<anyhow::Error>,
+    /// Which outputs are complete (listed in the error and summary when there were problems).
+    states: Vec<OutputState>,
+    /// Size of the recording [bytes] (0 if it was removed).
+    mcap_bytes: u64,
+    /// The charts written.
+    charts: Vec<PathBuf>,
+}
+
+/// Finishes every output, whatever happened: cuts the history back to its last complete row, closes the
+/// recording (salvaging it if it cannot be closed, removing it only if even that fails: a full disk), writes
+/// the final snapshot (skipped after a second signal, in the files and the recording) and the charts, and says
+/// which files are complete.
+fn finish(
+    outputs: &mut Outputs,
+    sim: &Simulation<'_>,
+    dir: &Path,
+    manifest: &Manifest,
+) -> Finished {
+    let hurry = signals::hurry();
+    let mut problems: Vec<anyhow::Error> = Vec::new();
+    let mut states = Vec::new();
+    let mut state = |file: &str, complete: bool, state: String| {
+        states.push(OutputState {
+            file: file.into(),
+            complete,
+            state,
+        })
+    };
+
+    let history_path = dir.join("history.csv");
+    let upto = |t: Option<Real>| {
+        t.map_or("the header only".to_string(), |t| {
+            format!("t = {} s", short_time(t))
+        })
+    };
+    match outputs.history.take_error() {
+        Some(e) => {
+            let e =
+                anyhow::Error::new(e).context(format!("cannot write {}", history_path.display()));
+            state(
+                "history.csv",
+                true,
+                format!(
+                    "complete up to {} ({} rows); later rows not written: {}",
+                    upto(outputs.history.last_time()),
+                    outputs.history.rows(),
+                    error_text(&e)
+                ),
+            );
+            problems.push(e);
+        }
+        None => state(
+            "history.csv",
+            true,
+            format!("complete up to {}", upto(outputs.history.last_time())),
+        ),
+    }
+
+    // The recording first: salvaging a recording cut short by a full disk frees the space of its broken chunk.
+    let record_error = outputs.recorder.take_error().map(anyhow::Error::from);
+    let closed = match (&record_error, hurry) {
+        // A writer that failed once refuses every later write: only the salvage can finish the file.
+        (Some(_), _) => outputs.recorder.close(),
+        (None, true) => outputs.recorder.close(),
+        (None, false) => outputs.recorder.finish(sim),
+    };
+    let mcap_path = dir.join("run.mcap");
+    let complete_to = format!("complete up to {}", upto(outputs.recorder.last_time()));
+    let mcap_bytes = match (closed, record_error) {
+        (Ok(bytes), None) => {
+            state("run.mcap", true, complete_to);
+            bytes
+        }
+        (closed, record_error) => {
+            // The first error is the cause; closing after it fails for that reason too.
+            let e = match (record_error, closed) {
+                (Some(e), _) => e,
+                (None, Err(e)) => anyhow::Error::from(e),
+                (None, Ok(_)) => unreachable!("handled above"),
+            };
+            let bytes = match salvage(&mcap_path) {
+                Ok(Salvage::Finished {
+                    after,
+                    last_log_time,
+                    ..
+                }) => {
+                    let t = last_log_time.map(|ns| ns as Real * 1e-9);
+                    state(
+                        "run.mcap",
+                        true,
+                        format!(
+                            "finalised up to {}; later states not recorded: {}",
+                            upto(t),
+                            error_text(&e)
+                        ),
+                    );
+                    after
+                }
+                Ok(Salvage::AlreadyValid { bytes }) => {
+                    state(
+                        "run.mcap",
+                        true,
+                        format!(
+                            "{complete_to}; later states not recorded: {}",
+                            error_text(&e)
+                        ),
+                    );
+                    bytes
+                }
+                Err(salvage_error) => {
+                    let removed = std::fs::remove_file(&mcap_path).is_ok();
+                    state(
+                        "run.mcap",
+                        false,
+                        format!(
+                            "incomplete ({}) and cannot be finished ({salvage_error}){}",
+                            error_text(&e),
+                            if removed { ": removed" } else { "" }
+                        ),
+                    );
+                    0
+                }
+            };
+            problems.push(e);
+            bytes
+        }
+    };
+
+    let snapshot_error = outputs.snapshots.take_error().map(anyhow::Error::from);
+    // After any output error (most often a full disk) the final snapshot is not attempted: the room left is
+    // for the charts and the summary.
+    let final_snapshot = if hurry || snapshot_error.is_some() || !problems.is_empty() {
+        None
+    } else {
+        outputs.snapshots.finish(sim).err().map(anyhow::Error::from)
+    };
+    let written = outputs.snapshots.snapshots();
+    let listed = written
+        .last()
+        .map(|s| {
+            format!(
+                ", the last at step {} (t = {} s)",
+                s.step,
+                short_time(s.time)
+            )
+        })
+        .unwrap_or_default();
+    match snapshot_error.or(final_snapshot) {
+        Some(e) => {
+            state(
+                "snapshots/",
+                false,
+                format!(
+                    "{} complete{listed}; the next not written: {}",
+                    written.len(),
+                    error_text(&e)
+                ),
+            );
+            problems.push(e);
+        }
+        None if hurry => state(
+            "snapshots/",
+            true,
+            format!(
+                "{} complete{listed}; final snapshot skipped (second signal)",
+                written.len()
+            ),
+        ),
+        None => state(
+            "snapshots/",
+            true,
+            format!("{} complete{listed}", written.len()),
+        ),
+    }
+
+    let charts = match outputs.charts.write(sim.model(), dir, Some(manifest)) {
+        Ok(files) => {
+            state("charts/", true, format!("{} complete", files.len()));
+            files
+        }
+        Err(e) => {
+            let e = anyhow::Error::from(e);
+            state(
+                "charts/",
+                false,
+                format!("not all drawn: {}", error_text(&e)),
+            );
+            problems.push(e);
+            Vec::new()
+        }
+    };
+    Finished {
+        problems,
+        states,
+        mcap_bytes,
+        charts,
+    }
+}
+
+/// The files' states for an error message, when some output could not be finished; empty otherwise.
+fn file_report(finished: &Finished) -> String {
+    if finished.problems.is_empty() {
+        return String::new();
+    }
+    let lines: Vec<String> = finished
+        .states
+        .iter()
+        .map(|s| {
+            format!(
+                "\n  {} {}: {}",
+                if s.complete { "✓" } else { "✗" },
+                s.file,
+                s.state
+            )
+        })
+        .collect();
+    format!("; the run folder holds:{}", lines.concat())
 }
 
 /// The failure report printed by a failed run (the same facts are in summary.json under `failure`).
@@ -549,12 +843,6 @@ fn failure_report(failure: &FailureReport, summary: &RunSummaryFile) -> String {
         short_time(failure.last_converged_time)
     ));
     lines.join("\n")
-}
-
-/// A time for messages: at most 9 decimals, trailing zeros dropped (`0.1`, not `0.10000000000000005`).
-fn short_time(t: Real) -> String {
-    let s = format!("{t:.9}");
-    s.trim_end_matches('0').trim_end_matches('.').to_string()
 }
 
 /// `1.2 MB`-style size.

@@ -5,7 +5,8 @@
 //! over the full device) and largest `‖η_l‖ / ‖η_temp,l‖` over the driven nodes — 1 at the temporary shape, 0 at
 //! the permanent one — and, for a radial contraction, `delta_r`: the mean radial contraction of the driven
 //! nodes (positive towards the axis; the paper's Δr).
-//! Rows are flushed as they are written, so an interrupted run leaves a valid file up to its last step.
+//! Rows are flushed as they are written, so an interrupted run leaves a valid file up to its last step; a row
+//! that cannot be written whole (a full disk) is cut off again, so the file always ends with a complete row.
 
 use crate::solver::{Observer, Simulation, StepReport};
 use std::fs::File;
@@ -16,7 +17,13 @@ use std::path::{Path, PathBuf};
 /// Writes `history.csv` as the simulation reports steps.
 pub struct HistoryWriter {
     path: PathBuf,
-    out: BufWriter<File>,
+    /// `None` once a write failed.
+    out: Option<BufWriter<File>>,
+    /// Length of the file up to its last complete row [bytes].
+    complete: u64,
+    /// Rows written (the initial state is row 0) and the time of the last one.
+    rows: usize,
+    last_time: Option<f64>,
     /// First write error; writing stops there and the run is asked to stop.
     error: Option<std::io::Error>,
 }
@@ -42,11 +49,25 @@ impl HistoryWriter {
             }
         }
         writeln!(out, "{header}")?;
+        out.flush()?;
         Ok(Self {
             path: path.to_path_buf(),
-            out,
+            complete: header.len() as u64 + 1,
+            out: Some(out),
+            rows: 0,
+            last_time: None,
             error: None,
         })
+    }
+
+    /// The time of the last complete row (`None`: the header only).
+    pub fn last_time(&self) -> Option<f64> {
+        self.last_time
+    }
+
+    /// Complete rows written (the initial state included).
+    pub fn rows(&self) -> usize {
+        self.rows
     }
 
     /// The file written.
@@ -84,13 +105,30 @@ impl HistoryWriter {
                 line.push_str(&format!(",{delta_r:.9e}"));
             }
         }
-        let result = writeln!(self.out, "{line}").and_then(|_| self.out.flush());
-        match result {
-            Ok(()) => ControlFlow::Continue(()),
+        let Some(out) = &mut self.out else {
+            return ControlFlow::Break(());
+        };
+        match writeln!(out, "{line}").and_then(|_| out.flush()) {
+            Ok(()) => {
+                self.complete += line.len() as u64 + 1;
+                self.rows += 1;
+                self.last_time = Some(t);
+                ControlFlow::Continue(())
+            }
             Err(e) => {
+                self.cut_partial_row();
                 self.error = Some(e);
                 ControlFlow::Break(())
             }
+        }
+    }
+
+    /// Drops what a failed write left in the buffer and cuts the file back to its last complete row.
+    fn cut_partial_row(&mut self) {
+        if let Some(out) = self.out.take() {
+            let (file, _unwritten) = out.into_parts();
+            // Best effort: truncating needs no free space; if even that fails the error already reported stands.
+            let _ = file.set_len(self.complete).and_then(|()| file.sync_all());
         }
     }
 }

@@ -580,6 +580,27 @@ impl McapRecorder {
         self.error.take()
     }
 
+    /// The simulated time of the last state recorded [s].
+    pub fn last_time(&self) -> Option<Real> {
+        self.last.map(|(_, _, t)| t)
+    }
+
+    /// Closes the current chunk and flushes it to the file, so that a run killed after this call (SIGKILL, a
+    /// power loss) leaves a recording that [`crate::io::mcap_salvage::salvage`] restores up to here. The run
+    /// calls it every few seconds; each call costs a chunk boundary (slightly less compression).
+    ///
+    /// # Errors
+    /// [`McapError::Write`] when the chunk cannot be written (the recording stops there).
+    pub fn flush_chunk(&mut self) -> Result<(), McapError> {
+        let Some(writer) = &mut self.writer else {
+            return Ok(());
+        };
+        writer.flush().map_err(|source| McapError::Write {
+            path: self.path.clone(),
+            source,
+        })
+    }
+
     fn write(&mut self, channel: u16, log_time: u64, message: &[u8]) -> Result<(), McapError> {
         let Some(writer) = &mut self.writer else {
             return Ok(());
@@ -758,8 +779,11 @@ impl McapRecorder {
         self.close()
     }
 
-    /// Closes the file without recording anything more; returns its size in bytes.
-    fn close(&mut self) -> Result<u64, McapError> {
+    /// Closes the file without recording anything more (no final mesh); returns its size in bytes.
+    ///
+    /// # Errors
+    /// [`McapError`] when the summary section cannot be written.
+    pub fn close(&mut self) -> Result<u64, McapError> {
         if let Some(mut writer) = self.writer.take() {
             writer.finish().map_err(|source| McapError::Write {
                 path: self.path.clone(),

@@ -12,6 +12,7 @@
 //! * `newton.svg` — Newton iterations per step against time (every run).
 
 use super::chart::{ChartError, LineChart, Series, write_svg};
+use super::run_folder::Manifest;
 use super::state::{LoadChannel, StateSample, load_channels};
 use crate::math::Real;
 use crate::model::Model;
@@ -190,11 +191,17 @@ impl RunCharts {
         charts
     }
 
-    /// Writes the charts into `run_dir/charts`; returns the files written (relative to `run_dir`).
+    /// Writes the charts into `run_dir/charts`, each listed in the run folder's `manifest` first (if given);
+    /// returns the files written (relative to `run_dir`).
     ///
     /// # Errors
-    /// [`ChartError`] when a chart cannot be drawn or written.
-    pub fn write(&self, model: &Model, run_dir: &Path) -> Result<Vec<PathBuf>, ChartError> {
+    /// [`ChartError`] when a chart cannot be listed, drawn or written.
+    pub fn write(
+        &self,
+        model: &Model,
+        run_dir: &Path,
+        manifest: Option<&Manifest>,
+    ) -> Result<Vec<PathBuf>, ChartError> {
         let folder = run_dir.join(Self::FOLDER);
         std::fs::create_dir_all(&folder).map_err(|source| ChartError::Io {
             path: folder.clone(),
@@ -202,8 +209,15 @@ impl RunCharts {
         })?;
         let mut written = Vec::new();
         for (file, chart) in self.charts(model) {
+            let relative = Path::new(Self::FOLDER).join(file);
+            if let Some(manifest) = manifest {
+                manifest.claim(&relative).map_err(|source| ChartError::Io {
+                    path: run_dir.join(super::run_folder::MANIFEST),
+                    source,
+                })?;
+            }
             write_svg(&chart, &folder.join(file))?;
-            written.push(Path::new(Self::FOLDER).join(file));
+            written.push(relative);
         }
         Ok(written)
     }

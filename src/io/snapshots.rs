@@ -5,6 +5,7 @@
 
 use super::design::SnapshotSettings;
 use super::device::{current_device_shapes, device_tube_mesh};
+use super::run_folder::Manifest;
 use super::stl::MeshIoError;
 use super::{obj, stl};
 use crate::geometry::tube::{DeviceMeshError, TriangleMesh};
@@ -97,6 +98,9 @@ pub enum SnapshotError {
     /// A file could not be written.
     #[error(transparent)]
     Write(#[from] MeshIoError),
+    /// The run folder's manifest could not list the snapshot's files.
+    #[error("cannot list a snapshot in the run folder's manifest: {0}")]
+    Manifest(std::io::Error),
 }
 
 /// The full device's tube mesh in the current state of `sim`, with `segments` vertices around and about
@@ -124,6 +128,8 @@ pub struct SnapshotWriter {
     last: Option<(usize, Real)>,
     written: Vec<Snapshot>,
     error: Option<SnapshotError>,
+    /// The run folder's manifest, which lists each file before it is written.
+    manifest: Option<Manifest>,
 }
 
 impl SnapshotWriter {
@@ -152,7 +158,15 @@ impl SnapshotWriter {
             last: None,
             written: Vec::new(),
             error: None,
+            manifest: None,
         })
+    }
+
+    /// Lists every snapshot file in `manifest` before writing it (a run folder's files, see
+    /// [`crate::io::run_folder`]).
+    pub fn with_manifest(mut self, manifest: Manifest) -> Self {
+        self.manifest = Some(manifest);
+        self
     }
 
     /// The snapshots written so far.
@@ -192,6 +206,11 @@ impl SnapshotWriter {
         let name = format!("step_{step:05}");
         let stl_path = Path::new(Self::FOLDER).join(format!("{name}.stl"));
         let obj_path = Path::new(Self::FOLDER).join(format!("{name}.obj"));
+        if let Some(manifest) = &self.manifest {
+            for path in [&stl_path, &obj_path] {
+                manifest.claim(path).map_err(SnapshotError::Manifest)?;
+            }
+        }
         let header = format!(
             "{} step {step} t={time:.6} {}",
             model.name,

@@ -1,6 +1,8 @@
 //! `summary.json`: what a run was and what it did — design, units, version and command line, status, wall
 //! time and its split, steps, Newton iterations, step cuts, size of the problem, the snapshots and other files
-//! written, the final state, warnings and notices. Written at the end of every run, also one that failed.
+//! written, the final state, warnings and notices. Written when the run starts (`"status": "running"`),
+//! rewritten every few seconds with the last converged step, and at the end of every run, also one that failed
+//! (`stentkit repair` marks the summary of a killed run `"killed"`).
 
 use super::snapshots::Snapshot;
 use super::state::StateSample;
@@ -10,18 +12,37 @@ use serde::Serialize;
 use std::collections::BTreeMap;
 use std::path::Path;
 
-/// How the run ended.
+/// How the run ended, or that it has not ended yet.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
 #[serde(rename_all = "snake_case")]
 pub enum RunStatus {
+    /// Still running (or killed without a chance to say so: SIGKILL, power loss; `stentkit repair` then says
+    /// `killed`). The summary holds the last converged step, rewritten every few seconds.
+    Running,
+    /// The process was killed while running (found and marked by `stentkit repair`); the outputs hold the
+    /// states up to the last converged step they recorded.
+    Killed,
     /// Reached the end time.
     Completed,
     /// Stopped early by an output that could not be written (see `error`).
     Stopped,
     /// The solver failed (see `error`); the outputs hold the states up to the last converged step.
     Failed,
-    /// Interrupted by the user (Ctrl-C); the outputs hold the states up to the last converged step.
+    /// Interrupted by a signal (SIGINT, SIGTERM, SIGHUP); the outputs hold the states up to the last converged
+    /// step.
     Interrupted,
+}
+
+/// The state of one output at the end of a run that could not write everything (e.g. a full disk): which
+/// files are complete and which are not.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct OutputState {
+    /// The file or folder, relative to the run folder.
+    pub file: String,
+    /// Whether it is complete and valid (possibly ending before the run did).
+    pub complete: bool,
+    /// What it holds, or why it is missing.
+    pub state: String,
 }
 
 /// Where and how the solver failed (`status: failed`), and the last converged state the run folder holds.
@@ -250,8 +271,11 @@ pub struct RunSummaryFile {
     pub command_line: String,
     /// Units of every number in the run folder.
     pub units: UnitsSummary,
-    /// How the run ended.
+    /// How the run ended (`running` while it runs).
     pub status: RunStatus,
+    /// When this summary was written (UTC, RFC 3339): a `running` summary much older than a few seconds
+    /// belongs to a run that was killed.
+    pub updated: String,
     /// Why it stopped or failed.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub error: Option<String>,
@@ -290,6 +314,9 @@ pub struct RunSummaryFile {
     pub snapshots: Vec<SnapshotEntry>,
     /// Other files.
     pub files: Files,
+    /// Which outputs are complete, when some could not be written (e.g. a full disk).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub outputs: Vec<OutputState>,
     /// The last recorded state.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub final_state: Option<FinalState>,
@@ -300,6 +327,52 @@ pub struct RunSummaryFile {
 }
 
 impl RunSummaryFile {
+    /// The summary of a run of `model` that is starting: `"status": "running"`, nothing done yet.
+    pub fn start(
+        model: &Model,
+        design_file: &str,
+        version: &str,
+        command_line: &str,
+        warnings: Vec<String>,
+    ) -> Self {
+        Self {
+            design: model.name.clone(),
+            design_file: design_file.to_string(),
+            stentkit_version: version.to_string(),
+            command_line: command_line.to_string(),
+            units: UnitsSummary::of(model),
+            status: RunStatus::Running,
+            updated: String::new(),
+            error: None,
+            failure: None,
+            wall_time_s: 0.0,
+            peak_memory_mib: None,
+            timing: Timing::default(),
+            steps: 0,
+            newton_iterations: 0,
+            iterations_per_step: 0.0,
+            step_cuts: 0,
+            final_time: 0.0,
+            end_time: model.time.end,
+            time_step: model.time.step,
+            patches: model.patches.len(),
+            collocation_points: model.num_collocation_points(),
+            unknowns: model.num_unknowns(),
+            symmetry_planes: model.symmetry_planes.len(),
+            snapshots: Vec::new(),
+            files: Files {
+                history: "history.csv".into(),
+                mcap: "run.mcap".into(),
+                mcap_bytes: 0,
+                charts: Vec::new(),
+            },
+            outputs: Vec::new(),
+            final_state: None,
+            warnings,
+            notices: Vec::new(),
+        }
+    }
+
     /// Writes the summary as pretty-printed JSON, atomically (a temporary file renamed over the target), so
     /// that a reader never sees a partial summary.
     ///

@@ -24,6 +24,22 @@ pub type Mat3 = nalgebra::Matrix3<Real>;
 /// A rotation; its matrix columns are the directors `d1, d2, d3` in global coordinates.
 pub type Rot3 = nalgebra::Rotation3<Real>;
 
+/// A number for messages: Rust's shortest round-trip form, in exponent notation outside `[1e-5, 1e15)` so that a
+/// time of `1e300` (a typo) prints as `1e300`, not as 301 digits.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Short(pub Real);
+
+impl std::fmt::Display for Short {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let x = self.0;
+        if x == 0.0 || !x.is_finite() || (1e-5..1e15).contains(&x.abs()) {
+            write!(f, "{x}")
+        } else {
+            write!(f, "{x:e}")
+        }
+    }
+}
+
 /// Errors raised by the math layer when data (not the programmer) is wrong.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum MathError {

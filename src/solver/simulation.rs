@@ -167,6 +167,11 @@ pub trait Observer {
     fn step_failed(&mut self, time: Real, dt: Real, newton: &NewtonReport) {
         let _ = (time, dt, newton);
     }
+
+    /// Polled between Newton iterations and step cuts: `true` abandons the step in progress.
+    fn interrupted(&self) -> bool {
+        false
+    }
 }
 
 /// An observer that records nothing.

@@ -10,6 +10,7 @@ mod fuzz;
 mod mesh;
 mod outputs;
 mod reliability;
+mod run_folder;
 mod solver;
 mod stent;
 mod studies;

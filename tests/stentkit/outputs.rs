@@ -32,22 +32,22 @@ pub fn test_outputs(name: &str) -> PathBuf {
     dir
 }
 
-fn stentkit(args: &[&str]) -> Output {
+pub(crate) fn stentkit(args: &[&str]) -> Output {
     Command::new(env!("CARGO_BIN_EXE_stentkit"))
         .args(args)
         .output()
         .expect("stentkit runs")
 }
 
-fn text(bytes: &[u8]) -> String {
+pub(crate) fn text(bytes: &[u8]) -> String {
     String::from_utf8_lossy(bytes).into_owned()
 }
 
-fn path_str(p: &Path) -> &str {
+pub(crate) fn path_str(p: &Path) -> &str {
     p.to_str().expect("UTF-8 path")
 }
 
-fn design(name: &str) -> PathBuf {
+pub(crate) fn design(name: &str) -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR"))
         .join("designs")
         .join(name)
@@ -67,13 +67,13 @@ fn run_ok(design: &Path, dir: &Path, extra: &[&str]) -> Output {
     out
 }
 
-fn summary(dir: &Path) -> Value {
+pub(crate) fn summary(dir: &Path) -> Value {
     let text = std::fs::read_to_string(dir.join("summary.json")).expect("summary.json");
     serde_json::from_str(&text).expect("summary.json is JSON")
 }
 
 /// What the recording holds, read back with the mcap crate.
-struct Recording {
+pub(crate) struct Recording {
     /// Messages per topic: (log time, JSON body).
     messages: BTreeMap<String, Vec<(u64, Value)>>,
     /// Schema name per topic.
@@ -84,7 +84,7 @@ struct Recording {
     metadata: BTreeMap<String, BTreeMap<String, String>>,
 }
 
-fn read_recording(path: &Path) -> Recording {
+pub(crate) fn read_recording(path: &Path) -> Recording {
     let bytes = std::fs::read(path).expect("run.mcap");
     let summary = mcap::Summary::read(&bytes)
         .expect("readable summary")
@@ -135,7 +135,7 @@ fn read_recording(path: &Path) -> Recording {
 }
 
 /// Checks the recording against the summary and the design file; returns it.
-fn check_recording(dir: &Path, design_file: &Path) -> Recording {
+pub(crate) fn check_recording(dir: &Path, design_file: &Path) -> Recording {
     let s = summary(dir);
     let rec = read_recording(&dir.join("run.mcap"));
     let steps = s["steps"].as_u64().expect("steps") as usize;
@@ -182,7 +182,7 @@ fn check_recording(dir: &Path, design_file: &Path) -> Recording {
 
 /// Checks that history.csv holds the initial state and `steps` converged steps, every row complete (as many
 /// numbers as the header has columns), the last at `final_time`.
-fn check_history(dir: &Path, steps: usize, final_time: Real) {
+pub(crate) fn check_history(dir: &Path, steps: usize, final_time: Real) {
     let history = std::fs::read_to_string(dir.join("history.csv")).expect("history.csv");
     assert!(history.ends_with('\n'), "the last row is complete");
     let mut lines = history.lines();
@@ -205,7 +205,7 @@ fn check_history(dir: &Path, steps: usize, final_time: Real) {
 
 /// Reads every snapshot STL back (vertices merged by their f32 coordinates) and checks it closed with a
 /// positive volume equal to the reported one; returns the meshes' (volume, triangles) per snapshot.
-fn check_snapshots(dir: &Path) -> Vec<(Real, usize)> {
+pub(crate) fn check_snapshots(dir: &Path) -> Vec<(Real, usize)> {
     let s = summary(dir);
     let mut out = Vec::new();
     for snapshot in s["snapshots"].as_array().expect("snapshots") {
@@ -523,10 +523,10 @@ fn failed_run_leaves_every_file_valid() {
     std::fs::write(&file, text).expect("design written");
     let dir = root.join("run");
     let out = stentkit(&["run", path_str(&file), "-o", path_str(&dir), "--quiet"]);
-    assert!(!out.status.success());
+    assert_eq!(out.status.code(), Some(1), "exit status of a failed run");
     let stderr = String::from_utf8_lossy(&out.stderr);
     assert!(
-        stderr.contains("the run stopped at t = 0.3") && !stderr.contains("panicked"),
+        stderr.contains("the run failed at t = 0.3") && !stderr.contains("panicked"),
         "{stderr}"
     );
     // The failure report, printed and in the summary: time, step, step size, iterations, residual history and
@@ -616,7 +616,12 @@ fn interrupted_run_leaves_every_file_valid() {
     let out = child.wait_with_output().expect("stentkit ends");
     assert!(!out.status.success());
     let stderr = text(&out.stderr);
-    assert!(stderr.contains("interrupted at t = "), "{stderr}");
+    assert!(stderr.contains("interrupted by SIGINT after "), "{stderr}");
+    assert_eq!(
+        out.status.code(),
+        Some(130),
+        "exit status of an interrupted run"
+    );
     let s = summary(&dir);
     assert_eq!(s["status"], "interrupted");
     assert!(

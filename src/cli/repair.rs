@@ -1,0 +1,210 @@
+//! `stentkit repair RUN_DIR`: makes the folder of a run that was killed (SIGKILL, a power loss, a crash) whole,
+//! as far as what it holds allows:
+//!
+//! - hidden temporaries of unfinished atomic writes are removed;
+//! - `history.csv` is cut back to its last complete row;
+//! - `run.mcap` is finished after its last complete chunk ([`crate::io::mcap_salvage`]);
+//! - a `summary.json` still saying `"running"` says `"killed"`, with the time of the last row of the history,
+//!   the steps it holds and every complete snapshot on disk.
+//!
+//! The folder's lock is taken first, so a folder whose run is still going is refused. Only files the run
+//! folder's manifest lists are touched. Repairing a folder twice changes nothing the second time.
+
+use super::{BadInput, short_time};
+use crate::io::mcap_salvage::{Salvage, salvage};
+use crate::io::run_folder::{FolderKind, classify, lock_existing, remove_stale_temporaries};
+use anyhow::Context;
+use serde_json::{Value, json};
+use std::path::{Path, PathBuf};
+
+/// Repairs the run folder `dir` and prints what was done.
+///
+/// # Errors
+/// [`BadInput`] for a folder that is not a run folder; the I/O error of a file that cannot be repaired.
+pub fn run(dir: &Path) -> anyhow::Result<()> {
+    let listed = match classify(dir)? {
+        FolderKind::Run(files) => files,
+        FolderKind::Empty => {
+            return Err(BadInput(format!(
+                "{}: empty or missing, nothing to repair",
+                dir.display()
+            ))
+            .into());
+        }
+        FolderKind::Foreign => {
+            return Err(BadInput(format!(
+                "{}: not a stentkit run folder (no .stentkit-run manifest); nothing was changed",
+                dir.display()
+            ))
+            .into());
+        }
+    };
+    let _lock = lock_existing(dir)?;
+    let mut done: Vec<String> = Vec::new();
+    for removed in remove_stale_temporaries(dir, &listed)? {
+        done.push(format!(
+            "removed the unfinished temporary {}",
+            removed.display()
+        ));
+    }
+    let history = dir.join("history.csv");
+    let rows = if history.exists() {
+        let (rows, cut) = repair_history(&history)?;
+        if cut > 0 {
+            done.push(format!("history.csv: cut a partial last row ({cut} bytes)"));
+        }
+        rows
+    } else {
+        Vec::new()
+    };
+    let mcap = dir.join("run.mcap");
+    let mut mcap_bytes = None;
+    if mcap.exists() {
+        match salvage(&mcap)? {
+            Salvage::AlreadyValid { bytes } => mcap_bytes = Some(bytes),
+            Salvage::Finished {
+                before,
+                after,
+                messages,
+                last_log_time,
+                indexed,
+            } => {
+                mcap_bytes = Some(after);
+                done.push(format!(
+                    "run.mcap: finished after its last complete chunk ({messages} messages up to t = {} s; {after} bytes, {before} before){}",
+                    short_time(last_log_time.map_or(0.0, |ns| ns as f64 * 1e-9)),
+                    if indexed { "" } else { "; not indexed (no room for a copy): viewers read it linearly" }
+                ));
+            }
+        }
+    }
+    let summary_path = dir.join("summary.json");
+    if summary_path.exists() {
+        let text = std::fs::read_to_string(&summary_path)
+            .with_context(|| format!("cannot read {}", summary_path.display()))?;
+        let mut summary: Value = serde_json::from_str(&text)
+            .with_context(|| format!("{}: not a stentkit summary", summary_path.display()))?;
+        if summary["status"] == "running" {
+            mark_killed(&mut summary, &rows, dir, &listed, mcap_bytes);
+            let mut text = serde_json::to_string_pretty(&summary)?;
+            text.push('\n');
+            crate::io::stl::write_bytes_atomically(&summary_path, text.as_bytes())
+                .with_context(|| format!("cannot write {}", summary_path.display()))?;
+            done.push(format!(
+                "summary.json: status `killed`, the run folder holds steps 0–{} up to t = {} s",
+                rows.len().saturating_sub(1),
+                short_time(rows.last().copied().unwrap_or(0.0))
+            ));
+        }
+    } else {
+        done.push(
+            "summary.json is missing (the run was killed while starting): not written".into(),
+        );
+    }
+    if done.is_empty() {
+        println!("{}: nothing to repair", dir.display());
+    } else {
+        println!("{}: repaired", dir.display());
+        for line in done {
+            println!("  {line}");
+        }
+    }
+    Ok(())
+}
+
+/// Cuts `history.csv` back to its last complete row; returns the time of every row (row `k` is step `k`) and
+/// the bytes cut.
+fn repair_history(path: &Path) -> anyhow::Result<(Vec<f64>, usize)> {
+    let text = std::fs::read(path).with_context(|| format!("cannot read {}", path.display()))?;
+    let complete = text.iter().rposition(|&b| b == b'\n').map_or(0, |i| i + 1);
+    let cut = text.len() - complete;
+    if cut > 0 {
+        let file = std::fs::OpenOptions::new()
+            .write(true)
+            .open(path)
+            .and_then(|f| f.set_len(complete as u64).and_then(|()| f.sync_all()));
+        file.with_context(|| format!("cannot cut {}", path.display()))?;
+    }
+    let rows = String::from_utf8_lossy(&text[..complete])
+        .lines()
+        .skip(1)
+        .map_while(|l| l.split(',').next().and_then(|t| t.parse::<f64>().ok()))
+        .collect();
+    Ok((rows, cut))
+}
+
+/// Turns a `running` summary into the summary of a killed run: status, error, the time and steps the history
+/// holds, the recording's size, and every snapshot whose two files are on disk (a snapshot written after the
+/// last summary is added with the time of its history row).
+fn mark_killed(
+    summary: &mut Value,
+    rows: &[f64],
+    dir: &Path,
+    listed: &std::collections::BTreeSet<PathBuf>,
+    mcap_bytes: Option<u64>,
+) {
+    let last_step = rows.len().saturating_sub(1);
+    let last_time = rows.last().copied().unwrap_or(0.0);
+    summary["status"] = json!("killed");
+    summary["error"] = json!(format!(
+        "the run was killed (SIGKILL, a power loss or a crash) after t = {} s; repaired by `stentkit repair`",
+        short_time(last_time)
+    ));
+    summary["updated"] = json!(crate::io::run_folder::utc_timestamp(
+        std::time::SystemTime::now()
+    ));
+    summary["steps"] = json!(last_step);
+    summary["final_time"] = json!(last_time);
+    if let Some(bytes) = mcap_bytes {
+        summary["files"]["mcap_bytes"] = json!(bytes);
+    }
+    let mut snapshots: Vec<Value> = summary["snapshots"]
+        .as_array()
+        .cloned()
+        .unwrap_or_default()
+        .into_iter()
+        .filter(|s| {
+            ["stl", "obj"]
+                .iter()
+                .all(|k| s[k].as_str().is_some_and(|f| dir.join(f).is_file()))
+        })
+        .collect();
+    let known: Vec<u64> = snapshots
+        .iter()
+        .filter_map(|s| s["step"].as_u64())
+        .collect();
+    for stl in listed
+        .iter()
+        .filter(|p| p.extension().is_some_and(|e| e == "stl"))
+    {
+        let obj = stl.with_extension("obj");
+        let Some(step) = stl
+            .file_stem()
+            .and_then(|s| s.to_str())
+            .and_then(|s| s.strip_prefix("step_"))
+            .and_then(|s| s.parse::<u64>().ok())
+        else {
+            continue;
+        };
+        if known.contains(&step) || !dir.join(stl).is_file() || !dir.join(&obj).is_file() {
+            continue;
+        }
+        snapshots.push(json!({
+            "step": step,
+            "time": rows.get(step as usize).copied(),
+            "stl": stl.display().to_string(),
+            "obj": obj.display().to_string(),
+            "triangles": stl_triangles(&dir.join(stl)),
+            "volume": null,
+        }));
+    }
+    snapshots.sort_by_key(|s| s["step"].as_u64());
+    summary["snapshots"] = Value::Array(snapshots);
+}
+
+/// The triangle count a binary STL declares (bytes 80–83), if the file is that long.
+fn stl_triangles(path: &Path) -> Option<u32> {
+    let bytes = std::fs::read(path).ok()?;
+    let count: [u8; 4] = bytes.get(80..84)?.try_into().ok()?;
+    Some(u32::from_le_bytes(count))
+}

@@ -1,0 +1,91 @@
+//! The signals that end a run: SIGINT (Ctrl-C), SIGTERM (Slurm at the time limit or on `scancel`, `timeout`,
+//! `docker stop`, `kill`) and SIGHUP (a closed terminal or dropped SSH session) are handled alike.
+//!
+//! - The first asks the run to stop: the solver abandons the step in progress at its next Newton iteration or
+//!   step cut, rolls back to the last converged state, and every output is finished there.
+//! - The second says, in one line, that the files are being finished and the run then exits: the expensive
+//!   part of finishing (the final snapshot's tube meshes, in the files and the recording) is skipped, the
+//!   recording is closed, the charts drawn and `summary.json` written.
+//! - A third quits at once (exit status 130); `stentkit repair DIR` then finishes the folder.
+//!
+//! A dedicated thread receives the signals (signal-hook's iterator), so nothing here runs in a signal handler.
+//! SIGKILL cannot be caught: what it leaves is made useful by the periodic summary and chunk flushes
+//! (`cli::run`) and by `stentkit repair`.
+
+use signal_hook::consts::{SIGHUP, SIGINT, SIGTERM};
+use std::sync::Once;
+use std::sync::atomic::{AtomicI32, AtomicUsize, Ordering};
+
+/// Signals received so far.
+static COUNT: AtomicUsize = AtomicUsize::new(0);
+/// The first signal received (0: none).
+static FIRST: AtomicI32 = AtomicI32::new(0);
+static INSTALL: Once = Once::new();
+
+/// Starts the thread that receives SIGINT, SIGTERM and SIGHUP for the rest of the process. Later calls do
+/// nothing. If the handlers cannot be installed the default actions stay (the process is killed) and a warning
+/// says so.
+pub fn install() {
+    INSTALL.call_once(|| {
+        let mut signals = match signal_hook::iterator::Signals::new([SIGINT, SIGTERM, SIGHUP]) {
+            Ok(s) => s,
+            Err(e) => {
+                eprintln!("warning: cannot handle SIGINT/SIGTERM/SIGHUP ({e}); a signal will kill the run");
+                return;
+            }
+        };
+        let spawned = std::thread::Builder::new()
+            .name("stentkit-signals".into())
+            .spawn(move || {
+                for signal in signals.forever() {
+                    let _ = FIRST.compare_exchange(0, signal, Ordering::SeqCst, Ordering::SeqCst);
+                    let n = COUNT.fetch_add(1, Ordering::SeqCst) + 1;
+                    let name = name(signal);
+                    match n {
+                        1 => eprintln!(
+                            "\n{name}: stopping at the next Newton iteration and finishing every file (send it again to skip the final snapshot)"
+                        ),
+                        2 => eprintln!(
+                            "{name} again: finishing run.mcap and summary.json, then exiting (a third signal quits at once)"
+                        ),
+                        _ => {
+                            eprintln!(
+                                "{name} a third time: quitting now; `stentkit repair RUN_DIR` finishes the run folder"
+                            );
+                            std::process::exit(130);
+                        }
+                    }
+                }
+            });
+        if let Err(e) = spawned {
+            eprintln!("warning: cannot start the signal thread ({e}); a signal will kill the run");
+        }
+    });
+}
+
+/// Whether a run was asked to stop (any handled signal received).
+pub fn stop_requested() -> bool {
+    COUNT.load(Ordering::SeqCst) > 0
+}
+
+/// Whether a second signal asked to finish the files at once (skip the optional work).
+pub fn hurry() -> bool {
+    COUNT.load(Ordering::SeqCst) > 1
+}
+
+/// The name of the first signal received (`SIGINT`, `SIGTERM`, `SIGHUP`), if any.
+pub fn first() -> Option<&'static str> {
+    match FIRST.load(Ordering::SeqCst) {
+        0 => None,
+        s => Some(name(s)),
+    }
+}
+
+fn name(signal: i32) -> &'static str {
+    match signal {
+        SIGINT => "SIGINT",
+        SIGTERM => "SIGTERM",
+        SIGHUP => "SIGHUP",
+        _ => "signal",
+    }
+}

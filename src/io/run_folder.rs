@@ -1,0 +1,664 @@
+//! The run folder as a place on disk: which folders a run may write into, the manifest of the files stentkit
+//! wrote there, the lock that keeps two runs out of one folder, and what `--force` may remove.
+//!
+//! Rules (README, "When things go wrong"):
+//!
+//! - A run writes only into an empty or missing folder, or into a **stentkit run folder**: one holding the
+//!   manifest [`MANIFEST`] (or, for folders written before the manifest existed, a `summary.json` whose
+//!   `stentkit_version` marks it as ours; its file lists are the manifest then). The file-system root, the
+//!   home folder and the folder of the design file are refused whatever they hold.
+//! - The manifest lists every file the run writes, each appended (and synced) **before** the file is created,
+//!   so that even a run killed half-way has listed everything it left. `--force` removes exactly the listed
+//!   files (and their hidden temporaries), then the `snapshots/` and `charts/` folders if that left them
+//!   empty: a file the user put in the folder is never removed.
+//! - A run holds an advisory lock on [`LOCK`] (`flock`, released by the kernel when the process ends, also on
+//!   SIGKILL) for its whole length; the lock file records the holder's pid and start time, which a second run
+//!   into the same folder is refused with.
+
+use serde::Deserialize;
+use std::collections::BTreeSet;
+use std::fs::{self, File, OpenOptions};
+use std::io::{self, Read, Seek, Write};
+use std::path::{Path, PathBuf};
+use std::sync::{Arc, Mutex, PoisonError};
+
+/// The manifest's file name inside a run folder.
+pub const MANIFEST: &str = ".stentkit-run";
+/// The lock file's name inside a run folder.
+pub const LOCK: &str = ".stentkit-run.lock";
+/// The space reserve's file name inside a run folder (see [`RunFolder::reserve`]).
+pub const RESERVE: &str = ".stentkit-reserve";
+/// The manifest's first line (the format: one path relative to the run folder per following line).
+const MANIFEST_HEADER: &str = "# stentkit run folder: files written by stentkit (`run --force` removes only these), one per line";
+
+/// Why a folder cannot be used as a run folder.
+#[derive(Debug, thiserror::Error)]
+pub enum RunFolderError {
+    /// The folder is not one a run may write into (bad input: choose another `-o`).
+    #[error("{path}: {reason}")]
+    Refused {
+        /// The folder.
+        path: PathBuf,
+        /// Why, and what to do instead.
+        reason: String,
+    },
+    /// Another run holds the folder's lock.
+    #[error(
+        "{path} is in use by another stentkit run ({holder}); wait for it to end or choose another folder with -o"
+    )]
+    Busy {
+        /// The folder.
+        path: PathBuf,
+        /// The holder as its lock file describes it: `pid N, started T`.
+        holder: String,
+    },
+    /// A file-system operation failed.
+    #[error("{path}: {source}")]
+    Io {
+        /// The file or folder.
+        path: PathBuf,
+        /// The operating-system error (its message is part of this error's, so it is not also the source).
+        source: io::Error,
+    },
+}
+
+fn io_error(path: &Path) -> impl FnOnce(io::Error) -> RunFolderError + '_ {
+    move |source| RunFolderError::Io {
+        path: path.to_path_buf(),
+        source,
+    }
+}
+
+/// What a folder holds, as far as a run is concerned.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub enum FolderKind {
+    /// Missing, or holding nothing (a lone lock file of ours counts as nothing).
+    Empty,
+    /// A stentkit run folder; the files stentkit wrote there (relative paths).
+    Run(BTreeSet<PathBuf>),
+    /// Anything else: a run must not write there.
+    Foreign,
+}
+
+/// Looks at `dir` without changing anything.
+///
+/// # Errors
+/// [`RunFolderError::Io`] when the folder or its manifest cannot be read.
+pub fn classify(dir: &Path) -> Result<FolderKind, RunFolderError> {
+    if !dir.exists() {
+        return Ok(FolderKind::Empty);
+    }
+    if !dir.is_dir() {
+        return Err(RunFolderError::Refused {
+            path: dir.to_path_buf(),
+            reason: "exists and is not a folder".into(),
+        });
+    }
+    let manifest = dir.join(MANIFEST);
+    if manifest.exists() {
+        let text = fs::read_to_string(&manifest).map_err(io_error(&manifest))?;
+        return Ok(FolderKind::Run(parse_manifest(&text)));
+    }
+    if let Some(files) = legacy_outputs(dir) {
+        return Ok(FolderKind::Run(files));
+    }
+    let mut entries = fs::read_dir(dir).map_err(io_error(dir))?;
+    let foreign = entries.any(|e| e.is_ok_and(|e| e.file_name() != LOCK));
+    Ok(if foreign {
+        FolderKind::Foreign
+    } else {
+        FolderKind::Empty
+    })
+}
+
+/// The relative paths a manifest lists: every line but comments and blanks; absolute paths and paths that
+/// climb out of the folder (`..`) are ignored, so that a tampered manifest cannot make `--force` remove
+/// anything outside the run folder.
+fn parse_manifest(text: &str) -> BTreeSet<PathBuf> {
+    text.lines()
+        .map(str::trim)
+        .filter(|l| !l.is_empty() && !l.starts_with('#'))
+        .map(PathBuf::from)
+        .filter(|p| is_inside(p))
+        .collect()
+}
+
+/// Whether a relative path stays inside its folder (no root, no `..`, not empty).
+fn is_inside(path: &Path) -> bool {
+    use std::path::Component;
+    path.components().next().is_some()
+        && path
+            .components()
+            .all(|c| matches!(c, Component::Normal(_) | Component::CurDir))
+}
+
+/// The summary fields that list a run's files (summaries written before the manifest existed).
+#[derive(Deserialize)]
+struct LegacySummary {
+    stentkit_version: String,
+    #[serde(default)]
+    snapshots: Vec<LegacySnapshot>,
+    files: LegacyFiles,
+}
+
+#[derive(Deserialize)]
+struct LegacySnapshot {
+    stl: PathBuf,
+    obj: PathBuf,
+}
+
+#[derive(Deserialize)]
+struct LegacyFiles {
+    history: PathBuf,
+    mcap: PathBuf,
+    #[serde(default)]
+    charts: Vec<PathBuf>,
+}
+
+/// The files of a run folder written before the manifest existed, as its `summary.json` lists them; `None`
+/// when there is no such summary.
+fn legacy_outputs(dir: &Path) -> Option<BTreeSet<PathBuf>> {
+    let text = fs::read_to_string(dir.join("summary.json")).ok()?;
+    let summary: LegacySummary = serde_json::from_str(&text).ok()?;
+    if summary.stentkit_version.is_empty() {
+        return None;
+    }
+    let mut files: BTreeSet<PathBuf> = [
+        PathBuf::from("summary.json"),
+        summary.files.history,
+        summary.files.mcap,
+    ]
+    .into_iter()
+    .chain(summary.files.charts)
+    .chain(summary.snapshots.into_iter().flat_map(|s| [s.stl, s.obj]))
+    .collect();
+    files.retain(|p| is_inside(p));
+    Some(files)
+}
+
+/// Folders no run may write into, whatever they hold: the file-system root, the home folder and the folder of
+/// the design file. `None` when `dir` is none of them.
+fn forbidden(dir: &Path, design_file: &Path) -> Option<&'static str> {
+    let Ok(dir) = dir.canonicalize() else {
+        // A folder that does not exist yet is none of these (they all exist).
+        return None;
+    };
+    if dir.parent().is_none() {
+        return Some("is the file-system root");
+    }
+    if std::env::var_os("HOME")
+        .and_then(|h| PathBuf::from(h).canonicalize().ok())
+        .is_some_and(|home| home == dir)
+    {
+        return Some("is your home folder");
+    }
+    let design_dir = design_file
+        .parent()
+        .filter(|p| !p.as_os_str().is_empty())
+        .unwrap_or(Path::new("."));
+    if design_dir.canonicalize().is_ok_and(|d| d == dir) {
+        return Some("is the folder of the design file");
+    }
+    None
+}
+
+/// A run folder held by this process: locked, with its manifest open for appending.
+#[derive(Debug)]
+pub struct RunFolder {
+    dir: PathBuf,
+    /// Files of the previous run here (removed by [`RunFolder::clear_previous`]).
+    previous: BTreeSet<PathBuf>,
+    manifest: Manifest,
+    /// Held for the life of the run: the kernel releases the lock when the process ends.
+    _lock: File,
+}
+
+/// The manifest of a run folder, shared by the writers of one run (cheap to clone).
+#[derive(Debug, Clone)]
+pub struct Manifest {
+    inner: Arc<Mutex<ManifestFile>>,
+}
+
+#[derive(Debug)]
+struct ManifestFile {
+    path: PathBuf,
+    file: File,
+    listed: BTreeSet<PathBuf>,
+}
+
+impl Manifest {
+    /// Lists `relative` (a path inside the run folder) before the file is created: appended and synced, so that
+    /// a run killed right after still owns the file. Listing a file twice writes it once.
+    ///
+    /// # Errors
+    /// The I/O error (e.g. a full disk), naming the manifest.
+    pub fn claim(&self, relative: &Path) -> io::Result<()> {
+        let mut m = self.inner.lock().unwrap_or_else(PoisonError::into_inner);
+        if m.listed.contains(relative) {
+            return Ok(());
+        }
+        let line = format!("{}\n", relative.display());
+        let result = m
+            .file
+            .write_all(line.as_bytes())
+            .and_then(|()| m.file.sync_data());
+        result.map_err(|e| io::Error::new(e.kind(), format!("{}: {e}", m.path.display())))?;
+        m.listed.insert(relative.to_path_buf());
+        Ok(())
+    }
+
+    /// The files listed so far.
+    pub fn listed(&self) -> BTreeSet<PathBuf> {
+        self.inner
+            .lock()
+            .unwrap_or_else(PoisonError::into_inner)
+            .listed
+            .clone()
+    }
+}
+
+impl RunFolder {
+    /// Takes `dir` for a run of the design in `design_file`: refuses the root, the home folder, the design's
+    /// folder, a folder that is not empty and not a run folder, and (without `force`) a run folder that holds
+    /// an earlier run; creates the folder, takes its lock and opens the manifest. Nothing is removed yet.
+    ///
+    /// # Errors
+    /// [`RunFolderError::Refused`] (bad input), [`RunFolderError::Busy`] (another run holds the lock),
+    /// [`RunFolderError::Io`].
+    pub fn open(dir: &Path, design_file: &Path, force: bool) -> Result<Self, RunFolderError> {
+        let refuse = |reason: String| RunFolderError::Refused {
+            path: dir.to_path_buf(),
+            reason,
+        };
+        if let Some(why) = forbidden(dir, design_file) {
+            return Err(refuse(format!(
+                "{why}; a run writes into a folder of its own: choose one with -o (default runs/<design name>)"
+            )));
+        }
+        let previous = match classify(dir)? {
+            FolderKind::Empty => BTreeSet::new(),
+            FolderKind::Foreign => {
+                return Err(refuse(
+                    "is not empty and is not a stentkit run folder (it has no .stentkit-run manifest); \
+                     choose an empty or new folder with -o"
+                        .into(),
+                ));
+            }
+            // A folder whose earlier run left none of its files (a refused or cleared run) is as good as empty.
+            FolderKind::Run(files) if files.iter().all(|f| !dir.join(f).exists()) => files,
+            FolderKind::Run(_) if !force => {
+                return Err(refuse(
+                    "holds an earlier run; pass --force to replace it (only the files that run wrote are \
+                     removed) or choose another folder with -o"
+                        .into(),
+                ));
+            }
+            FolderKind::Run(files) => files,
+        };
+        fs::create_dir_all(dir).map_err(io_error(dir))?;
+        let lock = lock(dir)?;
+        let path = dir.join(MANIFEST);
+        let mut file = OpenOptions::new()
+            .create(true)
+            .append(true)
+            .read(true)
+            .open(&path)
+            .map_err(io_error(&path))?;
+        let mut text = String::new();
+        file.seek(io::SeekFrom::Start(0))
+            .and_then(|_| file.read_to_string(&mut text))
+            .map_err(io_error(&path))?;
+        if text.is_empty() {
+            writeln!(file, "{MANIFEST_HEADER}")
+                .and_then(|()| file.sync_data())
+                .map_err(io_error(&path))?;
+        }
+        let listed = parse_manifest(&text);
+        Ok(Self {
+            dir: dir.to_path_buf(),
+            previous,
+            manifest: Manifest {
+                inner: Arc::new(Mutex::new(ManifestFile { path, file, listed })),
+            },
+            _lock: lock,
+        })
+    }
+
+    /// The folder.
+    pub fn dir(&self) -> &Path {
+        &self.dir
+    }
+
+    /// The manifest, for the writers of the run.
+    pub fn manifest(&self) -> &Manifest {
+        &self.manifest
+    }
+
+    /// Writes a hidden file of `bytes` zeros (real blocks, not a sparse file), deleted when the returned
+    /// [`Reserve`] is released or dropped: a disk that fills up during the run still has that much room for the
+    /// summary and the charts.
+    ///
+    /// # Errors
+    /// [`RunFolderError::Io`] when the reserve cannot be written (the disk is already full).
+    pub fn reserve(&self, bytes: usize) -> Result<Reserve, RunFolderError> {
+        let relative = Path::new(RESERVE);
+        let path = self.dir.join(relative);
+        self.manifest.claim(relative).map_err(io_error(&path))?;
+        let written = File::create(&path)
+            .and_then(|mut f| f.write_all(&vec![0u8; bytes]).and_then(|()| f.sync_data()));
+        if let Err(e) = written {
+            let _ = fs::remove_file(&path);
+            return Err(io_error(&path)(e));
+        }
+        Ok(Reserve { path })
+    }
+
+    /// Bytes that [`RunFolder::clear_previous`] will free (the earlier run's files).
+    pub fn previous_bytes(&self) -> u64 {
+        self.previous
+            .iter()
+            .filter_map(|p| fs::metadata(self.dir.join(p)).ok())
+            .map(|m| m.len())
+            .sum()
+    }
+
+    /// Removes the files of the earlier run in this folder (only those its manifest lists), stale hidden
+    /// temporaries of listed files (left by a killed run), then `snapshots/` and `charts/` if that left them
+    /// empty; starts a fresh manifest.
+    ///
+    /// # Errors
+    /// [`RunFolderError::Io`] naming the file that could not be removed.
+    pub fn clear_previous(&mut self) -> Result<(), RunFolderError> {
+        remove_stale_temporaries(&self.dir, &self.previous)?;
+        for relative in &self.previous {
+            let path = self.dir.join(relative);
+            if path.is_file() {
+                fs::remove_file(&path).map_err(io_error(&path))?;
+            }
+        }
+        for folder in ["snapshots", "charts"] {
+            // Only if empty: a file of the user's keeps its folder.
+            let _ = fs::remove_dir(self.dir.join(folder));
+        }
+        let mut m = self
+            .manifest
+            .inner
+            .lock()
+            .unwrap_or_else(PoisonError::into_inner);
+        let path = m.path.clone();
+        m.file
+            .set_len(0)
+            .and_then(|()| writeln!(m.file, "{MANIFEST_HEADER}"))
+            .and_then(|()| m.file.sync_data())
+            .map_err(io_error(&path))?;
+        m.listed.clear();
+        self.previous.clear();
+        Ok(())
+    }
+}
+
+/// Room on disk held for finishing a run (see [`RunFolder::reserve`]); given back by [`Reserve::release`] or
+/// when dropped.
+#[derive(Debug)]
+pub struct Reserve {
+    path: PathBuf,
+}
+
+impl Reserve {
+    /// Deletes the reserve file, giving its room to the files that finish the run.
+    pub fn release(self) {}
+}
+
+impl Drop for Reserve {
+    fn drop(&mut self) {
+        // Best effort: a reserve that cannot be deleted is listed in the manifest and removed by `--force`.
+        let _ = fs::remove_file(&self.path);
+    }
+}
+
+/// Removes the hidden temporaries `.<name>.<pid>.<n>.tmp` (see [`crate::io::stl`]'s atomic writes) of the
+/// listed files `owned`, in their folders: what a run killed during an atomic write leaves.
+///
+/// # Errors
+/// [`RunFolderError::Io`] naming the file that could not be removed.
+pub fn remove_stale_temporaries(
+    dir: &Path,
+    owned: &BTreeSet<PathBuf>,
+) -> Result<Vec<PathBuf>, RunFolderError> {
+    let folders: BTreeSet<PathBuf> = owned
+        .iter()
+        .map(|p| p.parent().map(Path::to_path_buf).unwrap_or_default())
+        .collect();
+    let mut removed = Vec::new();
+    for folder in folders {
+        let Ok(entries) = fs::read_dir(dir.join(&folder)) else {
+            continue;
+        };
+        for entry in entries.flatten() {
+            let name = entry.file_name();
+            let Some(target) = name.to_str().and_then(temporary_target) else {
+                continue;
+            };
+            if owned.contains(&folder.join(target)) {
+                let path = entry.path();
+                fs::remove_file(&path).map_err(io_error(&path))?;
+                removed.push(folder.join(&name));
+            }
+        }
+    }
+    Ok(removed)
+}
+
+/// The file a temporary `.<name>.<pid>.<n>.tmp` was to become (`<name>`), if `name` is one.
+fn temporary_target(name: &str) -> Option<&str> {
+    let rest = name.strip_prefix('.')?.strip_suffix(".tmp")?;
+    let (rest, counter) = rest.rsplit_once('.')?;
+    let (target, pid) = rest.rsplit_once('.')?;
+    let digits = |s: &str| !s.is_empty() && s.bytes().all(|b| b.is_ascii_digit());
+    (digits(counter) && digits(pid) && !target.is_empty()).then_some(target)
+}
+
+/// Takes the lock of `dir` and writes who holds it.
+fn lock(dir: &Path) -> Result<File, RunFolderError> {
+    let path = dir.join(LOCK);
+    let mut file = OpenOptions::new()
+        .create(true)
+        .truncate(false)
+        .read(true)
+        .write(true)
+        .open(&path)
+        .map_err(io_error(&path))?;
+    match file.try_lock() {
+        Ok(()) => {}
+        Err(fs::TryLockError::WouldBlock) => {
+            let mut holder = String::new();
+            let _ = file.read_to_string(&mut holder);
+            let holder = holder.trim();
+            return Err(RunFolderError::Busy {
+                path: dir.to_path_buf(),
+                holder: if holder.is_empty() {
+                    "pid unknown".into()
+                } else {
+                    holder.to_string()
+                },
+            });
+        }
+        Err(fs::TryLockError::Error(e)) => return Err(io_error(&path)(e)),
+    }
+    let holder = format!(
+        "pid {}, started {}",
+        std::process::id(),
+        utc_timestamp(std::time::SystemTime::now())
+    );
+    file.set_len(0)
+        .and_then(|()| file.write_all(holder.as_bytes()))
+        .and_then(|()| file.sync_data())
+        .map_err(io_error(&path))?;
+    Ok(file)
+}
+
+/// Takes the lock of an existing run folder without starting a run (for `stentkit repair`): refuses a folder
+/// another run holds.
+///
+/// # Errors
+/// As [`RunFolder::open`].
+pub fn lock_existing(dir: &Path) -> Result<File, RunFolderError> {
+    lock(dir)
+}
+
+/// `2026-11-23T21:56:03Z` for a system time (UTC; days to civil date by Howard Hinnant's algorithm,
+/// <https://howardhinnant.github.io/date_algorithms.html#civil_from_days>).
+pub fn utc_timestamp(time: std::time::SystemTime) -> String {
+    let secs = time
+        .duration_since(std::time::UNIX_EPOCH)
+        .map_or(0, |d| d.as_secs());
+    let (days, rest) = ((secs / 86_400) as i64, secs % 86_400);
+    let z = days + 719_468;
+    let era = z.div_euclid(146_097);
+    let doe = z.rem_euclid(146_097);
+    let yoe = (doe - doe / 1460 + doe / 36_524 - doe / 146_096) / 365;
+    let doy = doe - (365 * yoe + yoe / 4 - yoe / 100);
+    let mp = (5 * doy + 2) / 153;
+    let day = doy - (153 * mp + 2) / 5 + 1;
+    let month = if mp < 10 { mp + 3 } else { mp - 9 };
+    let year = yoe + era * 400 + i64::from(month <= 2);
+    format!(
+        "{year:04}-{month:02}-{day:02}T{:02}:{:02}:{:02}Z",
+        rest / 3600,
+        rest % 3600 / 60,
+        rest % 60
+    )
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn scratch(name: &str) -> PathBuf {
+        let dir =
+            std::env::temp_dir().join(format!("stentkit-folder-{name}-{}", std::process::id()));
+        let _ = fs::remove_dir_all(&dir);
+        fs::create_dir_all(&dir).expect("scratch folder");
+        dir
+    }
+
+    /// Known instants: the Unix epoch, a leap day and the session's date (checked with `date -u -d @SECS`).
+    #[test]
+    fn utc_timestamps_match_the_civil_calendar() {
+        let at = |s| utc_timestamp(std::time::UNIX_EPOCH + std::time::Duration::from_secs(s));
+        assert_eq!(at(0), "1970-01-01T00:00:00Z");
+        assert_eq!(at(951_782_400), "2000-02-29T00:00:00Z");
+        assert_eq!(at(1_795_471_563), "2026-11-23T22:06:03Z");
+    }
+
+    #[test]
+    fn temporaries_are_recognised_by_their_whole_pattern() {
+        assert_eq!(
+            temporary_target(".summary.json.123.4.tmp"),
+            Some("summary.json")
+        );
+        assert_eq!(
+            temporary_target(".step_00001.stl.9.0.tmp"),
+            Some("step_00001.stl")
+        );
+        assert_eq!(temporary_target("summary.json.123.4.tmp"), None);
+        assert_eq!(temporary_target(".notes.tmp"), None);
+        assert_eq!(temporary_target(".a.b.c.tmp"), None);
+    }
+
+    #[test]
+    fn a_manifest_cannot_point_outside_its_folder() {
+        let listed = parse_manifest(
+            "# header\nhistory.csv\n../x\n/etc/passwd\nsnapshots/step_00000.stl\n\n",
+        );
+        let expected: BTreeSet<PathBuf> = ["history.csv", "snapshots/step_00000.stl"]
+            .into_iter()
+            .map(PathBuf::from)
+            .collect();
+        assert_eq!(listed, expected);
+    }
+
+    /// A second lock on the same folder (another open file description, as another process would hold) is
+    /// refused and names the holder's pid.
+    #[test]
+    fn a_locked_folder_is_refused_with_its_holder() {
+        let dir = scratch("lock");
+        let design = dir.join("design.yaml");
+        let run = dir.join("run");
+        let first = RunFolder::open(&run, &design, false).expect("first run");
+        let second = RunFolder::open(&run, &design, true);
+        match second {
+            Err(RunFolderError::Busy { holder, .. }) => {
+                assert!(
+                    holder.contains(&format!("pid {}", std::process::id())),
+                    "{holder}"
+                )
+            }
+            other => panic!("expected Busy, got {other:?}"),
+        }
+        drop(first);
+        RunFolder::open(&run, &design, true).expect("free again once the first is dropped");
+    }
+
+    /// `clear_previous` removes the listed files and their stale temporaries, nothing else.
+    #[test]
+    fn force_removes_only_listed_files() {
+        let dir = scratch("force");
+        let design = dir.join("design.yaml");
+        let run = dir.join("run");
+        {
+            let folder = RunFolder::open(&run, &design, false).expect("open");
+            fs::create_dir_all(run.join("snapshots")).expect("mkdir");
+            for f in ["history.csv", "snapshots/step_00000.stl"] {
+                folder.manifest().claim(Path::new(f)).expect("claim");
+                fs::write(run.join(f), "ours").expect("write");
+            }
+        }
+        fs::write(run.join("notes.txt"), "user").expect("write");
+        fs::write(run.join("snapshots/mine.stl"), "user").expect("write");
+        fs::write(run.join("snapshots/.step_00000.stl.77.0.tmp"), "stale").expect("write");
+        fs::write(run.join("snapshots/.mine.stl.77.0.tmp"), "user's").expect("write");
+        assert!(matches!(
+            RunFolder::open(&run, &design, false),
+            Err(RunFolderError::Refused { .. })
+        ));
+        let mut folder = RunFolder::open(&run, &design, true).expect("force");
+        folder.clear_previous().expect("clear");
+        assert!(!run.join("history.csv").exists());
+        assert!(!run.join("snapshots/step_00000.stl").exists());
+        assert!(!run.join("snapshots/.step_00000.stl.77.0.tmp").exists());
+        assert!(run.join("notes.txt").exists());
+        assert!(run.join("snapshots/mine.stl").exists());
+        assert!(run.join("snapshots/.mine.stl.77.0.tmp").exists());
+        assert!(folder.manifest().listed().is_empty());
+    }
+
+    #[test]
+    fn foreign_root_home_and_design_folders_are_refused() {
+        let dir = scratch("refuse");
+        let design = dir.join("design.yaml");
+        fs::write(&design, "x").expect("write");
+        for (target, force) in [(dir.clone(), true), (PathBuf::from("/"), true)] {
+            assert!(
+                matches!(
+                    RunFolder::open(&target, &design, force),
+                    Err(RunFolderError::Refused { .. })
+                ),
+                "{} accepted",
+                target.display()
+            );
+        }
+        let foreign = dir.join("foreign");
+        fs::create_dir_all(&foreign).expect("mkdir");
+        fs::write(foreign.join("thesis.tex"), "user").expect("write");
+        assert!(matches!(
+            RunFolder::open(&foreign, &design, true),
+            Err(RunFolderError::Refused { .. })
+        ));
+        assert!(foreign.join("thesis.tex").exists());
+        assert!(
+            !foreign.join(LOCK).exists(),
+            "nothing written into a refused folder"
+        );
+    }
+}
