@@ -169,68 +169,7 @@ impl Outputs {
         }
         flow
     }
-}
 
-/// The observer of a run: the outputs, and the running summary every [`HEARTBEAT`].
-struct RunObserver<'a> {
-    outputs: &'a mut Outputs,
-    summary: &'a mut SummaryFile,
-}
-
-impl RunObserver<'_> {
-    /// Every [`HEARTBEAT`]: closes the recording's chunk and rewrites the running summary.
-    fn heartbeat(&mut self, sim: &Simulation<'_>) -> ControlFlow<()> {
-        if self.outputs.beat.elapsed() < HEARTBEAT {
-            return ControlFlow::Continue(());
-        }
-        self.outputs.beat = Instant::now();
-        if let Err(e) = self.outputs.recorder.flush_chunk() {
-            self.summary.problem = Some(anyhow::Error::new(e));
-            return ControlFlow::Break(());
-        }
-        let outputs = &*self.outputs;
-        if let Err(e) = self.summary.write(|s| outputs.fill(s, sim)) {
-            self.summary.problem = Some(e);
-            return ControlFlow::Break(());
-        }
-        ControlFlow::Continue(())
-    }
-}
-
-impl Observer for RunObserver<'_> {
-    fn start(&mut self, sim: &Simulation<'_>) -> ControlFlow<()> {
-        let flow = self.outputs.observe(|o| o.start(sim));
-        self.outputs.beat = Instant::now() - HEARTBEAT;
-        if self.heartbeat(sim).is_break() {
-            return ControlFlow::Break(());
-        }
-        flow
-    }
-
-    fn step(&mut self, sim: &Simulation<'_>, report: &StepReport) -> ControlFlow<()> {
-        let totals = &mut self.outputs.totals;
-        totals.steps = report.step;
-        totals.iterations += report.newton.iterations;
-        totals.factorisations += report.newton.factorisations;
-        totals.cuts += report.cuts;
-        totals.time = report.time;
-        let flow = self.outputs.observe(|o| o.step(sim, report));
-        if self.heartbeat(sim).is_break() {
-            return ControlFlow::Break(());
-        }
-        flow
-    }
-
-    fn step_failed(&mut self, time: Real, dt: Real, newton: &NewtonReport) {
-        self.outputs.progress.step_failed(time, dt, newton);
-    }
-
-    fn interrupted(&self) -> bool {
-        signals::stop_requested()
-    }
-}
-
-impl Outputs {
     /// Puts what the run did so far into `s`: counts, the time reached, snapshots, the last state, notices and
     /// the solver's time split.
     fn fill(&self, s: &mut RunSummaryFile, sim: &Simulation<'_>) {
@@ -253,6 +192,64 @@ impl Outputs {
             .zip(&self.spent)
             .map(|(name, d)| (name.to_string(), d.as_secs_f64()))
             .collect();
+    }
+}
+
+/// The observer of a run: the outputs, and the running summary every [`HEARTBEAT`].
+struct RunObserver<'a> {
+    outputs: &'a mut Outputs,
+    summary: &'a mut SummaryFile,
+}
+
+impl RunObserver<'_> {
+    /// Every [`HEARTBEAT`] (or now, with `now`): closes the recording's chunk and rewrites the running summary.
+    fn heartbeat(&mut self, sim: &Simulation<'_>, now: bool) -> ControlFlow<()> {
+        if !now && self.outputs.beat.elapsed() < HEARTBEAT {
+            return ControlFlow::Continue(());
+        }
+        self.outputs.beat = Instant::now();
+        if let Err(e) = self.outputs.recorder.flush_chunk() {
+            self.summary.problem = Some(anyhow::Error::new(e));
+            return ControlFlow::Break(());
+        }
+        let outputs = &*self.outputs;
+        if let Err(e) = self.summary.write(|s| outputs.fill(s, sim)) {
+            self.summary.problem = Some(e);
+            return ControlFlow::Break(());
+        }
+        ControlFlow::Continue(())
+    }
+}
+
+impl Observer for RunObserver<'_> {
+    fn start(&mut self, sim: &Simulation<'_>) -> ControlFlow<()> {
+        let flow = self.outputs.observe(|o| o.start(sim));
+        if self.heartbeat(sim, true).is_break() {
+            return ControlFlow::Break(());
+        }
+        flow
+    }
+
+    fn step(&mut self, sim: &Simulation<'_>, report: &StepReport) -> ControlFlow<()> {
+        let totals = &mut self.outputs.totals;
+        totals.steps = report.step;
+        totals.iterations += report.newton.iterations;
+        totals.factorisations += report.newton.factorisations;
+        totals.cuts += report.cuts;
+        totals.time = report.time;
+        let flow = self.outputs.observe(|o| o.step(sim, report));
+        if self.heartbeat(sim, false).is_break() {
+            return ControlFlow::Break(());
+        }
+        flow
+    }
+
+    fn step_failed(&mut self, time: Real, dt: Real, newton: &NewtonReport) {
+        self.outputs.progress.step_failed(time, dt, newton);
+    }
+
+    fn interrupted(&self) -> bool {
+        signals::stop_requested()
     }
 }
 

@@ -83,7 +83,7 @@ pub enum SnapshotError {
         source: std::io::Error,
     },
     /// The deformed tubes could not be built (e.g. a section turned into the centreline).
-    #[error("step {step} (t = {time}): patch `{patch}`: {source}")]
+    #[error("step {step} (t = {}): patch `{patch}`: {source}", crate::math::Short(*time))]
     Mesh {
         /// Step.
         step: usize,

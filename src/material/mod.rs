@@ -62,7 +62,7 @@ pub use prony::{Prony, PronyBranch};
 pub use section::{CircularSection, Section, SectionProperties, SectionShape, ShearFactor};
 pub use wlf::Wlf;
 
-use crate::math::Real;
+use crate::math::{Real, Short};
 
 /// Errors raised by the material layer when data (not the programmer) is wrong. Branch indices are 1-based,
 /// as `α` in the paper's Table `PLA`.
@@ -144,7 +144,7 @@ pub enum MaterialError {
         t_np1: Real,
     },
     /// A prescribed history (temperature, strain or stress) returned a non-finite value.
-    #[error("{quantity} at t = {time} is {value}, not a finite number")]
+    #[error("{quantity} at t = {} is {value}, not a finite number", Short(*time))]
     NonFiniteInput {
         /// Which history: `"temperature"`, `"strain"` or `"stress"`.
         quantity: &'static str,
@@ -155,7 +155,7 @@ pub enum MaterialError {
     },
     /// Stress control is impossible: the step's effective modulus vanished (a Maxwell fluid, `E∞ = 0`, whose
     /// branches all relax completely within one step cannot carry a prescribed stress).
-    #[error("effective modulus {modulus} at t = {time} leaves the stress-controlled step singular")]
+    #[error("effective modulus {modulus} at t = {} leaves the stress-controlled step singular", Short(*time))]
     SingularCompliance {
         /// End of the step \[time\].
         time: Real,

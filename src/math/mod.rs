@@ -72,3 +72,21 @@ pub enum MathError {
         context: String,
     },
 }
+
+#[cfg(test)]
+mod tests {
+    use super::Short;
+
+    /// Shortest round-trip digits in the usual range, exponent notation far from it.
+    #[test]
+    fn short_numbers_stay_short() {
+        let shown = |x: f64| Short(x).to_string();
+        assert_eq!(shown(1.75), "1.75");
+        assert_eq!(shown(0.1), "0.1");
+        assert_eq!(shown(0.0), "0");
+        assert_eq!(shown(1e300), "1e300");
+        assert_eq!(shown(-2.5e-7), "-2.5e-7");
+        assert_eq!(shown(f64::NAN), "NaN");
+        assert_eq!(shown(f64::INFINITY), "inf");
+    }
+}

@@ -1,6 +1,6 @@
 //! Time functions: the schedules of temperature, loads and prescribed components.
 
-use crate::math::Real;
+use crate::math::{Real, Short};
 
 /// A piecewise-linear function of time given by a table of `(t, value)` points with strictly increasing
 /// times; constant before the first and after the last point. A single point is a constant.
@@ -16,7 +16,7 @@ pub enum ScheduleError {
     #[error("a time table needs at least one [time, value] point")]
     Empty,
     /// A time or value is NaN or infinite.
-    #[error("point {index} ([{time}, {value}]) is not finite")]
+    #[error("point {index} ([{}, {}]) is not finite", Short(*time), Short(*value))]
     NotFinite {
         /// Index of the point in the table.
         index: usize,
@@ -26,7 +26,7 @@ pub enum ScheduleError {
         value: Real,
     },
     /// Times do not increase strictly.
-    #[error("times must increase strictly, but point {index} has t = {time} after t = {previous}")]
+    #[error("times must increase strictly, but point {index} has t = {} after t = {}", Short(*time), Short(*previous))]
     NotIncreasing {
         /// Index of the offending point.
         index: usize,

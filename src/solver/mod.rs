@@ -64,7 +64,8 @@ pub enum SolverError {
     },
     /// Newton failed even at the smallest allowed step.
     #[error(
-        "no convergence at t = {time} (step {step}, dt = {dt:.3e} ≤ min_step): after {iterations} Newton iterations the normalised residuals were {residuals:?}{}",
+        "no convergence at t = {} (step {step}, dt = {dt:.3e} ≤ min_step): after {iterations} Newton iterations the normalised residuals were {residuals:?}{}",
+        crate::math::Short(*time),
         diagnosis.as_ref().map(|w| format!("; {w}")).unwrap_or_default()
     )]
     StepFailed {

@@ -518,3 +518,32 @@ fn a_full_disk_leaves_every_output_finished_or_removed() {
         }
     }
 }
+
+/// A failure at t = 1e299 (a typo in `time:`) is reported as `1e299`, not as 300 digits, in the message and in
+/// the failure report.
+#[test]
+fn times_far_from_seconds_are_printed_short() {
+    let dir = scratch("huge_time");
+    let file = dir.join("huge.yaml");
+    let text_ = std::fs::read_to_string(bend45())
+        .expect("design")
+        .replace(
+            "time: {end: 1.0, step: 0.1}",
+            "time: {end: 1.0e300, step: 1.0e299, min_step: 1.0e299}",
+        )
+        .replace("[[0, 0], [1, 600]]", "[[0, 0], [1.0e300, 6.0e9]]");
+    assert!(text_.contains("1.0e299") && text_.contains("6.0e9"));
+    std::fs::write(&file, text_).expect("write");
+    let out = stentkit(&[
+        "run",
+        path_str(&file),
+        "-o",
+        path_str(&dir.join("run")),
+        "--quiet",
+    ]);
+    let stderr = text(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{stderr}");
+    assert!(stderr.contains("no convergence at t = 1e299 "), "{stderr}");
+    assert!(stderr.contains("step 1 to t = 1e299 s failed"), "{stderr}");
+    assert!(!stderr.contains("0000000000"), "{stderr}");
+}
