@@ -52,7 +52,7 @@ pub enum Command {
     Run {
         /// The design file (YAML).
         design: PathBuf,
-        /// Run folder (default: runs/<design name>).
+        /// Run folder (default: `runs/<design name>`).
         #[arg(short, long)]
         output: Option<PathBuf>,
         /// Replace an earlier run in the run folder: only the files that run wrote (its manifest lists them) are

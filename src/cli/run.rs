@@ -11,7 +11,7 @@
 //! The folder is taken through [`crate::io::run_folder`] (refusals, lock, manifest, `--force`). The outputs
 //! are observers of the simulation, composed here with a progress bar (indicatif, on stderr, hidden when
 //! stderr is not a terminal or with `--quiet`). `summary.json` exists from the start (`"status": "running"`)
-//! and is rewritten every [`HEARTBEAT`] with the last converged step, when the recording's chunk is also
+//! and is rewritten every `HEARTBEAT` (2 s) with the last converged step, when the recording's chunk is also
 //! closed, so that SIGKILL leaves a folder `stentkit repair` makes whole. Every file is finished whether the
 //! run completes, fails, is interrupted by a signal ([`super::signals`]: the step in progress is abandoned at
 //! its next Newton iteration) or is stopped by an output error (a full disk: the history is cut back to its
@@ -43,7 +43,7 @@ use std::time::{Duration, Instant};
 /// Each chunk boundary costs a little compression; every 2 s is far below a percent of the recording.
 const HEARTBEAT: Duration = Duration::from_secs(2);
 
-/// Room kept free for finishing a run [bytes]: the summary (a few kB) and the charts (tens of kB each), written
+/// Room kept free for finishing a run \[bytes\]: the summary (a few kB) and the charts (tens of kB each), written
 /// after a disk that filled up during the run (see [`RunFolder::reserve`]).
 const FINISHING_RESERVE: usize = 1 << 20;
 
@@ -587,7 +587,7 @@ struct Finished {
     problems: Vec<anyhow::Error>,
     /// Which outputs are complete (listed in the error and summary when there were problems).
     states: Vec<OutputState>,
-    /// Size of the recording [bytes] (0 if it was removed).
+    /// Size of the recording \[bytes\] (0 if it was removed).
     mcap_bytes: u64,
     /// The charts written.
     charts: Vec<PathBuf>,

@@ -580,7 +580,7 @@ impl McapRecorder {
         self.error.take()
     }
 
-    /// The simulated time of the last state recorded [s].
+    /// The simulated time of the last state recorded \[s\].
     pub fn last_time(&self) -> Option<Real> {
         self.last.map(|(_, _, t)| t)
     }

@@ -21,7 +21,7 @@ const MAGIC: &[u8; 8] = b"\x89MCAP0\r\n";
 /// Opcodes of the records a salvage looks at (MCAP specification).
 const OP_FOOTER: u8 = 0x02;
 const OP_DATA_END: u8 = 0x0F;
-/// Opcode byte and length field of every record [bytes].
+/// Opcode byte and length field of every record \[bytes\].
 const RECORD_PREFIX: usize = 9;
 
 /// What [`salvage`] found and did.
@@ -29,18 +29,18 @@ const RECORD_PREFIX: usize = 9;
 pub enum Salvage {
     /// The file was already a complete MCAP file; nothing was changed.
     AlreadyValid {
-        /// Its size [bytes].
+        /// Its size \[bytes\].
         bytes: u64,
     },
     /// The file was cut after its last complete record and given an ending.
     Finished {
-        /// Size before [bytes].
+        /// Size before \[bytes\].
         before: u64,
-        /// Size after [bytes].
+        /// Size after \[bytes\].
         after: u64,
         /// Messages kept (outside and inside chunks).
         messages: usize,
-        /// Log time of the last message kept [ns].
+        /// Log time of the last message kept \[ns\].
         last_log_time: Option<u64>,
         /// Whether it was written again with a summary section (statistics and indexes); `false` when the disk
         /// had no room for the copy (the file is valid, read linearly).
