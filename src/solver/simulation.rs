@@ -22,6 +22,11 @@
 //! fresh tangent did not halve it), and says so once in [`Simulation::notices`] (time, residual reached,
 //! tolerance asked); [`NewtonReport::at_round_off`] marks each such step. At tolerances from
 //! [`ROUND_OFF_TOLERANCE`] up (the default is 1e-9) this rule never applies: the stopping rule is unchanged.
+//!
+//! **Interruption.** [`Observer::interrupted`] is polled by Newton before every iteration and by `run` before
+//! every attempt of a step (first, retried with a fresh tangent, or cut). When it answers true the step in
+//! progress is abandoned and rolled back exactly as a failed step is, and `run` returns at the last converged
+//! step with [`RunSummary::stopped`] set.
 
 use super::SolverError;
 use super::assembly::{
@@ -230,6 +235,19 @@ pub trait Observer {
     fn step_failed(&mut self, time: Real, dt: Real, newton: &NewtonReport) {
         let _ = (time, dt, newton);
     }
+
+    /// Whether the run should stop now, within the step in progress: the seam for an interrupt (Ctrl-C) that
+    /// should not wait for a long step and its cuts to finish. Polled (cheaply and often: keep it an atomic
+    /// load or a counter) by Newton before every iteration and by [`Simulation::run`] before every attempt of a
+    /// step: the first, the retry with a fresh tangent, and each cut. When it answers true, the step in progress
+    /// is abandoned and rolled back exactly as a failed step is (positions, rotations, curvatures, gauge
+    /// multipliers, captured release reactions, the step's history stresses; the factorisations of the abandoned
+    /// iterates are invalidated), [`Observer::step`] and [`Observer::step_failed`] are not called for it, and
+    /// `run` returns `Ok` with [`RunSummary::stopped`] at the last converged step, which is the simulation's
+    /// state. A later `run` resumes from there. The default never interrupts.
+    fn interrupted(&self) -> bool {
+        false
+    }
 }
 
 /// An observer that records nothing.
@@ -248,6 +266,19 @@ enum NewtonFailure {
     NotConverged(NewtonReport),
     /// A fatal error (singular tangent, broken linear algebra).
     Fatal(SolverError),
+    /// The observer asked to stop ([`Observer::interrupted`]).
+    Interrupted,
+}
+
+/// What a step changes before it converges, saved at its start so that a failed or interrupted attempt can be
+/// undone exactly.
+struct StepStart {
+    /// The last converged state.
+    state: State,
+    /// The constitutive data `(Ē, coefficients, history stresses)` of the last solved step.
+    material: (Real, StepCoefficients, Vec<[Vec3; 4]>),
+    /// Whether the gauge constraints were active.
+    gauge_active: bool,
 }
 
 /// A running simulation of one model.
@@ -824,8 +855,13 @@ impl<'m> Simulation<'m> {
     /// Newton's method at time `t` from the current state (modified in place). With `reuse`, the last
     /// factorisation of the tangent (from an earlier iteration or step) is kept while each iteration reduces the
     /// normalised residual at least by the factor `refactor_ratio`; otherwise the tangent is assembled and
-    /// factorised afresh.
-    fn newton(&mut self, t: Real, reuse: bool) -> Result<NewtonReport, NewtonFailure> {
+    /// factorised afresh. `observer` is polled before every iteration ([`Observer::interrupted`]).
+    fn newton(
+        &mut self,
+        t: Real,
+        reuse: bool,
+        observer: &dyn Observer,
+    ) -> Result<NewtonReport, NewtonFailure> {
         let actions = Actions::at(self.model, t, &self.ramps);
         let settings = &self.model.solver;
         let (tol, max_iterations, ratio) = (
@@ -879,6 +915,9 @@ impl<'m> Simulation<'m> {
             if report.iterations >= max_iterations {
                 return Err(NewtonFailure::NotConverged(report));
             }
+            if observer.interrupted() {
+                return Err(NewtonFailure::Interrupted);
+            }
             let factored = self.active_system().0.is_factored();
             // A reused factorisation is kept while it contracts the residual fast enough.
             let fresh_tangent = !reuse || !factored || r > ratio * previous;
@@ -931,6 +970,11 @@ impl<'m> Simulation<'m> {
     }
 
     /// Runs from the current time to the model's end time, reporting each converged step to `observer`.
+    ///
+    /// Returns with [`RunSummary::stopped`] when the observer asked to stop, from [`Observer::start`] or
+    /// [`Observer::step`] (after that step) or from [`Observer::interrupted`] (within a step, which is then
+    /// abandoned: the simulation stays at the last converged step). Fails with [`SolverError::StepFailed`] when
+    /// Newton fails at the smallest step.
     pub fn run(&mut self, observer: &mut dyn Observer) -> Result<RunSummary, SolverError> {
         let mut summary = RunSummary {
             time: self.time,
@@ -948,6 +992,11 @@ impl<'m> Simulation<'m> {
         let mut h = nominal;
         let mut cuts = 0;
         while self.time < end - snap {
+            // Before every attempt: the first of a step, and each cut.
+            if observer.interrupted() {
+                summary.stopped = true;
+                return Ok(summary);
+            }
             let next_break = breakpoints
                 .iter()
                 .copied()
@@ -959,23 +1008,32 @@ impl<'m> Simulation<'m> {
                 target = next_break;
             }
             let dt = target - self.time;
-            let saved = self.state.clone();
+            let start = self.step_start();
             let captured = self.capture_releases(target);
-            self.set_gauge(target)?;
-            self.prepare_step(self.time, target)?;
+            let prepared = self
+                .set_gauge(target)
+                .and_then(|()| self.prepare_step(self.time, target));
+            if let Err(e) = prepared {
+                self.roll_back(start, &captured);
+                return Err(e);
+            }
             if self.model.solver.extrapolate {
                 self.predict(dt);
             }
             let reuse = self.model.solver.reuse_factorisation;
-            let mut attempt = self.newton(target, reuse);
+            let mut attempt = self.newton(target, reuse, &*observer);
             if reuse && let Err(NewtonFailure::NotConverged(failed)) = &attempt {
                 // A reused factorisation may be what failed: retry the same step with Newton's method proper
                 // before cutting it.
                 observer.step_failed(target, dt, failed);
                 let factorisations = failed.factorisations;
-                self.state = saved.clone();
+                self.state = start.state.clone();
                 self.step_increment.clear();
-                attempt = self.newton(target, false);
+                attempt = if observer.interrupted() {
+                    Err(NewtonFailure::Interrupted)
+                } else {
+                    self.newton(target, false, &*observer)
+                };
                 if let Ok(newton) = &mut attempt {
                     newton.factorisations += factorisations;
                 }
@@ -1019,19 +1077,16 @@ impl<'m> Simulation<'m> {
                     }
                 }
                 Err(NewtonFailure::Fatal(e)) => {
-                    self.state = saved;
+                    self.roll_back(start, &captured);
                     return Err(e);
                 }
+                Err(NewtonFailure::Interrupted) => {
+                    self.roll_back(start, &captured);
+                    summary.stopped = true;
+                    return Ok(summary);
+                }
                 Err(NewtonFailure::NotConverged(newton)) => {
-                    self.state = saved;
-                    // The last factorisations belong to the abandoned iterates.
-                    self.system.invalidate();
-                    if let Some((_, system, _)) = &mut self.gauge {
-                        system.invalidate();
-                    }
-                    for (k, i) in captured {
-                        self.ramps[k][i] = None;
-                    }
+                    self.roll_back(start, &captured);
                     observer.step_failed(target, dt, &newton);
                     if is_smallest_step(dt, min_step, target) {
                         return Err(SolverError::StepFailed {
@@ -1050,6 +1105,33 @@ impl<'m> Simulation<'m> {
             }
         }
         Ok(summary)
+    }
+
+    /// What a step is about to change, saved before it starts (see [`Self::roll_back`]).
+    fn step_start(&self) -> StepStart {
+        StepStart {
+            state: self.state.clone(),
+            material: (self.modulus, self.coeffs.clone(), self.history.clone()),
+            gauge_active: self.gauge_active,
+        }
+    }
+
+    /// Undoes a step that failed or was interrupted: restores the last converged state and the constitutive
+    /// data and gauge activation of the last solved step, forgets the release reactions `captured` for it, and
+    /// invalidates the factorisations, which belong to the abandoned iterates. (The internal variables are
+    /// only advanced by a converged step, in `commit_step`.)
+    fn roll_back(&mut self, start: StepStart, captured: &[(usize, usize)]) {
+        self.state = start.state;
+        (self.modulus, self.coeffs, self.history) = start.material;
+        self.gauge_active = start.gauge_active;
+        self.system.invalidate();
+        if let Some((_, system, _)) = &mut self.gauge {
+            system.invalidate();
+        }
+        for &(k, i) in captured {
+            self.ramps[k][i] = None;
+        }
+        self.step_increment.clear();
     }
 }
 
