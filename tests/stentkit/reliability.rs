@@ -3,14 +3,23 @@
 //! free patch named, before any factorisation, or — for a part held too weakly — diagnosed from the increment it
 //! produces. (The failure report of a run and its run folder are checked end to end in `outputs`.)
 //!
-//! Every design here is the 45° bend (`designs/bend45.yaml`: one arc patch `bend` of 20 control points, clamped
-//! at node `root`, loaded at node `tip`), changed in one place.
+//! A run always makes progress or fails with a report (issue 12): the smallest step is recognised whatever the
+//! time's rounding, a tolerance below round-off is met at the round-off floor with a notice, and an observer's
+//! interrupt is honoured within a step, which is rolled back exactly.
+//!
+//! Most designs here are the 45° bend (`designs/bend45.yaml`: one arc patch `bend` of 20 control points,
+//! clamped at node `root`, loaded at node `tip`), changed in one place.
 
+use crate::common::{design_text, model_from_text, node_displacement, node_index, replace_line};
+use std::cell::{Cell, RefCell};
+use std::ops::ControlFlow;
 use std::path::Path;
 use std::process::Command;
 use stentkit::io::design::parse_design;
-use stentkit::solver::simulation::NoObserver;
-use stentkit::solver::{Simulation, SolverError};
+use stentkit::math::Real;
+use stentkit::model::Model;
+use stentkit::solver::simulation::{NoObserver, ROUND_OFF_TOLERANCE, STEP_ROUND_OFF_ULPS};
+use stentkit::solver::{NewtonReport, Observer, RunSummary, Simulation, SolverError, StepReport};
 
 fn bend45() -> String {
     std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join("designs/bend45.yaml"))
@@ -156,4 +165,447 @@ fn a_weakly_held_rod_gets_a_singular_tangent_diagnosis() {
         0.0,
         "the last converged state is the initial one"
     );
+}
+
+/// What the solver told an observer, in order.
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum Event {
+    /// `interrupted()` was polled.
+    Poll,
+    /// A Newton attempt failed after this many iterations.
+    Failed(usize),
+    /// This step converged.
+    Step(usize),
+}
+
+/// Records every call, answers `interrupted()` with true at the event numbered `stop_at` (an index into
+/// `events`), and stops after step `stop_after` through `step`. `poll_cap` is a guard: past that many polls it
+/// interrupts, so a run that no longer makes progress ends the test with counts instead of hanging it.
+struct Script {
+    events: RefCell<Vec<Event>>,
+    polls: Cell<usize>,
+    stop_at: Option<usize>,
+    stop_after: Option<usize>,
+    poll_cap: usize,
+    reports: Vec<StepReport>,
+}
+
+impl Script {
+    /// A script that never stops the run (but for the guard).
+    fn new() -> Self {
+        Self {
+            events: RefCell::new(Vec::new()),
+            polls: Cell::new(0),
+            stop_at: None,
+            stop_after: None,
+            poll_cap: usize::MAX,
+            reports: Vec::new(),
+        }
+    }
+
+    fn events(&self) -> Vec<Event> {
+        self.events.borrow().clone()
+    }
+
+    fn failures(&self) -> usize {
+        self.events()
+            .iter()
+            .filter(|e| matches!(e, Event::Failed(_)))
+            .count()
+    }
+
+    /// Newton iterations of every attempt, failed or converged.
+    fn all_iterations(&self) -> usize {
+        let failed: usize = self
+            .events()
+            .iter()
+            .map(|e| match e {
+                Event::Failed(i) => *i,
+                _ => 0,
+            })
+            .sum();
+        failed
+            + self
+                .reports
+                .iter()
+                .map(|r| r.newton.iterations)
+                .sum::<usize>()
+    }
+}
+
+impl Observer for Script {
+    fn step(&mut self, _: &Simulation<'_>, report: &StepReport) -> ControlFlow<()> {
+        self.events.borrow_mut().push(Event::Step(report.step));
+        self.reports.push(report.clone());
+        if self.stop_after == Some(report.step) {
+            ControlFlow::Break(())
+        } else {
+            ControlFlow::Continue(())
+        }
+    }
+
+    fn step_failed(&mut self, _: Real, _: Real, newton: &NewtonReport) {
+        self.events
+            .borrow_mut()
+            .push(Event::Failed(newton.iterations));
+    }
+
+    fn interrupted(&self) -> bool {
+        let mut events = self.events.borrow_mut();
+        events.push(Event::Poll);
+        self.polls.set(self.polls.get() + 1);
+        self.stop_at == Some(events.len() - 1) || self.polls.get() > self.poll_cap
+    }
+}
+
+/// Runs `model` with `script`, guarded by `poll_cap`.
+fn run_guarded<'m>(
+    model: &'m Model,
+    script: &mut Script,
+    poll_cap: usize,
+) -> (Simulation<'m>, Result<RunSummary, SolverError>) {
+    script.poll_cap = poll_cap;
+    let mut sim = Simulation::new(model).expect("simulation");
+    let result = sim.run(script);
+    (sim, result)
+}
+
+/// Polls allowed by the guard of the progress tests: each poll is a Newton iteration or a step attempt, and
+/// these runs need a few hundred; the old endless retry made 10⁴ per second.
+const POLL_GUARD: usize = 20_000;
+
+#[test]
+fn a_tolerance_below_round_off_ends_in_bounded_iterations() {
+    // Issue 12. The 45° bend's normalised residual has a round-off floor of 2e-11 … 1.5e-10 (increments
+    // 1e-11 … 3e-10; measured by iterating past convergence), so 1e-12 and 1e-13 cannot be met. Two variants:
+    // (a) the design with `solver: {tolerance: 1e-12}`, as reported; (b) tolerance 1e-13 with the load starting
+    // at t = 0.5 and `min_step: 1e-6`, where the old run cut down to the smallest step at t = 0.55 and, with
+    // `(t + h) − t` rounding above `min_step (1 + 1e-12)`, retried it forever (10 702 failed attempts in 20 s).
+    // Now a step whose residual stopped falling is accepted where it meets the stopping rule at
+    // ROUND_OFF_TOLERANCE (1e-9), with one notice naming the time, the residual and the tolerance.
+    // Measured: (a) 10 steps, no cut, 6 failed attempts (all with a reused factorisation, then retried with a
+    // fresh one), 192 iterations in all, 5 steps at round-off; (b) 10 steps, no cut, 5 failed attempts, 107
+    // iterations, 5 steps at round-off. Bounds: no cut, at most one failed (reused-factorisation) attempt per
+    // step and 25 iterations (max_iterations) per attempt. The tip displacement must agree with the
+    // default-tolerance run to 1e-8 relative: both are converged to ~1e-9 in normalised terms (translations
+    // over the patch length 78.5, tip displacement 61), measured 2.1e-9.
+    let base = model_from_text(&design_text("bend45.yaml"), "bend45.yaml");
+    let (reference, _) = crate::common::solve(&base);
+    let u_ref = node_displacement(&reference, "tip");
+    let reported = format!(
+        "{}solver: {{tolerance: 1.0e-12}}\n",
+        design_text("bend45.yaml")
+    );
+    let shifted = replace_line(
+        &replace_line(
+            &reported,
+            "force:",
+            "force: [0, 0, [[0, 0], [0.5, 0], [1, 600]]]",
+        ),
+        "time:",
+        "time: {end: 1.0, step: 0.1, min_step: 1.0e-6}",
+    )
+    .replace("tolerance: 1.0e-12", "tolerance: 1.0e-13");
+    for (name, text, tolerance) in [
+        ("1e-12", reported, "1e-12"),
+        ("1e-13 from t = 0.5", shifted, "1e-13"),
+    ] {
+        let model = model_from_text(&text, "bend45_tight.yaml");
+        let mut script = Script::new();
+        let (sim, result) = run_guarded(&model, &mut script, POLL_GUARD);
+        let summary = result.unwrap_or_else(|e| panic!("{name}: {e}"));
+        let at_round_off = script
+            .reports
+            .iter()
+            .filter(|r| r.newton.at_round_off)
+            .count();
+        println!(
+            "bend45, tolerance {name}: {} steps, {} iterations in converged steps, {} failed attempts, {} iterations in all, {} polls, {at_round_off} steps at round-off; notices {:?}",
+            summary.steps,
+            summary.iterations,
+            script.failures(),
+            script.all_iterations(),
+            script.polls.get(),
+            sim.notices()
+        );
+        assert!(
+            !summary.stopped,
+            "{name}: the guard stopped the run after {} polls",
+            script.polls.get()
+        );
+        assert_eq!(sim.time(), 1.0);
+        assert_eq!((summary.steps, summary.cuts), (10, 0), "{name}");
+        assert!(script.failures() <= summary.steps, "{name}");
+        assert!(script.all_iterations() <= 25 * 2 * summary.steps, "{name}");
+        assert!(
+            at_round_off >= 1,
+            "{name}: no step needed the round-off floor"
+        );
+        let notices: Vec<&String> = sim
+            .notices()
+            .iter()
+            .filter(|n| n.contains("round-off"))
+            .collect();
+        assert_eq!(notices.len(), 1, "{name}: said once: {notices:?}");
+        assert!(
+            notices[0].contains(&format!("tolerance {tolerance} asked"))
+                && notices[0].contains("at t = ")
+                && notices[0].contains("stopped falling at")
+                && notices[0].contains(&format!("{ROUND_OFF_TOLERANCE:e}")),
+            "{}",
+            notices[0]
+        );
+        let u = node_displacement(&sim, "tip");
+        if name == "1e-12" {
+            let d = (u - u_ref).norm() / u_ref.norm();
+            println!("  tip vs the default tolerance: {d:.2e} relative");
+            assert!(d < 1e-8, "{d:.3e}");
+        }
+    }
+}
+
+#[test]
+fn failing_at_the_smallest_step_at_a_large_time_ends_the_run() {
+    // Issue 12: the endless retry without any round-off question. bend45 with the load starting at t = 0.5,
+    // `min_step: 1e-6` and one Newton iteration per attempt: steps of 1e-6 converge in one iteration until
+    // t = 0.5000086, where even the smallest step fails. `(t + h) − t` is 1e-6 only to ±1.1e-16 (half an ulp of
+    // 0.5) there, 1e-10 relative: the old comparison `dt <= min_step (1 + 1e-12)` missed it and retried the
+    // step forever (69 948 failed attempts in 10 s). Now the run fails there with a StepFailed at a dt within
+    // STEP_ROUND_OFF_ULPS ulps of min_step.
+    // Counts: each step from 0.5 starts at the nominal 0.1 and halves at most ⌈log2(0.1 / 1e-6)⌉ = 17 times, each
+    // attempt failing twice (reused then fresh factorisation) — but the run ends at the first failure at the
+    // smallest step. Measured: 8 converged steps and 62 failed attempts; the bound is 20 steps × 2 × 18 attempts.
+    let text = replace_line(
+        &replace_line(
+            &format!(
+                "{}solver: {{max_iterations: 1}}\n",
+                design_text("bend45.yaml")
+            ),
+            "force:",
+            "force: [0, 0, [[0, 0], [0.5, 0], [1, 600]]]",
+        ),
+        "time:",
+        "time: {end: 1.0, step: 0.1, min_step: 1.0e-6}",
+    );
+    let model = model_from_text(&text, "bend45_one_iteration.yaml");
+    let mut script = Script::new();
+    let (sim, result) = run_guarded(&model, &mut script, POLL_GUARD);
+    println!(
+        "{} converged steps, {} failed attempts, {} polls: {result:?}",
+        script.reports.len(),
+        script.failures(),
+        script.polls.get()
+    );
+    let error = result.expect_err("no convergence at the smallest step");
+    let SolverError::StepFailed { time, dt, step, .. } = error else {
+        panic!("expected StepFailed, got {error}");
+    };
+    let min_step = model.time.min_step;
+    let ulp = time.next_up() - time;
+    assert!(
+        (dt - min_step).abs() <= STEP_ROUND_OFF_ULPS * ulp,
+        "dt = {dt:e}, min_step = {min_step:e}"
+    );
+    assert!(time > 0.5, "{time}");
+    assert_eq!(step, script.reports.len() + 1);
+    assert_eq!(sim.time(), script.reports.last().map_or(0.0, |r| r.time));
+    assert!(
+        script.failures() <= 20 * 2 * 18,
+        "{} failed attempts",
+        script.failures()
+    );
+}
+
+#[test]
+fn the_uncooled_straight_stent_fails_at_the_release_with_a_report() {
+    // Issue 12, as a new user met it: designs/straight_stent.yaml with its cooling removed (temperature held at
+    // 90 °C, above Tg = 70 °C, through the release at 1.75 s). Nothing fixes the programmed shape, so the
+    // release lets go of the full programming reaction and Newton diverges even over the smallest step,
+    // 2.5e-3 / 1024 = 2.44e-6 s. The old run reached t = 1.750361 s, then retried the step to 1.7503638 s
+    // (dt = 2.4414062500532907e-6: 2.2e-11 above min_step relative, missed by the `1e-12` allowance) forever;
+    // the CLI wrote nothing for 25 minutes. Now it fails there with StepFailed (the run folder's failure
+    // report); measured: 711 converged steps, 51 failed attempts and 3192 polls (1.6 s here, 3.4 s for the CLI
+    // run with its outputs). Expected: either the run completes (a better solver may get through the snap) or it
+    // fails with a dt within STEP_ROUND_OFF_ULPS ulps of min_step after few failed attempts: 500 is ten times
+    // the measured count and far below the old one (hundreds per second, until the poll guard stops the run).
+    let text = design_text("straight_stent.yaml");
+    let text = replace_line(&text, "temperature:", "temperature: 90");
+    let model = model_from_text(&text, "straight_stent_uncooled.yaml");
+    let mut script = Script::new();
+    let (sim, result) = run_guarded(&model, &mut script, POLL_GUARD);
+    println!(
+        "uncooled straight stent: {} converged steps to t = {}, {} failed attempts, {} polls: {}",
+        script.reports.len(),
+        sim.time(),
+        script.failures(),
+        script.polls.get(),
+        match &result {
+            Ok(s) => format!("{s:?}"),
+            Err(e) => format!("{e}"),
+        }
+    );
+    assert!(
+        script.failures() <= 500,
+        "{} failed attempts",
+        script.failures()
+    );
+    match result {
+        Ok(summary) => {
+            assert!(!summary.stopped, "the guard stopped the run");
+            assert_eq!(sim.time(), model.time.end);
+        }
+        Err(SolverError::StepFailed { time, dt, .. }) => {
+            let ulp = time.next_up() - time;
+            assert!(
+                (dt - model.time.min_step).abs() <= STEP_ROUND_OFF_ULPS * ulp,
+                "dt = {dt:e}"
+            );
+            assert!(time > 1.75, "fails after the release, at {time}");
+        }
+        Err(e) => panic!("{e}"),
+    }
+}
+
+/// The index of the first `Poll` after event `i`.
+fn first_poll_after(events: &[Event], i: usize) -> usize {
+    (i + 1..events.len())
+        .find(|&j| events[j] == Event::Poll)
+        .unwrap_or_else(|| panic!("no poll after event {i}: {events:?}"))
+}
+
+/// Runs `model` stopped at the event `stop_at` (a poll that answers true) and checks that the run returns
+/// stopped at the last converged step `last_step` with exactly the state (and, through the node resultants at
+/// `node`, the constitutive data) of `reference`, a run stopped after that step, and that nothing was reported
+/// after the interrupt. Returns the interrupted simulation.
+#[track_caller]
+fn check_interrupt<'m>(
+    model: &'m Model,
+    events: &[Event],
+    stop_at: usize,
+    last_step: usize,
+    reference: &Simulation<'_>,
+    node: &str,
+) -> Simulation<'m> {
+    let mut script = Script::new();
+    script.stop_at = Some(stop_at);
+    let (sim, result) = run_guarded(model, &mut script, usize::MAX);
+    let summary = result.expect("an interrupt is not an error");
+    assert!(summary.stopped);
+    assert_eq!(summary.steps, last_step);
+    assert_eq!(sim.time(), reference.time());
+    // The same calls as the uninterrupted run up to the poll that answered true, and none after it: no
+    // `step` or `step_failed` for the abandoned step.
+    assert_eq!(script.events(), events[..=stop_at]);
+    // Rolled back exactly: bitwise the state after the last converged step.
+    assert!(sim.state() == reference.state(), "state differs");
+    let k = node_index(model, node);
+    assert_eq!(sim.node_end_resultants(k), reference.node_end_resultants(k));
+    sim
+}
+
+#[test]
+fn an_interrupt_is_honoured_within_a_step_and_rolled_back() {
+    // Issue 12, item B: `Observer::interrupted` is polled by Newton before every iteration and by `run` before
+    // every attempt; an interrupt abandons the step in progress and leaves the simulation exactly at the last
+    // converged step. Design: bend45 in two load steps of 0.5, which needs cuts (tabulated by
+    // `stentkit study stability`): step 1 reaches only t = 0.25 after a cut, and the attempt of step 2 at 0.75
+    // fails with the reused factorisation, again with a fresh one, and is cut to 0.5.
+    // Expected values come from the same design's uninterrupted run, recorded call by call, and from a run
+    // stopped by `step` after step 1: the interrupted runs must repeat the first run's calls up to the poll that
+    // answers true and end with bitwise the second run's state (exact: the same operations on the same numbers).
+    let text = replace_line(
+        &design_text("bend45.yaml"),
+        "time:",
+        "time: {end: 1.0, step: 0.5}",
+    );
+    let model = model_from_text(&text, "bend45_two_steps.yaml");
+    let mut full = Script::new();
+    let (full_sim, result) = run_guarded(&model, &mut full, usize::MAX);
+    let full_summary = result.expect("completes");
+    let events = full.events();
+    let step1 = events
+        .iter()
+        .position(|e| *e == Event::Step(1))
+        .expect("step 1");
+    let step2 = events
+        .iter()
+        .position(|e| *e == Event::Step(2))
+        .expect("step 2");
+    let failures: Vec<usize> = (step1..step2)
+        .filter(|&i| matches!(events[i], Event::Failed(_)))
+        .collect();
+    assert!(
+        failures.len() >= 2,
+        "step 2 needs a retry with a fresh tangent and a cut: {events:?}"
+    );
+    // Newton polled between iterations: after the poll before the attempt, one poll per iteration of the
+    // attempt that then failed.
+    let Event::Failed(iterations) = events[failures[0]] else {
+        unreachable!()
+    };
+    assert!(iterations >= 2);
+    assert!(
+        events[step1 + 1..failures[0]]
+            .iter()
+            .all(|e| *e == Event::Poll)
+    );
+    assert_eq!(failures[0] - step1 - 1, 1 + iterations, "{events:?}");
+
+    let mut stop1 = Script::new();
+    stop1.stop_after = Some(1);
+    let (at_step1, result) = run_guarded(&model, &mut stop1, usize::MAX);
+    assert!(result.expect("stopped").stopped);
+
+    for (case, stop_at) in [
+        // The poll before the attempt, Newton's before iteration 1, before iteration 2: one iteration done.
+        ("within Newton", step1 + 3),
+        (
+            "before the retry with a fresh tangent",
+            first_poll_after(&events, failures[0]),
+        ),
+        ("before the cut", first_poll_after(&events, failures[1])),
+    ] {
+        let mut sim = check_interrupt(&model, &events, stop_at, 1, &at_step1, "root");
+        // Resumed, the run repeats the uninterrupted one exactly: the resumed step starts from step 1's state
+        // with the step size reset to the nominal 0.5 and no factorisation, and so does the uninterrupted run's
+        // step 2 once its first attempt (at 0.75, also the resumed one's) has failed and been rolled back.
+        let resumed = sim.run(&mut NoObserver).expect("resumes");
+        assert!(!resumed.stopped);
+        assert_eq!(sim.time(), 1.0);
+        assert_eq!(1 + resumed.steps, full_summary.steps, "{case}");
+        assert!(
+            sim.state() == full_sim.state(),
+            "{case}: resumed state differs"
+        );
+    }
+}
+
+#[test]
+fn an_interrupted_viscoelastic_step_restores_its_history_stresses() {
+    // The abandoned step's preparation computed history stresses and an effective modulus for its own time
+    // step; the rollback must restore those of the last converged step, or anything evaluated afterwards (the
+    // CLI's last snapshot, the node resultants) would mix the two. Design: designs/cantilever_morphing.yaml
+    // (PLA, 15 Maxwell branches, loaded at 90 °C, cooled from 0.5 s) in steps of 0.25 s to 1.5 s. Interrupted
+    // within Newton in step 3 (0.5 → 0.75, the first cooling step); expected: bitwise the state and the root
+    // resultants of the run stopped after step 2.
+    let text = replace_line(
+        &design_text("cantilever_morphing.yaml"),
+        "time:",
+        "time: {end: 1.5, step: 0.25}",
+    );
+    let model = model_from_text(&text, "cantilever_coarse.yaml");
+    let mut full = Script::new();
+    let (_, result) = run_guarded(&model, &mut full, usize::MAX);
+    result.expect("completes");
+    let events = full.events();
+    let step2 = events
+        .iter()
+        .position(|e| *e == Event::Step(2))
+        .expect("step 2");
+    assert_eq!(events[step2 + 1..step2 + 4], [Event::Poll; 3], "{events:?}");
+    let mut stop2 = Script::new();
+    stop2.stop_after = Some(2);
+    let (at_step2, result) = run_guarded(&model, &mut stop2, usize::MAX);
+    assert!(result.expect("stopped").stopped);
+    check_interrupt(&model, &events, step2 + 3, 2, &at_step2, "root");
 }
