@@ -4,10 +4,12 @@
 //! fields, wrong types and bad single numbers are reported there with line and column); [`build`] generates
 //! the geometry and checks everything that involves several values; [`locate`] maps the field path of such a
 //! check back to its line and column. Every error names the file, the line and column, the field, what is
-//! wrong and what is allowed.
+//! wrong and what is allowed. Before any of this, [`guard`] refuses text too large, too deeply nested or with
+//! aliases, which would make the parsers slow or the design enormous.
 
 pub mod build;
 pub mod dto;
+pub mod guard;
 pub mod locate;
 pub mod stent;
 
@@ -142,13 +144,40 @@ impl fmt::Display for DesignError {
 /// error chains print it twice).
 impl std::error::Error for DesignError {}
 
-/// Reads and validates the design file at `path`.
+/// Reads and validates the design file at `path`. At most [`guard::MAX_DESIGN_BYTES`] are read: a larger
+/// file is refused without reading the rest.
 pub fn load_design(path: &Path) -> Result<Design, DesignError> {
-    let text = std::fs::read_to_string(path).map_err(|source| DesignError::Read {
+    use std::io::Read as _;
+    let read_error = |source| DesignError::Read {
         file: path.to_path_buf(),
         source,
-    })?;
+    };
+    let mut bytes = Vec::new();
+    std::fs::File::open(path)
+        .and_then(|f| {
+            f.take(guard::MAX_DESIGN_BYTES as u64 + 1)
+                .read_to_end(&mut bytes)
+        })
+        .map_err(read_error)?;
+    if bytes.len() > guard::MAX_DESIGN_BYTES {
+        let size = std::fs::metadata(path).ok().map(|m| m.len());
+        return Err(refused(path, guard::too_large(size)));
+    }
+    let text = String::from_utf8(bytes)
+        .map_err(|e| read_error(std::io::Error::new(std::io::ErrorKind::InvalidData, e)))?;
     parse_design(&text, path)
+}
+
+/// The design error of a text refused by [`guard`] (no field: the text is refused before it is read as
+/// fields).
+fn refused(path: &Path, refusal: guard::Refusal) -> DesignError {
+    DesignError::Invalid {
+        file: path.to_path_buf(),
+        line: refusal.position.line,
+        column: refusal.position.column,
+        field: String::new(),
+        message: refusal.message,
+    }
 }
 
 /// Splits serde_yaml's message into the text and the position it names. A syntax error reads
@@ -244,6 +273,7 @@ pub fn parse_design_with(
     overrides: &DesignOverrides,
 ) -> Result<Design, DesignError> {
     let file = path.to_path_buf();
+    guard::check_text(text).map_err(|r| refused(path, r))?;
     let locator = locate::Locator::new(text);
     let deserializer = serde_yaml::Deserializer::from_str(text);
     let mut dto: dto::DesignDto = serde_path_to_error::deserialize(deserializer).map_err(|e| {
