@@ -370,3 +370,69 @@ fn a_file_over_the_size_limit_is_refused_with_its_size() {
         "{message}"
     );
 }
+
+#[test]
+fn long_values_are_quoted_shortened_in_errors() {
+    // Each design puts a 1 000 000-character value where an error quotes it: an enum word (serde_yaml's
+    // message), a patch name used twice and a node name that does not exist (stentkit's messages), an unknown
+    // key (the field path). The value must appear as its first 40 characters, `…` and its length
+    // (`quote::quoted`), and the whole error line stay short: these messages have at most about 250
+    // characters besides the value, so 400 is a generous bound (a whole value would be a million).
+    let long = "q".repeat(1_000_000);
+    let cut = format!("`{}…` (1000000 characters)", "q".repeat(40));
+    let base = std::fs::read_to_string(data("good_small.yaml")).expect("base");
+    let cases = [
+        (
+            "units",
+            base.replacen("units: SI", &format!("units: {long}"), 1),
+        ),
+        (
+            "patches[1].name",
+            base.replacen("name: beam", &format!("name: {long}"), 1)
+                .replacen("name: hook", &format!("name: {long}"), 1),
+        ),
+        (
+            "conditions[0].node",
+            base.replacen(
+                "{node: root, clamp: true}",
+                &format!("{{node: {long}, clamp: true}}"),
+                1,
+            ),
+        ),
+    ];
+    for (field, text) in cases {
+        let error =
+            stentkit::io::design::parse_design(&text, Path::new("long.yaml")).expect_err("refused");
+        let message = error.to_string();
+        assert!(
+            message.chars().count() < 400 && message.contains(&cut),
+            "{field}: {}",
+            shorten_for_report(&message)
+        );
+        let DesignError::Invalid { field: got, .. } = &error else {
+            panic!("{message}")
+        };
+        assert_eq!(got, field);
+    }
+    // An unknown key of 1000 characters (YAML allows implicit keys of at most 1024; a longer one is a syntax
+    // error at its end, which quotes nothing): serde_yaml names it in the message and the field path, and both
+    // are shortened (the path without backticks).
+    let key = "k".repeat(1000);
+    let text = base.replacen("units: SI", &format!("units: SI\n{key}: 1"), 1);
+    let error =
+        stentkit::io::design::parse_design(&text, Path::new("long.yaml")).expect_err("refused");
+    let message = error.to_string();
+    assert!(
+        message.chars().count() < 600
+            && message.contains(&format!(
+                "unknown field `{}…` (1000 characters)",
+                "k".repeat(40)
+            )),
+        "{}",
+        shorten_for_report(&message)
+    );
+    let DesignError::Invalid { field, .. } = &error else {
+        panic!("{message}")
+    };
+    assert!(field.ends_with("… (1000 characters)"), "{field}");
+}

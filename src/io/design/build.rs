@@ -3,6 +3,7 @@
 //! naming the field path; [`super`] turns it into a line and column.
 
 use super::dto::*;
+use super::quote::quoted;
 use super::stent;
 use crate::geometry::analytic::{
     Helix, ParametricCurve, RigidPlacement, SineWire, frame_from_axis, point_list_curve,
@@ -181,7 +182,7 @@ pub fn build(
         let names: Vec<String> = body
             .patches
             .iter()
-            .map(|&k| format!("`{}`", model.patches[k].name))
+            .map(|&k| quoted(&model.patches[k].name))
             .collect();
         warnings.push(format!(
             "no component of any node of patch{} {} is prescribed: {} free to move as a rigid body, the tangent is singular and `run` will refuse the design",
@@ -241,7 +242,7 @@ pub fn estimated_memory(dto: &DesignDto, time: &TimeSettings) -> Vec<(String, St
         patches += 1.0;
         terms.push((
             path,
-            format!("patch `{}` ({n} control points, p = {p})", pd.name),
+            format!("patch {} ({n} control points, p = {p})", quoted(&pd.name)),
             n as Real * bytes_per_control_point(p, branches),
             1.0,
         ));
@@ -636,8 +637,8 @@ fn patches(
             return Err(issue(
                 format!("{base}.name"),
                 format!(
-                    "`{}` is not a valid patch name: use a non-empty name without dots or spaces",
-                    pd.name
+                    "{} is not a valid patch name: use a non-empty name without dots or spaces",
+                    quoted(&pd.name)
                 ),
             ));
         }
@@ -645,8 +646,8 @@ fn patches(
             return Err(issue(
                 format!("{base}.name"),
                 format!(
-                    "patch name `{}` is already used by the generated stent",
-                    pd.name
+                    "patch name {} is already used by the generated stent",
+                    quoted(&pd.name)
                 ),
             ));
         }
@@ -654,8 +655,8 @@ fn patches(
             return Err(issue(
                 format!("{base}.name"),
                 format!(
-                    "patch name `{}` is already used by patches[{first}]",
-                    pd.name
+                    "patch name {} is already used by patches[{first}]",
+                    quoted(&pd.name)
                 ),
             ));
         }
@@ -756,8 +757,8 @@ fn patches(
             let d = sections[section].diameter();
             if dev > FIT_WARNING_FRACTION * d {
                 warnings.push(format!(
-                    "patch `{}`: the spline fit deviates up to {dev:.3e} from the curve, {:.1}% of the wire diameter; raise n",
-                    pd.name,
+                    "patch {}: the spline fit deviates up to {dev:.3e} from the curve, {:.1}% of the wire diameter; raise n",
+                    quoted(&pd.name),
                     100.0 * dev / d
                 ));
             }
@@ -835,15 +836,18 @@ fn nodes(
             return Err(issue(
                 format!("{base}.name"),
                 format!(
-                    "node name `{}` is already used by the generated stent",
-                    nd.name
+                    "node name {} is already used by the generated stent",
+                    quoted(&nd.name)
                 ),
             ));
         }
         if let Some(first) = names.insert(nd.name.clone(), k) {
             return Err(issue(
                 format!("{base}.name"),
-                format!("node name `{}` is already used by nodes[{first}]", nd.name),
+                format!(
+                    "node name {} is already used by nodes[{first}]",
+                    quoted(&nd.name)
+                ),
             ));
         }
         let mut ends = Vec::new();
@@ -859,7 +863,7 @@ fn nodes(
                     let e = parse_end(name, patches).ok_or_else(|| {
                         issue(
                             format!("{base}.ends[{j}]"),
-                            format!("`{name}` is not a patch end; write `<patch>.start` or `<patch>.end` with a patch named in `patches`"),
+                            format!("{} is not a patch end; write `<patch>.start` or `<patch>.end` with a patch named in `patches`", quoted(name)),
                         )
                     })?;
                     ends.push(e);
@@ -889,10 +893,9 @@ fn nodes(
                 return Err(issue(
                     format!("{base}.ends[{j}]"),
                     format!(
-                        "`{}.{}` already belongs to node `{}`",
-                        patches[e.patch].name,
-                        e.end.name(),
-                        nodes[other].name
+                        "{} already belongs to node {}",
+                        quoted(&format!("{}.{}", patches[e.patch].name, e.end.name())),
+                        quoted(&nodes[other].name)
                     ),
                 ));
             }
@@ -901,11 +904,13 @@ fn nodes(
                 return Err(issue(
                     format!("{base}.ends[{j}]"),
                     format!(
-                        "`{}.{}` is {gap:.3e} away from `{}.{}`: joined ends must coincide (tolerance {tolerance:.3e}; set `joints.tolerance` to change it)",
-                        patches[e.patch].name,
-                        e.end.name(),
-                        patches[ends[0].patch].name,
-                        ends[0].end.name()
+                        "{} is {gap:.3e} away from {}: joined ends must coincide (tolerance {tolerance:.3e}; set `joints.tolerance` to change it)",
+                        quoted(&format!("{}.{}", patches[e.patch].name, e.end.name())),
+                        quoted(&format!(
+                            "{}.{}",
+                            patches[ends[0].patch].name,
+                            ends[0].end.name()
+                        ))
                     ),
                 ));
             }
@@ -994,7 +999,7 @@ fn conditions(
             (Some(name), None) => vec![find_node(name, patches, nodes).ok_or_else(|| {
                 issue(
                     format!("{base}.node"),
-                    format!("no node `{name}`: name a node from `nodes` or a patch end `<patch>.start` / `<patch>.end`"),
+                    format!("no node {}: name a node from `nodes` or a patch end `<patch>.start` / `<patch>.end`", quoted(name)),
                 )
             })?],
             (None, Some(set)) => node_sets.get(set).cloned().ok_or_else(|| {
@@ -1002,9 +1007,9 @@ fn conditions(
                 issue(
                     format!("{base}.node_set"),
                     if known.is_empty() {
-                        format!("no node set `{set}`: node sets come from a generated `stent`")
+                        format!("no node set {}: node sets come from a generated `stent`", quoted(set))
                     } else {
-                        format!("no node set `{set}`; known sets: {}", known.join(", "))
+                        format!("no node set {}; known sets: {}", quoted(set), known.join(", "))
                     },
                 )
             })?,
@@ -1113,8 +1118,8 @@ fn conditions(
                         return Err(issue(
                             &base,
                             format!(
-                                "node `{}` already has a different basis from {first}; one node has one basis",
-                                nodes[node].name
+                                "node {} already has a different basis from {first}; one node has one basis",
+                                quoted(&nodes[node].name)
                             ),
                         ));
                     }
@@ -1138,8 +1143,9 @@ fn conditions(
                     return Err(issue(
                         path,
                         format!(
-                            "component {} of node `{}` is already set by {first}: one condition per component",
-                            NAMES[i], nodes[node].name
+                            "component {} of node {} is already set by {first}: one condition per component",
+                            NAMES[i],
+                            quoted(&nodes[node].name)
                         ),
                     ));
                 }
@@ -1186,7 +1192,7 @@ fn distributed_loads(dto: &DesignDto, patches: &[Patch]) -> Result<Vec<Distribut
                     .ok_or_else(|| {
                         issue(
                             format!("{base}.patch"),
-                            format!("no patch `{}`: name a patch or write `all`", d.patch),
+                            format!("no patch {}: name a patch or write `all`", quoted(&d.patch)),
                         )
                     })?,
             ]
@@ -1280,19 +1286,25 @@ fn probes(dto: &DesignDto, patches: &[Patch], nodes: &[Node]) -> Result<Vec<Prob
         if out.iter().any(|q| q.name == p.name) {
             return Err(issue(
                 format!("{base}.name"),
-                format!("probe name `{}` is used twice", p.name),
+                format!("probe name {} is used twice", quoted(&p.name)),
             ));
         }
         let location = match (&p.node, &p.patch, &p.u) {
-            (Some(n), None, None) => ProbeLocation::Node(
-                find_node(n, patches, nodes)
-                    .ok_or_else(|| issue(format!("{base}.node"), format!("no node `{n}`")))?,
-            ),
+            (Some(n), None, None) => {
+                ProbeLocation::Node(find_node(n, patches, nodes).ok_or_else(|| {
+                    issue(format!("{base}.node"), format!("no node {}", quoted(n)))
+                })?)
+            }
             (None, Some(name), Some(Finite(u))) => {
                 let patch = patches
                     .iter()
                     .position(|q| &q.name == name)
-                    .ok_or_else(|| issue(format!("{base}.patch"), format!("no patch `{name}`")))?;
+                    .ok_or_else(|| {
+                        issue(
+                            format!("{base}.patch"),
+                            format!("no patch {}", quoted(name)),
+                        )
+                    })?;
                 if !(0.0..=1.0).contains(u) {
                     return Err(issue(
                         format!("{base}.u"),

@@ -210,7 +210,8 @@ impl<'de> Visitor<'de> for ComponentVisitor {
             Ok(ComponentValue::Free)
         } else {
             Err(E::custom(format!(
-                "`{v}` is not a component value; allowed: free, null, a number or a table [[t, v], …]"
+                "{} is not a component value; allowed: free, null, a number or a table [[t, v], …]",
+                super::quote::quoted(v)
             )))
         }
     }

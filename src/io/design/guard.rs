@@ -3,8 +3,8 @@
 //!
 //! **Why before parsing.** Measured on this machine with the parsers stentkit uses (release build):
 //! - serde_yaml's scanner (libyaml) is quadratic in the depth of flow nesting: a `name:` of 10 000 nested `[`
-//!   took 0.28 s, 30 000 took 2.2 s, and a 200 kB design of 100 000 about a minute, before failing on its own
-//!   recursion limit.
+//!   took 0.28 s, 30 000 took 2.2 s, and a 200 kB design of 100 000 took 21.5 s (about a minute on a busy
+//!   machine), before failing on its own recursion limit.
 //! - Block nesting (`- - - - …` on one line) is linear in both parsers, but the field-position index
 //!   ([`super::locate`]) stores one path per node, and a path is as long as the node is deep: 30 000 levels took
 //!   8 s and 2.7 GB.

@@ -11,6 +11,7 @@ pub mod build;
 pub mod dto;
 pub mod guard;
 pub mod locate;
+pub mod quote;
 pub mod stent;
 
 use crate::math::Real;
@@ -304,8 +305,8 @@ pub fn parse_design_with(
             file: file.clone(),
             line: pos.line,
             column: pos.column,
-            field,
-            message,
+            field: quote::shortened(&field, quote::MAX_FIELD_CHARS).into_owned(),
+            message: quote::shortened_message(&message).into_owned(),
         }
     })?;
     overrides.apply(&mut dto);
@@ -319,8 +320,8 @@ pub fn parse_design_with(
             file: file.clone(),
             line: pos.line,
             column: pos.column,
+            message: quote::shortened_message(&issue.message).into_owned(),
             field: issue.path,
-            message: issue.message,
         }
     })?;
     Ok(Design {
