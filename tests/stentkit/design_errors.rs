@@ -436,3 +436,26 @@ fn long_values_are_quoted_shortened_in_errors() {
     };
     assert!(field.ends_with("… (1000 characters)"), "{field}");
 }
+
+#[test]
+fn a_design_name_is_one_folder_name() {
+    // The name becomes `runs/<name>` (broken designs 58–66 cover what a `name:` may not be). Without `name:`
+    // the file stem is the name, and `..yaml` has the stem `.` (Rust's `file_stem` keeps everything before the
+    // last dot): refused too, pointing at the design's first line (there is no `name` to point at).
+    let base = std::fs::read_to_string(data("good_small.yaml")).expect("base");
+    let error = stentkit::io::design::parse_design(&base, Path::new("..yaml"))
+        .expect_err("the stem `.` is not a folder name");
+    let message = error.to_string();
+    assert!(
+        message
+            .starts_with("..yaml:2:1: name: the design has no `name`, and its file name gives `.`"),
+        "{message}"
+    );
+    // Ordinary names, with spaces, dots inside and non-ASCII letters, are names.
+    for name in ["straight stent v2", "stent.2024-05", "Stent für Öhrli", "a"] {
+        let text = base.replacen("version: 1\n", &format!("version: 1\nname: {name}\n"), 1);
+        let design = stentkit::io::design::parse_design(&text, Path::new("named.yaml"))
+            .unwrap_or_else(|e| panic!("{name}: {e}"));
+        assert_eq!(design.model.name, name);
+    }
+}

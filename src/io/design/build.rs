@@ -74,6 +74,32 @@ pub fn build(
             format!("version {v} is not supported; allowed: 1"),
         ));
     }
+    let name = match &dto.name {
+        Some(name) => {
+            check_name(name).map_err(|why| {
+                issue(
+                    "name",
+                    format!(
+                        "{} is not a valid design name ({why}): {NAME_RULE}",
+                        quoted(name)
+                    ),
+                )
+            })?;
+            name.clone()
+        }
+        None => {
+            check_name(default_name).map_err(|why| {
+                issue(
+                    "name",
+                    format!(
+                        "the design has no `name`, and its file name gives {} ({why}): add `name:`; {NAME_RULE}",
+                        quoted(default_name)
+                    ),
+                )
+            })?;
+            default_name.to_string()
+        }
+    };
     let units = match dto.units {
         UnitsDto::Si => Units::Si,
         UnitsDto::MmNMpa => Units::MmNMpa,
@@ -160,7 +186,7 @@ pub fn build(
         .filter(|&t| t > 0.0)
         .collect();
     let model = Model {
-        name: dto.name.clone().unwrap_or_else(|| default_name.to_string()),
+        name,
         units,
         material,
         integrator,
@@ -192,6 +218,42 @@ pub fn build(
         ));
     }
     Ok((model, output, warnings))
+}
+
+/// Longest design name [bytes]: the name is the run folder's name (`runs/<name>`), and 255 bytes is the
+/// longest file name of the usual file systems (ext4, XFS, Btrfs, APFS).
+pub const MAX_NAME_BYTES: usize = 255;
+
+/// What a design name may be, as the errors say it.
+const NAME_RULE: &str = "a name becomes the run folder `runs/<name>`, so it must be one folder name: not empty, not `.` or `..`, at most 255 bytes, without `/`, `\\` or control characters";
+
+/// Why `name` cannot be a run folder's name, if it cannot: a single normal path component on every platform
+/// (no separator, no `.` or `..`, no absolute path or drive prefix), without control characters.
+fn check_name(name: &str) -> std::result::Result<(), String> {
+    if name.is_empty() {
+        return Err("it is empty".into());
+    }
+    if name == "." || name == ".." {
+        return Err("it names a folder itself, not a new one".into());
+    }
+    if let Some(c) = name.chars().find(|&c| c == '/' || c == '\\') {
+        return Err(format!("it contains `{c}`, a path separator"));
+    }
+    if let Some(c) = name.chars().find(|c| c.is_control()) {
+        return Err(format!(
+            "it contains the control character {}",
+            c.escape_debug()
+        ));
+    }
+    if name.len() > MAX_NAME_BYTES {
+        return Err(format!("it has {} bytes", name.len()));
+    }
+    // Whatever the platform adds (a Windows drive prefix such as `C:`): one normal component, itself.
+    let mut components = std::path::Path::new(name).components();
+    match (components.next(), components.next()) {
+        (Some(std::path::Component::Normal(c)), None) if c == name => Ok(()),
+        _ => Err("it is not a plain folder name on this system".into()),
+    }
 }
 
 /// Memory a design may need before it is refused [bytes]: 8 GB. The estimate ([`estimated_memory`]) is
