@@ -1,22 +1,21 @@
 //! `stentkit check`: validate a design and describe what a run would solve.
 
-use crate::io::design::load_design;
-use crate::model::{Component, Model};
+use crate::io::design::build::{MEMORY_LIMIT_BYTES, human_bytes};
+use crate::io::design::{Design, load_design};
+use crate::model::Component;
 use std::fmt::Write as _;
 use std::path::Path;
 
 /// Loads the design and prints its description.
 pub fn run(path: &Path) -> anyhow::Result<()> {
     let design = load_design(path)?;
-    print!(
-        "{}",
-        describe(&design.model, &path.display().to_string(), &design.warnings)
-    );
+    print!("{}", describe(&design, &path.display().to_string()));
     Ok(())
 }
 
 /// The human-readable description printed by `check`.
-pub fn describe(model: &Model, file: &str, warnings: &[String]) -> String {
+pub fn describe(design: &Design, file: &str) -> String {
+    let (model, warnings) = (&design.model, &design.warnings);
     let mut s = String::new();
     let u = model.units;
     let _ = writeln!(s, "design      {} ({file}), units {}", model.name, u.name());
@@ -125,13 +124,27 @@ pub fn describe(model: &Model, file: &str, warnings: &[String]) -> String {
     }
     let _ = writeln!(s, "collocation points  {}", model.num_collocation_points());
     let _ = writeln!(s, "unknowns            {}", model.num_unknowns());
+    let plan = model.planned_steps();
     let _ = writeln!(
         s,
-        "time steps          {} (h = {} s, end {} s)",
-        model.num_time_steps(),
+        "time steps          {} ({} of h = {} s + {} shortened to land on breakpoints; end {} s)",
+        plan.total(),
+        plan.full,
         model.time.step,
+        plan.shortened,
         model.time.end
     );
+    let memory = &design.memory;
+    let _ = write!(
+        s,
+        "memory              about {} (limit {})",
+        human_bytes(memory.total()),
+        human_bytes(MEMORY_LIMIT_BYTES)
+    );
+    if let Some(term) = memory.largest() {
+        let _ = write!(s, "; largest: {} ({})", term.what, term.field);
+    }
+    let _ = writeln!(s);
     let worst = model
         .patches
         .iter()

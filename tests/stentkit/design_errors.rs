@@ -294,6 +294,37 @@ fn generated_corpus() -> Vec<Generated> {
         fragment: "more than stentkit's limit of 4 MiB",
         quick: true,
     });
+    // Breakpoints that exhaust memory within the size limit: 2000 probes make a step cost 512 + 24 · 2000 =
+    // 48 512 bytes (build.rs, `bytes_per_step`); time end 200 000 with step 2000 is 100 nominal steps (4.9 MB),
+    // but a temperature table at t = 1, 2, …, 170 000 (1.6 MB) makes the run land on each: 170 000 shortened
+    // steps and 15 full ones (170 000 to 200 000), 170 015 · 48 512 = 8.25 GB, over the 8 GB limit. The
+    // breakpoints outnumber the full steps, so the field named is the table's, `temperature` (line 25, column
+    // 14).
+    let rows: String = (1..=170_000).map(|k| format!("[{k},1],")).collect();
+    let probes: String = (0..2000)
+        .map(|k| format!("    - {{name: p{k}, node: root}}\n"))
+        .collect();
+    corpus.push(Generated {
+        name: "170 000 breakpoints and 2000 probes",
+        text: base
+            .replace(
+                "temperature: [[0, 90], [1, 40]]",
+                &format!("temperature: [[0, 90],{rows}]"),
+            )
+            .replace(
+                "time: {end: 1.0, step: 0.01}",
+                "time: {end: 200000, step: 2000}",
+            )
+            .replace(
+                "    - {name: tip, node: hook.end}\n",
+                &format!("    - {{name: tip, node: hook.end}}\n{probes}"),
+            ),
+        line: 25,
+        column: 14,
+        field: "temperature",
+        fragment: "170015 time steps (15 of 2000 + 170000 shortened to land on breakpoints)",
+        quick: false,
+    });
     corpus
 }
 

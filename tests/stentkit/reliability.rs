@@ -157,3 +157,67 @@ fn a_weakly_held_rod_gets_a_singular_tangent_diagnosis() {
         "the last converged state is the initial one"
     );
 }
+
+#[test]
+fn planned_steps_are_the_steps_a_run_takes() {
+    // Reference: the run itself (its summary's step count). The 45° bend (h = 0.1, end 1; the load table's
+    // breakpoint is the end) takes 10 steps. Given a temperature table with breakpoints at 0.05, 0.33 and 0.77
+    // (no effect on this elastic rod, but time stepping lands on them) the intervals 0.05, 0.28, 0.44 and 0.23
+    // take 1, 2 + 1, 4 + 1 and 2 + 1 steps: 8 full and 4 shortened. Snapshot times 0.123 and 0.5 are landed on
+    // too: 0.123 splits the second interval (0.073: 1 shortened; 0.207: 2 full + 1 shortened) and 0.5 the third
+    // (0.17: 1 full + 1 shortened; 0.27: 2 full + 1 shortened), so 7 full and 6 shortened.
+    let table = "temperature: [[0, 20], [0.05, 20], [0.33, 25], [0.77, 20], [1, 20]]\ntime: {";
+    let cases = [
+        (bend45(), 10, 0),
+        (variant("time: {", table), 8, 4),
+        (
+            variant("time: {", table).replacen(
+                "output:\n",
+                "output:\n  snapshots: {times: [0.123, 0.5]}\n",
+                1,
+            ),
+            7,
+            6,
+        ),
+    ];
+    for (text, full, shortened) in cases {
+        let design = parse_design(&text, Path::new("steps.yaml")).expect("a valid design");
+        let plan = design.model.planned_steps();
+        assert_eq!((plan.full, plan.shortened), (full, shortened), "{text}");
+        let mut sim = Simulation::new(&design.model).expect("simulation");
+        let summary = sim.run(&mut NoObserver).expect("the bend converges");
+        assert_eq!(summary.steps, plan.total(), "{text}");
+    }
+}
+
+#[test]
+fn breakpoints_count_in_the_steps_and_the_snapshot_spacing() {
+    // A temperature table of 200 000 breakpoints (t = k · 5 µs, 3 MB: under the 4 MiB size limit) on the
+    // 45° bend (h = 0.1, 10 nominal steps): every interval is shorter than the step, so the run lands on each,
+    // 200 000 steps, and the default snapshot spacing is ⌈200 000 / 20⌉ = 10 000 steps (it was ⌈10 / 20⌉ = 1,
+    // a snapshot at every one of the 200 000 steps). At 536 bytes per step the memory estimate is 0.11 GB:
+    // accepted (a million breakpoints would be 0.54 GB, but their table is over the size limit).
+    let rows: String = (1..=200_000)
+        .map(|k| format!("[{:.6}, 20],", k as f64 * 5e-6))
+        .collect();
+    let text = variant(
+        "time: {",
+        &format!("temperature: [[0, 20],{rows}]\ntime: {{"),
+    );
+    let design = parse_design(&text, Path::new("table.yaml")).expect("accepted");
+    let plan = design.model.planned_steps();
+    assert_eq!((plan.full, plan.shortened), (0, 200_000));
+    assert_eq!(design.output.snapshots.every, 10_000);
+    let memory = design.memory.total();
+    assert!((0.1e9..0.12e9).contains(&memory), "{memory}");
+    let largest = design.memory.largest().expect("terms");
+    assert_eq!(largest.field, "temperature");
+    // `check` prints the count.
+    let description = stentkit::cli::check::describe(&design, "table.yaml");
+    assert!(
+        description.contains(
+            "time steps          200000 (0 of h = 0.1 s + 200000 shortened to land on breakpoints"
+        ),
+        "{description}"
+    );
+}

@@ -35,7 +35,8 @@ pub struct SnapshotSettings {
 }
 
 impl SnapshotSettings {
-    /// Default number of periodic snapshots over a run: `every = ⌈nominal steps / 20⌉`.
+    /// Default number of periodic snapshots over a run: `every = ⌈steps / 20⌉`, counting the steps that land
+    /// on breakpoints ([`crate::model::Model::planned_steps`]).
     pub const DEFAULT_COUNT: usize = 20;
     /// Default vertices around a section: 16, the section polygon has 97.4 % of the circle's area.
     pub const DEFAULT_SEGMENTS: usize = 16;
@@ -87,6 +88,8 @@ pub struct Design {
     pub output: OutputSettings,
     /// Things worth knowing that do not stop a run.
     pub warnings: Vec<String>,
+    /// The memory a run is estimated to need (below [`build::MEMORY_LIMIT_BYTES`]: larger designs are refused).
+    pub memory: build::MemoryEstimate,
     /// The YAML text as read (embedded in run recordings).
     pub source: String,
     /// Where it was read from.
@@ -314,7 +317,7 @@ pub fn parse_design_with(
         || "design".to_string(),
         |s| s.to_string_lossy().into_owned(),
     );
-    let (model, output, warnings) = build::build(&dto, &stem).map_err(|issue| {
+    let built = build::build(&dto, &stem).map_err(|issue| {
         let pos = locator.find(&issue.path);
         DesignError::Invalid {
             file: file.clone(),
@@ -325,9 +328,10 @@ pub fn parse_design_with(
         }
     })?;
     Ok(Design {
-        model,
-        output,
-        warnings,
+        model: built.model,
+        output: built.output,
+        warnings: built.warnings,
+        memory: built.memory,
         source: text.to_string(),
         path: file,
     })
