@@ -2,6 +2,7 @@
 
 use crate::io::design::build::{MEMORY_LIMIT_BYTES, human_bytes};
 use crate::io::design::{Design, load_design};
+use crate::io::estimate::estimated_disk;
 use crate::model::Component;
 use std::fmt::Write as _;
 use std::path::Path;
@@ -145,6 +146,21 @@ pub fn describe(design: &Design, file: &str) -> String {
         let _ = write!(s, "; largest: {} ({})", term.what, term.field);
     }
     let _ = writeln!(s);
+    let disk = estimated_disk(design);
+    let mb = |bytes: u64| bytes as f64 / 1e6;
+    let _ = writeln!(
+        s,
+        "disk                about {:.1} MB: {} snapshots {:.1} MB (STL {:.1} MB + OBJ {:.1} MB), run.mcap {:.1} MB, history.csv {:.1} MB, charts {:.1} MB, summary.json {:.1} MB",
+        mb(disk.total()),
+        disk.snapshots,
+        mb(disk.snapshot_stl + disk.snapshot_obj),
+        mb(disk.snapshot_stl),
+        mb(disk.snapshot_obj),
+        mb(disk.recording),
+        mb(disk.history),
+        mb(disk.charts),
+        mb(disk.summary)
+    );
     let worst = model
         .patches
         .iter()

@@ -221,3 +221,64 @@ fn breakpoints_count_in_the_steps_and_the_snapshot_spacing() {
         "{description}"
     );
 }
+
+/// Bytes of every file under `dir`.
+fn folder_bytes(dir: &Path) -> u64 {
+    std::fs::read_dir(dir)
+        .expect("folder")
+        .map(|e| {
+            let path = e.expect("entry").path();
+            if path.is_dir() {
+                folder_bytes(&path)
+            } else {
+                std::fs::metadata(&path).expect("file").len()
+            }
+        })
+        .sum()
+}
+
+#[test]
+fn the_disk_estimate_bounds_a_run_folder_from_above() {
+    // Reference: the run folder itself. The 45° bend at h = 1e-3 (1000 steps, 21 snapshots, every output
+    // written; about 0.3 s) wrote 3.29 MB against an estimate of 3.46 MB when the estimate was calibrated
+    // (io::estimate's table). The estimate must not be below what is written, nor more than 1.3 times it: a
+    // writer that grows (or an estimate that drifts) fails here.
+    let text = variant("step: 0.1}", "step: 1.0e-3}");
+    let dir = crate::outputs::test_outputs("disk_estimate");
+    std::fs::create_dir_all(&dir).expect("folder");
+    let file = dir.join("bend_fine.yaml");
+    std::fs::write(&file, &text).expect("design written");
+    let design = stentkit::io::design::load_design(&file).expect("valid");
+    let estimate = stentkit::io::estimate::estimated_disk(&design);
+    let run = dir.join("run");
+    let out = Command::new(env!("CARGO_BIN_EXE_stentkit"))
+        .args([
+            "run",
+            file.to_str().expect("path"),
+            "--force",
+            "--quiet",
+            "-o",
+        ])
+        .arg(&run)
+        .output()
+        .expect("stentkit runs");
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let written = folder_bytes(&run) as f64;
+    let ratio = estimate.total() as f64 / written;
+    assert!(
+        (1.0..1.3).contains(&ratio),
+        "{estimate:?}: {written} bytes written, ratio {ratio}"
+    );
+    let snapshots = std::fs::read_dir(run.join("snapshots"))
+        .expect("snapshots")
+        .count();
+    assert_eq!(
+        2 * estimate.snapshots,
+        snapshots,
+        "an STL and an OBJ per snapshot"
+    );
+}
