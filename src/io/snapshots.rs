@@ -81,8 +81,9 @@ pub enum SnapshotError {
         #[source]
         source: std::io::Error,
     },
-    /// The deformed tubes could not be built (e.g. a section turned into the centreline).
-    #[error("step {step} (t = {time}): patch `{patch}`: {source}")]
+    /// The deformed tubes could not be built (e.g. a section turned into the centreline). The cause is the
+    /// error's source, not part of its message: error chains (`{:#}`) print it once.
+    #[error("step {step} (t = {time}): patch `{patch}`")]
     Mesh {
         /// Step.
         step: usize,

@@ -282,3 +282,43 @@ fn the_disk_estimate_bounds_a_run_folder_from_above() {
         "an STL and an OBJ per snapshot"
     );
 }
+
+#[test]
+fn two_rings_per_patch_draw_a_rolled_up_beam() {
+    // The roll-up (designs/rollup.yaml: a beam bent into a full circle over 20 steps, one snapshot per step)
+    // with the smallest ring counts allowed, 2 per patch for the snapshots and for the recorded meshes. At step
+    // 10 the beam is a half circle: both end sections contain the chord between them, and the run used to stop
+    // there ("stopped", exit 1, "section 0 is not transverse" printed twice). Now the rings are tilted to 60°
+    // from the chord and the run completes with all 21 snapshots.
+    let text =
+        std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join("designs/rollup.yaml"))
+            .expect("rollup")
+            .replacen(
+                "output:\n",
+                "output:\n  snapshots: {rings: 2}\n  recording: {mesh_rings: 2}\n",
+                1,
+            );
+    let dir = crate::outputs::test_outputs("two_rings");
+    std::fs::create_dir_all(&dir).expect("folder");
+    let file = dir.join("rollup_two_rings.yaml");
+    std::fs::write(&file, &text).expect("design written");
+    let out = Command::new(env!("CARGO_BIN_EXE_stentkit"))
+        .args([
+            "run",
+            file.to_str().expect("path"),
+            "--force",
+            "--quiet",
+            "-o",
+        ])
+        .arg(dir.join("run"))
+        .output()
+        .expect("stentkit runs");
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{stderr}");
+    let summary = std::fs::read_to_string(dir.join("run/summary.json")).expect("summary");
+    assert!(summary.contains("\"status\": \"completed\""), "{summary}");
+    let snapshots = std::fs::read_dir(dir.join("run/snapshots"))
+        .expect("snapshots")
+        .count();
+    assert_eq!(snapshots, 2 * 21, "an STL and an OBJ at steps 0 to 20");
+}
