@@ -322,3 +322,24 @@ fn two_rings_per_patch_draw_a_rolled_up_beam() {
         .count();
     assert_eq!(snapshots, 2 * 21, "an STL and an OBJ at steps 0 to 20");
 }
+
+#[test]
+fn a_million_breakpoints_are_counted_in_linear_time() {
+    // A design file cannot hold a 10⁶-breakpoint table (about 15 MB, over the 4 MiB size limit; the generated
+    // corpus in design_errors checks that refusal), but a model built in code can. The 45° bend (h = 0.1, end
+    // 1) given a temperature table at t = k · 1e-6, k = 0 … 10⁶: every interval is shorter than the step, so
+    // the run would land on each of the 10⁶ breakpoints; counted in well under a second (the count is linear
+    // after a sort; the bound leaves a hundredfold margin on this shared machine).
+    let mut model = parse_design(&bend45(), Path::new("bend45.yaml"))
+        .expect("bend45")
+        .model;
+    let table = (0..=1_000_000).map(|k| (k as f64 * 1e-6, 20.0)).collect();
+    model.temperature = stentkit::model::TimeFunction::try_table(table).expect("increasing");
+    let started = std::time::Instant::now();
+    let plan = model.planned_steps();
+    let elapsed = started.elapsed();
+    assert_eq!((plan.full, plan.shortened), (0, 1_000_000));
+    assert!(elapsed.as_secs_f64() < 1.0, "{elapsed:?}");
+    // At 536 bytes per step (one probe) that is 0.54 GB of samples: within the 8 GB limit, so such a model is
+    // not refused for its steps; a design is refused for its size first.
+}
