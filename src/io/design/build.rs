@@ -217,8 +217,8 @@ pub fn build(dto: &DesignDto, default_name: &str) -> Result<Built> {
     };
     // The steps the run takes, landing on every breakpoint: refused if their memory is too much, and the
     // default snapshot spacing follows them.
-    let planned = model.planned_steps().total();
-    let memory = check_size(dto, &StepCount::planned(&model, dto))?;
+    let plan = model.planned_steps();
+    let memory = check_size(dto, &StepCount::planned(&plan, model.time.step, dto))?;
     if dto
         .output
         .as_ref()
@@ -226,7 +226,9 @@ pub fn build(dto: &DesignDto, default_name: &str) -> Result<Built> {
         .and_then(|s| s.every)
         .is_none()
     {
-        output.snapshots.every = planned.div_ceil(super::SnapshotSettings::DEFAULT_COUNT);
+        output.snapshots.every = plan
+            .total()
+            .div_ceil(super::SnapshotSettings::DEFAULT_COUNT);
     }
     // A part no condition holds can move as a rigid body: `run` refuses it (the solver's check), `check` warns.
     for body in crate::solver::diagnose::free_bodies(&model) {
@@ -362,10 +364,10 @@ impl StepCount {
         }
     }
 
-    /// The steps the run takes ([`Model::planned_steps`]): charged to `time.step` unless the steps shortened to
-    /// land on breakpoints outnumber the full ones, then to the schedule with the most breakpoints.
-    pub fn planned(model: &Model, dto: &DesignDto) -> Self {
-        let plan = model.planned_steps();
+    /// The steps the run takes (`plan`, [`Model::planned_steps`] with nominal step `step`): charged to
+    /// `time.step` unless the steps shortened to land on breakpoints outnumber the full ones, then to the
+    /// schedule with the most breakpoints.
+    pub fn planned(plan: &StepPlan, step: Real, dto: &DesignDto) -> Self {
         let field = match busiest_schedule(dto) {
             Some(field) if plan.shortened > plan.full => field,
             _ => "time.step".to_string(),
@@ -376,7 +378,7 @@ impl StepCount {
                 "{} time steps ({} of {} + {} shortened to land on breakpoints)",
                 plan.total(),
                 plan.full,
-                model.time.step,
+                step,
                 plan.shortened
             ),
             field,
