@@ -1,22 +1,22 @@
 //! `stentkit check`: validate a design and describe what a run would solve.
 
-use crate::io::design::load_design;
-use crate::model::{Component, Model};
+use crate::io::design::build::{MEMORY_LIMIT_BYTES, human_bytes};
+use crate::io::design::{Design, load_design};
+use crate::io::estimate::estimated_disk;
+use crate::model::Component;
 use std::fmt::Write as _;
 use std::path::Path;
 
 /// Loads the design and prints its description.
 pub fn run(path: &Path) -> anyhow::Result<()> {
     let design = load_design(path)?;
-    print!(
-        "{}",
-        describe(&design.model, &path.display().to_string(), &design.warnings)
-    );
+    print!("{}", describe(&design, &path.display().to_string()));
     Ok(())
 }
 
 /// The human-readable description printed by `check`.
-pub fn describe(model: &Model, file: &str, warnings: &[String]) -> String {
+pub fn describe(design: &Design, file: &str) -> String {
+    let (model, warnings) = (&design.model, &design.warnings);
     let mut s = String::new();
     let u = model.units;
     let _ = writeln!(s, "design      {} ({file}), units {}", model.name, u.name());
@@ -125,12 +125,41 @@ pub fn describe(model: &Model, file: &str, warnings: &[String]) -> String {
     }
     let _ = writeln!(s, "collocation points  {}", model.num_collocation_points());
     let _ = writeln!(s, "unknowns            {}", model.num_unknowns());
+    let plan = model.planned_steps();
     let _ = writeln!(
         s,
-        "time steps          {} (h = {} s, end {} s)",
-        model.num_time_steps(),
+        "time steps          {} ({} of h = {} s + {} shortened to land on breakpoints; end {} s)",
+        plan.total(),
+        plan.full,
         model.time.step,
+        plan.shortened,
         model.time.end
+    );
+    let memory = &design.memory;
+    let _ = write!(
+        s,
+        "memory              about {} (limit {})",
+        human_bytes(memory.total()),
+        human_bytes(MEMORY_LIMIT_BYTES)
+    );
+    if let Some(term) = memory.largest() {
+        let _ = write!(s, "; largest: {} ({})", term.what, term.field);
+    }
+    let _ = writeln!(s);
+    let disk = estimated_disk(design);
+    let mb = |bytes: u64| bytes as f64 / 1e6;
+    let _ = writeln!(
+        s,
+        "disk                about {:.1} MB: {} snapshots {:.1} MB (STL {:.1} MB + OBJ {:.1} MB), run.mcap {:.1} MB, history.csv {:.1} MB, charts {:.1} MB, summary.json {:.1} MB",
+        mb(disk.total()),
+        disk.snapshots,
+        mb(disk.snapshot_stl + disk.snapshot_obj),
+        mb(disk.snapshot_stl),
+        mb(disk.snapshot_obj),
+        mb(disk.recording),
+        mb(disk.history),
+        mb(disk.charts),
+        mb(disk.summary)
     );
     let worst = model
         .patches

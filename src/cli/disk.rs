@@ -1,25 +1,81 @@
-//! Refusing a run that the disk cannot hold: the run's estimated output (snapshots, recording, history) against
-//! the free space of the run folder's file system, before anything is removed or written.
+//! Refusing a run that the disk cannot hold: the run's estimated output ([`estimated_disk`]: snapshots,
+//! recording, history, charts, summary) and the finishing reserve against the free space of the run folder's
+//! file system, before anything is removed or written.
 
 use super::BadInput;
 use crate::io::design::Design;
-use crate::io::run_folder::RunFolder;
+use crate::io::design::build::human_bytes;
+use crate::io::design::locate::Locator;
+use crate::io::estimate::{DiskEstimate, estimated_disk};
+use crate::io::run_folder::bytes_of;
+use crate::math::Real;
+use std::collections::BTreeSet;
+use std::path::{Path, PathBuf};
 
-/// Refuses (with [`BadInput`]) a run whose estimated output exceeds the free space of the run folder's file
-/// system plus what `--force` will free (the earlier run's files).
+/// Room a run keeps free for finishing \[bytes\]: the summary (a few kB) and the charts (tens of kB each), written
+/// after a disk that filled up during the run ([`crate::io::run_folder::RunFolder::reserve`]).
+pub const FINISHING_RESERVE: usize = 1 << 20;
+
+/// Refuses (with [`BadInput`]) a run into `dir` whose estimated output plus [`FINISHING_RESERVE`] exceeds the
+/// free space of the folder's file system (of its nearest existing ancestor, if it does not exist yet) plus what
+/// `--force` will free (`previous`, the earlier run's files). A file system whose free space cannot be read is
+/// not checked.
 ///
 /// # Errors
-/// [`BadInput`] naming the estimate, the free space and the fields that size the output.
-pub fn check_space(design: &Design, folder: &RunFolder) -> anyhow::Result<()> {
-    let needed: u64 = 0; // TODO(merge): the disk estimate
-    let _ = design;
-    let Ok(free) = fs4::available_space(folder.dir()) else {
-        // Unknown free space (an unusual file system): nothing to compare with.
+/// [`BadInput`] naming the design file, the field that sizes the largest part (with its line and column when
+/// the design sets it), the estimate by part and the free space.
+pub fn check_space(
+    design: &Design,
+    dir: &Path,
+    previous: &BTreeSet<PathBuf>,
+) -> anyhow::Result<()> {
+    let estimate = estimated_disk(design);
+    let needed = estimate.total() + FINISHING_RESERVE as u64;
+    let Some(Ok(free)) = dir
+        .ancestors()
+        .find(|a| a.exists())
+        .map(fs4::available_space)
+    else {
         return Ok(());
     };
-    let free = free + folder.previous_bytes();
-    if needed > free {
-        return Err(BadInput(format!("{}: not enough space", folder.dir().display())).into());
+    let free = free + bytes_of(dir, previous);
+    if needed <= free {
+        return Ok(());
     }
-    Ok(())
+    let (field, advice) = largest_part(&estimate);
+    let position = Locator::new(&design.source)
+        .get(field)
+        .map(|p| format!(":{}:{}", p.line, p.column))
+        .unwrap_or_default();
+    Err(BadInput(format!(
+        "{}{position}: {field}: this run would write about {} ({} snapshots {}, run.mcap {}, history.csv {}, charts and summary {}) into {}, whose file system has {} free: {advice}, or choose a folder on a larger disk with -o",
+        design.path.display(),
+        human_bytes(needed as Real),
+        estimate.snapshots,
+        human_bytes((estimate.snapshot_stl + estimate.snapshot_obj) as Real),
+        human_bytes(estimate.recording as Real),
+        human_bytes(estimate.history as Real),
+        human_bytes((estimate.charts + estimate.summary) as Real),
+        dir.display(),
+        human_bytes(free as Real),
+    ))
+    .into())
+}
+
+/// The field that sizes the largest part of `estimate`, and what to do with it.
+fn largest_part(estimate: &DiskEstimate) -> (&'static str, &'static str) {
+    let snapshots = estimate.snapshot_stl + estimate.snapshot_obj;
+    if snapshots >= estimate.recording && snapshots >= estimate.history {
+        (
+            "output.snapshots.every",
+            "take fewer snapshots (a larger `every`, fewer `times`) or smaller ones (fewer `rings`, `segments`)",
+        )
+    } else if estimate.recording >= estimate.history {
+        (
+            "output.recording.centreline_points",
+            "record fewer centreline points per patch, or set `meshes: false`",
+        )
+    } else {
+        ("time.step", "take larger time steps")
+    }
 }

@@ -20,12 +20,13 @@
 
 use super::signals;
 use super::{BadInput, Interrupted, error_text, short_time};
+use crate::io::design::build::human_bytes;
 use crate::io::design::{Design, load_design};
 use crate::io::history::HistoryWriter;
 use crate::io::mcap::{McapRecorder, RunInfo};
 use crate::io::mcap_salvage::{Salvage, salvage};
 use crate::io::run_charts::RunCharts;
-use crate::io::run_folder::{Manifest, RunFolder, RunFolderError};
+use crate::io::run_folder::{self, Manifest, RunFolder, RunFolderError};
 use crate::io::snapshots::SnapshotWriter;
 use crate::io::summary::{
     FailureReport, FinalState, OutputState, RunStatus, RunSummaryFile, peak_memory_mib,
@@ -42,10 +43,6 @@ use std::time::{Duration, Instant};
 /// chunk: what SIGKILL or a power loss can take is at most this much of the run (plus the step in progress).
 /// Each chunk boundary costs a little compression; every 2 s is far below a percent of the recording.
 const HEARTBEAT: Duration = Duration::from_secs(2);
-
-/// Room kept free for finishing a run \[bytes\]: the summary (a few kB) and the charts (tens of kB each), written
-/// after a disk that filled up during the run (see [`RunFolder::reserve`]).
-const FINISHING_RESERVE: usize = 1 << 20;
 
 /// Positions of the progress bar over the run (simulated time is mapped onto them).
 const PROGRESS_RESOLUTION: u64 = 10_000;
@@ -328,11 +325,14 @@ pub fn run(design_path: &Path, options: RunOptions) -> anyhow::Result<()> {
         .into());
     }
     let dir = run_dir(options.output.clone(), &design.model.name);
-    let mut folder = RunFolder::open(&dir, design_path, options.force).map_err(|e| match e {
+    let refused = |e: RunFolderError| match e {
         RunFolderError::Refused { .. } => anyhow::Error::new(BadInput(e.to_string())),
         e => e.into(),
-    })?;
-    super::disk::check_space(&design, &folder)?;
+    };
+    // Nothing is written before the folder and the disk are found fit for the run.
+    let previous = run_folder::check(&dir, design_path, options.force).map_err(refused)?;
+    super::disk::check_space(&design, &dir, &previous)?;
+    let mut folder = RunFolder::open(&dir, design_path, options.force).map_err(refused)?;
     folder.clear_previous()?;
     run_in(&design, &folder, &options, started)
 }
@@ -364,7 +364,7 @@ fn run_in(
         problem: None,
     };
     summary.write(|_| {})?;
-    let reserve = folder.reserve(FINISHING_RESERVE)?;
+    let reserve = folder.reserve(super::disk::FINISHING_RESERVE)?;
     let setup = (|| -> anyhow::Result<_> {
         let sim = Simulation::new(model)?;
         if !options.quiet {
@@ -373,7 +373,7 @@ fn run_in(
                 model.name,
                 model.patches.len(),
                 model.num_unknowns(),
-                model.num_time_steps(),
+                model.planned_steps().total(),
                 model.time.step,
                 model.time.end,
                 dir.display()
@@ -512,7 +512,7 @@ fn run_in(
         totals.factorisations,
         totals.cuts,
         summary.summary.snapshots.len(),
-        human_bytes(mcap_bytes),
+        human_bytes(mcap_bytes as Real),
         summary.summary.wall_time_s,
         summary
             .summary
@@ -840,18 +840,4 @@ fn failure_report(failure: &FailureReport, summary: &RunSummaryFile) -> String {
         short_time(failure.last_converged_time)
     ));
     lines.join("\n")
-}
-
-/// `1.2 MB`-style size.
-fn human_bytes(bytes: u64) -> String {
-    let b = bytes as f64;
-    if b >= 1e9 {
-        format!("{:.2} GB", b / 1e9)
-    } else if b >= 1e6 {
-        format!("{:.1} MB", b / 1e6)
-    } else if b >= 1e3 {
-        format!("{:.0} kB", b / 1e3)
-    } else {
-        format!("{bytes} B")
-    }
 }

@@ -516,6 +516,14 @@ pub struct TubeSettings {
     /// rotations are orthonormal to rounding (`~1e-15`); anything worse than `1e-6` would draw a visibly
     /// elliptic or skewed section and indicates a bug or unnormalised input.
     pub frame_tolerance: Real,
+    /// Largest angle [rad] between a ring's section normal (`d2 × d3`) and the sampled centreline direction
+    /// that [`device_mesh`] draws as given. Coarse samples of a bent rod tilt the sections against the polyline
+    /// that joins them (by half the angle the rod turns between two samples): two rings on a patch bent into a
+    /// half circle put both sections edge-on to the chord, which no tube can be swept through. A ring tilted
+    /// further is turned, about the axis normal to both directions, until its tilt is this angle. Default
+    /// `π/3` (60°): up to 120° of turn between samples is drawn as the solver's sections; the default 41
+    /// rings per patch never come close.
+    pub max_section_tilt: Real,
     /// Largest distance of an end ring from a symmetry plane, as a fraction of the tube radius, for
     /// [`device_mesh`] to treat the ring as lying in the plane (left open and welded to its mirror image).
     /// Default `1e-6`: a rod end held by symmetry conditions lies in the plane to the solver's round-off
@@ -524,12 +532,13 @@ pub struct TubeSettings {
 }
 
 impl Default for TubeSettings {
-    /// 16 segments around, `min_section_cosine = 1e-3`, `frame_tolerance = 1e-6`, `seam_tolerance = 1e-6`
-    /// (see the fields).
+    /// 16 segments around, `min_section_cosine = 1e-3`, `max_section_tilt = π/3`, `frame_tolerance = 1e-6`,
+    /// `seam_tolerance = 1e-6` (see the fields).
     fn default() -> Self {
         Self {
             segments_around: 16,
             min_section_cosine: 1e-3,
+            max_section_tilt: PI / 3.0,
             frame_tolerance: 1e-6,
             seam_tolerance: 1e-6,
         }
@@ -632,6 +641,13 @@ impl TubeSettings {
                 name: "min_section_cosine",
                 value: self.min_section_cosine,
                 expected: "0 <= value < 1",
+            });
+        }
+        if !(self.max_section_tilt > 0.0 && self.max_section_tilt.cos() > self.min_section_cosine) {
+            return Err(TubeError::InvalidSetting {
+                name: "max_section_tilt",
+                value: self.max_section_tilt,
+                expected: "0 < value, cos(value) > min_section_cosine",
             });
         }
         if !(self.frame_tolerance >= 0.0 && self.frame_tolerance.is_finite()) {
@@ -1676,6 +1692,53 @@ pub fn phase_turn(phase: Real, segments: usize) -> Mat3 {
     *crate::math::so3::exp(&(Vec3::x() * (2.0 * PI * phase / segments.max(1) as Real))).matrix()
 }
 
+/// `frames` for drawing the polyline `centre` as a tube: each frame whose section normal (`d2 × d3`) is more
+/// than `max_tilt` from the sampled centreline direction (the tangents of [`sweep_tube`]) is turned, about
+/// the axis normal to both, until it is `max_tilt` from it; the others are kept. The normals are compared on
+/// the side most of the rod's sections face (`d2 × d3` along or against the samples' order; along when
+/// undecided), so a ring facing the wrong way is turned too. Frames the sweep would reject (too few samples,
+/// coincident samples, non-finite or degenerate frames) are returned unchanged, for the sweep to report.
+pub fn limited_tilt(centre: &[Vec3], frames: &[Mat3], max_tilt: Real) -> Vec<Mat3> {
+    let Ok(tangents) = centreline_tangents(centre) else {
+        return frames.to_vec();
+    };
+    if tangents.len() != frames.len() {
+        return frames.to_vec();
+    }
+    let normals: Vec<Option<Vec3>> = frames
+        .iter()
+        .map(|f| f.column(1).cross(&f.column(2)).try_normalize(0.0))
+        .collect();
+    let facing: Real = normals
+        .iter()
+        .zip(&tangents)
+        .filter_map(|(n, t)| n.map(|n| n.dot(t)))
+        .filter(|c| c.is_finite())
+        .sum();
+    let side = if facing < 0.0 { -1.0 } else { 1.0 };
+    frames
+        .iter()
+        .zip(&normals)
+        .zip(&tangents)
+        .map(|((frame, normal), tangent)| {
+            let Some(n) = normal.map(|n| side * n) else {
+                return *frame;
+            };
+            let tilt = n.dot(tangent).clamp(-1.0, 1.0).acos();
+            if !(tilt > max_tilt) {
+                return *frame;
+            }
+            // Turning n about n × t moves it towards t; edge-on the other way, any axis normal to t.
+            let axis = n
+                .cross(tangent)
+                .try_normalize(0.0)
+                .unwrap_or_else(|| super::frame::normal_to(tangent, None));
+            let turn = crate::math::so3::exp(&(axis * (tilt - max_tilt)));
+            turn.matrix() * frame
+        })
+        .collect()
+}
+
 /// One rod of a device, sampled for drawing as a tube.
 #[derive(Debug, Clone, Copy)]
 pub struct RodTube<'a> {
@@ -1750,7 +1813,8 @@ pub fn device_mesh(
             }));
         }
         let turn = phase_turn(rod.phase, m);
-        let frames: Vec<Mat3> = rod.frames.iter().map(|f| f * turn).collect();
+        let turned: Vec<Mat3> = rod.frames.iter().map(|f| f * turn).collect();
+        let frames = limited_tilt(rod.centre, &turned, settings.max_section_tilt);
         // The plane an end ring lies in: its largest distance from the plane is
         // |(c − p)·n| + r |(d2·n, d3·n)|.
         let ring_plane = |i: usize| {
@@ -1929,5 +1993,47 @@ mod device_tests {
         keys.sort_unstable();
         keys.dedup();
         assert_eq!(keys.len(), mesh.vertices.len());
+    }
+
+    #[test]
+    fn two_rings_on_a_half_circle_are_drawn_as_a_tilted_straight_tube() {
+        // A half ring (R = 1) sampled at its two ends only: the chord is (−2, 0, 0), and both sections (normal
+        // to the arc's tangent, ±y) contain it, so the sweep alone rejects them (cosine 0). device_mesh turns
+        // each ring towards the chord until its normal is 60° from it (TubeSettings::max_section_tilt); the
+        // tube is then closed and outward, with each ring's plane at 60° from the chord: the normal of the
+        // plane through three of a ring's vertices, dotted with the chord direction, is cos 60° = 0.5 in
+        // magnitude (round-off aside).
+        let (centre, frames) = arc(1.0, 0.0, PI, 2);
+        let settings = TubeSettings::default();
+        assert!(matches!(
+            sweep_tube(&centre, &frames, 0.1, &settings),
+            Err(TubeError::SectionNotTransverse { .. })
+        ));
+        let rod = RodTube {
+            centre: &centre,
+            frames: &frames,
+            radius: 0.1,
+            phase: 0.0,
+            in_plane: None,
+        };
+        let mesh = device_mesh(&[rod], &[], &settings).expect("drawn");
+        assert_eq!(mesh.check_closed(), Ok(()));
+        assert!(mesh.volume() > 0.0);
+        let m = settings.segments_around;
+        let chord = Vec3::new(-1.0, 0.0, 0.0);
+        for ring in 0..2 {
+            let v = |k: usize| mesh.vertices[ring * m + k];
+            let normal = (v(1) - v(0)).cross(&(v(m / 2) - v(0))).normalize();
+            assert!(
+                (normal.dot(&chord).abs() - 0.5).abs() < 1e-12,
+                "ring {ring}"
+            );
+        }
+        // A ring within 60° of the samples' direction is kept as given (the quarter ring's 45° at two samples).
+        let (centre, frames) = arc(1.0, 0.0, 0.5 * PI, 2);
+        assert_eq!(
+            limited_tilt(&centre, &frames, settings.max_section_tilt),
+            frames
+        );
     }
 }

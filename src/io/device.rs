@@ -47,17 +47,32 @@ pub fn decimated(shape: &PatchShape, target: usize) -> PatchShape {
 /// number of samples per control point that gives at least that many for every patch, then reduced
 /// ([`decimated`]). The ends of every patch are always samples.
 pub fn current_device_shapes(sim: &Simulation<'_>, samples: usize) -> Vec<PatchShape> {
-    let per_point = sim
-        .model()
+    current_shapes(sim, samples_per_point(sim.model(), samples))
+        .iter()
+        .map(|s| decimated(s, samples))
+        .collect()
+}
+
+/// The smallest whole number of samples per control point that gives every patch of `model` at least
+/// `samples` samples ([`current_device_shapes`] samples at it, then decimates).
+pub fn samples_per_point(model: &Model, samples: usize) -> usize {
+    model
         .patches
         .iter()
         .map(|p| (samples.saturating_sub(1)).div_ceil(p.curve.num_points().max(1)))
         .max()
         .unwrap_or(1)
-        .max(1);
-    current_shapes(sim, per_point)
+        .max(1)
+}
+
+/// The number of samples (rings of a tube, points of a centreline) each patch of `model` gets from
+/// [`current_device_shapes`] with `samples`, in patch order: `samples_per_point · n + 1` decimated.
+pub fn device_sample_counts(model: &Model, samples: usize) -> Vec<usize> {
+    let per_point = samples_per_point(model, samples);
+    model
+        .patches
         .iter()
-        .map(|s| decimated(s, samples))
+        .map(|p| decimation(per_point * p.curve.num_points().max(1) + 1, samples).len())
         .collect()
 }
 

@@ -4,6 +4,7 @@
 pub mod chart;
 pub mod design;
 pub mod device;
+pub mod estimate;
 pub mod history;
 pub mod mcap;
 pub mod mcap_salvage;

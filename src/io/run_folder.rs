@@ -202,6 +202,53 @@ fn forbidden(dir: &Path, design_file: &Path) -> Option<&'static str> {
     None
 }
 
+/// Whether a run of the design in `design_file` may write into `dir`, changing nothing: refuses the root, the
+/// home folder, the design's folder, a folder that is not empty and not a run folder, and (without `force`) a
+/// run folder that holds an earlier run. Returns the earlier run's files (what `--force` will remove).
+///
+/// # Errors
+/// [`RunFolderError::Refused`] (bad input), [`RunFolderError::Io`].
+pub fn check(
+    dir: &Path,
+    design_file: &Path,
+    force: bool,
+) -> Result<BTreeSet<PathBuf>, RunFolderError> {
+    let refuse = |reason: String| RunFolderError::Refused {
+        path: dir.to_path_buf(),
+        reason,
+    };
+    if let Some(why) = forbidden(dir, design_file) {
+        return Err(refuse(format!(
+            "{why}; a run writes into a folder of its own: choose one with -o (default runs/<design name>)"
+        )));
+    }
+    match classify(dir)? {
+        FolderKind::Empty => Ok(BTreeSet::new()),
+        FolderKind::Foreign => Err(refuse(
+            "is not empty and is not a stentkit run folder (it has no .stentkit-run manifest); \
+             choose an empty or new folder with -o"
+                .into(),
+        )),
+        // A folder whose earlier run left none of its files (a refused or cleared run) is as good as empty.
+        FolderKind::Run(files) if files.iter().all(|f| !dir.join(f).exists()) => Ok(files),
+        FolderKind::Run(_) if !force => Err(refuse(
+            "holds an earlier run; pass --force to replace it (only the files that run wrote are \
+             removed) or choose another folder with -o"
+                .into(),
+        )),
+        FolderKind::Run(files) => Ok(files),
+    }
+}
+
+/// Bytes of the files `files` (relative to `dir`) that exist: what removing an earlier run frees.
+pub fn bytes_of(dir: &Path, files: &BTreeSet<PathBuf>) -> u64 {
+    files
+        .iter()
+        .filter_map(|p| fs::metadata(dir.join(p)).ok())
+        .map(|m| m.len())
+        .sum()
+}
+
 /// A run folder held by this process: locked, with its manifest open for appending.
 #[derive(Debug)]
 pub struct RunFolder {
@@ -258,43 +305,13 @@ impl Manifest {
 }
 
 impl RunFolder {
-    /// Takes `dir` for a run of the design in `design_file`: refuses the root, the home folder, the design's
-    /// folder, a folder that is not empty and not a run folder, and (without `force`) a run folder that holds
-    /// an earlier run; creates the folder, takes its lock and opens the manifest. Nothing is removed yet.
+    /// Takes `dir` for a run of the design in `design_file` (after [`check`]): creates the folder, takes its
+    /// lock and opens the manifest. Nothing is removed yet.
     ///
     /// # Errors
-    /// [`RunFolderError::Refused`] (bad input), [`RunFolderError::Busy`] (another run holds the lock),
-    /// [`RunFolderError::Io`].
+    /// As [`check`]; [`RunFolderError::Busy`] when another run holds the lock, [`RunFolderError::Io`].
     pub fn open(dir: &Path, design_file: &Path, force: bool) -> Result<Self, RunFolderError> {
-        let refuse = |reason: String| RunFolderError::Refused {
-            path: dir.to_path_buf(),
-            reason,
-        };
-        if let Some(why) = forbidden(dir, design_file) {
-            return Err(refuse(format!(
-                "{why}; a run writes into a folder of its own: choose one with -o (default runs/<design name>)"
-            )));
-        }
-        let previous = match classify(dir)? {
-            FolderKind::Empty => BTreeSet::new(),
-            FolderKind::Foreign => {
-                return Err(refuse(
-                    "is not empty and is not a stentkit run folder (it has no .stentkit-run manifest); \
-                     choose an empty or new folder with -o"
-                        .into(),
-                ));
-            }
-            // A folder whose earlier run left none of its files (a refused or cleared run) is as good as empty.
-            FolderKind::Run(files) if files.iter().all(|f| !dir.join(f).exists()) => files,
-            FolderKind::Run(_) if !force => {
-                return Err(refuse(
-                    "holds an earlier run; pass --force to replace it (only the files that run wrote are \
-                     removed) or choose another folder with -o"
-                        .into(),
-                ));
-            }
-            FolderKind::Run(files) => files,
-        };
+        let previous = check(dir, design_file, force)?;
         fs::create_dir_all(dir).map_err(io_error(dir))?;
         let lock = lock(dir)?;
         let path = dir.join(MANIFEST);
@@ -351,15 +368,6 @@ impl RunFolder {
             return Err(io_error(&path)(e));
         }
         Ok(Reserve { path })
-    }
-
-    /// Bytes that [`RunFolder::clear_previous`] will free (the earlier run's files).
-    pub fn previous_bytes(&self) -> u64 {
-        self.previous
-            .iter()
-            .filter_map(|p| fs::metadata(self.dir.join(p)).ok())
-            .map(|m| m.len())
-            .sum()
     }
 
     /// Removes the files of the earlier run in this folder (only those its manifest lists), stale hidden

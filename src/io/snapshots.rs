@@ -82,8 +82,9 @@ pub enum SnapshotError {
         #[source]
         source: std::io::Error,
     },
-    /// The deformed tubes could not be built (e.g. a section turned into the centreline).
-    #[error("step {step} (t = {}): patch `{patch}`: {source}", crate::math::Short(*time))]
+    /// The deformed tubes could not be built (e.g. a section turned into the centreline). The cause is the
+    /// error's source, not part of its message: error chains print it once.
+    #[error("step {step} (t = {}): patch `{patch}`", crate::math::Short(*time))]
     Mesh {
         /// Step.
         step: usize,

@@ -89,7 +89,7 @@ fn check_describes_every_design() {
         assert_eq!(count("nodes"), model.nodes.len());
         assert_eq!(count("collocation points"), model.num_collocation_points());
         assert_eq!(count("unknowns"), model.num_unknowns());
-        assert_eq!(count("time steps"), model.num_time_steps());
+        assert_eq!(count("time steps"), model.planned_steps().total());
         let fit = value_after(&stdout, "geometry fit error");
         match model
             .patches

@@ -196,3 +196,297 @@ fn every_broken_design_gets_a_clear_located_error() {
         failures.join("\n")
     );
 }
+
+/// A hostile design generated in code (too large to commit as a file), with the error it must get.
+struct Generated {
+    name: &'static str,
+    text: String,
+    line: usize,
+    column: usize,
+    field: &'static str,
+    fragment: &'static str,
+    /// Must be refused before parsing, in well under a second: checked against 1 s, a thousand times what the
+    /// scan takes on this shared 2-core machine (release build), so that only a quadratic scan can fail it.
+    quick: bool,
+}
+
+/// `good_small.yaml` with `line` inserted after its `version: 1` (line 2), so the inserted text starts on
+/// line 3.
+fn good_small_with(line: &str) -> String {
+    let text = std::fs::read_to_string(data("good_small.yaml")).expect("base");
+    assert!(text.contains("version: 1\n"));
+    text.replacen("version: 1\n", &format!("version: 1\n{line}\n"), 1)
+}
+
+/// The generated broken designs. Each expected position is derived in its comment from how the text is made;
+/// the root mapping is nesting level 1 and the limit is 32 levels (`guard::MAX_NESTING_DEPTH`), so level 33
+/// is where each deep design is refused.
+fn generated_corpus() -> Vec<Generated> {
+    let n = 100_000;
+    let mut corpus = vec![
+        // `name: ` then 100 000 `[` (a 200 kB design; about a minute in serde_yaml's scanner before this
+        // check existed). The k-th `[` is at column 6 + k and opens level k + 1: level 33 at column 38.
+        Generated {
+            name: "100 000 nested flow sequences",
+            text: good_small_with(&format!("name: {}{}", "[".repeat(n), "]".repeat(n))),
+            line: 3,
+            column: 38,
+            field: "",
+            fragment: "nesting 33 levels deep",
+            quick: true,
+        },
+        // `name:` then, on line 4 indented by 2, 100 000 `- `: the k-th dash is at column 3 + 2(k − 1) and opens
+        // level k + 1: level 33 at column 65.
+        Generated {
+            name: "100 000 nested block sequences on one line",
+            text: good_small_with(&format!("name:\n  {}x", "- ".repeat(n))),
+            line: 4,
+            column: 65,
+            field: "",
+            fragment: "nesting 33 levels deep",
+            quick: true,
+        },
+        // `name: ` then 100 000 `{a: `: the k-th `{` is at column 7 + 4(k − 1), level k + 1: level 33 at 131.
+        Generated {
+            name: "100 000 nested flow mappings",
+            text: good_small_with(&format!("name: {}1{}", "{a: ".repeat(n), "}".repeat(n))),
+            line: 3,
+            column: 131,
+            field: "",
+            fragment: "nesting 33 levels deep",
+            quick: true,
+        },
+    ];
+    // A linear alias bomb: the first patch anchored and repeated 300 000 times (2 MB of `  - *beam`); each
+    // repetition would be a patch of the design. Refused at the first alias: the patches list starts on line
+    // 13 with `- &beam` (14), its two lines and the two of `hook`, so the first alias is line 19, column 5.
+    let base = std::fs::read_to_string(data("good_small.yaml")).expect("base");
+    let repeated = base
+        .replacen("  - name: beam\n", "  - &beam\n    name: beam\n", 1)
+        .replacen(
+            "nodes:\n",
+            &format!("{}nodes:\n", "  - *beam\n".repeat(300_000)),
+            1,
+        );
+    corpus.push(Generated {
+        name: "a patch repeated 300 000 times by an alias",
+        text: repeated,
+        line: 19,
+        column: 5,
+        field: "",
+        fragment: "aliases (`*name`) are not allowed",
+        quick: true,
+    });
+    // A temperature table of 10⁶ breakpoints (about 17 MB): more than the 4 MiB size limit, refused at 1:1
+    // before anything is parsed.
+    let rows: String = (1..=1_000_000)
+        .map(|k| format!("[{:.6}, 40],", k as f64 * 1e-6))
+        .collect();
+    corpus.push(Generated {
+        name: "a temperature table of 10⁶ breakpoints",
+        text: base.replace(
+            "temperature: [[0, 90], [1, 40]]",
+            &format!("temperature: [[0, 90],{rows}]"),
+        ),
+        line: 1,
+        column: 1,
+        field: "",
+        fragment: "more than stentkit's limit of 4 MiB",
+        quick: true,
+    });
+    // Breakpoints that exhaust memory within the size limit: 2000 probes make a step cost 512 + 24 · 2000 =
+    // 48 512 bytes (build.rs, `bytes_per_step`); time end 200 000 with step 2000 is 100 nominal steps (4.9 MB),
+    // but a temperature table at t = 1, 2, …, 170 000 (1.6 MB) makes the run land on each: 170 000 shortened
+    // steps and 15 full ones (170 000 to 200 000), 170 015 · 48 512 = 8.25 GB, over the 8 GB limit. The
+    // breakpoints outnumber the full steps, so the field named is the table's, `temperature` (line 25, column
+    // 14).
+    let rows: String = (1..=170_000).map(|k| format!("[{k},1],")).collect();
+    let probes: String = (0..2000)
+        .map(|k| format!("    - {{name: p{k}, node: root}}\n"))
+        .collect();
+    corpus.push(Generated {
+        name: "170 000 breakpoints and 2000 probes",
+        text: base
+            .replace(
+                "temperature: [[0, 90], [1, 40]]",
+                &format!("temperature: [[0, 90],{rows}]"),
+            )
+            .replace(
+                "time: {end: 1.0, step: 0.01}",
+                "time: {end: 200000, step: 2000}",
+            )
+            .replace(
+                "    - {name: tip, node: hook.end}\n",
+                &format!("    - {{name: tip, node: hook.end}}\n{probes}"),
+            ),
+        line: 25,
+        column: 14,
+        field: "temperature",
+        fragment: "170015 time steps (15 of 2000 + 170000 shortened to land on breakpoints)",
+        quick: false,
+    });
+    corpus
+}
+
+#[test]
+fn generated_hostile_designs_are_refused_quickly_with_located_errors() {
+    let path = Path::new("generated.yaml");
+    let mut failures = Vec::new();
+    for case in generated_corpus() {
+        let started = std::time::Instant::now();
+        let result = stentkit::io::design::parse_design(&case.text, path);
+        let elapsed = started.elapsed();
+        eprintln!(
+            "{}: {} bytes, refused in {elapsed:?}",
+            case.name,
+            case.text.len()
+        );
+        let outcome = match result {
+            Ok(_) => Err("was accepted".to_string()),
+            Err(e @ DesignError::Read { .. }) => Err(format!("{e}")),
+            Err(
+                ref e @ DesignError::Invalid {
+                    line,
+                    column,
+                    ref field,
+                    ref message,
+                    ..
+                },
+            ) => {
+                if (line, column) != (case.line, case.column)
+                    || field != case.field
+                    || !message.contains(case.fragment)
+                {
+                    Err(format!("got `{}`", shorten_for_report(&e.to_string())))
+                } else if case.quick && elapsed.as_secs_f64() > 1.0 {
+                    Err(format!("took {elapsed:?}"))
+                } else {
+                    Ok(())
+                }
+            }
+        };
+        if let Err(why) = outcome {
+            failures.push(format!(
+                "{}: expected {}:{} `{}` containing `{}`; {why}",
+                case.name, case.line, case.column, case.field, case.fragment
+            ));
+        }
+    }
+    assert!(failures.is_empty(), "{}", failures.join("\n"));
+}
+
+/// The first 300 characters of a message (an assertion message must not echo a generated design).
+fn shorten_for_report(message: &str) -> String {
+    message.chars().take(300).collect()
+}
+
+#[test]
+fn a_file_over_the_size_limit_is_refused_with_its_size() {
+    // 5 MiB of comments after a valid design: over the 4 MiB limit (`guard::MAX_DESIGN_BYTES`), refused at
+    // 1:1 with the file's size from the file system, whatever the content.
+    let dir = crate::outputs::test_outputs("oversized_design");
+    std::fs::create_dir_all(&dir).expect("folder");
+    let file = dir.join("oversized.yaml");
+    let mut text = std::fs::read_to_string(data("good_small.yaml")).expect("base");
+    text.push_str(&"# padding\n".repeat(5 * 1024 * 1024 / 10));
+    std::fs::write(&file, &text).expect("written");
+    let error = load_design(&file).expect_err("too large");
+    let message = error.to_string();
+    assert!(
+        message.starts_with(&format!(
+            "{}:1:1: the design is {} bytes",
+            file.display(),
+            text.len()
+        )) && message.contains("limit of 4 MiB"),
+        "{message}"
+    );
+}
+
+#[test]
+fn long_values_are_quoted_shortened_in_errors() {
+    // Each design puts a 1 000 000-character value where an error quotes it: an enum word (serde_yaml's
+    // message), a patch name used twice and a node name that does not exist (stentkit's messages), an unknown
+    // key (the field path). The value must appear as its first 40 characters, `…` and its length
+    // (`quote::quoted`), and the whole error line stay short: these messages have at most about 250
+    // characters besides the value, so 400 is a generous bound (a whole value would be a million).
+    let long = "q".repeat(1_000_000);
+    let cut = format!("`{}…` (1000000 characters)", "q".repeat(40));
+    let base = std::fs::read_to_string(data("good_small.yaml")).expect("base");
+    let cases = [
+        (
+            "units",
+            base.replacen("units: SI", &format!("units: {long}"), 1),
+        ),
+        (
+            "patches[1].name",
+            base.replacen("name: beam", &format!("name: {long}"), 1)
+                .replacen("name: hook", &format!("name: {long}"), 1),
+        ),
+        (
+            "conditions[0].node",
+            base.replacen(
+                "{node: root, clamp: true}",
+                &format!("{{node: {long}, clamp: true}}"),
+                1,
+            ),
+        ),
+    ];
+    for (field, text) in cases {
+        let error =
+            stentkit::io::design::parse_design(&text, Path::new("long.yaml")).expect_err("refused");
+        let message = error.to_string();
+        assert!(
+            message.chars().count() < 400 && message.contains(&cut),
+            "{field}: {}",
+            shorten_for_report(&message)
+        );
+        let DesignError::Invalid { field: got, .. } = &error else {
+            panic!("{message}")
+        };
+        assert_eq!(got, field);
+    }
+    // An unknown key of 1000 characters (YAML allows implicit keys of at most 1024; a longer one is a syntax
+    // error at its end, which quotes nothing): serde_yaml names it in the message and the field path, and both
+    // are shortened (the path without backticks).
+    let key = "k".repeat(1000);
+    let text = base.replacen("units: SI", &format!("units: SI\n{key}: 1"), 1);
+    let error =
+        stentkit::io::design::parse_design(&text, Path::new("long.yaml")).expect_err("refused");
+    let message = error.to_string();
+    assert!(
+        message.chars().count() < 600
+            && message.contains(&format!(
+                "unknown field `{}…` (1000 characters)",
+                "k".repeat(40)
+            )),
+        "{}",
+        shorten_for_report(&message)
+    );
+    let DesignError::Invalid { field, .. } = &error else {
+        panic!("{message}")
+    };
+    assert!(field.ends_with("… (1000 characters)"), "{field}");
+}
+
+#[test]
+fn a_design_name_is_one_folder_name() {
+    // The name becomes `runs/<name>` (broken designs 58–66 cover what a `name:` may not be). Without `name:`
+    // the file stem is the name, and `..yaml` has the stem `.` (Rust's `file_stem` keeps everything before the
+    // last dot): refused too, pointing at the design's first line (there is no `name` to point at).
+    let base = std::fs::read_to_string(data("good_small.yaml")).expect("base");
+    let error = stentkit::io::design::parse_design(&base, Path::new("..yaml"))
+        .expect_err("the stem `.` is not a folder name");
+    let message = error.to_string();
+    assert!(
+        message
+            .starts_with("..yaml:2:1: name: the design has no `name`, and its file name gives `.`"),
+        "{message}"
+    );
+    // Ordinary names, with spaces, dots inside and non-ASCII letters, are names.
+    for name in ["straight stent v2", "stent.2024-05", "Stent für Öhrli", "a"] {
+        let text = base.replacen("version: 1\n", &format!("version: 1\nname: {name}\n"), 1);
+        let design = stentkit::io::design::parse_design(&text, Path::new("named.yaml"))
+            .unwrap_or_else(|e| panic!("{name}: {e}"));
+        assert_eq!(design.model.name, name);
+    }
+}

@@ -609,3 +609,189 @@ fn an_interrupted_viscoelastic_step_restores_its_history_stresses() {
     assert!(result.expect("stopped").stopped);
     check_interrupt(&model, &events, step2 + 3, 2, &at_step2, "root");
 }
+
+#[test]
+fn planned_steps_are_the_steps_a_run_takes() {
+    // Reference: the run itself (its summary's step count). The 45° bend (h = 0.1, end 1; the load table's
+    // breakpoint is the end) takes 10 steps. Given a temperature table with breakpoints at 0.05, 0.33 and 0.77
+    // (no effect on this elastic rod, but time stepping lands on them) the intervals 0.05, 0.28, 0.44 and 0.23
+    // take 1, 2 + 1, 4 + 1 and 2 + 1 steps: 8 full and 4 shortened. Snapshot times 0.123 and 0.5 are landed on
+    // too: 0.123 splits the second interval (0.073: 1 shortened; 0.207: 2 full + 1 shortened) and 0.5 the third
+    // (0.17: 1 full + 1 shortened; 0.27: 2 full + 1 shortened), so 7 full and 6 shortened.
+    let table = "temperature: [[0, 20], [0.05, 20], [0.33, 25], [0.77, 20], [1, 20]]\ntime: {";
+    let cases = [
+        (bend45(), 10, 0),
+        (variant("time: {", table), 8, 4),
+        (
+            variant("time: {", table).replacen(
+                "output:\n",
+                "output:\n  snapshots: {times: [0.123, 0.5]}\n",
+                1,
+            ),
+            7,
+            6,
+        ),
+    ];
+    for (text, full, shortened) in cases {
+        let design = parse_design(&text, Path::new("steps.yaml")).expect("a valid design");
+        let plan = design.model.planned_steps();
+        assert_eq!((plan.full, plan.shortened), (full, shortened), "{text}");
+        let mut sim = Simulation::new(&design.model).expect("simulation");
+        let summary = sim.run(&mut NoObserver).expect("the bend converges");
+        assert_eq!(summary.steps, plan.total(), "{text}");
+    }
+}
+
+#[test]
+fn breakpoints_count_in_the_steps_and_the_snapshot_spacing() {
+    // A temperature table of 200 000 breakpoints (t = k · 5 µs, 3 MB: under the 4 MiB size limit) on the
+    // 45° bend (h = 0.1, 10 nominal steps): every interval is shorter than the step, so the run lands on each,
+    // 200 000 steps, and the default snapshot spacing is ⌈200 000 / 20⌉ = 10 000 steps (it was ⌈10 / 20⌉ = 1,
+    // a snapshot at every one of the 200 000 steps). At 536 bytes per step the memory estimate is 0.11 GB:
+    // accepted (a million breakpoints would be 0.54 GB, but their table is over the size limit).
+    let rows: String = (1..=200_000)
+        .map(|k| format!("[{:.6}, 20],", k as f64 * 5e-6))
+        .collect();
+    let text = variant(
+        "time: {",
+        &format!("temperature: [[0, 20],{rows}]\ntime: {{"),
+    );
+    let design = parse_design(&text, Path::new("table.yaml")).expect("accepted");
+    let plan = design.model.planned_steps();
+    assert_eq!((plan.full, plan.shortened), (0, 200_000));
+    assert_eq!(design.output.snapshots.every, 10_000);
+    let memory = design.memory.total();
+    assert!((0.1e9..0.12e9).contains(&memory), "{memory}");
+    let largest = design.memory.largest().expect("terms");
+    assert_eq!(largest.field, "temperature");
+    // `check` prints the count.
+    let description = stentkit::cli::check::describe(&design, "table.yaml");
+    assert!(
+        description.contains(
+            "time steps          200000 (0 of h = 0.1 s + 200000 shortened to land on breakpoints"
+        ),
+        "{description}"
+    );
+}
+
+/// Bytes of every file under `dir`.
+fn folder_bytes(dir: &Path) -> u64 {
+    std::fs::read_dir(dir)
+        .expect("folder")
+        .map(|e| {
+            let path = e.expect("entry").path();
+            if path.is_dir() {
+                folder_bytes(&path)
+            } else {
+                std::fs::metadata(&path).expect("file").len()
+            }
+        })
+        .sum()
+}
+
+#[test]
+fn the_disk_estimate_bounds_a_run_folder_from_above() {
+    // Reference: the run folder itself. The 45° bend at h = 1e-3 (1000 steps, 21 snapshots, every output
+    // written; about 0.3 s) wrote 3.29 MB against an estimate of 3.46 MB when the estimate was calibrated
+    // (io::estimate's table). The estimate must not be below what is written, nor more than 1.3 times it: a
+    // writer that grows (or an estimate that drifts) fails here.
+    let text = variant("step: 0.1}", "step: 1.0e-3}");
+    let dir = crate::outputs::test_outputs("disk_estimate");
+    std::fs::create_dir_all(&dir).expect("folder");
+    let file = dir.join("bend_fine.yaml");
+    std::fs::write(&file, &text).expect("design written");
+    let design = stentkit::io::design::load_design(&file).expect("valid");
+    let estimate = stentkit::io::estimate::estimated_disk(&design);
+    let run = dir.join("run");
+    let out = Command::new(env!("CARGO_BIN_EXE_stentkit"))
+        .args([
+            "run",
+            file.to_str().expect("path"),
+            "--force",
+            "--quiet",
+            "-o",
+        ])
+        .arg(&run)
+        .output()
+        .expect("stentkit runs");
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let written = folder_bytes(&run) as f64;
+    let ratio = estimate.total() as f64 / written;
+    assert!(
+        (1.0..1.3).contains(&ratio),
+        "{estimate:?}: {written} bytes written, ratio {ratio}"
+    );
+    let snapshots = std::fs::read_dir(run.join("snapshots"))
+        .expect("snapshots")
+        .count();
+    assert_eq!(
+        2 * estimate.snapshots,
+        snapshots,
+        "an STL and an OBJ per snapshot"
+    );
+}
+
+#[test]
+fn two_rings_per_patch_draw_a_rolled_up_beam() {
+    // The roll-up (designs/rollup.yaml: a beam bent into a full circle over 20 steps, one snapshot per step)
+    // with the smallest ring counts allowed, 2 per patch for the snapshots and for the recorded meshes. At step
+    // 10 the beam is a half circle: both end sections contain the chord between them, and the run used to stop
+    // there ("stopped", exit 1, "section 0 is not transverse" printed twice). Now the rings are tilted to 60°
+    // from the chord and the run completes with all 21 snapshots.
+    let text =
+        std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join("designs/rollup.yaml"))
+            .expect("rollup")
+            .replacen(
+                "output:\n",
+                "output:\n  snapshots: {rings: 2}\n  recording: {mesh_rings: 2}\n",
+                1,
+            );
+    let dir = crate::outputs::test_outputs("two_rings");
+    std::fs::create_dir_all(&dir).expect("folder");
+    let file = dir.join("rollup_two_rings.yaml");
+    std::fs::write(&file, &text).expect("design written");
+    let out = Command::new(env!("CARGO_BIN_EXE_stentkit"))
+        .args([
+            "run",
+            file.to_str().expect("path"),
+            "--force",
+            "--quiet",
+            "-o",
+        ])
+        .arg(dir.join("run"))
+        .output()
+        .expect("stentkit runs");
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{stderr}");
+    let summary = std::fs::read_to_string(dir.join("run/summary.json")).expect("summary");
+    assert!(summary.contains("\"status\": \"completed\""), "{summary}");
+    let snapshots = std::fs::read_dir(dir.join("run/snapshots"))
+        .expect("snapshots")
+        .count();
+    assert_eq!(snapshots, 2 * 21, "an STL and an OBJ at steps 0 to 20");
+}
+
+#[test]
+fn a_million_breakpoints_are_counted_in_linear_time() {
+    // A design file cannot hold a 10⁶-breakpoint table (about 15 MB, over the 4 MiB size limit; the generated
+    // corpus in design_errors checks that refusal), but a model built in code can. The 45° bend (h = 0.1, end
+    // 1) given a temperature table at t = k · 1e-6, k = 0 … 10⁶: every interval is shorter than the step, so
+    // the run would land on each of the 10⁶ breakpoints; counted in well under a second (the count is linear
+    // after a sort; the bound leaves a hundredfold margin on this shared machine).
+    let mut model = parse_design(&bend45(), Path::new("bend45.yaml"))
+        .expect("bend45")
+        .model;
+    let table = (0..=1_000_000).map(|k| (k as f64 * 1e-6, 20.0)).collect();
+    model.temperature = stentkit::model::TimeFunction::try_table(table).expect("increasing");
+    let started = std::time::Instant::now();
+    let plan = model.planned_steps();
+    let elapsed = started.elapsed();
+    assert_eq!((plan.full, plan.shortened), (0, 1_000_000));
+    assert!(elapsed.as_secs_f64() < 1.0, "{elapsed:?}");
+    // At 536 bytes per step (one probe) that is 0.54 GB of samples: within the 8 GB limit, so such a model is
+    // not refused for its steps; a design is refused for its size first.
+}

@@ -547,3 +547,47 @@ fn times_far_from_seconds_are_printed_short() {
     assert!(stderr.contains("step 1 to t = 1e299 s failed"), "{stderr}");
     assert!(!stderr.contains("0000000000"), "{stderr}");
 }
+
+/// A run that the disk cannot hold is refused before anything is written (exit status 2), with the estimate
+/// by part and the field to change: the straight stent (about 300 MB, mostly its snapshots) into a 20 MB tmpfs.
+#[test]
+fn a_run_the_disk_cannot_hold_is_refused_before_writing() {
+    let dir = scratch("disk_refused");
+    let script = format!(
+        r#"
+        mount -t tmpfs -o size=20m tmpfs {tmp}
+        set +e; {bin} run {design} -o {tmp}/ss --quiet 2> {dir}/stderr; echo $? > {dir}/status; set -e
+        ls -A {tmp} > {dir}/listing
+        "#,
+        tmp = path_str(&dir.join("mnt")),
+        bin = env!("CARGO_BIN_EXE_stentkit"),
+        design = path_str(&design("straight_stent.yaml")),
+        dir = path_str(&dir),
+    );
+    std::fs::create_dir_all(dir.join("mnt")).expect("mount point");
+    let out = in_mount_namespace(&script);
+    assert!(
+        out.status.success(),
+        "the script failed: {}",
+        text(&out.stderr)
+    );
+    let stderr = std::fs::read_to_string(dir.join("stderr")).expect("stderr");
+    assert_eq!(
+        std::fs::read_to_string(dir.join("status"))
+            .expect("status")
+            .trim(),
+        "2",
+        "{stderr}"
+    );
+    assert!(
+        stderr.contains("straight_stent.yaml: output.snapshots.every: this run would write about")
+            && stderr.contains("21 snapshots")
+            && stderr.contains("free"),
+        "{stderr}"
+    );
+    assert_eq!(
+        std::fs::read_to_string(dir.join("listing")).expect("listing"),
+        "",
+        "nothing written"
+    );
+}

@@ -210,7 +210,8 @@ impl<'de> Visitor<'de> for ComponentVisitor {
             Ok(ComponentValue::Free)
         } else {
             Err(E::custom(format!(
-                "`{v}` is not a component value; allowed: free, null, a number or a table [[t, v], …]"
+                "{} is not a component value; allowed: free, null, a number or a table [[t, v], …]",
+                super::quote::quoted(v)
             )))
         }
     }
@@ -633,7 +634,8 @@ pub struct SnapshotsDto {
     #[serde(default)]
     pub times: Option<Vec<NonNegative>>,
     /// A snapshot every this many converged steps (0: none besides `times`, the initial and the final
-    /// shape). Default: about 20 snapshots over the run, ⌈nominal steps / 20⌉.
+    /// shape). Default: about 20 snapshots over the run, ⌈steps / 20⌉ (counting the steps that land on
+    /// schedule breakpoints).
     #[serde(default)]
     pub every: Option<usize>,
     /// Vertices around each tube section (default 16, at least 3).

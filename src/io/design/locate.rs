@@ -13,6 +13,11 @@ pub struct Position {
     pub column: usize,
 }
 
+/// Keys longer than this many bytes appear as `…` in the paths of the nodes below them. No field of the
+/// format is longer than 20; without the cap, a long key (up to the size limit) would be copied into the path
+/// of every node below it, and the index would grow with the key's length times their number.
+const MAX_PATH_KEY_BYTES: usize = 64;
+
 /// Field path → position of its value (and of its key, for mapping entries).
 #[derive(Debug, Default, Clone)]
 pub struct Locator {
@@ -64,7 +69,11 @@ impl Locator {
                                 _ => "?".to_string(),
                             };
                             values.entry(join_key(path, &k)).or_insert(pos);
-                            *key = Some(k);
+                            *key = Some(if k.len() > MAX_PATH_KEY_BYTES {
+                                "…".to_string()
+                            } else {
+                                k
+                            });
                             None
                         }
                         Some(k) => Some(join_key(path, &k)),

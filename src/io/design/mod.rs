@@ -4,11 +4,14 @@
 //! fields, wrong types and bad single numbers are reported there with line and column); [`build`] generates
 //! the geometry and checks everything that involves several values; [`locate`] maps the field path of such a
 //! check back to its line and column. Every error names the file, the line and column, the field, what is
-//! wrong and what is allowed.
+//! wrong and what is allowed. Before any of this, [`guard`] refuses text too large, too deeply nested or with
+//! aliases, which would make the parsers slow or the design enormous.
 
 pub mod build;
 pub mod dto;
+pub mod guard;
 pub mod locate;
+pub mod quote;
 pub mod stent;
 
 use crate::math::Real;
@@ -32,7 +35,8 @@ pub struct SnapshotSettings {
 }
 
 impl SnapshotSettings {
-    /// Default number of periodic snapshots over a run: `every = ⌈nominal steps / 20⌉`.
+    /// Default number of periodic snapshots over a run: `every = ⌈steps / 20⌉`, counting the steps that land
+    /// on breakpoints ([`crate::model::Model::planned_steps`]).
     pub const DEFAULT_COUNT: usize = 20;
     /// Default vertices around a section: 16, the section polygon has 97.4 % of the circle's area.
     pub const DEFAULT_SEGMENTS: usize = 16;
@@ -84,6 +88,8 @@ pub struct Design {
     pub output: OutputSettings,
     /// Things worth knowing that do not stop a run.
     pub warnings: Vec<String>,
+    /// The memory a run is estimated to need (below [`build::MEMORY_LIMIT_BYTES`]: larger designs are refused).
+    pub memory: build::MemoryEstimate,
     /// The YAML text as read (embedded in run recordings).
     pub source: String,
     /// Where it was read from.
@@ -142,13 +148,40 @@ impl fmt::Display for DesignError {
 /// error chains print it twice).
 impl std::error::Error for DesignError {}
 
-/// Reads and validates the design file at `path`.
+/// Reads and validates the design file at `path`. At most [`guard::MAX_DESIGN_BYTES`] are read: a larger
+/// file is refused without reading the rest.
 pub fn load_design(path: &Path) -> Result<Design, DesignError> {
-    let text = std::fs::read_to_string(path).map_err(|source| DesignError::Read {
+    use std::io::Read as _;
+    let read_error = |source| DesignError::Read {
         file: path.to_path_buf(),
         source,
-    })?;
+    };
+    let mut bytes = Vec::new();
+    std::fs::File::open(path)
+        .and_then(|f| {
+            f.take(guard::MAX_DESIGN_BYTES as u64 + 1)
+                .read_to_end(&mut bytes)
+        })
+        .map_err(read_error)?;
+    if bytes.len() > guard::MAX_DESIGN_BYTES {
+        let size = std::fs::metadata(path).ok().map(|m| m.len());
+        return Err(refused(path, guard::too_large(size)));
+    }
+    let text = String::from_utf8(bytes)
+        .map_err(|e| read_error(std::io::Error::new(std::io::ErrorKind::InvalidData, e)))?;
     parse_design(&text, path)
+}
+
+/// The design error of a text refused by [`guard`] (no field: the text is refused before it is read as
+/// fields).
+fn refused(path: &Path, refusal: guard::Refusal) -> DesignError {
+    DesignError::Invalid {
+        file: path.to_path_buf(),
+        line: refusal.position.line,
+        column: refusal.position.column,
+        field: String::new(),
+        message: refusal.message,
+    }
 }
 
 /// Splits serde_yaml's message into the text and the position it names. A syntax error reads
@@ -244,6 +277,7 @@ pub fn parse_design_with(
     overrides: &DesignOverrides,
 ) -> Result<Design, DesignError> {
     let file = path.to_path_buf();
+    guard::check_text(text).map_err(|r| refused(path, r))?;
     let locator = locate::Locator::new(text);
     let deserializer = serde_yaml::Deserializer::from_str(text);
     let mut dto: dto::DesignDto = serde_path_to_error::deserialize(deserializer).map_err(|e| {
@@ -274,8 +308,8 @@ pub fn parse_design_with(
             file: file.clone(),
             line: pos.line,
             column: pos.column,
-            field,
-            message,
+            field: quote::shortened(&field, quote::MAX_FIELD_CHARS).into_owned(),
+            message: quote::shortened_message(&message).into_owned(),
         }
     })?;
     overrides.apply(&mut dto);
@@ -283,20 +317,21 @@ pub fn parse_design_with(
         || "design".to_string(),
         |s| s.to_string_lossy().into_owned(),
     );
-    let (model, output, warnings) = build::build(&dto, &stem).map_err(|issue| {
+    let built = build::build(&dto, &stem).map_err(|issue| {
         let pos = locator.find(&issue.path);
         DesignError::Invalid {
             file: file.clone(),
             line: pos.line,
             column: pos.column,
+            message: quote::shortened_message(&issue.message).into_owned(),
             field: issue.path,
-            message: issue.message,
         }
     })?;
     Ok(Design {
-        model,
-        output,
-        warnings,
+        model: built.model,
+        output: built.output,
+        warnings: built.warnings,
+        memory: built.memory,
         source: text.to_string(),
         path: file,
     })

@@ -633,7 +633,8 @@ pub fn programme(
         return Err(issue(
             format!("{base}.nodes"),
             format!(
-                "no node set `{set_name}`; the stent has: {}",
+                "no node set {}; the stent has: {}",
+                super::quote::quoted(&set_name),
                 known.join(", ")
             ),
         ));
@@ -641,7 +642,7 @@ pub fn programme(
     if set.is_empty() {
         return Err(issue(
             format!("{base}.nodes"),
-            format!("node set `{set_name}` is empty"),
+            format!("node set {} is empty", super::quote::quoted(&set_name)),
         ));
     }
     let (t0, t1) = (dto.ramp[0].0, dto.ramp[1].0);
