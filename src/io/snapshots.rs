@@ -48,8 +48,9 @@ impl SnapshotSchedule {
             || time >= self.end - self.snap
             || self
                 .times
-                .iter()
-                .any(|&t| t > previous + self.snap && t <= time + self.snap)
+                // Sorted: the first requested time after `previous` decides (one binary search per step).
+                .get(self.times.partition_point(|&t| t <= previous + self.snap))
+                .is_some_and(|&t| t <= time + self.snap)
     }
 }
 

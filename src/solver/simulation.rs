@@ -997,10 +997,11 @@ impl<'m> Simulation<'m> {
                 summary.stopped = true;
                 return Ok(summary);
             }
+            // Breakpoints are sorted: a binary search keeps a step's cost independent of their number (a table of
+            // 10⁵ breakpoints made every step scan it).
             let next_break = breakpoints
-                .iter()
+                .get(breakpoints.partition_point(|&b| b <= self.time + snap))
                 .copied()
-                .find(|&b| b > self.time + snap)
                 .unwrap_or(end)
                 .min(end);
             let mut target = self.time + h;
@@ -1042,7 +1043,10 @@ impl<'m> Simulation<'m> {
                 Ok(newton) => {
                     self.commit_step();
                     // A schedule's rate changes at its breakpoints: no extrapolation across them.
-                    let at_break = breakpoints.iter().any(|&b| (b - target).abs() <= snap);
+                    let nearest = breakpoints.partition_point(|&b| b < target - snap);
+                    let at_break = breakpoints
+                        .get(nearest)
+                        .is_some_and(|&b| (b - target).abs() <= snap);
                     let increment = std::mem::take(&mut self.step_increment);
                     self.last_increment = (!at_break).then_some((increment, dt));
                     self.time = target;
