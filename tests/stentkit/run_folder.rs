@@ -68,17 +68,25 @@ fn bend45() -> PathBuf {
     design("bend45.yaml")
 }
 
+/// `stentkit run bend45.yaml -o DIR --quiet` with `extra` arguments.
+fn run_bend45(dir: &Path, extra: &[&str]) -> Output {
+    let file = bend45();
+    let mut args = vec!["run", path_str(&file), "-o", path_str(dir), "--quiet"];
+    args.extend_from_slice(extra);
+    stentkit(&args)
+}
+
 #[test]
 fn force_replaces_a_run_and_keeps_the_users_files() {
     let dir = scratch("force");
     let run = dir.join("run");
-    let first = stentkit(&["run", path_str(&bend45()), "-o", path_str(&run), "--quiet"]);
+    let first = run_bend45(&run, &[]);
     assert_eq!(first.status.code(), Some(0), "{}", text(&first.stderr));
     // The user keeps notes in the run folder, one inside `snapshots/`.
     std::fs::write(run.join("notes.txt"), "mine").expect("write");
     std::fs::write(run.join("snapshots").join("best.stl"), "mine").expect("write");
     // Without --force: refused (bad input), nothing changed.
-    let again = stentkit(&["run", path_str(&bend45()), "-o", path_str(&run), "--quiet"]);
+    let again = run_bend45(&run, &[]);
     assert_eq!(again.status.code(), Some(2));
     assert!(
         text(&again.stderr).contains("pass --force"),
@@ -86,14 +94,7 @@ fn force_replaces_a_run_and_keeps_the_users_files() {
         text(&again.stderr)
     );
     // With it: the earlier run is replaced, the user's files stay.
-    let forced = stentkit(&[
-        "run",
-        path_str(&bend45()),
-        "-o",
-        path_str(&run),
-        "--quiet",
-        "--force",
-    ]);
+    let forced = run_bend45(&run, &["--force"]);
     assert_eq!(forced.status.code(), Some(0), "{}", text(&forced.stderr));
     assert_eq!(
         std::fs::read_to_string(run.join("notes.txt")).expect("kept"),
@@ -198,14 +199,7 @@ fn a_run_folder_of_an_earlier_version_is_replaced_by_its_summarys_file_list() {
         "files": {"history": "history.csv", "mcap": "run.mcap", "charts": []}
     });
     std::fs::write(run.join("summary.json"), legacy.to_string()).expect("write");
-    let out = stentkit(&[
-        "run",
-        path_str(&bend45()),
-        "-o",
-        path_str(&run),
-        "--quiet",
-        "--force",
-    ]);
+    let out = run_bend45(&run, &["--force"]);
     assert_eq!(out.status.code(), Some(0), "{}", text(&out.stderr));
     assert_eq!(
         std::fs::read_to_string(run.join("mine.txt")).expect("kept"),
@@ -219,14 +213,7 @@ fn a_second_run_into_a_busy_folder_is_refused_with_the_holders_pid() {
     let dir = test_outputs("busy_folder");
     let child = spawn_run(&design("straight_stent.yaml"), &dir);
     wait_for("the first run's history", || history_rows(&dir) >= 3);
-    let second = stentkit(&[
-        "run",
-        path_str(&bend45()),
-        "-o",
-        path_str(&dir),
-        "--quiet",
-        "--force",
-    ]);
+    let second = run_bend45(&dir, &["--force"]);
     let stderr = text(&second.stderr);
     assert_eq!(second.status.code(), Some(1), "{stderr}");
     assert!(
