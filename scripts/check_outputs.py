@@ -16,7 +16,8 @@ Every DIR is searched recursively. Checked:
 * every ``*.stl`` file, with trimesh: watertight, consistently wound, positive volume (and, for snapshots
   listed in a ``summary.json``, the volume stentkit reported, to single precision);
 * every run folder (a folder with ``summary.json``): ``history.csv`` has one row per recorded state, the files
-  the summary lists exist, and the charts are SVG documents. A run that was killed and repaired
+  the summary lists exist, and the charts are SVG documents (a run that failed or was interrupted during its
+  setup has only its summary, which must say so). A run that was killed and repaired
   (``"status": "killed"``, by ``stentkit repair``) has no charts, and its recording may end a few seconds
   before its history (the recording's chunks are closed every 2 s): it must hold at most, not exactly, one
   ``/state`` per step.
@@ -181,6 +182,12 @@ def check_run_folder(folder):
     for key in ("design", "units", "stentkit_version", "command_line", "wall_time_s", "steps",
                 "newton_iterations", "step_cuts", "final_time", "unknowns", "snapshots", "warnings", "notices"):
         require(key in summary, f"summary.json lacks {key}")
+    if not (folder / "history.csv").exists():
+        # A run that failed or was interrupted while being set up (e.g. a part held by nothing) leaves only its
+        # summary, which must say so.
+        require(summary["status"] in ("failed", "interrupted") and summary["steps"] == 0 and not summary["snapshots"],
+                f"no history.csv, but the summary says {summary['status']} after {summary['steps']} steps")
+        return f"{summary['design']}: {summary['status']} during setup: {summary.get('error', '')[:80]}"
     with open(folder / "history.csv", newline="") as f:
         rows = list(csv.reader(f))
     require(rows and rows[0][0] == "time", "history.csv header")
