@@ -22,7 +22,7 @@
 //! failed factorisation, and the caller falls back to the general sparse LU.
 
 use super::SolverError;
-use super::linear::SparseSystem;
+use super::sparse::SparseSystem;
 use crate::math::Real;
 use rayon::prelude::*;
 

@@ -1,7 +1,7 @@
 //! The quasi-static IGA-collocation solver (paper §3; DESIGN §4).
 //!
 //! [`Simulation`] owns the discrete problem ([`discretisation`]), the evolving [`state::State`], the assembly of
-//! residual and tangent ([`assembly`]) and the sparse LU ([`linear`]). It steps through time with Newton's
+//! residual and tangent ([`assembly`]) and the linear solves ([`linear`]: the block-bordered solver of [`block`] or the sparse LU of [`sparse`]). It steps through time with Newton's
 //! method on normalised per-field norms, cuts the step when Newton fails (restoring the last converged state),
 //! and reports every converged step to an [`Observer`] — the engine reports, observers record.
 
@@ -13,6 +13,7 @@ pub mod gauge;
 pub mod linear;
 pub mod shape;
 pub mod simulation;
+pub mod sparse;
 pub mod state;
 
 pub use simulation::{NewtonReport, Observer, RunSummary, Simulation, SolverTiming, StepReport};
