@@ -1,9 +1,10 @@
 //! The quasi-static IGA-collocation solver (paper §3; DESIGN §4).
 //!
 //! [`Simulation`] owns the discrete problem ([`discretisation`]), the evolving [`state::State`], the assembly of
-//! residual and tangent ([`assembly`]) and the linear solves ([`linear`]: the block-bordered solver of [`block`] or the sparse LU of [`sparse`]). It steps through time with Newton's
-//! method on normalised per-field norms, cuts the step when Newton fails (restoring the last converged state),
-//! and reports every converged step to an [`Observer`] — the engine reports, observers record.
+//! residual and tangent ([`assembly`]) and the linear solves ([`linear`]: the block-bordered solver of [`block`]
+//! or the sparse LU of [`sparse`]). It steps through time with Newton's method on normalised per-field norms,
+//! cuts the step when Newton fails (restoring the last converged state), and reports every converged step to an
+//! [`Observer`] — the engine reports, observers record.
 
 pub mod assembly;
 pub mod block;
