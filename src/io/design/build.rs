@@ -3,6 +3,8 @@
 //! naming the field path; [`super`] turns it into a line and column.
 
 use super::dto::*;
+pub use super::issue::Issue;
+use super::issue::{FIT_WARNING_FRACTION, Result, issue};
 use super::quote::quoted;
 use super::stent;
 use crate::geometry::analytic::{
@@ -18,31 +20,10 @@ use crate::math::{Mat3, NurbsCurve, Real, Vec3};
 use crate::model::*;
 use std::collections::{BTreeMap, HashMap};
 
-/// A problem found while building the model, at a field path.
-#[derive(Debug, Clone, PartialEq)]
-pub struct Issue {
-    /// Field path, e.g. `patches[2].arc.angle_deg`.
-    pub path: String,
-    /// What is wrong and what is allowed.
-    pub message: String,
-}
-
-fn issue(path: impl Into<String>, message: impl Into<String>) -> Issue {
-    Issue {
-        path: path.into(),
-        message: message.into(),
-    }
-}
-
-type Result<T> = std::result::Result<T, Issue>;
-
 /// Relative size of the default joint tolerance: ends closer than this fraction of the model's bounding-box
 /// diagonal are the same point. Fits and exact primitives place shared ends to ~1e-14 relative, so 1e-8
 /// separates coincident ends from distinct ones with a wide margin on both sides.
 const DEFAULT_JOINT_TOLERANCE: Real = 1e-8;
-
-/// Fit deviation, as a fraction of the wire diameter, above which the design gets a warning.
-pub(super) const FIT_WARNING_FRACTION: Real = 0.01;
 
 /// Default smallest step, as a fraction of the nominal step: ten halvings.
 const DEFAULT_MIN_STEP_FRACTION: Real = 1.0 / 1024.0;
@@ -466,9 +447,9 @@ pub fn estimated_memory(dto: &DesignDto, steps: &StepCount) -> MemoryEstimate {
     if let Some(s) = &dto.stent {
         let sector = match s.symmetry {
             _ if s.full_model => 1.0,
-            None | Some(stent::SymmetryDto::None) => 1.0,
-            Some(stent::SymmetryDto::Half) => 2.0,
-            Some(stent::SymmetryDto::Quarter) => 4.0,
+            None | Some(SymmetryDto::None) => 1.0,
+            Some(SymmetryDto::Half) => 2.0,
+            Some(SymmetryDto::Quarter) => 4.0,
         };
         let (crowns, peaks) = (s.crowns as Real, s.peaks as Real);
         let every = s

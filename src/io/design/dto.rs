@@ -271,10 +271,10 @@ pub struct DesignDto {
     pub patches: Vec<PatchDto>,
     /// A generated stent: crowns, bridges, centreline, symmetry ([`super::stent`]).
     #[serde(default)]
-    pub stent: Option<super::stent::StentDto>,
+    pub stent: Option<StentDto>,
     /// A programme driving a node set of the stent to a target shape ([`super::stent`]).
     #[serde(default)]
-    pub programme: Option<super::stent::ProgrammeDto>,
+    pub programme: Option<ProgrammeDto>,
     /// Automatic joining of coincident patch ends.
     #[serde(default)]
     pub joints: Option<JointsDto>,
@@ -680,4 +680,206 @@ pub struct ProbeDto {
     /// Curve parameter on the patch, in [0, 1].
     #[serde(default)]
     pub u: Option<Finite>,
+}
+
+/// The `stent:` block.
+#[derive(Debug, Clone, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct StentDto {
+    /// Number of crowns.
+    pub crowns: usize,
+    /// Crown radius `R` [length].
+    pub radius: Positive,
+    /// Crown amplitude `h_c` (half the crown height) [length].
+    pub amplitude: Positive,
+    /// Crests per crown.
+    pub peaks: usize,
+    /// Crown spacing `d_c` along the centreline [length].
+    #[serde(default)]
+    pub spacing: Option<Positive>,
+    /// Rotation of each crown about the axis relative to the previous one [degrees] (default `180/peaks`).
+    #[serde(default)]
+    pub rotation_deg: Option<Finite>,
+    /// Bridges between consecutive crowns (none when absent).
+    #[serde(default)]
+    pub bridges: Option<BridgesDto>,
+    /// The stent axis.
+    #[serde(alias = "centerline")]
+    pub centreline: CentrelineDto,
+    /// Symmetry of the device: `none` (default), `half`, `quarter`.
+    #[serde(default)]
+    pub symmetry: Option<SymmetryDto>,
+    /// Model the whole (symmetric) device instead of one sector.
+    #[serde(default)]
+    pub full_model: bool,
+    /// Discretisation of the crown wires (default: `mesh`).
+    #[serde(default)]
+    pub crown_mesh: Option<MeshDto>,
+    /// Discretisation of the bridges (default: `mesh`).
+    #[serde(default)]
+    pub bridge_mesh: Option<MeshDto>,
+}
+
+/// Bridge shape keyword.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, JsonSchema)]
+#[serde(rename_all = "snake_case")]
+pub enum BridgeShapeDto {
+    /// Straight.
+    Straight,
+    /// Sinusoidal.
+    Sinusoidal,
+}
+
+/// Sinusoidal bridge direction keyword.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, JsonSchema)]
+#[serde(rename_all = "snake_case")]
+pub enum BridgeDirectionDto {
+    /// On the cylinder.
+    Circumferential,
+    /// In the meridional plane.
+    Radial,
+}
+
+/// The bridges.
+#[derive(Debug, Clone, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct BridgesDto {
+    /// `straight` or `sinusoidal`.
+    pub shape: BridgeShapeDto,
+    /// Amplitude `h_b` of a sinusoidal bridge [length].
+    #[serde(default)]
+    pub amplitude: Option<Positive>,
+    /// Waves over a sinusoidal bridge (default 1; a multiple of 1/2).
+    #[serde(default)]
+    pub waves: Option<Positive>,
+    /// `circumferential` (default) or `radial`.
+    #[serde(default)]
+    pub direction: Option<BridgeDirectionDto>,
+    /// A bridge at every `every`-th crest (default 1: every crest).
+    #[serde(default)]
+    pub every: Option<usize>,
+    /// The first bridged crest, 1-based (default 1: the crest at ϑ = rotation × crown index).
+    #[serde(default)]
+    pub first: Option<usize>,
+}
+
+/// The centreline: exactly one of `straight`, `arc`, `points`.
+#[derive(Debug, Clone, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct CentrelineDto {
+    /// A straight axis.
+    #[serde(default)]
+    pub straight: Option<StraightDto>,
+    /// A circular arc.
+    #[serde(default)]
+    pub arc: Option<ArcCentrelineDto>,
+    /// A spline through points.
+    #[serde(default)]
+    pub points: Option<PointsCentrelineDto>,
+}
+
+/// A straight axis.
+#[derive(Debug, Clone, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct StraightDto {
+    /// Centre of the first crown (default origin).
+    #[serde(default)]
+    pub origin: Option<Vector>,
+    /// Axis direction (default `[1, 0, 0]`).
+    #[serde(default)]
+    pub direction: Option<Vector>,
+    /// Direction of ϑ = 0 (the first symmetry plane contains it and the axis).
+    #[serde(default)]
+    pub reference: Option<Vector>,
+}
+
+/// A circular-arc axis.
+#[derive(Debug, Clone, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct ArcCentrelineDto {
+    /// Centre of the circle.
+    pub center: Vector,
+    /// Start point (the first crown's centre).
+    pub start: Vector,
+    /// Rotation axis (right-hand rule).
+    pub axis: Vector,
+    /// Swept angle [degrees].
+    pub angle_deg: Finite,
+    /// Direction of ϑ = 0 at the start (default: outward from the centre).
+    #[serde(default)]
+    pub reference: Option<Vector>,
+}
+
+/// A point-list axis.
+#[derive(Debug, Clone, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct PointsCentrelineDto {
+    /// The points (a cubic spline passes through them).
+    pub points: Vec<Vector>,
+    /// Direction of ϑ = 0 at the start.
+    #[serde(default)]
+    pub reference: Option<Vector>,
+}
+
+/// Symmetry keyword.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, JsonSchema)]
+#[serde(rename_all = "snake_case")]
+pub enum SymmetryDto {
+    /// No symmetry.
+    None,
+    /// About the plane through the axis and ϑ = 0.
+    Half,
+    /// About that plane and the one through ϑ = 90°.
+    Quarter,
+}
+
+/// Programme kind keyword.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, JsonSchema)]
+#[serde(rename_all = "snake_case")]
+pub enum ProgrammeKindDto {
+    /// `η = −Δr e_r`.
+    RadialContraction,
+    /// `η = P_temp − P_0`.
+    TargetShape,
+}
+
+/// The `programme:` block.
+#[derive(Debug, Clone, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct ProgrammeDto {
+    /// `radial_contraction` or `target_shape`.
+    pub kind: ProgrammeKindDto,
+    /// The driven node set (default `all_joints`).
+    #[serde(default)]
+    pub nodes: Option<String>,
+    /// Radial contraction `Δr` [length] (radial_contraction).
+    #[serde(default)]
+    pub delta_r: Option<Positive>,
+    /// The temporary placement (target_shape).
+    #[serde(default)]
+    pub temporary: Option<TemporaryDto>,
+    /// Ramp `[start, end]` [time]: the target is reached linearly over it and then held.
+    pub ramp: [NonNegative; 2],
+    /// Release time [time]: the driven components become free (default: never).
+    #[serde(default)]
+    pub release: Option<NonNegative>,
+}
+
+/// The temporary placement of a target-shape programme.
+#[derive(Debug, Clone, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct TemporaryDto {
+    /// Straighten the centreline about its middle station.
+    #[serde(default)]
+    pub straighten: bool,
+    /// Or a given centreline (crowns at the same arc lengths).
+    #[serde(default, alias = "centerline")]
+    pub centreline: Option<CentrelineDto>,
+    /// Crown radius in the temporary shape (default: the permanent one) [length].
+    #[serde(default)]
+    pub radius: Option<Positive>,
+    /// Place the temporary shape by the rigid motion that best fits its driven nodes to their permanent
+    /// positions (default true), so that `η_temp` has no rigid part.
+    #[serde(default)]
+    pub align: Option<bool>,
 }

@@ -10,6 +10,7 @@
 pub mod build;
 pub mod dto;
 pub mod guard;
+pub mod issue;
 pub mod locate;
 pub mod quote;
 pub mod stent;
