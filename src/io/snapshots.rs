@@ -24,7 +24,8 @@ pub struct SnapshotSchedule {
     every: usize,
     /// End time of the run.
     end: Real,
-    /// Times closer than this are equal: the solver's landing tolerance, `1e-9` of the nominal step.
+    /// Times closer than this are equal: the solver's landing tolerance ([`crate::model::LANDING_TOLERANCE`] of
+    /// the nominal step).
     snap: Real,
 }
 
@@ -35,7 +36,7 @@ impl SnapshotSchedule {
             times: settings.times.clone(),
             every: settings.every,
             end: model.time.end,
-            snap: 1e-9 * model.time.step,
+            snap: crate::model::LANDING_TOLERANCE * model.time.step,
         }
     }
 

@@ -251,9 +251,14 @@ pub struct TimeSettings {
 }
 
 /// Times closer than this fraction of the nominal step are one time when time stepping lands on schedule
-/// breakpoints: the solver's landing tolerance ([`crate::solver::Simulation::run`], `snap = 1e-9 h`), which
-/// keeps round-off from making sliver steps. [`Model::planned_steps`] counts with it.
+/// breakpoints: the landing tolerance of the solver ([`crate::solver::Simulation::run`]), of the snapshot
+/// schedule and of [`Model::planned_steps`], which keeps round-off from making sliver steps.
 pub const LANDING_TOLERANCE: Real = 1e-9;
+
+/// Breakpoints closer than this fraction of the end time are merged into one ([`Model::schedule_breakpoints`]):
+/// the same time written in two tables (`1.75` and `1.7500000000000002` after unit arithmetic), far below
+/// [`LANDING_TOLERANCE`] of any step.
+pub const BREAKPOINT_MERGE: Real = 1e-12;
 
 /// The time steps a run takes when no step is cut ([`Model::planned_steps`]).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
@@ -474,7 +479,7 @@ impl Model {
         let end = self.time.end;
         times.retain(|&t| t > 0.0 && t <= end);
         times.sort_by(Real::total_cmp);
-        times.dedup_by(|a, b| (*a - *b).abs() <= 1e-12 * end);
+        times.dedup_by(|a, b| (*a - *b).abs() <= BREAKPOINT_MERGE * end);
         times
     }
 }

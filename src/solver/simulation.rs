@@ -84,9 +84,10 @@ pub const ROUND_OFF_TOLERANCE: Real = 1e-9;
 /// taking (at `t = 1e3` s, 4 ulps are 5e-13 s).
 pub const STEP_ROUND_OFF_ULPS: Real = 4.0;
 
-/// Times closer than this fraction of the nominal step to a breakpoint or the end are that breakpoint (no
-/// sliver steps from round-off in the sum of steps).
-const BREAKPOINT_SNAP: Real = 1e-9;
+/// The increment norm's length of a patch whose ends coincide (a closed loop) is its chord floored at this
+/// fraction of the model size: a translation increment is measured against a length of the order of the
+/// patch, never against zero.
+const CLOSED_PATCH_LENGTH_FRACTION: Real = 1e-3;
 
 /// Unit in the last place of `x`: the gap from `|x|` to the next larger float.
 fn ulp(x: Real) -> Real {
@@ -388,7 +389,10 @@ impl<'m> Simulation<'m> {
             .flat_map(|r| {
                 let length = (disc.control0[r.offset + r.n - 1] - disc.control0[r.offset]).norm();
                 // Chord length, floored by the model size for closed patches.
-                std::iter::repeat_n(length.max(1e-3 * disc.length_scale), r.n)
+                std::iter::repeat_n(
+                    length.max(CLOSED_PATCH_LENGTH_FRACTION * disc.length_scale),
+                    r.n,
+                )
             })
             .collect();
         let n = disc.num_unknowns();
@@ -988,7 +992,8 @@ impl<'m> Simulation<'m> {
         let nominal = self.model.time.step;
         let min_step = self.model.time.min_step;
         let breakpoints = self.model.schedule_breakpoints();
-        let snap = BREAKPOINT_SNAP * nominal;
+        // Times closer than this to a breakpoint or the end are that breakpoint (the model's landing tolerance).
+        let snap = crate::model::LANDING_TOLERANCE * nominal;
         let mut h = nominal;
         let mut cuts = 0;
         while self.time < end - snap {
