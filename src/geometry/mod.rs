@@ -25,6 +25,14 @@ pub enum GeometryError {
         /// What is wrong, with the value.
         reason: String,
     },
+    /// A parameter of a stent specification is out of range.
+    #[error("invalid {parameter}: {reason}")]
+    InvalidStent {
+        /// Which parameter.
+        parameter: stent::StentParameter,
+        /// What is wrong, with the value.
+        reason: String,
+    },
     /// A curve is degenerate where a frame is needed (zero tangent).
     #[error("degenerate curve: zero tangent at u = {u}")]
     ZeroTangent {

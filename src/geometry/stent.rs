@@ -362,9 +362,73 @@ pub struct StentGeometry {
     pub stations: Vec<Real>,
 }
 
-fn invalid(what: &'static str, reason: impl Into<String>) -> GeometryError {
-    GeometryError::InvalidParameter {
-        what,
+/// A parameter of a [`StentSpec`] (or its temporary shape) that is out of range, named in
+/// [`GeometryError::InvalidStent`]: the design layer maps each to its field, with no string matching.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum StentParameter {
+    /// The number of crowns.
+    Crowns,
+    /// The crown radius `R`.
+    Radius,
+    /// The crown amplitude `h_c`.
+    Amplitude,
+    /// The crests per crown.
+    Peaks,
+    /// The crown spacing `d_c`.
+    Spacing,
+    /// The rotation of each crown about the axis.
+    Rotation,
+    /// The symmetry cut.
+    Symmetry,
+    /// The bridges as a whole.
+    Bridges,
+    /// Bridges every so many crests.
+    BridgesEvery,
+    /// The first bridged crest.
+    BridgesFirst,
+    /// The amplitude of sinusoidal bridges.
+    BridgesAmplitude,
+    /// The waves of sinusoidal bridges.
+    BridgesWaves,
+    /// The direction of sinusoidal bridges.
+    BridgesDirection,
+    /// The centreline.
+    Centreline,
+    /// The angle of an arc centreline.
+    CentrelineAngle,
+    /// The radius of the temporary shape.
+    TemporaryRadius,
+    /// The centreline of the temporary shape.
+    TemporaryCentreline,
+}
+
+impl std::fmt::Display for StentParameter {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(match self {
+            Self::Crowns => "crown count",
+            Self::Radius => "radius",
+            Self::Amplitude => "amplitude",
+            Self::Peaks => "peak count",
+            Self::Spacing => "crown spacing",
+            Self::Rotation => "crown rotation",
+            Self::Symmetry => "symmetry",
+            Self::Bridges => "bridges",
+            Self::BridgesEvery => "bridge spacing",
+            Self::BridgesFirst => "first bridge",
+            Self::BridgesAmplitude => "bridge amplitude",
+            Self::BridgesWaves => "bridge waves",
+            Self::BridgesDirection => "bridge direction",
+            Self::Centreline => "centreline",
+            Self::CentrelineAngle => "centreline angle",
+            Self::TemporaryRadius => "temporary radius",
+            Self::TemporaryCentreline => "temporary centreline",
+        })
+    }
+}
+
+fn invalid(parameter: StentParameter, reason: impl Into<String>) -> GeometryError {
+    GeometryError::InvalidStent {
+        parameter,
         reason: reason.into(),
     }
 }
@@ -408,7 +472,7 @@ fn frame_from(tangent: &Vec3, reference: Option<Vec3>) -> Mat3 {
     Mat3::from_columns(&[*tangent, d2, tangent.cross(&d2)])
 }
 
-fn finite(what: &'static str, v: &Vec3) -> Result<(), GeometryError> {
+fn finite(what: StentParameter, v: &Vec3) -> Result<(), GeometryError> {
     if v.iter().all(|x| x.is_finite()) {
         Ok(())
     } else {
@@ -424,11 +488,11 @@ impl Axis {
                 direction,
                 reference,
             } => {
-                finite("centreline", origin)?;
-                finite("centreline", direction)?;
+                finite(StentParameter::Centreline, origin)?;
+                finite(StentParameter::Centreline, direction)?;
                 let n = direction.norm();
                 if !(n.is_finite() && n > 0.0) {
-                    return Err(invalid("centreline", "the direction is zero"));
+                    return Err(invalid(StentParameter::Centreline, "the direction is zero"));
                 }
                 Ok(Axis::Straight {
                     origin: *origin,
@@ -442,12 +506,12 @@ impl Axis {
                 angle,
                 reference,
             } => {
-                finite("centreline", centre)?;
-                finite("centreline", start)?;
-                finite("centreline", axis)?;
+                finite(StentParameter::Centreline, centre)?;
+                finite(StentParameter::Centreline, start)?;
+                finite(StentParameter::Centreline, axis)?;
                 if !(angle.is_finite() && *angle != 0.0 && angle.abs() <= TAU) {
                     return Err(invalid(
-                        "centreline.angle",
+                        StentParameter::CentrelineAngle,
                         format!(
                             "the swept angle must be non-zero and at most 360°, got {}°",
                             angle.to_degrees()
@@ -456,7 +520,7 @@ impl Axis {
                 }
                 let a = axis.norm();
                 if !(a.is_finite() && a > 0.0) {
-                    return Err(invalid("centreline", "the arc axis is zero"));
+                    return Err(invalid(StentParameter::Centreline, "the arc axis is zero"));
                 }
                 let axis = axis / a;
                 let offset = start - centre;
@@ -465,7 +529,7 @@ impl Axis {
                     || offset.dot(&axis).abs() > PLANARITY_TOLERANCE * radius
                 {
                     return Err(invalid(
-                        "centreline",
+                        StentParameter::Centreline,
                         "the start point must differ from the centre and lie in the plane through the centre normal to the axis",
                     ));
                 }
@@ -484,7 +548,7 @@ impl Axis {
             }
             CentrelineSpec::Points { points, reference } => {
                 for p in points {
-                    finite("centreline", p)?;
+                    finite(StentParameter::Centreline, p)?;
                 }
                 let curve = point_list_curve(points)?;
                 Ok(Axis::Curve {
@@ -672,35 +736,47 @@ impl StentSpec {
     fn check_numbers(&self) -> Result<(), GeometryError> {
         let c = &self.crown;
         if !(c.radius.is_finite() && c.radius > 0.0) {
-            return Err(invalid("radius", format!("must be > 0, got {}", c.radius)));
+            return Err(invalid(
+                StentParameter::Radius,
+                format!("must be > 0, got {}", c.radius),
+            ));
         }
         if !(c.amplitude.is_finite() && c.amplitude > 0.0) {
             return Err(invalid(
-                "amplitude",
+                StentParameter::Amplitude,
                 format!("must be > 0, got {}", c.amplitude),
             ));
         }
         if c.peaks == 0 {
-            return Err(invalid("peaks", "a crown needs at least one peak"));
+            return Err(invalid(
+                StentParameter::Peaks,
+                "a crown needs at least one peak",
+            ));
         }
         if self.crowns == 0 {
-            return Err(invalid("crowns", "a stent needs at least one crown"));
+            return Err(invalid(
+                StentParameter::Crowns,
+                "a stent needs at least one crown",
+            ));
         }
         if !self.rotation.is_finite() {
-            return Err(invalid("rotation", "must be finite"));
+            return Err(invalid(StentParameter::Rotation, "must be finite"));
         }
         if let Some(d) = self.spacing
             && !(d.is_finite() && d > 0.0)
         {
-            return Err(invalid("spacing", format!("must be > 0, got {d}")));
+            return Err(invalid(
+                StentParameter::Spacing,
+                format!("must be > 0, got {d}"),
+            ));
         }
         if let Some(b) = &self.bridges {
             if b.every == 0 {
-                return Err(invalid("bridges.every", "must be ≥ 1"));
+                return Err(invalid(StentParameter::BridgesEvery, "must be ≥ 1"));
             }
             if b.first >= b.every {
                 return Err(invalid(
-                    "bridges.first",
+                    StentParameter::BridgesFirst,
                     format!(
                         "crest {} does not exist in a pattern of every {} crests: use 1 … {}",
                         b.first + 1,
@@ -717,13 +793,13 @@ impl StentSpec {
             {
                 if !(amplitude.is_finite() && amplitude > 0.0) {
                     return Err(invalid(
-                        "bridges.amplitude",
+                        StentParameter::BridgesAmplitude,
                         format!("must be > 0, got {amplitude}"),
                     ));
                 }
                 if !(waves > 0.0 && is_multiple(2.0 * waves, 1.0)) {
                     return Err(invalid(
-                        "bridges.waves",
+                        StentParameter::BridgesWaves,
                         format!(
                             "must be a positive multiple of 1/2 so that the sine vanishes at both ends, got {waves}"
                         ),
@@ -731,7 +807,7 @@ impl StentSpec {
                 }
                 if direction == BridgeDirection::Radial && amplitude >= c.radius {
                     return Err(invalid(
-                        "bridges.amplitude",
+                        StentParameter::BridgesAmplitude,
                         format!(
                             "a radial bridge amplitude {amplitude} must be below the crown radius {}",
                             c.radius
@@ -751,7 +827,7 @@ impl StentSpec {
             (None, None) if n == 1 => (0.0, 0.0),
             (None, None) => {
                 return Err(invalid(
-                    "spacing",
+                    StentParameter::Spacing,
                     "a straight centreline needs the crown spacing d_c",
                 ));
             }
@@ -761,7 +837,7 @@ impl StentSpec {
                 let span = d * (n - 1) as Real;
                 if span > l * (1.0 + PLANARITY_TOLERANCE) {
                     return Err(invalid(
-                        "spacing",
+                        StentParameter::Spacing,
                         format!(
                             "{n} crowns at spacing {d} span {span}, more than the centreline length {l}"
                         ),
@@ -772,7 +848,7 @@ impl StentSpec {
         };
         if n > 1 && spacing <= 2.0 * self.crown.amplitude {
             return Err(invalid(
-                "spacing",
+                StentParameter::Spacing,
                 format!(
                     "the crown spacing {spacing} must exceed the crown height 2 h_c = {}, or crowns overlap",
                     2.0 * self.crown.amplitude
@@ -787,7 +863,7 @@ impl StentSpec {
         let m = self.crown.peaks as Real;
         if self.symmetry != Symmetry::None && !is_multiple(m * self.rotation, PI) {
             return Err(invalid(
-                "rotation",
+                StentParameter::Rotation,
                 format!(
                     "a symmetric device needs every crown even about the cut planes: peaks × rotation must be a multiple of 180°, got {} × {}°",
                     self.crown.peaks,
@@ -800,7 +876,7 @@ impl StentSpec {
             (Symmetry::Quarter, Axis::Straight { .. }) => {
                 if !self.crown.peaks.is_multiple_of(2) {
                     return Err(invalid(
-                        "symmetry",
+                        StentParameter::Symmetry,
                         format!(
                             "quarter symmetry needs an even number of peaks (a crest or trough on the plane ϑ = 90°), got {}",
                             self.crown.peaks
@@ -810,14 +886,14 @@ impl StentSpec {
                 Ok(())
             }
             (Symmetry::Quarter, _) => Err(invalid(
-                "symmetry",
+                StentParameter::Symmetry,
                 "quarter symmetry needs a straight centreline; use half symmetry for a planar bent one",
             )),
             (Symmetry::Half, Axis::Straight { .. }) => Ok(()),
             (Symmetry::Half, Axis::Arc { axis: a, frame, .. }) => {
                 if frame.column(1).dot(a).abs() > PLANARITY_TOLERANCE {
                     return Err(invalid(
-                        "symmetry",
+                        StentParameter::Symmetry,
                         "half symmetry needs the reference direction (ϑ = 0) in the plane of the arc",
                     ));
                 }
@@ -834,7 +910,7 @@ impl StentSpec {
                         || (r.column(2) - normal).norm() > PLANARITY_TOLERANCE
                     {
                         return Err(invalid(
-                            "symmetry",
+                            StentParameter::Symmetry,
                             "half symmetry needs a planar centreline with the reference direction (ϑ = 0) in its plane",
                         ));
                     }
@@ -853,7 +929,7 @@ impl StentSpec {
             && self.crown.radius >= *radius
         {
             return Err(invalid(
-                "radius",
+                StentParameter::Radius,
                 format!(
                     "the crown radius {} must be smaller than the centreline's bend radius {radius}",
                     self.crown.radius
@@ -866,7 +942,7 @@ impl StentSpec {
         let n = self.crowns;
         if self.bridges.is_some() && n > 1 && !is_multiple(mf * self.rotation - PI, TAU) {
             return Err(invalid(
-                "rotation",
+                StentParameter::Rotation,
                 format!(
                     "bridges join each crest to the facing trough of the next crown, which needs peaks × rotation ≡ 180° (mod 360°); got {} × {}° (e.g. use {}°)",
                     m,
@@ -1043,7 +1119,7 @@ impl StentSpec {
                     let (Some(start), Some(end)) = (node_index[k][2 * c], node_index[k + 1][j])
                     else {
                         return Err(invalid(
-                            "rotation",
+                            StentParameter::Rotation,
                             format!(
                                 "the bridge from crown {} at ϑ = {:.6} rad finds no trough of crown {} facing it; give a rotation in degrees within (−360, 360)",
                                 k + 1,
@@ -1072,7 +1148,7 @@ impl StentSpec {
                             };
                             if sign.abs() <= sin_tol {
                                 return Err(invalid(
-                                    "bridges.direction",
+                                    StentParameter::BridgesDirection,
                                     format!(
                                         "the circumferential sinusoidal bridge at ϑ = {:.3}° lies on a symmetry plane and cannot be symmetric about it: use `direction: radial`, straight bridges, or crests off the plane (`every`, `first`)",
                                         a.to_degrees()
@@ -1157,7 +1233,7 @@ impl StentSpec {
             for &a in angles {
                 if !angles.iter().any(|&b| same_angle(mirror(a), b)) {
                     return Err(invalid(
-                        "bridges",
+                        StentParameter::Bridges,
                         format!(
                             "the bridges between crowns {} and {} are not symmetric about the plane {plane}: the bridge at ϑ = {:.3}° has no mirror image; choose `every` and `first` so that the bridged crests are symmetric",
                             k + 1,
@@ -1192,7 +1268,7 @@ impl StentSpec {
                 && (q.position - crest.position).dot(&r.column(0)) <= 0.0
             {
                 return Err(invalid(
-                    "spacing",
+                    StentParameter::Spacing,
                     format!(
                         "crowns {} and {} overlap at ϑ = {:.1}°: the bend is too tight for the crown height (increase the spacing or the bend radius)",
                         k + 1,
@@ -1215,7 +1291,7 @@ impl StentSpec {
         let radius = temporary.radius.unwrap_or(self.crown.radius);
         if !(radius.is_finite() && radius > 0.0) {
             return Err(invalid(
-                "temporary.radius",
+                StentParameter::TemporaryRadius,
                 format!("must be > 0, got {radius}"),
             ));
         }
@@ -1233,8 +1309,8 @@ impl StentSpec {
             }
             TemporaryCentreline::Given(spec) => {
                 let axis = Axis::new(spec).map_err(|e| match e {
-                    GeometryError::InvalidParameter { reason, .. } => {
-                        invalid("temporary.centreline", reason)
+                    GeometryError::InvalidStent { reason, .. } => {
+                        invalid(StentParameter::TemporaryCentreline, reason)
                     }
                     e => e,
                 })?;
@@ -1242,7 +1318,7 @@ impl StentSpec {
                     let last = stations[stations.len() - 1];
                     if last > l * (1.0 + PLANARITY_TOLERANCE) {
                         return Err(invalid(
-                            "temporary.centreline",
+                            StentParameter::TemporaryCentreline,
                             format!(
                                 "the last crown sits at arc length {last}, beyond the temporary centreline's length {l}"
                             ),
@@ -1345,8 +1421,8 @@ mod tests {
         s.rotation = 0.0;
         assert!(matches!(
             s.generate(),
-            Err(GeometryError::InvalidParameter {
-                what: "rotation",
+            Err(GeometryError::InvalidStent {
+                parameter: StentParameter::Rotation,
                 ..
             })
         ));

@@ -31,7 +31,7 @@ use crate::geometry::frame::normal_to;
 use crate::geometry::primitives;
 use crate::geometry::stent::{
     BridgeDirection, BridgeShape, BridgeSpec, CentrelineSpec, CrownSpec, PatchRole, StentGeometry,
-    StentSpec, Symmetry, TemporaryCentreline, TemporarySpec, WireEnd,
+    StentParameter, StentSpec, Symmetry, TemporaryCentreline, TemporarySpec, WireEnd,
 };
 use crate::material::{Section, SectionProperties};
 use crate::math::{Mat3, Real, Vec3};
@@ -97,33 +97,33 @@ pub struct GeneratedStent {
 }
 
 /// Maps a generator parameter name to its field path under `stent` (or `programme`).
-fn spec_path(what: &str) -> String {
-    match what {
-        "rotation" => "stent.rotation_deg".into(),
-        "centreline.angle" => "stent.centreline.arc.angle_deg".into(),
-        "temporary.radius" => "programme.temporary.radius".into(),
-        "temporary.centreline" => "programme.temporary.centreline".into(),
-        w if w.starts_with("bridges")
-            || w.starts_with("centreline")
-            || [
-                "radius",
-                "amplitude",
-                "peaks",
-                "crowns",
-                "spacing",
-                "symmetry",
-            ]
-            .contains(&w) =>
-        {
-            format!("stent.{w}")
-        }
-        _ => "stent".into(),
+/// The field of a stent parameter.
+fn spec_path(parameter: StentParameter) -> &'static str {
+    use StentParameter as P;
+    match parameter {
+        P::Crowns => "stent.crowns",
+        P::Radius => "stent.radius",
+        P::Amplitude => "stent.amplitude",
+        P::Peaks => "stent.peaks",
+        P::Spacing => "stent.spacing",
+        P::Rotation => "stent.rotation_deg",
+        P::Symmetry => "stent.symmetry",
+        P::Bridges => "stent.bridges",
+        P::BridgesEvery => "stent.bridges.every",
+        P::BridgesFirst => "stent.bridges.first",
+        P::BridgesAmplitude => "stent.bridges.amplitude",
+        P::BridgesWaves => "stent.bridges.waves",
+        P::BridgesDirection => "stent.bridges.direction",
+        P::Centreline => "stent.centreline",
+        P::CentrelineAngle => "stent.centreline.arc.angle_deg",
+        P::TemporaryRadius => "programme.temporary.radius",
+        P::TemporaryCentreline => "programme.temporary.centreline",
     }
 }
 
 fn geometry_issue(e: GeometryError) -> Issue {
     match e {
-        GeometryError::InvalidParameter { what, reason } => issue(spec_path(what), reason),
+        GeometryError::InvalidStent { parameter, reason } => issue(spec_path(parameter), reason),
         e => issue("stent", e.to_string()),
     }
 }
