@@ -80,8 +80,9 @@ impl SectionLaw {
 #[cfg(test)]
 mod tests {
     // Source: the law is affine in the strain with slope C̄ (module docs), so a central difference of `stress`
-    // in any strain direction equals C̄ times that direction up to round-off (exact for an affine map; the
-    // tolerance 1e-9 relative to the stress scale covers the cancellation of the difference quotient).
+    // in any strain direction equals C̄ times that direction up to round-off. Stresses and history are of the
+    // size C̄·1e-2, so the difference quotient (step 1e-6) carries a round-off of about 1e-16·1e-2/1e-6 = 1e-12
+    // relative to the slope; the tolerance 1e-9 is far above that and far below any wrong stiffness.
     use super::*;
     use crate::material::{CircularSection, Material};
 
@@ -91,11 +92,12 @@ mod tests {
         let shape = material.section_shape(&CircularSection::try_new(0.05).expect("valid").into());
         let modulus = material.prony().instantaneous_modulus();
         let v = |k: Real| Vec3::new(k.sin(), (k + 1.0).cos(), (0.7 * k).sin());
+        let (c_n, c_m) = (shape.force * modulus, shape.moment * modulus);
         let history = SectionStress {
-            force: v(1.0),
-            moment: v(2.0),
-            force_ds: v(3.0),
-            moment_ds: v(4.0),
+            force: c_n.component_mul(&v(1.0)) * 1e-2,
+            moment: c_m.component_mul(&v(2.0)) * 1e-2,
+            force_ds: c_n.component_mul(&v(3.0)) * 1e-2,
+            moment_ds: c_m.component_mul(&v(4.0)) * 1e-2,
         };
         let law = SectionLaw::new(&shape, modulus, history);
         let strain = SectionStrains {
@@ -106,6 +108,7 @@ mod tests {
         };
         // At zero strain the stress is −H.
         assert_eq!(law.stress(&SectionStrains::default()).force, -history.force);
+        assert_eq!(law.stiffness(), (c_n, c_m));
         let (c_n, c_m) = law.stiffness_matrices();
         let eps = 1e-6;
         let d = v(9.0);
@@ -122,9 +125,5 @@ mod tests {
         let scale_m = (c_m * d).norm();
         assert!((fd_n - c_n * d).norm() < 1e-9 * scale_n, "{fd_n:?}");
         assert!((fd_m - c_m * d).norm() < 1e-9 * scale_m, "{fd_m:?}");
-        assert_eq!(
-            law.stiffness(),
-            (shape.force * modulus, shape.moment * modulus)
-        );
     }
 }
