@@ -685,7 +685,7 @@ fn material(m: &MaterialDto) -> Result<(Material, Integrator)> {
 }
 
 /// The design field a material constructor's error is about (`material.prony[k][0]`, `material.wlf.C2`, …),
-/// with the constructor's message.
+/// with the constructor's message. Errors count Prony branches `α` from 1, the design's list from 0.
 fn material_issue(e: MaterialError) -> Issue {
     let path = match e {
         MaterialError::BranchModulus { branch, .. } => format!("material.prony[{}][0]", branch - 1),
