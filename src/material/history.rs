@@ -14,8 +14,8 @@
 //! ```
 //!
 //! and the same with every strain replaced by its s-derivative for `N,s`, `M,s`. The history `H` is formed once
-//! per step and point ([`history_stress`]); Newton only multiplies `C̄ = S ⊙ Ē` by increments
-//! ([`section_stress`]); after convergence [`update_branch_strains`] advances the branches in place.
+//! per step and point ([`history_stress`]); Newton evaluates the law with it ([`super::SectionLaw`], which
+//! holds `C̄ = S ⊙ Ē` and `H`); after convergence [`update_branch_strains`] advances the branches in place.
 
 use super::{Prony, SectionShape, StepCoefficients};
 use crate::math::{Real, Vec3};
@@ -165,25 +165,6 @@ pub fn history_stress(
     }
 }
 
-/// The section stresses `N = S_N ⊙ Ē Γ_N − H_N`, `M = S_M ⊙ Ē K_M − H_M` and their s-derivatives at the new
-/// strains, given the step's effective modulus `Ē` \[stress\] ([`StepCoefficients::effective_modulus`]) and
-/// history ([`history_stress`]).
-pub fn section_stress(
-    shape: &SectionShape,
-    effective_modulus: Real,
-    history: &SectionStress,
-    strain_np1: &SectionStrains,
-) -> SectionStress {
-    let c_n = shape.force * effective_modulus;
-    let c_m = shape.moment * effective_modulus;
-    SectionStress {
-        force: c_n.component_mul(&strain_np1.force) - history.force,
-        moment: c_m.component_mul(&strain_np1.moment) - history.moment,
-        force_ds: c_n.component_mul(&strain_np1.force_ds) - history.force_ds,
-        moment_ds: c_m.component_mul(&strain_np1.moment_ds) - history.moment_ds,
-    }
-}
-
 /// After convergence: advances the branch strains of one point in place,
 /// `ε_α ← β_α ε^{n+1} + γ_α ε^n + δ_α ε_α` (all four vectors). Panics if the branch counts differ.
 #[track_caller]
@@ -216,7 +197,7 @@ mod tests {
     // in Newton. Same algebra, different order of operations: agreement to 1e-13 relative to the largest
     // stress term (PLA moduli ~1e3 against strains ~1e-2, 16 terms).
     use super::*;
-    use crate::material::{CircularSection, Integrator, Material, step_coefficients};
+    use crate::material::{CircularSection, Integrator, Material, SectionLaw, step_coefficients};
 
     fn strains(seed: Real) -> SectionStrains {
         let v = |k: Real| {
@@ -258,7 +239,7 @@ mod tests {
                 let strain_np1 = strains(20.0 + p as Real);
                 let mut branches = history.point(p).to_vec();
                 let h = history_stress(prony, &shape, &coeffs, &strain_n, &branches);
-                let split = section_stress(&shape, e_bar, &h, &strain_np1);
+                let split = SectionLaw::new(&shape, e_bar, h).stress(&strain_np1);
                 update_branch_strains(&coeffs, &strain_np1, &strain_n, &mut branches);
                 // Definition, per vector: S ⊙ (E∞ ε + Σ E_α (ε − ε_α)).
                 let define = |s: &Vec3, eps: Vec3, pick: fn(&SectionStrains) -> Vec3| {

@@ -29,8 +29,9 @@
 //! so that within a time step the section law is linear in the unknown strain:
 //! `N^{n+1} = C̄ Γ_N^{n+1} − H_N` with `C̄ = S_N ⊙ Ē`, `Ē = E∞ + Σ_α E_α (1 − β_α)`
 //! ([`StepCoefficients::effective_modulus`]) and a history force `H_N` fixed during Newton
-//! ([`history_stress`]). After convergence the branch strains are advanced in place
-//! ([`update_branch_strains`]); they live in a [`BranchHistory`].
+//! ([`history_stress`]); [`SectionLaw`] evaluates this law at one point and is what the solver calls. After
+//! convergence the branch strains are advanced in place ([`update_branch_strains`]); they live in a
+//! [`BranchHistory`].
 //!
 //! # Units
 //!
@@ -44,19 +45,20 @@
 
 pub mod history;
 pub mod integrator;
+pub mod law;
 pub mod point;
 pub mod prony;
 pub mod section;
 pub mod wlf;
 
 pub use history::{
-    BranchHistory, SectionStrains, SectionStress, history_stress, section_stress,
-    update_branch_strains,
+    BranchHistory, SectionStrains, SectionStress, history_stress, update_branch_strains,
 };
 pub use integrator::{
     Integrator, MAX_STEP_RATE, ReducedTimeQuadrature, StepCoefficients, exponential_coefficients,
     reduced_time_increment, step_coefficients, step_coefficients_into,
 };
+pub use law::SectionLaw;
 pub use point::{simulate_strain_history, simulate_stress_history};
 pub use prony::{Prony, PronyBranch};
 pub use section::{CircularSection, Section, SectionProperties, SectionShape, ShearFactor};

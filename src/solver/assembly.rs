@@ -5,7 +5,8 @@
 //! F = K × N + N,s + Rᵀ n̄ = 0,      T = K × M + M,s + Γ × N + Rᵀ m̄ = 0
 //! ```
 //! with `N = C̄_N (Γ − Γ0) − H_N`, `M = C̄_M (K − K0) − H_M` (N_constitutive_disc, M_constitutive_disc; the
-//! history terms `H` are constant during Newton) and `Γ,s = Rᵀ c,ss − K × Γ`.
+//! history terms `H` are constant during Newton; evaluated by [`crate::material::SectionLaw`], the only place
+//! the law is written) and `Γ,s = Rᵀ c,ss − K × Γ`.
 //! Their linearisation under `R exp(εδΘ̃)`, `c + εδη` uses
 //! ```text
 //! δΓ = Γ × δΘ + Rᵀ δη,s            δK = K × δΘ + δΘ,s
@@ -30,7 +31,7 @@
 use super::discretisation::{CollocationPoint, Discretisation};
 use super::gauge::Gauge;
 use super::state::State;
-use crate::material::SectionStrains;
+use crate::material::{SectionLaw, SectionStrains, SectionStress};
 use crate::math::so3::{hat, log};
 use crate::math::{Mat3, Real, Rot3, Vec3};
 use crate::model::{Component, Model};
@@ -166,13 +167,24 @@ impl Actions {
 }
 
 /// The constitutive data of one time step: the effective modulus of `C̄ = modulus · shape` and, per
-/// collocation point, the history stresses `[H_N, H_N,s, H_M, H_M,s]` (empty = all zero, elastic).
+/// collocation point, the history stresses `H` (empty = all zero, elastic).
 #[derive(Debug, Clone, Copy)]
 pub struct StepMaterial<'a> {
     /// Effective modulus of `C̄` [stress].
     pub modulus: Real,
     /// History stresses per collocation point.
-    pub history: &'a [[Vec3; 4]],
+    pub history: &'a [SectionStress],
+}
+
+impl StepMaterial<'_> {
+    /// The section law of collocation point `g` (the one place the residual, tangent and resultants take `N`,
+    /// `M` and `C̄` from).
+    #[inline]
+    fn law(&self, disc: &Discretisation, g: usize) -> SectionLaw {
+        let shape = &disc.shapes[disc.points[g].shape];
+        let history = self.history.get(g).copied().unwrap_or_default();
+        SectionLaw::new(shape, self.modulus, history)
+    }
 }
 
 /// One end of a node, as the node equations see it.
@@ -426,29 +438,15 @@ impl Assembler {
             .iter()
             .map(|e| {
                 let point = &disc.points[e.point];
-                let (CN, CM) = self.section(disc, point, material.modulus);
                 let kin = kinematics(point, state, e.point);
-                let [hn, _, hm, _] = material
-                    .history
-                    .get(e.point)
-                    .copied()
-                    .unwrap_or([Vec3::zeros(); 4]);
-                let N = CN * (kin.gamma - point.gamma0) - hn;
-                let M = CM * (state.kappa[e.point] - point.kappa0) - hm;
+                let stress = material
+                    .law(disc, e.point)
+                    .stress(&strains(point, state, e.point, &kin));
+                let (N, M) = (stress.force, stress.moment);
                 let R = &state.rotation[e.point];
                 (R * N * e.sign, R * M * e.sign)
             })
             .collect()
-    }
-
-    fn section(
-        &self,
-        disc: &Discretisation,
-        point: &CollocationPoint,
-        modulus: Real,
-    ) -> (Mat3, Mat3) {
-        let shape = &disc.shapes[point.shape];
-        (shape.force_matrix(modulus), shape.moment_matrix(modulus))
     }
 
     #[allow(non_snake_case, clippy::too_many_arguments)]
@@ -464,19 +462,18 @@ impl Assembler {
         row_scale: &mut [Real],
         sink: &mut Sink<'_>,
     ) {
-        let (CN, CM) = self.section(disc, point, material.modulus);
+        let law = material.law(disc, g);
+        let (CN, CM) = law.stiffness_matrices();
         let k = kinematics(point, state, g);
-        let [hn, hn_s, hm, hm_s] = material
-            .history
-            .get(g)
-            .copied()
-            .unwrap_or([Vec3::zeros(); 4]);
-        let N = CN * (k.gamma - point.gamma0) - hn;
-        let N_s = CN * (k.gamma_s - point.gamma0_s) - hn_s;
+        let stress = law.stress(&strains(point, state, g, &k));
+        let (N, N_s, M, M_s) = (
+            stress.force,
+            stress.force_ds,
+            stress.moment,
+            stress.moment_ds,
+        );
         let K = state.kappa[g];
         let K_s = state.kappa_s[g];
-        let M = CM * (K - point.kappa0) - hm;
-        let M_s = CM * (K_s - point.kappa0_s) - hm_s;
         let R = &state.rotation[g];
         let Rt = R.transpose();
         let nbar = Rt * actions.dist_force[point.patch];
@@ -555,16 +552,12 @@ impl Assembler {
         let mut terms = Vec::with_capacity(node.ends.len());
         for e in &node.ends {
             let point = &disc.points[e.point];
-            let (CN, CM) = self.section(disc, point, material.modulus);
+            let law = material.law(disc, e.point);
+            let (CN, CM) = law.stiffness_matrices();
             let kin = kinematics(point, state, e.point);
-            let [hn, _, hm, _] = material
-                .history
-                .get(e.point)
-                .copied()
-                .unwrap_or([Vec3::zeros(); 4]);
-            let N = CN * (kin.gamma - point.gamma0) - hn;
+            let stress = law.stress(&strains(point, state, e.point, &kin));
+            let (N, M) = (stress.force, stress.moment);
             let K = state.kappa[e.point];
-            let M = CM * (K - point.kappa0) - hm;
             let R = &state.rotation[e.point];
             force += R * N * e.sign;
             moment += R * M * e.sign;
@@ -729,7 +722,12 @@ fn kinematics(point: &CollocationPoint, state: &State, g: usize) -> Kinematics {
 /// The total strains `Γ_N = Γ − Γ0`, `K_M = K − K0` and their arc-length derivatives at collocation point `g`.
 pub fn point_strains(disc: &Discretisation, state: &State, g: usize) -> SectionStrains {
     let point = &disc.points[g];
-    let k = kinematics(point, state, g);
+    strains(point, state, g, &kinematics(point, state, g))
+}
+
+/// The total strains at collocation point `g` from its kinematics `k`.
+#[inline]
+fn strains(point: &CollocationPoint, state: &State, g: usize, k: &Kinematics) -> SectionStrains {
     SectionStrains {
         force: k.gamma - point.gamma0,
         moment: state.kappa[g] - point.kappa0,

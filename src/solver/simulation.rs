@@ -38,8 +38,8 @@ use super::gauge::Gauge;
 use super::linear::LinearSystem;
 use super::state::State;
 use crate::material::{
-    BranchHistory, ReducedTimeQuadrature, SectionStrains, StepCoefficients, history_stress,
-    step_coefficients_into, update_branch_strains,
+    BranchHistory, ReducedTimeQuadrature, SectionStrains, SectionStress, StepCoefficients,
+    history_stress, step_coefficients_into, update_branch_strains,
 };
 use crate::math::{Real, Vec3};
 use crate::model::{Model, ProbeLocation};
@@ -277,7 +277,7 @@ struct StepStart {
     /// The last converged state.
     state: State,
     /// The constitutive data `(Ē, coefficients, history stresses)` of the last solved step.
-    material: (Real, StepCoefficients, Vec<[Vec3; 4]>),
+    material: (Real, StepCoefficients, Vec<SectionStress>),
     /// Whether the gauge constraints were active.
     gauge_active: bool,
 }
@@ -305,7 +305,7 @@ pub struct Simulation<'m> {
     /// Effective modulus `Ē` of that step [stress].
     modulus: Real,
     /// History stresses `[H_N, H_N,s, H_M, H_M,s]` per collocation point for that step.
-    history: Vec<[Vec3; 4]>,
+    history: Vec<SectionStress>,
     /// Messages for the user, each said once (e.g. the WLF freeze).
     notices: Vec<String>,
     /// Whether the WLF freeze has been reported.
@@ -414,7 +414,7 @@ impl<'m> Simulation<'m> {
             branches,
             coeffs: StepCoefficients::identity(model.material.num_branches()),
             modulus: model.material.prony().e_inf(),
-            history: vec![[Vec3::zeros(); 4]; points],
+            history: vec![SectionStress::default(); points],
             notices: Vec::new(),
             freeze_reported: false,
             ramps: vec![[None; 6]; model.nodes.len()],
@@ -459,14 +459,13 @@ impl<'m> Simulation<'m> {
                 .enumerate()
                 .for_each(|(g, history)| {
                     let shape = &disc.shapes[disc.points[g].shape];
-                    let h = history_stress(
+                    *history = history_stress(
                         material.prony(),
                         shape,
                         coeffs,
                         &strain_n[g],
                         branches.point(g),
                     );
-                    *history = [h.force, h.force_ds, h.moment, h.moment_ds];
                 });
         }
         if !self.freeze_reported && material.is_frozen(temperature(t_np1)) {

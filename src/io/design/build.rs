@@ -13,8 +13,8 @@ use crate::geometry::analytic::{
 use crate::geometry::fit::{FitSettings, fit_curve};
 use crate::geometry::{GeometryError, primitives};
 use crate::material::{
-    CircularSection, Integrator, Material, Prony, PronyBranch, Section, SectionProperties,
-    ShearFactor, Wlf,
+    CircularSection, Integrator, Material, MaterialError, Prony, PronyBranch, Section,
+    SectionProperties, ShearFactor, Wlf,
 };
 use crate::math::{Mat3, NurbsCurve, Real, Vec3};
 use crate::model::*;
@@ -653,64 +653,55 @@ fn output_settings(
     })
 }
 
+/// The design's material, validated once, by the material constructors ([`Prony::try_new`], [`Wlf::try_new`],
+/// [`Material::try_new`]); their errors are mapped to the design's fields by [`material_issue`].
 fn material(m: &MaterialDto) -> Result<(Material, Integrator)> {
-    let mut branches = Vec::with_capacity(m.prony.len());
-    for (k, [Finite(e), Finite(tau)]) in m.prony.iter().enumerate() {
-        if !(*e > 0.0) {
-            return Err(issue(
-                format!("material.prony[{k}][0]"),
-                format!("branch modulus E = {e} must be > 0"),
-            ));
-        }
-        if !(*tau > 0.0) {
-            return Err(issue(
-                format!("material.prony[{k}][1]"),
-                format!("relaxation time τ = {tau} must be > 0"),
-            ));
-        }
-        branches.push(PronyBranch {
+    let branches = m
+        .prony
+        .iter()
+        .map(|[Finite(e), Finite(tau)]| PronyBranch {
             modulus: *e,
             tau_g: *tau,
-        });
+        })
+        .collect();
+    let prony = Prony::try_new(m.e_inf.0, branches).map_err(material_issue)?;
+    let wlf = m
+        .wlf
+        .as_ref()
+        .map(|w| Wlf::try_new(w.c1.0, w.c2.0, w.tg.0))
+        .transpose();
+    let material = match wlf {
+        Ok(wlf) => Material::try_new(prony, m.nu.0, wlf),
+        // ν precedes the WLF constants in a design and is reported first.
+        Err(e) => Material::try_new(prony, m.nu.0, None).and(Err(e)),
     }
-    let prony =
-        Prony::try_new(m.e_inf.0, branches).map_err(|e| issue("material.E_inf", e.to_string()))?;
-    let nu = m.nu.0;
-    if !(nu > -1.0 && nu < 0.5) {
-        return Err(issue(
-            "material.nu",
-            format!("Poisson's ratio {nu} must lie in (−1, 0.5)"),
-        ));
-    }
-    let wlf = match &m.wlf {
-        None => None,
-        Some(w) => {
-            if !(w.c1.0 > 0.0) {
-                return Err(issue(
-                    "material.wlf.C1",
-                    format!("C1 = {} must be > 0", w.c1.0),
-                ));
-            }
-            if !(w.c2.0 > 0.0) {
-                return Err(issue(
-                    "material.wlf.C2",
-                    format!("C2 = {} must be > 0", w.c2.0),
-                ));
-            }
-            Some(
-                Wlf::try_new(w.c1.0, w.c2.0, w.tg.0)
-                    .map_err(|e| issue("material.wlf", e.to_string()))?,
-            )
-        }
-    };
+    .map_err(material_issue)?;
     let integrator = match m.integrator {
         None | Some(IntegratorDto::Trapezoidal) => Integrator::Trapezoidal,
         Some(IntegratorDto::BackwardEuler) => Integrator::BackwardEuler,
         Some(IntegratorDto::Exponential) => Integrator::Exponential,
     };
-    let material =
-        Material::try_new(prony, nu, wlf).map_err(|e| issue("material", e.to_string()))?;
     Ok((material, integrator))
+}
+
+/// The design field a material constructor's error is about (`material.prony[k][0]`, `material.wlf.C2`, …),
+/// with the constructor's message. Errors count Prony branches `α` from 1, the design's list from 0.
+fn material_issue(e: MaterialError) -> Issue {
+    let path = match e {
+        MaterialError::BranchModulus { branch, .. } => format!("material.prony[{}][0]", branch - 1),
+        MaterialError::BranchRelaxationTime { branch, .. } => {
+            format!("material.prony[{}][1]", branch - 1)
+        }
+        MaterialError::EquilibriumModulus { .. } | MaterialError::InstantaneousModulus { .. } => {
+            "material.E_inf".into()
+        }
+        MaterialError::PoissonRatio { .. } => "material.nu".into(),
+        MaterialError::WlfC1 { .. } => "material.wlf.C1".into(),
+        MaterialError::WlfC2 { .. } => "material.wlf.C2".into(),
+        MaterialError::GlassTransition { .. } => "material.wlf.Tg".into(),
+        _ => "material".into(),
+    };
+    issue(path, e.to_string())
 }
 
 /// The design's section and the shear-factor rule patches with their own diameter inherit.
