@@ -2,6 +2,7 @@
 //! centrelines drawn as tubes, where the circular section makes twist irrelevant. The reference frames of
 //! the rod model, along spline curves, come from [`super::frame`].
 
+use super::frame::{double_reflection, normal_to};
 use super::tube::{TubeError, centreline_tangents};
 use crate::math::{Mat3, Vec3};
 
@@ -9,15 +10,19 @@ use crate::math::{Mat3, Vec3};
 /// Wang, Jüttler, Zheng & Liu, *Computation of rotation minimizing frames*, ACM TOG 27(1), 2008, §4.
 ///
 /// Frame `i` has columns `d1 = t_i` (unit tangent by chord-weighted central differences, second order,
-/// see [`sweep_tube`]), `d2 = r_i`, `d3 = t_i × r_i` (a proper rotation). The first reference vector
-/// `r_0` is the coordinate axis least aligned with `t_0`, made orthogonal to it. Each next one is obtained
-/// by reflecting `(r_i, t_i)` in the bisector plane of `x_i, x_{i+1}` (normal `v1 = x_{i+1} − x_i`) and
-/// then in the plane that maps the reflected tangent onto `t_{i+1}` (normal `v2 = t_{i+1} − t_i^L`):
+/// see [`super::tube::sweep_tube`]), `d2 = r_i`, `d3 = t_i × r_i` (a proper rotation). The first reference
+/// vector `r_0` is the coordinate axis least aligned with `t_0`, made orthogonal to it ([`normal_to`]). Each
+/// next one is obtained by reflecting `(r_i, t_i)` in the bisector plane of `x_i, x_{i+1}` (normal
+/// `v1 = x_{i+1} − x_i`) and then in the plane that maps the reflected tangent onto `t_{i+1}` (normal
+/// `v2 = t_{i+1} − t_i^L`):
 ///
 /// ```text
 /// r_i^L = r_i − 2 (v1·r_i)/(v1·v1) v1,   t_i^L = t_i − 2 (v1·t_i)/(v1·v1) v1,
-/// r_{i+1} = r_i^L − 2 (v2·r_i^L)/(v2·v2) v2   (no second reflection when v2 = 0).
+/// r_{i+1} = r_i^L − 2 (v2·r_i^L)/(v2·v2) v2   (no second reflection when v2 = 0),
 /// ```
+///
+/// then made orthogonal to `t_{i+1}` and normalised against rounding drift: one step of
+/// [`double_reflection`], the same step [`super::frame::FrameField`] integrates along spline curves.
 ///
 /// With exact tangents the method is fourth-order accurate; here the tangents are second-order, which
 /// limits the frames to second order. Meant for deformed centrelines drawn as tubes, where a circular
@@ -31,27 +36,13 @@ pub fn parallel_transport_frames(centre: &[Vec3]) -> Result<Vec<Mat3>, TubeError
     let tangents = centreline_tangents(centre)?;
     let t0 = tangents[0];
     // The coordinate axis least aligned with t0 is at least 54.7° away from it, so r0 is well conditioned.
-    let axis = (0..3)
-        .min_by(|&a, &b| t0[a].abs().total_cmp(&t0[b].abs()))
-        .map_or_else(Vec3::x, |a| Vec3::ith(a, 1.0));
-    let mut r = (axis - axis.dot(&t0) * t0).normalize();
+    let mut r = normal_to(&t0, None);
     let mut frames = Vec::with_capacity(centre.len());
     frames.push(Mat3::from_columns(&[t0, r, t0.cross(&r)]));
     for i in 0..centre.len() - 1 {
-        let (t, t_next) = (tangents[i], tangents[i + 1]);
-        let v1 = centre[i + 1] - centre[i];
-        let c1 = v1.norm_squared(); // > 0: coincident samples were rejected.
-        let r_l = r - (2.0 / c1) * v1.dot(&r) * v1;
-        let t_l = t - (2.0 / c1) * v1.dot(&t) * v1;
-        let v2 = t_next - t_l;
-        let c2 = v2.norm_squared();
-        r = if c2 > 0.0 {
-            r_l - (2.0 / c2) * v2.dot(&r_l) * v2
-        } else {
-            r_l
-        };
-        // Reflections preserve length and orthogonality to rounding; re-orthonormalise against drift.
-        r = (r - r.dot(&t_next) * t_next).normalize();
+        let t_next = tangents[i + 1];
+        // v1 = x_{i+1} − x_i ≠ 0: coincident samples were rejected.
+        r = double_reflection(&centre[i], &tangents[i], &r, &centre[i + 1], &t_next);
         frames.push(Mat3::from_columns(&[t_next, r, t_next.cross(&r)]));
     }
     Ok(frames)
