@@ -15,7 +15,7 @@ const PHASE_STEP: Real = 0.618_033_988_749_894_9;
 
 /// The section phase of the `k`-th rod of a device, a fraction of a segment in `[0, 1)`: `k φ mod 1` with
 /// `φ` the golden-ratio conjugate. Sweeping each rod with its own phase keeps the end rings of rods meeting at
-/// a joint from coinciding vertex for vertex (see [`sweep_curve`]).
+/// a joint from coinciding vertex for vertex (see [`super::tube::sweep_curve`]).
 pub fn section_phase(k: usize) -> Real {
     (k as Real * PHASE_STEP).fract()
 }
@@ -27,9 +27,9 @@ pub fn phase_turn(phase: Real, segments: usize) -> Mat3 {
 }
 
 /// `frames` for drawing the polyline `centre` as a tube: each frame whose section normal (`d2 × d3`) is more
-/// than `max_tilt` from the sampled centreline direction (the tangents of [`sweep_tube`]) is turned, about
-/// the axis normal to both, until it is `max_tilt` from it; the others are kept. The normals are compared on
-/// the side most of the rod's sections face (`d2 × d3` along or against the samples' order; along when
+/// than `max_tilt` from the sampled centreline direction (the tangents of [`super::tube::sweep_tube`]) is
+/// turned, about the axis normal to both, until it is `max_tilt` from it; the others are kept. The normals are
+/// compared on the side most of the rod's sections face (`d2 × d3` along or against the samples' order; along when
 /// undecided), so a ring facing the wrong way is turned too. Frames the sweep would reject (too few samples,
 /// coincident samples, non-finite or degenerate frames) are returned unchanged, for the sweep to report.
 pub fn limited_tilt(centre: &[Vec3], frames: &[Mat3], max_tilt: Real) -> Vec<Mat3> {
@@ -109,7 +109,7 @@ pub struct DeviceMeshError {
 /// ([`TriangleMesh::mirrored_welded`]), so the rod and its image form one closed tube, without two caps
 /// coinciding (which would make their edges non-manifold once an STL reader merges equal vertices). Every
 /// other end is capped. The result is closed ([`TriangleMesh::check_closed`]) and outward; like any device
-/// from [`sweep_tube`], tubes overlap at joints.
+/// from [`super::tube::sweep_tube`], tubes overlap at joints.
 ///
 /// Mirroring about several planes assumes that the reflections commute (orthogonal planes, as for half and
 /// quarter models).

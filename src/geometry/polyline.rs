@@ -21,8 +21,8 @@ use crate::math::{Mat3, Vec3};
 /// r_{i+1} = r_i^L − 2 (v2·r_i^L)/(v2·v2) v2   (no second reflection when v2 = 0),
 /// ```
 ///
-/// then made orthogonal to `t_{i+1}` and normalised against rounding drift: one step of
-/// [`double_reflection`], the same step [`super::frame::FrameField`] integrates along spline curves.
+/// then made orthogonal to `t_{i+1}` and normalised against rounding drift: one step of `double_reflection`
+/// in `geometry::frame`, the same step [`super::frame::FrameField`] integrates along spline curves.
 ///
 /// With exact tangents the method is fourth-order accurate; here the tangents are second-order, which
 /// limits the frames to second order. Meant for deformed centrelines drawn as tubes, where a circular
