@@ -9,6 +9,33 @@ use super::mesh::TriangleMesh;
 use super::tube::{EndCaps, TubeError, TubeSettings, centreline_tangents, sweep_tube_with_caps};
 use crate::math::{Mat3, Real, Vec3};
 
+/// One rod of a device, sampled for drawing as a tube.
+#[derive(Debug, Clone, Copy)]
+pub struct RodTube<'a> {
+    /// Centreline samples \[length\].
+    pub centre: &'a [Vec3],
+    /// Section frames at the samples (columns `d1, d2, d3`).
+    pub frames: &'a [Mat3],
+    /// Tube radius \[length\].
+    pub radius: Real,
+    /// Section phase, a fraction of a segment (see [`section_phase`]).
+    pub phase: Real,
+    /// The symmetry plane (index into the planes given to [`device_mesh`]) the rod lies in, if any: it is its
+    /// own mirror image there and is drawn once, not mirrored about that plane.
+    pub in_plane: Option<usize>,
+}
+
+/// Why a device could not be meshed: which rod failed and why.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[error("rod {rod}: {source}")]
+pub struct DeviceMeshError {
+    /// Index of the rod.
+    pub rod: usize,
+    /// What went wrong.
+    #[source]
+    pub source: TubeError,
+}
+
 /// Golden-ratio conjugate: successive multiples modulo 1 are as evenly spread as possible, so no two patches
 /// get (nearly) the same section phase.
 const PHASE_STEP: Real = 0.618_033_988_749_894_9;
@@ -71,33 +98,6 @@ pub fn limited_tilt(centre: &[Vec3], frames: &[Mat3], max_tilt: Real) -> Vec<Mat
             turn.matrix() * frame
         })
         .collect()
-}
-
-/// One rod of a device, sampled for drawing as a tube.
-#[derive(Debug, Clone, Copy)]
-pub struct RodTube<'a> {
-    /// Centreline samples \[length\].
-    pub centre: &'a [Vec3],
-    /// Section frames at the samples (columns `d1, d2, d3`).
-    pub frames: &'a [Mat3],
-    /// Tube radius \[length\].
-    pub radius: Real,
-    /// Section phase, a fraction of a segment (see [`section_phase`]).
-    pub phase: Real,
-    /// The symmetry plane (index into the planes given to [`device_mesh`]) the rod lies in, if any: it is its
-    /// own mirror image there and is drawn once, not mirrored about that plane.
-    pub in_plane: Option<usize>,
-}
-
-/// Why a device could not be meshed: which rod failed and why.
-#[derive(Debug, Clone, PartialEq, thiserror::Error)]
-#[error("rod {rod}: {source}")]
-pub struct DeviceMeshError {
-    /// Index of the rod.
-    pub rod: usize,
-    /// What went wrong.
-    #[source]
-    pub source: TubeError,
 }
 
 /// The closed surface of a whole device from the rods of a symmetry-reduced model: one tube per rod, mirrored

@@ -123,17 +123,6 @@ pub enum MeshDefect {
     },
 }
 
-/// Per undirected edge: how often it is used in each direction and by which triangles first.
-#[derive(Debug, Clone, Copy)]
-struct EdgeUse {
-    /// Uses from the smaller to the larger vertex index.
-    forward: usize,
-    /// Uses from the larger to the smaller vertex index.
-    backward: usize,
-    /// The first two triangles that use the edge.
-    first: [usize; 2],
-}
-
 impl TriangleMesh {
     /// An empty mesh.
     pub fn new() -> Self {
@@ -476,6 +465,17 @@ impl TriangleMesh {
         );
         (out, image)
     }
+}
+
+/// Per undirected edge: how often it is used in each direction and by which triangles first.
+#[derive(Debug, Clone, Copy)]
+struct EdgeUse {
+    /// Uses from the smaller to the larger vertex index.
+    forward: usize,
+    /// Uses from the larger to the smaller vertex index.
+    backward: usize,
+    /// The first two triangles that use the edge.
+    first: [usize; 2],
 }
 
 /// The three directed edges `(a, b), (b, c), (c, a)` of a triangle.

@@ -158,6 +158,34 @@ pub enum TubeError {
     },
 }
 
+/// Which ends of a swept tube get a flat cap.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct EndCaps {
+    /// Cap at the first sample.
+    pub start: bool,
+    /// Cap at the last sample.
+    pub end: bool,
+}
+
+impl EndCaps {
+    /// Both ends capped: a closed tube.
+    pub const BOTH: EndCaps = EndCaps {
+        start: true,
+        end: true,
+    };
+}
+
+/// Why a curve could not be swept.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum SweepError {
+    /// The frames could not be evaluated.
+    #[error(transparent)]
+    Frame(#[from] super::GeometryError),
+    /// The tube could not be built.
+    #[error(transparent)]
+    Tube(#[from] TubeError),
+}
+
 impl TubeSettings {
     /// Checks the settings' ranges.
     pub(crate) fn validate(&self) -> Result<(), TubeError> {
@@ -232,23 +260,6 @@ pub fn sweep_tube(
     settings: &TubeSettings,
 ) -> Result<TriangleMesh, TubeError> {
     sweep_tube_with_caps(centre, frames, radius, EndCaps::BOTH, settings)
-}
-
-/// Which ends of a swept tube get a flat cap.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub struct EndCaps {
-    /// Cap at the first sample.
-    pub start: bool,
-    /// Cap at the last sample.
-    pub end: bool,
-}
-
-impl EndCaps {
-    /// Both ends capped: a closed tube.
-    pub const BOTH: EndCaps = EndCaps {
-        start: true,
-        end: true,
-    };
 }
 
 /// [`sweep_tube`] with a choice of caps. An uncapped end leaves its ring as a boundary: the surface is open
@@ -386,17 +397,6 @@ pub fn sweep_curve(
         rotations.push(f.rotation * turn.matrix());
     }
     Ok(sweep_tube(&centre, &rotations, radius, settings)?)
-}
-
-/// Why a curve could not be swept.
-#[derive(Debug, Clone, PartialEq, thiserror::Error)]
-pub enum SweepError {
-    /// The frames could not be evaluated.
-    #[error(transparent)]
-    Frame(#[from] super::GeometryError),
-    /// The tube could not be built.
-    #[error(transparent)]
-    Tube(#[from] TubeError),
 }
 
 /// Unit tangents of a sampled centreline by chord-length-weighted central differences.
