@@ -113,7 +113,7 @@ pub fn normal_to(t: &Vec3, hint: Option<Vec3>) -> Vec3 {
 
 /// One double-reflection step (Wang et al. 2008, Algorithm "double reflection"): transports the section
 /// axis `r0` from `(x0, t0)` to `(x1, t1)` without twist; returns the new axis, orthonormal to `t1`.
-fn double_reflection(x0: &Vec3, t0: &Vec3, r0: &Vec3, x1: &Vec3, t1: &Vec3) -> Vec3 {
+pub(crate) fn double_reflection(x0: &Vec3, t0: &Vec3, r0: &Vec3, x1: &Vec3, t1: &Vec3) -> Vec3 {
     let v1 = x1 - x0;
     let c1 = v1.dot(&v1);
     let (r_l, t_l) = if c1 > 0.0 {

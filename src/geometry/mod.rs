@@ -1,12 +1,20 @@
 //! Geometry: exact NURBS primitives (lines, circular arcs), analytic curves and their spline fits,
-//! rotation-minimising section frames, the stent generator, and tube surfaces swept along centrelines
-//! (vertices and triangles only; writing files is the `io` layer's job).
+//! rotation-minimising section frames (along spline curves in `frame`, along bare polylines in `polyline`), the
+//! stent generator, and closed surfaces: the triangle mesh type (`mesh`), tubes swept along centrelines
+//! (`tube`), spheres (`sphere`) and whole devices (`device_tubes`) — vertices and triangles only; writing files
+//! is the `io` layer's job.
 
 pub mod analytic;
+pub mod device_tubes;
 pub mod fit;
 pub mod frame;
+pub mod mesh;
+pub mod polyline;
 pub mod primitives;
+pub mod sphere;
 pub mod stent;
+#[cfg(test)]
+mod test_shapes;
 pub mod tube;
 
 use crate::math::{MathError, Real};

@@ -17,14 +17,25 @@
 //!
 //! The file is complete only after [`McapRecorder::finish`] (also called on drop): the run calls it whether
 //! the simulation succeeded or failed.
+//!
+//! The recorder lives here; the channels' JSON Schemas are in `mcap/schema.rs` and the hand-written message
+//! JSON (fixed-point coordinates, colours, scene updates) in `mcap/format.rs`, both private:
+//! [`coordinate_decimals`], [`path_key`], [`scene_update_schema`] and [`FRAME_ID`] are re-exported here.
+
+mod format;
+mod schema;
+
+pub use format::{FRAME_ID, coordinate_decimals, path_key};
+pub use schema::scene_update_schema;
 
 use super::design::{Design, RecordingSettings, SnapshotSettings};
 use super::device::{current_device_shapes, device_centrelines, device_tube_mesh};
 use super::snapshots::SnapshotSchedule;
 use super::state::{LoadChannel, StateSample, load_channels};
-use crate::math::{Real, Vec3};
-use crate::model::Model;
+use crate::math::Real;
 use crate::solver::{Observer, Simulation, StepReport};
+use format::{IDENTITY_POSE, color, number, push_points, scene_update, temperature_color};
+use schema::{StateKeys, state_schema};
 use serde_json::{Map, Value, json};
 use std::borrow::Cow;
 use std::collections::BTreeMap;
@@ -34,24 +45,12 @@ use std::io::{BufWriter, Write};
 use std::ops::ControlFlow;
 use std::path::{Path, PathBuf};
 
-/// Decimals of recorded coordinates for a device of size `scale` (largest distance of a control point from
-/// the origin) [length]: `max(0, 5 − ⌊log₁₀ scale⌋)`, a resolution `10^(⌊log₁₀ scale⌋ − 5)` between `10⁻⁶` and
-/// `10⁻⁵` of the size.
-pub fn coordinate_decimals(scale: Real) -> usize {
-    if !(scale > 0.0 && scale.is_finite()) {
-        return 6;
-    }
-    (5 - scale.log10().floor() as i64).clamp(0, 12) as usize
-}
-
 /// Topic of the state channel.
 pub const STATE_TOPIC: &str = "/state";
 /// Topic of the centrelines.
 pub const CENTRELINE_TOPIC: &str = "/centrelines";
 /// Topic of the tube meshes.
 pub const DEVICE_TOPIC: &str = "/device";
-/// Frame of every scene entity.
-pub const FRAME_ID: &str = "world";
 
 /// What the recording says about the run that made it.
 #[derive(Debug, Clone, PartialEq)]
@@ -103,305 +102,6 @@ pub enum McapError {
         #[source]
         source: crate::geometry::tube::TubeError,
     },
-}
-
-/// A JSON number, `null` for NaN or infinity (which JSON cannot hold).
-fn number(x: Real) -> Value {
-    serde_json::Number::from_f64(x).map_or(Value::Null, Value::Number)
-}
-
-/// Appends `x` with `decimals` decimals, trailing zeros dropped, as a JSON number (`null` if not finite).
-///
-/// Rounds in integers (`x · 10^decimals` to the nearest integer, then its digits), not with `format!("{:.N}")`,
-/// whose exact decimal expansion cost a fifth of a straight-stent run; values too large for that fall back to it.
-fn push_coordinate(out: &mut String, x: Real, decimals: usize) {
-    if !x.is_finite() {
-        out.push_str("null");
-        return;
-    }
-    let scale = 10f64.powi(decimals as i32);
-    let scaled = (x * scale).round();
-    if decimals > 15 || scaled.abs() >= 1e15 {
-        let start = out.len();
-        let _ = write!(out, "{x:.decimals$}");
-        if out[start..].contains('.') {
-            let trimmed = out.trim_end_matches('0').trim_end_matches('.').len();
-            out.truncate(trimmed);
-        }
-        if &out[start..] == "-0" {
-            out.truncate(start);
-            out.push('0');
-        }
-        return;
-    }
-    let n = scaled as i64;
-    if n == 0 {
-        out.push('0');
-        return;
-    }
-    let unit = 10i64.pow(decimals as u32);
-    let (whole, mut fraction) = (n.abs() / unit, n.abs() % unit);
-    if n < 0 {
-        out.push('-');
-    }
-    let _ = write!(out, "{whole}");
-    if fraction != 0 {
-        let mut digits = decimals;
-        while fraction % 10 == 0 {
-            fraction /= 10;
-            digits -= 1;
-        }
-        let _ = write!(out, ".{fraction:0digits$}");
-    }
-}
-
-/// Appends a `foxglove.Point3`.
-fn push_point(out: &mut String, p: &Vec3, decimals: usize) {
-    out.push_str("{\"x\":");
-    push_coordinate(out, p.x, decimals);
-    out.push_str(",\"y\":");
-    push_coordinate(out, p.y, decimals);
-    out.push_str(",\"z\":");
-    push_coordinate(out, p.z, decimals);
-    out.push('}');
-}
-
-/// Appends a JSON array of points.
-fn push_points(out: &mut String, points: &[Vec3], decimals: usize) {
-    out.push('[');
-    for (i, p) in points.iter().enumerate() {
-        if i > 0 {
-            out.push(',');
-        }
-        push_point(out, p, decimals);
-    }
-    out.push(']');
-}
-
-/// The identity `foxglove.Pose`.
-const IDENTITY_POSE: &str =
-    r#"{"position":{"x":0,"y":0,"z":0},"orientation":{"x":0,"y":0,"z":0,"w":1}}"#;
-
-/// A `foxglove.Color` as JSON.
-fn color(r: Real, g: Real, b: Real) -> String {
-    format!(r#"{{"r":{r:.3},"g":{g:.3},"b":{b:.3},"a":1}}"#)
-}
-
-/// A key usable in a Foxglove message path (`/state.probes.tip.x`): letters, digits and `_`.
-pub fn path_key(name: &str) -> String {
-    name.chars()
-        .map(|c| if c.is_ascii_alphanumeric() { c } else { '_' })
-        .collect()
-}
-
-/// Colour for temperature `t` between `lo` and `hi`: blue (cold) to red (hot).
-fn temperature_color(t: Real, lo: Real, hi: Real) -> String {
-    let s = if hi > lo {
-        ((t - lo) / (hi - lo)).clamp(0.0, 1.0)
-    } else {
-        1.0
-    };
-    color(0.15 + 0.8 * s, 0.35, 0.95 - 0.8 * s)
-}
-
-/// A `foxglove.SceneUpdate` replacing entity `id` with the given line and triangle-list primitives (JSON
-/// array contents). Written by hand: the centrelines are recorded at every step and dominate the recording
-/// time.
-fn scene_update(id: &str, nanoseconds: u64, lines: &str, triangles: &str) -> String {
-    let (sec, nsec) = (nanoseconds / 1_000_000_000, nanoseconds % 1_000_000_000);
-    format!(
-        r#"{{"deletions":[],"entities":[{{"timestamp":{{"sec":{sec},"nsec":{nsec}}},"frame_id":"{FRAME_ID}","id":"{id}","lifetime":{{"sec":0,"nsec":0}},"frame_locked":false,"metadata":[],"arrows":[],"cubes":[],"spheres":[],"cylinders":[],"lines":[{lines}],"triangles":[{triangles}],"texts":[],"models":[]}}]}}"#
-    )
-}
-
-/// JSON Schema of the `foxglove.SceneUpdate` fields used here (entities with line and triangle-list
-/// primitives); Foxglove recognises the message by its schema name.
-pub fn scene_update_schema() -> Value {
-    let xyz = |title: &str| {
-        json!({
-            "title": title, "type": "object",
-            "properties": {"x": {"type": "number"}, "y": {"type": "number"}, "z": {"type": "number"}},
-            "required": ["x", "y", "z"]
-        })
-    };
-    let time = json!({
-        "type": "object", "title": "time",
-        "properties": {"sec": {"type": "integer", "minimum": 0}, "nsec": {"type": "integer", "minimum": 0, "maximum": 999_999_999}}
-    });
-    let duration = json!({
-        "type": "object", "title": "duration",
-        "properties": {"sec": {"type": "integer"}, "nsec": {"type": "integer", "minimum": 0, "maximum": 999_999_999}}
-    });
-    let color = json!({
-        "title": "foxglove.Color", "type": "object",
-        "properties": {"r": {"type": "number"}, "g": {"type": "number"}, "b": {"type": "number"}, "a": {"type": "number"}},
-        "required": ["r", "g", "b", "a"]
-    });
-    let pose = json!({
-        "title": "foxglove.Pose", "type": "object",
-        "properties": {
-            "position": xyz("foxglove.Vector3"),
-            "orientation": {
-                "title": "foxglove.Quaternion", "type": "object",
-                "properties": {"x": {"type": "number"}, "y": {"type": "number"}, "z": {"type": "number"}, "w": {"type": "number"}},
-                "required": ["x", "y", "z", "w"]
-            }
-        },
-        "required": ["position", "orientation"]
-    });
-    let points = json!({"type": "array", "items": xyz("foxglove.Point3")});
-    let colors = json!({"type": "array", "items": color});
-    let indices = json!({"type": "array", "items": {"type": "integer", "minimum": 0}});
-    let line = json!({
-        "title": "foxglove.LinePrimitive",
-        "description": "A primitive representing a series of points connected by lines",
-        "type": "object",
-        "properties": {
-            "type": {
-                "title": "foxglove.LineType",
-                "oneOf": [
-                    {"title": "LINE_STRIP", "const": 0},
-                    {"title": "LINE_LOOP", "const": 1},
-                    {"title": "LINE_LIST", "const": 2}
-                ]
-            },
-            "pose": pose,
-            "thickness": {"type": "number"},
-            "scale_invariant": {"type": "boolean"},
-            "points": points,
-            "color": color,
-            "colors": colors,
-            "indices": indices
-        },
-        "required": ["type", "pose", "thickness", "scale_invariant", "points", "color", "colors", "indices"]
-    });
-    let triangles = json!({
-        "title": "foxglove.TriangleListPrimitive",
-        "description": "A primitive representing a set of triangles or a surface tiled by triangles",
-        "type": "object",
-        "properties": {"pose": pose, "points": points, "color": color, "colors": colors, "indices": indices},
-        "required": ["pose", "points", "color", "colors", "indices"]
-    });
-    let other = json!({"type": "array", "items": {"type": "object"}});
-    json!({
-        "title": "foxglove.SceneUpdate",
-        "description": "An update to the entities displayed in a 3D scene",
-        "type": "object",
-        "properties": {
-            "deletions": {
-                "type": "array",
-                "items": {
-                    "title": "foxglove.SceneEntityDeletion",
-                    "type": "object",
-                    "properties": {
-                        "timestamp": time,
-                        "type": {"oneOf": [{"title": "MATCHING_ID", "const": 0}, {"title": "ALL", "const": 1}]},
-                        "id": {"type": "string"}
-                    }
-                }
-            },
-            "entities": {
-                "type": "array",
-                "items": {
-                    "title": "foxglove.SceneEntity",
-                    "type": "object",
-                    "properties": {
-                        "timestamp": time,
-                        "frame_id": {"type": "string"},
-                        "id": {"type": "string"},
-                        "lifetime": duration,
-                        "frame_locked": {"type": "boolean"},
-                        "metadata": {"type": "array", "items": {
-                            "type": "object",
-                            "properties": {"key": {"type": "string"}, "value": {"type": "string"}}
-                        }},
-                        "arrows": other,
-                        "cubes": other,
-                        "spheres": other,
-                        "cylinders": other,
-                        "lines": {"type": "array", "items": line},
-                        "triangles": {"type": "array", "items": triangles},
-                        "texts": other,
-                        "models": other
-                    },
-                    "required": ["timestamp", "frame_id", "id", "lifetime", "frame_locked", "metadata", "arrows",
-                        "cubes", "spheres", "cylinders", "lines", "triangles", "texts", "models"]
-                }
-            }
-        },
-        "required": ["deletions", "entities"]
-    })
-}
-
-/// Names of the probe and load keys of the state messages (sanitised for message paths).
-struct StateKeys {
-    probes: Vec<String>,
-    loads: Vec<String>,
-}
-
-/// JSON Schema of the `/state` messages of `model`.
-fn state_schema(model: &Model, channels: &[LoadChannel], keys: &StateKeys) -> Value {
-    let units = model.units;
-    let length = units.length();
-    let num = |description: String| json!({"type": "number", "description": description});
-    let mut probes = Map::new();
-    for (key, probe) in keys.probes.iter().zip(&model.probes) {
-        probes.insert(
-            key.clone(),
-            json!({
-                "type": "object",
-                "description": format!("displacement of probe `{}` [{length}]", probe.name),
-                "properties": {
-                    "x": {"type": "number"}, "y": {"type": "number"}, "z": {"type": "number"},
-                    "magnitude": {"type": "number"}
-                }
-            }),
-        );
-    }
-    let mut loads = Map::new();
-    for (key, c) in keys.loads.iter().zip(channels) {
-        loads.insert(key.clone(), num(format!("{} [{}]", c.name, c.unit)));
-    }
-    let mut properties = json!({
-        "step": {"type": "integer", "description": "step number (0: initial state)"},
-        "time": num("simulated time [s]".into()),
-        "dt": num("step size that reached this state [s]".into()),
-        "temperature": num("temperature [°C]".into()),
-        "loads": {"type": "object", "properties": loads},
-        "iterations": {"type": "integer", "description": "Newton iterations of the step"},
-        "residual": num("final normalised residual".into()),
-        "residuals": {"type": "array", "items": {"type": "number"}, "description": "normalised residual after each Newton iteration"},
-        "cuts": {"type": "integer", "description": "step cuts before the step converged"},
-        "probes": {"type": "object", "properties": probes}
-    });
-    if let Some(p) = &model.programme {
-        let map = properties.as_object_mut().expect("object literal");
-        map.insert(
-            "recovery_ratio_mean".into(),
-            num("mean |η| / |η_temp| over the driven nodes: 1 at the temporary shape, 0 at the permanent one".into()),
-        );
-        map.insert(
-            "recovery_ratio_max".into(),
-            num("largest |η| / |η_temp| over the driven nodes".into()),
-        );
-        if matches!(
-            p.kind,
-            crate::model::ProgrammeKind::RadialContraction { .. }
-        ) {
-            map.insert(
-                "delta_r".into(),
-                num(format!(
-                    "mean radial contraction of the driven nodes [{length}]"
-                )),
-            );
-        }
-    }
-    json!({
-        "title": "stentkit.State",
-        "description": format!("state of a stentkit run (units {}; time in s, temperature in °C)", units.name()),
-        "type": "object",
-        "properties": properties
-    })
 }
 
 /// Records a run into an MCAP file as the simulation reports its steps.
@@ -820,68 +520,5 @@ impl Observer for McapRecorder {
 
     fn step(&mut self, sim: &Simulation<'_>, report: &StepReport) -> ControlFlow<()> {
         self.observe(sim, Some(report))
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn coordinates_are_short_fixed_point_numbers() {
-        assert_eq!(coordinate_decimals(110.0), 3);
-        assert_eq!(coordinate_decimals(75.0), 4);
-        assert_eq!(coordinate_decimals(1.0), 5);
-        assert_eq!(coordinate_decimals(1e7), 0);
-        let text = |x: Real, d: usize| {
-            let mut s = String::new();
-            push_coordinate(&mut s, x, d);
-            s
-        };
-        assert_eq!(text(109.856_4, 3), "109.856");
-        assert_eq!(text(0.050_943_5, 3), "0.051");
-        assert_eq!(text(19.999_999_9, 4), "20");
-        assert_eq!(text(-0.000_01, 3), "0");
-        assert_eq!(text(-2.5, 3), "-2.5");
-        assert_eq!(text(1234.0, 0), "1234");
-        assert_eq!(text(-0.0307, 3), "-0.031");
-        assert_eq!(text(3.000_5, 5), "3.0005");
-        assert_eq!(text(2e16, 3), "20000000000000000");
-        assert_eq!(text(Real::NAN, 3), "null");
-        assert_eq!(number(Real::NAN), Value::Null);
-    }
-
-    #[test]
-    fn hand_written_scene_updates_are_json() {
-        let mut points = String::new();
-        push_points(
-            &mut points,
-            &[
-                Vec3::new(1.0, -0.5, 1e-7),
-                Vec3::new(19.999_999_9, 0.0, -0.0),
-            ],
-            6,
-        );
-        let line = format!(
-            r#"{{"type":0,"pose":{IDENTITY_POSE},"thickness":0.6,"scale_invariant":false,"color":{},"colors":[],"indices":[],"points":{points}}}"#,
-            temperature_color(50.0, 20.0, 90.0)
-        );
-        let message: Value =
-            serde_json::from_str(&scene_update("centrelines", 1_500_000_001, &line, ""))
-                .expect("valid JSON");
-        let entity = &message["entities"][0];
-        assert_eq!(entity["timestamp"]["sec"], 1);
-        assert_eq!(entity["timestamp"]["nsec"], 500_000_001);
-        assert_eq!(entity["lines"][0]["points"][1]["x"], 20.0);
-        assert_eq!(entity["lines"][0]["points"][0]["z"], 0.0);
-        assert_eq!(entity["lines"][0]["points"][0]["y"], -0.5);
-        assert_eq!(entity["triangles"], json!([]));
-    }
-
-    #[test]
-    fn path_keys_are_identifiers() {
-        assert_eq!(path_key("tip"), "tip");
-        assert_eq!(path_key("arch.end.F3"), "arch_end_F3");
-        assert_eq!(path_key("a-b c"), "a_b_c");
     }
 }
