@@ -628,8 +628,11 @@ fn interrupted_run_leaves_every_file_valid() {
         s.get("failure").is_none(),
         "an interruption is not a failure"
     );
+    // Four lines of history (the header, the initial state and two steps) were seen before the signal; the
+    // step in progress then may be abandoned and rolled back (the interrupt is honoured within a step), so the
+    // run holds at least those two steps and fewer than all 1301.
     let steps = s["steps"].as_u64().expect("steps");
-    assert!((3..1300).contains(&steps), "{steps} steps");
+    assert!((2..1300).contains(&steps), "{steps} steps");
     check_history(
         &dir,
         steps as usize,
