@@ -416,12 +416,22 @@ fn bad_input_exits_with_status_2() {
 }
 
 /// Runs `script` (bash) in a private mount namespace as root of a user namespace (`unshare`), where it can mount
-/// a tmpfs of its own: a real file system that fills up, with nothing to clean up afterwards.
-fn in_mount_namespace(script: &str) -> Output {
-    Command::new("unshare")
+/// a tmpfs of its own at `dir/mnt`: a real file system that fills up, with nothing to clean up afterwards. The
+/// script leaves the run's exit status in `dir/status` and its stderr in `dir/stderr`; returns both.
+fn in_mount_namespace(dir: &Path, script: &str) -> (String, String) {
+    std::fs::create_dir_all(dir.join("mnt")).expect("mount point");
+    let out = Command::new("unshare")
         .args(["--map-root-user", "--mount", "bash", "-euc", script])
         .output()
-        .expect("unshare runs (util-linux)")
+        .expect("unshare runs (util-linux)");
+    assert!(
+        out.status.success(),
+        "the script failed: {}",
+        text(&out.stderr)
+    );
+    let status = std::fs::read_to_string(dir.join("status")).expect("status");
+    let stderr = std::fs::read_to_string(dir.join("stderr")).expect("stderr");
+    (status.trim().to_string(), stderr)
 }
 
 /// A disk that fills up during a run (another process takes the last free bytes of an 8 MB tmpfs while the
@@ -449,16 +459,8 @@ fn a_full_disk_leaves_every_output_finished_or_removed() {
         dir = path_str(&dir),
         copy = path_str(&copy),
     );
-    std::fs::create_dir_all(dir.join("mnt")).expect("mount point");
-    let out = in_mount_namespace(&script);
-    assert!(
-        out.status.success(),
-        "the script failed: {}",
-        text(&out.stderr)
-    );
-    let status = std::fs::read_to_string(dir.join("status")).expect("status");
-    let stderr = std::fs::read_to_string(dir.join("stderr")).expect("stderr");
-    assert_eq!(status.trim(), "1", "{stderr}");
+    let (status, stderr) = in_mount_namespace(&dir, &script);
+    assert_eq!(status, "1", "{stderr}");
     assert!(
         stderr.contains("No space left on device") && stderr.contains("the run folder holds:"),
         "{stderr}"
@@ -551,21 +553,8 @@ fn a_run_the_disk_cannot_hold_is_refused_before_writing() {
         design = path_str(&design("straight_stent.yaml")),
         dir = path_str(&dir),
     );
-    std::fs::create_dir_all(dir.join("mnt")).expect("mount point");
-    let out = in_mount_namespace(&script);
-    assert!(
-        out.status.success(),
-        "the script failed: {}",
-        text(&out.stderr)
-    );
-    let stderr = std::fs::read_to_string(dir.join("stderr")).expect("stderr");
-    assert_eq!(
-        std::fs::read_to_string(dir.join("status"))
-            .expect("status")
-            .trim(),
-        "2",
-        "{stderr}"
-    );
+    let (status, stderr) = in_mount_namespace(&dir, &script);
+    assert_eq!(status, "2", "{stderr}");
     assert!(
         stderr.contains("straight_stent.yaml: output.snapshots.every: this run would write about")
             && stderr.contains("21 snapshots")
