@@ -33,15 +33,7 @@ pub fn sphere(
     let m = settings.segments_around;
     let bands = (m / 2).max(2);
     let rings = bands - 1;
-    let vertex_count = rings
-        .checked_mul(m)
-        .and_then(|v| v.checked_add(2))
-        .unwrap_or(usize::MAX);
-    if u32::try_from(vertex_count).is_err() {
-        return Err(TubeError::TooManyVertices {
-            vertices: vertex_count,
-        });
-    }
+    let vertex_count = super::tube::ring_vertex_count(rings, m)?;
     let mut mesh = TriangleMesh {
         vertices: Vec::with_capacity(vertex_count),
         triangles: Vec::with_capacity(2 * m * bands),

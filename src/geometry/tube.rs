@@ -301,15 +301,7 @@ pub fn sweep_tube_with_caps(
     }
     let tangents = centreline_tangents(centre)?;
     let m = settings.segments_around;
-    let vertex_count = n
-        .checked_mul(m)
-        .and_then(|v| v.checked_add(2))
-        .unwrap_or(usize::MAX);
-    if u32::try_from(vertex_count).is_err() {
-        return Err(TubeError::TooManyVertices {
-            vertices: vertex_count,
-        });
-    }
+    let vertex_count = ring_vertex_count(n, m)?;
 
     // Direction of traversal per ring: +1 when d2 × d3 points along the marching direction.
     let mut handedness = Vec::with_capacity(n);
@@ -444,6 +436,19 @@ pub(crate) fn centreline_tangents(centre: &[Vec3]) -> Result<Vec<Vec3>, TubeErro
     // p'(s2) = ((h1 + 2h2) u2 − h2 u1) / (h1 + h2)
     tangents.push(unit((h1 + 2.0 * h2) * u2 - h2 * u1, n - 1)?);
     Ok(tangents)
+}
+
+/// Vertices of `rings` rings of `segments` vertices plus two cap (or pole) centres: the size of a swept tube
+/// or a sphere, refused as [`TubeError::TooManyVertices`] when it does not fit the `u32` indices of a mesh.
+pub(crate) fn ring_vertex_count(rings: usize, segments: usize) -> Result<usize, TubeError> {
+    let count = rings
+        .checked_mul(segments)
+        .and_then(|v| v.checked_add(2))
+        .unwrap_or(usize::MAX);
+    if u32::try_from(count).is_err() {
+        return Err(TubeError::TooManyVertices { vertices: count });
+    }
+    Ok(count)
 }
 
 #[cfg(test)]
