@@ -7,28 +7,22 @@ use crate::io::design::Design;
 use crate::io::design::build::human_bytes;
 use crate::io::design::locate::Locator;
 use crate::io::estimate::{DiskEstimate, estimated_disk};
-use crate::io::run_folder::bytes_of;
+use crate::io::run_folder::FitFolder;
 use crate::math::Real;
-use std::collections::BTreeSet;
-use std::path::{Path, PathBuf};
 
 /// Room a run keeps free for finishing \[bytes\]: the summary (a few kB) and the charts (tens of kB each), written
 /// after a disk that filled up during the run ([`crate::io::run_folder::RunFolder::reserve`]).
 pub const FINISHING_RESERVE: usize = 1 << 20;
 
-/// Refuses (with [`BadInput`]) a run into `dir` whose estimated output plus [`FINISHING_RESERVE`] exceeds the
+/// Refuses (with [`BadInput`]) a run into `folder` whose estimated output plus [`FINISHING_RESERVE`] exceeds the
 /// free space of the folder's file system (of its nearest existing ancestor, if it does not exist yet) plus what
-/// `--force` will free (`previous`, the earlier run's files). A file system whose free space cannot be read is
-/// not checked.
+/// `--force` will free (the earlier run's files). A file system whose free space cannot be read is not checked.
 ///
 /// # Errors
 /// [`BadInput`] naming the design file, the field that sizes the largest part (with its line and column when
 /// the design sets it), the estimate by part and the free space.
-pub fn check_space(
-    design: &Design,
-    dir: &Path,
-    previous: &BTreeSet<PathBuf>,
-) -> anyhow::Result<()> {
+pub fn check_space(design: &Design, folder: &FitFolder) -> anyhow::Result<()> {
+    let dir = folder.dir();
     let estimate = estimated_disk(design);
     let needed = estimate.total() + FINISHING_RESERVE as u64;
     let Some(Ok(free)) = dir
@@ -38,7 +32,7 @@ pub fn check_space(
     else {
         return Ok(());
     };
-    let free = free + bytes_of(dir, previous);
+    let free = free + folder.previous_bytes();
     if needed <= free {
         return Ok(());
     }

@@ -202,9 +202,12 @@ fn mark_killed(
     summary["snapshots"] = Value::Array(snapshots);
 }
 
-/// The triangle count a binary STL declares (bytes 80–83), if the file is that long.
+/// The triangle count a binary STL declares (bytes 80–83), if the file is that long; reads those bytes only.
 fn stl_triangles(path: &Path) -> Option<u32> {
-    let bytes = std::fs::read(path).ok()?;
-    let count: [u8; 4] = bytes.get(80..84)?.try_into().ok()?;
+    use std::io::{Read, Seek};
+    let mut file = std::fs::File::open(path).ok()?;
+    let mut count = [0u8; 4];
+    file.seek(std::io::SeekFrom::Start(80)).ok()?;
+    file.read_exact(&mut count).ok()?;
     Some(u32::from_le_bytes(count))
 }

@@ -330,9 +330,9 @@ pub fn run(design_path: &Path, options: RunOptions) -> anyhow::Result<()> {
         e => e.into(),
     };
     // Nothing is written before the folder and the disk are found fit for the run.
-    let previous = run_folder::check(&dir, design_path, options.force).map_err(refused)?;
-    super::disk::check_space(&design, &dir, &previous)?;
-    let mut folder = RunFolder::open(&dir, design_path, options.force).map_err(refused)?;
+    let fit = run_folder::check(&dir, design_path, options.force).map_err(refused)?;
+    super::disk::check_space(&design, &fit)?;
+    let mut folder = fit.open()?;
     folder.clear_previous()?;
     run_in(&design, &folder, &options, started)
 }
@@ -373,7 +373,7 @@ fn run_in(
                 model.name,
                 model.patches.len(),
                 model.num_unknowns(),
-                model.planned_steps().total(),
+                design.steps.total(),
                 model.time.step,
                 model.time.end,
                 dir.display()
@@ -645,26 +645,25 @@ fn finish(
 
     // The recording first: salvaging a recording cut short by a full disk frees the space of its broken chunk.
     let record_error = outputs.recorder.take_error().map(anyhow::Error::from);
-    let closed = match (&record_error, hurry) {
-        // A writer that failed once refuses every later write: only the salvage can finish the file.
-        (Some(_), _) => outputs.recorder.close(),
-        (None, true) => outputs.recorder.close(),
-        (None, false) => outputs.recorder.finish(sim),
+    // A writer that failed once refuses every later write: only the salvage can finish the file.
+    let closed = if record_error.is_some() || hurry {
+        outputs.recorder.close()
+    } else {
+        outputs.recorder.finish(sim)
     };
     let mcap_path = dir.join("run.mcap");
     let complete_to = format!("complete up to {}", upto(outputs.recorder.last_time()));
-    let mcap_bytes = match (closed, record_error) {
-        (Ok(bytes), None) => {
+    // The first error is the cause; closing after it fails for that reason too.
+    let (closed_bytes, cause) = match closed {
+        Ok(bytes) => (bytes, record_error),
+        Err(e) => (0, Some(record_error.unwrap_or_else(|| e.into()))),
+    };
+    let mcap_bytes = match cause {
+        None => {
             state("run.mcap", true, complete_to);
-            bytes
+            closed_bytes
         }
-        (closed, record_error) => {
-            // The first error is the cause; closing after it fails for that reason too.
-            let e = match (record_error, closed) {
-                (Some(e), _) => e,
-                (None, Err(e)) => anyhow::Error::from(e),
-                (None, Ok(_)) => unreachable!("handled above"),
-            };
+        Some(e) => {
             let bytes = match salvage(&mcap_path) {
                 Ok(Salvage::Finished {
                     after,

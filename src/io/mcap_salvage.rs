@@ -77,19 +77,25 @@ pub fn salvage(path: &Path) -> Result<Salvage, SalvageError> {
         source,
     };
     let bytes = std::fs::read(path).map_err(io_err)?;
-    if is_valid(&bytes) && has_summary(&bytes) {
+    // Read whole once: a complete file is either left alone (indexed) or only re-indexed.
+    let complete = if bytes.ends_with(MAGIC) {
+        messages_in(&bytes)
+    } else {
+        None
+    };
+    if complete.is_some() && has_summary(&bytes) {
         return Ok(Salvage::AlreadyValid {
             bytes: bytes.len() as u64,
         });
     }
     let before = bytes.len() as u64;
-    let (messages, last_log_time) = match messages_in(&bytes).filter(|_| bytes.ends_with(MAGIC)) {
+    let (content, (messages, last_log_time)) = match complete {
         // Complete but unindexed (an earlier salvage without room for the copy).
-        Some(found) => found,
+        Some(found) => (bytes, found),
         None => cut_in_place(path, &bytes)?,
     };
-    drop(bytes);
-    let indexed = rewrite_indexed(path).is_ok();
+    let indexed = rewrite_indexed(path, &content).is_ok();
+    drop(content);
     let after = std::fs::metadata(path).map_err(io_err)?.len();
     Ok(Salvage::Finished {
         before,
@@ -100,9 +106,12 @@ pub fn salvage(path: &Path) -> Result<Salvage, SalvageError> {
     })
 }
 
+/// A recording's new content, with its message count and last log time.
+type Cut = (Vec<u8>, (usize, Option<u64>));
+
 /// Cuts `bytes` (the content of `path`) after the latest record boundary up to which the file reads whole,
-/// and writes the ending there; returns the messages kept and the last one's log time.
-fn cut_in_place(path: &Path, bytes: &[u8]) -> Result<(usize, Option<u64>), SalvageError> {
+/// and writes the ending there; returns the new content, the messages kept and the last one's log time.
+fn cut_in_place(path: &Path, bytes: &[u8]) -> Result<Cut, SalvageError> {
     let io_err = |source| SalvageError::Io {
         path: path.to_path_buf(),
         source,
@@ -121,7 +130,7 @@ fn cut_in_place(path: &Path, bytes: &[u8]) -> Result<(usize, Option<u64>), Salva
                     file.sync_all()
                 })
                 .map_err(io_err)?;
-            return Ok(found);
+            return Ok((candidate, found));
         }
     }
     Err(SalvageError::NotMcap {
@@ -132,13 +141,13 @@ fn cut_in_place(path: &Path, bytes: &[u8]) -> Result<(usize, Option<u64>), Salva
 /// Writes the records of the complete (possibly unindexed) recording at `path` again through the `mcap`
 /// writer — schemas, channels, messages in file order, attachments, metadata, with the original header's
 /// profile and library — into a temporary file renamed over `path` (see [`crate::io::stl`]'s atomic write).
-fn rewrite_indexed(path: &Path) -> Result<(), Box<dyn std::error::Error>> {
+/// `bytes` is the file's content.
+fn rewrite_indexed(path: &Path, bytes: &[u8]) -> Result<(), Box<dyn std::error::Error>> {
     use ::mcap::records::Record;
-    let bytes = std::fs::read(path)?;
     crate::io::stl::write_atomically(path, |out| {
         let other = |e: ::mcap::McapError| io::Error::other(e.to_string());
         let mut writer: Option<::mcap::Writer<io::Cursor<Vec<u8>>>> = None;
-        for record in ::mcap::read::ChunkFlattener::new(&bytes).map_err(other)? {
+        for record in ::mcap::read::ChunkFlattener::new(bytes).map_err(other)? {
             let record = record.map_err(other)?;
             if let Record::Header(header) = &record {
                 writer = Some(

@@ -204,15 +204,12 @@ fn forbidden(dir: &Path, design_file: &Path) -> Option<&'static str> {
 
 /// Whether a run of the design in `design_file` may write into `dir`, changing nothing: refuses the root, the
 /// home folder, the design's folder, a folder that is not empty and not a run folder, and (without `force`) a
-/// run folder that holds an earlier run. Returns the earlier run's files (what `--force` will remove).
+/// run folder that holds an earlier run. Returns the folder found fit, with the earlier run's files (what
+/// `--force` will remove), to be taken with [`FitFolder::open`].
 ///
 /// # Errors
 /// [`RunFolderError::Refused`] (bad input), [`RunFolderError::Io`].
-pub fn check(
-    dir: &Path,
-    design_file: &Path,
-    force: bool,
-) -> Result<BTreeSet<PathBuf>, RunFolderError> {
+pub fn check(dir: &Path, design_file: &Path, force: bool) -> Result<FitFolder, RunFolderError> {
     let refuse = |reason: String| RunFolderError::Refused {
         path: dir.to_path_buf(),
         reason,
@@ -222,31 +219,62 @@ pub fn check(
             "{why}; a run writes into a folder of its own: choose one with -o (default runs/<design name>)"
         )));
     }
-    match classify(dir)? {
-        FolderKind::Empty => Ok(BTreeSet::new()),
-        FolderKind::Foreign => Err(refuse(
-            "is not empty and is not a stentkit run folder (it has no .stentkit-run manifest); \
-             choose an empty or new folder with -o"
-                .into(),
-        )),
+    let previous = match classify(dir)? {
+        FolderKind::Empty => BTreeSet::new(),
+        FolderKind::Foreign => {
+            return Err(refuse(
+                "is not empty and is not a stentkit run folder (it has no .stentkit-run manifest); \
+                 choose an empty or new folder with -o"
+                    .into(),
+            ));
+        }
         // A folder whose earlier run left none of its files (a refused or cleared run) is as good as empty.
-        FolderKind::Run(files) if files.iter().all(|f| !dir.join(f).exists()) => Ok(files),
-        FolderKind::Run(_) if !force => Err(refuse(
-            "holds an earlier run; pass --force to replace it (only the files that run wrote are \
-             removed) or choose another folder with -o"
-                .into(),
-        )),
-        FolderKind::Run(files) => Ok(files),
-    }
+        FolderKind::Run(files) if files.iter().all(|f| !dir.join(f).exists()) => files,
+        FolderKind::Run(_) if !force => {
+            return Err(refuse(
+                "holds an earlier run; pass --force to replace it (only the files that run wrote are \
+                 removed) or choose another folder with -o"
+                    .into(),
+            ));
+        }
+        FolderKind::Run(files) => files,
+    };
+    Ok(FitFolder {
+        dir: dir.to_path_buf(),
+        previous,
+    })
 }
 
-/// Bytes of the files `files` (relative to `dir`) that exist: what removing an earlier run frees.
-pub fn bytes_of(dir: &Path, files: &BTreeSet<PathBuf>) -> u64 {
-    files
-        .iter()
-        .filter_map(|p| fs::metadata(dir.join(p)).ok())
-        .map(|m| m.len())
-        .sum()
+/// A folder [`check`] found fit for a run, not yet taken: nothing has been written.
+#[derive(Debug)]
+pub struct FitFolder {
+    dir: PathBuf,
+    /// Files of the earlier run here.
+    previous: BTreeSet<PathBuf>,
+}
+
+impl FitFolder {
+    /// The folder.
+    pub fn dir(&self) -> &Path {
+        &self.dir
+    }
+
+    /// Bytes of the earlier run's files: what `--force` will free.
+    pub fn previous_bytes(&self) -> u64 {
+        self.previous
+            .iter()
+            .filter_map(|p| fs::metadata(self.dir.join(p)).ok())
+            .map(|m| m.len())
+            .sum()
+    }
+
+    /// Takes the folder: creates it, takes its lock and opens the manifest. Nothing is removed yet.
+    ///
+    /// # Errors
+    /// [`RunFolderError::Busy`] when another run holds the lock, [`RunFolderError::Io`].
+    pub fn open(self) -> Result<RunFolder, RunFolderError> {
+        RunFolder::take(self.dir, self.previous)
+    }
 }
 
 /// A run folder held by this process: locked, with its manifest open for appending.
@@ -305,13 +333,16 @@ impl Manifest {
 }
 
 impl RunFolder {
-    /// Takes `dir` for a run of the design in `design_file` (after [`check`]): creates the folder, takes its
-    /// lock and opens the manifest. Nothing is removed yet.
+    /// [`check`] then [`FitFolder::open`]: takes `dir` for a run of the design in `design_file`.
     ///
     /// # Errors
-    /// As [`check`]; [`RunFolderError::Busy`] when another run holds the lock, [`RunFolderError::Io`].
+    /// As those two.
     pub fn open(dir: &Path, design_file: &Path, force: bool) -> Result<Self, RunFolderError> {
-        let previous = check(dir, design_file, force)?;
+        check(dir, design_file, force)?.open()
+    }
+
+    fn take(dir: PathBuf, previous: BTreeSet<PathBuf>) -> Result<Self, RunFolderError> {
+        let dir = dir.as_path();
         fs::create_dir_all(dir).map_err(io_error(dir))?;
         let lock = lock(dir)?;
         let path = dir.join(MANIFEST);
