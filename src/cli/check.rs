@@ -125,7 +125,7 @@ pub fn describe(design: &Design, file: &str) -> String {
     }
     let _ = writeln!(s, "collocation points  {}", model.num_collocation_points());
     let _ = writeln!(s, "unknowns            {}", model.num_unknowns());
-    let plan = model.planned_steps();
+    let plan = design.steps;
     let _ = writeln!(
         s,
         "time steps          {} ({} of h = {} s + {} shortened to land on breakpoints; end {} s)",

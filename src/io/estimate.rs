@@ -120,7 +120,7 @@ pub fn estimated_disk(design: &Design) -> DiskEstimate {
     let model = &design.model;
     let snapshot = &design.output.snapshots;
     let recording = &design.output.recording;
-    let steps = model.planned_steps().total();
+    let steps = design.steps.total();
     let states = steps as Real + 1.0;
     let snapshots = snapshot_count(model, steps, snapshot.every, &snapshot.times);
     let count = snapshots as Real;

@@ -384,12 +384,6 @@ impl Model {
         6 * self.num_collocation_points()
     }
 
-    /// Number of nominal time steps `⌈end / step⌉`, ignoring the breakpoints that time stepping lands on
-    /// (see [`Model::planned_steps`] for the steps a run takes).
-    pub fn num_time_steps(&self) -> usize {
-        (self.time.end / self.time.step - 1e-9).ceil().max(0.0) as usize
-    }
-
     /// The node that holds the given patch end.
     pub fn node_of(&self, end: PatchEnd) -> Option<usize> {
         self.nodes.iter().position(|n| n.ends.contains(&end))

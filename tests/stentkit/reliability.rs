@@ -11,6 +11,7 @@
 //! clamped at node `root`, loaded at node `tip`), changed in one place.
 
 use crate::common::{design_text, model_from_text, node_displacement, node_index, replace_line};
+use crate::outputs::{path_str, stentkit};
 use std::cell::{Cell, RefCell};
 use std::ops::ControlFlow;
 use std::path::Path;
@@ -703,17 +704,14 @@ fn the_disk_estimate_bounds_a_run_folder_from_above() {
     let design = stentkit::io::design::load_design(&file).expect("valid");
     let estimate = stentkit::io::estimate::estimated_disk(&design);
     let run = dir.join("run");
-    let out = Command::new(env!("CARGO_BIN_EXE_stentkit"))
-        .args([
-            "run",
-            file.to_str().expect("path"),
-            "--force",
-            "--quiet",
-            "-o",
-        ])
-        .arg(&run)
-        .output()
-        .expect("stentkit runs");
+    let out = stentkit(&[
+        "run",
+        path_str(&file),
+        "--force",
+        "--quiet",
+        "-o",
+        path_str(&run),
+    ]);
     assert!(
         out.status.success(),
         "{}",
@@ -754,17 +752,14 @@ fn two_rings_per_patch_draw_a_rolled_up_beam() {
     std::fs::create_dir_all(&dir).expect("folder");
     let file = dir.join("rollup_two_rings.yaml");
     std::fs::write(&file, &text).expect("design written");
-    let out = Command::new(env!("CARGO_BIN_EXE_stentkit"))
-        .args([
-            "run",
-            file.to_str().expect("path"),
-            "--force",
-            "--quiet",
-            "-o",
-        ])
-        .arg(dir.join("run"))
-        .output()
-        .expect("stentkit runs");
+    let out = stentkit(&[
+        "run",
+        path_str(&file),
+        "--force",
+        "--quiet",
+        "-o",
+        path_str(&dir.join("run")),
+    ]);
     let stderr = String::from_utf8_lossy(&out.stderr);
     assert!(out.status.success(), "{stderr}");
     let summary = std::fs::read_to_string(dir.join("run/summary.json")).expect("summary");

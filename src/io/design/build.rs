@@ -52,6 +52,8 @@ pub struct Built {
     pub warnings: Vec<String>,
     /// The memory the run is estimated to need (below [`MEMORY_LIMIT_BYTES`]).
     pub memory: MemoryEstimate,
+    /// The steps the run takes when no step is cut ([`Model::planned_steps`]).
+    pub steps: StepPlan,
 }
 
 /// Builds and validates the model; returns it with the output settings, the warnings found and the memory
@@ -230,6 +232,7 @@ pub fn build(dto: &DesignDto, default_name: &str) -> Result<Built> {
         output,
         warnings,
         memory,
+        steps: plan,
     })
 }
 
@@ -349,10 +352,11 @@ impl StepCount {
     /// `time.step` unless the steps shortened to land on breakpoints outnumber the full ones, then to the
     /// schedule with the most breakpoints.
     pub fn planned(plan: &StepPlan, step: Real, dto: &DesignDto) -> Self {
-        let field = match busiest_schedule(dto) {
-            Some(field) if plan.shortened > plan.full => field,
-            _ => "time.step".to_string(),
-        };
+        // The schedules are walked only when they make most of the steps.
+        let field = (plan.shortened > plan.full)
+            .then(|| busiest_schedule(dto))
+            .flatten()
+            .unwrap_or_else(|| "time.step".to_string());
         Self {
             steps: plan.total() as Real,
             what: format!(

@@ -91,6 +91,9 @@ pub struct Design {
     pub warnings: Vec<String>,
     /// The memory a run is estimated to need (below [`build::MEMORY_LIMIT_BYTES`]: larger designs are refused).
     pub memory: build::MemoryEstimate,
+    /// The steps a run takes when no step is cut ([`Model::planned_steps`], computed once here: it sorts every
+    /// breakpoint).
+    pub steps: crate::model::StepPlan,
     /// The YAML text as read (embedded in run recordings).
     pub source: String,
     /// Where it was read from.
@@ -333,6 +336,7 @@ pub fn parse_design_with(
         output: built.output,
         warnings: built.warnings,
         memory: built.memory,
+        steps: built.steps,
         source: text.to_string(),
         path: file,
     })
