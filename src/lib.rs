@@ -7,8 +7,8 @@
 //! ## Layers
 //!
 //! Dependencies point one way, left to right never imported from the right:
-//! `math → geometry → material → model → solver → io → cli`.
-//! `math`, `geometry`, `material`, `model` and `solver` are pure: no files, no printing, no serde.
+//! `math → geometry → material → model → solver → post → io → cli`.
+//! `math`, `geometry`, `material`, `model`, `solver` and `post` are pure: no files, no printing, no serde.
 //!
 //! | module | owns |
 //! |---|---|
@@ -17,7 +17,8 @@
 //! | [`material`] | Prony series, WLF shift, section stiffness |
 //! | [`model`] | the continuous problem: patches, nodes, conditions, loads, schedules |
 //! | [`solver`] | collocation, residual and tangent, Newton, time stepping |
-//! | [`io`] | YAML design files, STL/OBJ writers |
+//! | [`post`] | the full device from a (symmetry-reduced) model or state: sampled shapes, mirror copies, tube meshes |
+//! | [`io`] | YAML design files; writers of STL/OBJ, the run folder, charts |
 //! | [`cli`] | the `stentkit` command line |
 //!
 //! ## Conventions (stated once, here and in [`math::so3`])
@@ -40,4 +41,5 @@ pub mod io;
 pub mod material;
 pub mod math;
 pub mod model;
+pub mod post;
 pub mod solver;

@@ -1,28 +1,10 @@
 //! `stentkit mesh`: the reference shape of the full device as a closed tube surface.
 
-use crate::geometry::tube::TriangleMesh;
 use crate::io::design::load_design;
-use crate::io::device::{device_tube_mesh, reference_patch_shapes};
 use crate::io::{obj, stl};
-use crate::model::Model;
+use crate::post::device::reference_device_mesh;
 use anyhow::{Context, bail};
 use std::path::Path;
-
-/// The closed tube surface of the full device (mirrored back from a symmetry-reduced model) in its reference
-/// shape.
-pub fn reference_mesh(
-    model: &Model,
-    segments: usize,
-    samples_per_point: usize,
-) -> anyhow::Result<TriangleMesh> {
-    let shapes = reference_patch_shapes(model, samples_per_point).map_err(|(k, e)| {
-        anyhow::Error::new(e).context(format!("patch `{}`", model.patches[k].name))
-    })?;
-    device_tube_mesh(model, &shapes, segments).map_err(|e| {
-        let name = &model.patches[e.rod].name;
-        anyhow::Error::new(e.source).context(format!("patch `{name}`"))
-    })
-}
 
 /// Writes the reference shape of the design to `output` (`.stl` or `.obj`).
 pub fn run(design: &Path, output: &Path, segments: usize, samples: usize) -> anyhow::Result<()> {
@@ -35,7 +17,7 @@ pub fn run(design: &Path, output: &Path, segments: usize, samples: usize) -> any
     }
     let design = load_design(design)?;
     let model = &design.model;
-    let mesh = reference_mesh(model, segments, samples)?;
+    let mesh = reference_device_mesh(model, segments, samples)?;
     mesh.check_closed()
         .context("the tube surface is not closed (please report this)")?;
     let header = format!(

@@ -4,7 +4,7 @@
 //!
 //! Everything but the recording's compression is counted from what the writers write: the snapshot steps of
 //! [`crate::io::snapshots::SnapshotSchedule`] over [`Model::planned_steps`], the ring and point counts of
-//! [`crate::io::device`], binary STL's 84 + 50 bytes per triangle, OBJ's `v`/`f` lines, the recording's JSON
+//! [`crate::post::device`], binary STL's 84 + 50 bytes per triangle, OBJ's `v`/`f` lines, the recording's JSON
 //! messages. Step cuts add steps (and so rows, states and possibly snapshots): the estimate is for a run
 //! without cuts.
 //!
@@ -27,11 +27,11 @@
 //! measured one.
 
 use super::design::Design;
-use super::device::{device_sample_counts, patch_copies};
 use super::mcap::coordinate_decimals;
 use super::state::load_channels;
 use crate::math::Real;
 use crate::model::Model;
+use crate::post::device::{device_sample_counts, patch_copies};
 
 /// Bytes a run is estimated to write, part by part ([`estimated_disk`]).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
@@ -188,7 +188,7 @@ fn snapshot_count(model: &Model, steps: usize, every: usize, times: &[Real]) -> 
 }
 
 /// Vertices and triangles of the full device's tube mesh with about `rings` rings per patch and `segments`
-/// vertices around ([`crate::io::device::device_tube_mesh`]): per copy of a patch, `r · m` ring vertices
+/// vertices around ([`crate::post::device::device_tube_mesh`]): per copy of a patch, `r · m` ring vertices
 /// and `2m(r − 1)` side triangles, plus two capped ends (a centre vertex and `m` triangles each; ends welded to
 /// a mirror image have none, so this is an upper bound).
 fn tube_mesh_size(model: &Model, rings: usize, segments: usize) -> (Real, Real) {

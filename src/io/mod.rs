@@ -1,9 +1,9 @@
 //! Files: YAML design files, STL and OBJ meshes, the run folder (history CSV, snapshots, MCAP recording,
-//! charts, summary), SVG charts.
+//! charts, summary), SVG charts. What the meshes and recorded centrelines show (the full device mirrored from a
+//! reduced model) is computed in [`crate::post`]; this layer writes it.
 
 pub mod chart;
 pub mod design;
-pub mod device;
 pub mod estimate;
 pub mod history;
 pub mod mcap;

@@ -4,13 +4,13 @@
 //! model's record times).
 
 use super::design::SnapshotSettings;
-use super::device::{current_device_shapes, device_tube_mesh};
 use super::run_folder::Manifest;
 use super::stl::MeshIoError;
 use super::{obj, stl};
 use crate::geometry::tube::{DeviceMeshError, TriangleMesh};
 use crate::math::Real;
 use crate::model::Model;
+use crate::post::device::{current_device_shapes, device_tube_mesh};
 use crate::solver::{Observer, Simulation, StepReport};
 use std::ops::ControlFlow;
 use std::path::{Path, PathBuf};

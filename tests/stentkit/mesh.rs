@@ -13,7 +13,7 @@
 //! sum of their volumes, which is what we compare with.
 //!
 //! A symmetry-reduced stent is exported as the full device: each patch counts once per mirror copy
-//! (`io::device::patch_copies`: 4 in a quarter model, 2 for a bridge lying in a plane). A wire ending on a
+//! (`post::device::patch_copies`: 4 in a quarter model, 2 for a bridge lying in a plane). A wire ending on a
 //! plane is welded to its image without caps; the two flat caps it would otherwise have coincide with opposite
 //! orientations and contribute nothing to the volume, so the sum is unchanged.
 //!
@@ -22,15 +22,15 @@
 
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicUsize, Ordering};
-use stentkit::cli::mesh::reference_mesh;
 use stentkit::geometry::analytic::ArcLengthTable;
 use stentkit::geometry::frame::{FrameField, FrameSettings};
 use stentkit::geometry::tube::{TriangleMesh, TubeSettings, sweep_curve};
 use stentkit::io::design::load_design;
-use stentkit::io::device::patch_copies;
 use stentkit::io::{obj, stl};
 use stentkit::math::{Real, Vec3};
 use stentkit::model::Model;
+use stentkit::post::device::patch_copies;
+use stentkit::post::device::reference_device_mesh;
 
 /// Segments around each tube and samples per control point: the `stentkit mesh` defaults.
 pub const SEGMENTS: usize = 16;
@@ -157,7 +157,7 @@ struct Measured {
 
 /// Meshes `model`, writes STL and OBJ into `dir`, reads both back and checks them; returns the numbers.
 fn check_model(model: &Model, dir: &TempDir, name: &str) -> Measured {
-    let mesh = reference_mesh(model, SEGMENTS, SAMPLES_PER_POINT).expect("reference mesh");
+    let mesh = reference_device_mesh(model, SEGMENTS, SAMPLES_PER_POINT).expect("reference mesh");
     mesh.check_closed()
         .unwrap_or_else(|e| panic!("{name}: in memory: {e}"));
     let (expected, relative) = expected_volume(model);
@@ -223,7 +223,7 @@ fn every_design_exports_closed_outward_stl_and_obj() {
 }
 
 /// The closed-check of the STL read back when every patch is swept with the same section phase, as
-/// `reference_mesh` would without its per-patch phase.
+/// `reference_device_mesh` would without its per-patch phase.
 fn same_phase_stl_is_closed(model: &Model, dir: &TempDir, name: &str) -> bool {
     let settings = TubeSettings {
         segments_around: SEGMENTS,
@@ -257,7 +257,7 @@ fn same_phase_stl_is_closed(model: &Model, dir: &TempDir, name: &str) -> bool {
 fn tangential_joints_stay_manifold_after_vertex_merging() {
     // Two patches meeting tangentially with the same frame have coinciding end rings when swept with the
     // same section phase; STL vertex merging then glues four triangles to each ring edge. The control
-    // (same phase) must fail, and `reference_mesh` (its own phase per patch) must pass, both on the
+    // (same phase) must fail, and `reference_device_mesh` (its own phase per patch) must pass, both on the
     // multi-patch `good_small.yaml` (line + arc, tangent +x and d2 = e_y at the knee) and on two collinear
     // lines.
     let dir = TempDir::new("mesh-phase");

@@ -13,11 +13,11 @@ use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 use stentkit::io::design::{DesignOverrides, parse_design_with};
-use stentkit::io::device::patch_copies;
 use stentkit::io::snapshots::SnapshotWriter;
 use stentkit::io::stl::read_stl;
 use stentkit::math::Real;
 use stentkit::model::Model;
+use stentkit::post::device::patch_copies;
 use stentkit::solver::Simulation;
 
 /// A fresh folder for test `name`'s outputs under `$STENTKIT_TEST_OUTPUTS` (set by `.ci/run`), or under

@@ -4,12 +4,12 @@
 
 use std::ops::ControlFlow;
 use std::path::{Path, PathBuf};
-use stentkit::cli::mesh::reference_mesh;
 use stentkit::geometry::frame::{FrameField, FrameSettings};
 use stentkit::io::design::{load_design, parse_design};
 use stentkit::io::stl::{read_stl, write_stl};
 use stentkit::math::{Real, Vec3};
 use stentkit::model::{Model, ProbeLocation};
+use stentkit::post::device::reference_device_mesh;
 use stentkit::solver::simulation::NoObserver;
 use stentkit::solver::{Observer, Simulation, StepReport};
 
@@ -204,7 +204,7 @@ fn frames_are_continuous() {
 #[test]
 fn device_stl_is_watertight() {
     for (name, model) in devices().into_iter().step_by(2) {
-        let mesh = reference_mesh(&model, 12, 3).expect("mesh");
+        let mesh = reference_device_mesh(&model, 12, 3).expect("mesh");
         mesh.check_closed()
             .unwrap_or_else(|e| panic!("{name}: {e}"));
         let path = std::env::temp_dir().join(format!(

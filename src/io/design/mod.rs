@@ -31,7 +31,7 @@ pub struct SnapshotSettings {
     /// Vertices around each tube section.
     pub segments: usize,
     /// Rings (sections) along each patch, about: every k-th of the samples taken at a whole number of samples
-    /// per control point, the ends always included ([`crate::io::device::current_device_shapes`]).
+    /// per control point, the ends always included ([`crate::post::device::current_device_shapes`]).
     pub rings: usize,
 }
 

@@ -29,10 +29,10 @@ pub use format::{FRAME_ID, coordinate_decimals, path_key};
 pub use schema::scene_update_schema;
 
 use super::design::{Design, RecordingSettings, SnapshotSettings};
-use super::device::{current_device_shapes, device_centrelines, device_tube_mesh};
 use super::snapshots::SnapshotSchedule;
 use super::state::{LoadChannel, StateSample, load_channels};
 use crate::math::Real;
+use crate::post::device::{current_device_shapes, device_centrelines, device_tube_mesh};
 use crate::solver::{Observer, Simulation, StepReport};
 use format::{IDENTITY_POSE, color, number, push_points, scene_update, temperature_color};
 use schema::{StateKeys, state_schema};
@@ -241,7 +241,7 @@ impl McapRecorder {
         let thickness = (0..model.patches.len())
             .flat_map(|k| {
                 let d = model.sections[model.patches[k].section].diameter();
-                std::iter::repeat_n(d, super::device::patch_copies(model, k).len())
+                std::iter::repeat_n(d, crate::post::device::patch_copies(model, k).len())
             })
             .collect();
         Ok(Self {

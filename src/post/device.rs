@@ -11,12 +11,40 @@
 use crate::geometry::GeometryError;
 use crate::geometry::frame::{FrameField, FrameSettings};
 use crate::geometry::tube::{
-    DeviceMeshError, RodTube, TriangleMesh, TubeSettings, device_mesh, section_phase,
+    DeviceMeshError, RodTube, TriangleMesh, TubeError, TubeSettings, device_mesh, section_phase,
 };
 use crate::math::{Real, Vec3};
 use crate::model::Model;
 use crate::solver::Simulation;
 use crate::solver::shape::{PatchShape, current_shapes};
+
+/// Why the full device could not be meshed in its reference shape ([`reference_device_mesh`]): the patch
+/// (index and name) and the cause.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum ReferenceMeshError {
+    /// The patch's rotation-minimising frame cannot be evaluated.
+    #[error("patch `{name}`")]
+    Frame {
+        /// Index into [`Model::patches`].
+        patch: usize,
+        /// The patch's name.
+        name: String,
+        /// What is wrong.
+        #[source]
+        source: GeometryError,
+    },
+    /// The patch's tube cannot be swept.
+    #[error("patch `{name}`")]
+    Tube {
+        /// Index into [`Model::patches`].
+        patch: usize,
+        /// The patch's name.
+        name: String,
+        /// What is wrong.
+        #[source]
+        source: TubeError,
+    },
+}
 
 /// Indices of about `target` of `n` samples, evenly spaced (every k-th, `k = round((n − 1)/(target − 1))`),
 /// the first and the last always included; all of them when `n ≤ target`.
@@ -142,6 +170,32 @@ pub fn device_tube_mesh(
         })
         .collect();
     device_mesh(&rods, &model.symmetry_planes, &settings)
+}
+
+/// The closed tube surface of the full device (mirrored back from a symmetry-reduced model) in its reference
+/// shape: every patch sampled with [`reference_patch_shapes`] at `samples_per_point` samples per control point
+/// and swept with `segments` vertices around ([`device_tube_mesh`]).
+///
+/// # Errors
+/// [`ReferenceMeshError`] naming the patch whose frame or tube failed.
+pub fn reference_device_mesh(
+    model: &Model,
+    segments: usize,
+    samples_per_point: usize,
+) -> Result<TriangleMesh, ReferenceMeshError> {
+    let name = |k: usize| model.patches[k].name.clone();
+    let shapes = reference_patch_shapes(model, samples_per_point).map_err(|(patch, source)| {
+        ReferenceMeshError::Frame {
+            patch,
+            name: name(patch),
+            source,
+        }
+    })?;
+    device_tube_mesh(model, &shapes, segments).map_err(|e| ReferenceMeshError::Tube {
+        patch: e.rod,
+        name: name(e.rod),
+        source: e.source,
+    })
 }
 
 /// The reflections that make the full device's copies of patch `patch`: each entry lists the symmetry planes
