@@ -9,7 +9,7 @@
 mod stents;
 
 use std::time::Instant;
-use stentkit::cli::study::fit_log_slope;
+use stentkit::study::fit_log_slope;
 
 /// Mean wall time of `f` over `repeats` calls [ms].
 fn mean_ms(repeats: usize, mut f: impl FnMut()) -> f64 {

@@ -7,8 +7,10 @@
 //! ## Layers
 //!
 //! Dependencies point one way, left to right never imported from the right:
-//! `math → geometry → material → model → solver → post → io → cli`.
+//! `math → geometry → material → model → solver → post → io → study → cli`.
 //! `math`, `geometry`, `material`, `model`, `solver` and `post` are pure: no files, no printing, no serde.
+//! `study` writes no file and prints nothing either, but sits above `io`: it re-builds designs whose geometry it
+//! varies through `io::design` and draws its results as `io::chart` charts, which `cli` writes.
 //!
 //! | module | owns |
 //! |---|---|
@@ -19,6 +21,7 @@
 //! | [`solver`] | collocation, residual and tangent, Newton, time stepping |
 //! | [`post`] | the full device from a (symmetry-reduced) model or state: sampled shapes, mirror copies, tube meshes |
 //! | [`io`] | YAML design files; writers of STL/OBJ, the run folder, charts |
+//! | [`study`] | accuracy against cost: scenarios, exact references, error measures and fits, sweeps over variants of a model |
 //! | [`cli`] | the `stentkit` command line |
 //!
 //! ## Conventions (stated once, here and in [`math::so3`])
@@ -43,3 +46,4 @@ pub mod math;
 pub mod model;
 pub mod post;
 pub mod solver;
+pub mod study;

@@ -1,5 +1,5 @@
 //! The `stentkit` command line: `check` (validate a design and describe it), `mesh` (write the reference
-//! shape as a closed tube surface), `run` (simulate and write the run folder), `study` (convergence studies)
+//! shape as a closed tube surface), `run` (simulate and write the run folder), `study` (accuracy against cost)
 //! and `schema` (the JSON Schema of the design format). The only module that uses `anyhow` and prints.
 
 pub mod check;
@@ -282,7 +282,7 @@ pub fn main() -> ExitCode {
             time,
             reference,
             samples,
-        }) => study_convergence(&design, &output, degrees, points, time, reference, samples),
+        }) => study::convergence(&design, &output, degrees, points, time, reference, samples),
         Command::Study(StudyCommand::Time {
             design,
             output,
@@ -291,7 +291,7 @@ pub fn main() -> ExitCode {
             integrators,
             reference,
             samples,
-        }) => study_time(
+        }) => study::time(
             &design,
             &output,
             time,
@@ -300,7 +300,9 @@ pub fn main() -> ExitCode {
             &reference,
             samples,
         ),
-        Command::Study(StudyCommand::Stability { output, maps }) => study_stability(&output, &maps),
+        Command::Study(StudyCommand::Stability { output, maps }) => {
+            study::stability_maps(&output, &maps)
+        }
         Command::Mesh {
             design,
             output,
@@ -323,139 +325,5 @@ fn schema() -> anyhow::Result<()> {
         "{}",
         serde_json::to_string_pretty(&crate::io::design::design_schema())?
     );
-    Ok(())
-}
-
-fn study_convergence(
-    design: &std::path::Path,
-    output: &std::path::Path,
-    degrees: Vec<usize>,
-    points: Vec<usize>,
-    time: Option<f64>,
-    reference: Vec<usize>,
-    samples: usize,
-) -> anyhow::Result<()> {
-    use anyhow::Context;
-    let text = std::fs::read_to_string(design)
-        .with_context(|| format!("cannot read {}", design.display()))?;
-    let model = crate::io::design::parse_design(&text, design)?.model;
-    let [rp, rn] = reference[..] else {
-        anyhow::bail!("--reference takes two numbers, P,N");
-    };
-    let study = study::ConvergenceStudy {
-        degrees,
-        points,
-        time: time.unwrap_or(model.time.end),
-        reference: (rp, rn),
-        samples,
-    };
-    std::fs::create_dir_all(output)
-        .with_context(|| format!("cannot create {}", output.display()))?;
-    let rows = study::convergence(&text, design, &study, |line| eprintln!("  {line}"))?;
-    let csv = output.join("convergence.csv");
-    std::fs::write(&csv, study::convergence_csv(&rows, &study, &model.name))
-        .with_context(|| format!("cannot write {}", csv.display()))?;
-    let [by_n, by_time] = study::convergence_charts(&rows, &study, &model.name);
-    crate::io::chart::write_svg(&by_n, &output.join("error_vs_n.svg"))?;
-    crate::io::chart::write_svg(&by_time, &output.join("error_vs_time.svg"))?;
-    println!(
-        "{}: {} runs → {} (and error_vs_n.svg, error_vs_time.svg)",
-        model.name,
-        rows.len(),
-        csv.display()
-    );
-    Ok(())
-}
-
-fn study_time(
-    design: &std::path::Path,
-    output: &std::path::Path,
-    time: Option<f64>,
-    steps: Vec<f64>,
-    integrators: &[String],
-    reference: &str,
-    samples: usize,
-) -> anyhow::Result<()> {
-    use anyhow::Context;
-    use study::time::{TimeReference, TimeStudy, parse_integrator};
-    let text = std::fs::read_to_string(design)
-        .with_context(|| format!("cannot read {}", design.display()))?;
-    let model = crate::io::design::parse_design(&text, design)?.model;
-    let integrators = integrators
-        .iter()
-        .map(|name| parse_integrator(name).map_err(anyhow::Error::msg))
-        .collect::<anyhow::Result<Vec<_>>>()?;
-    let reference = match reference {
-        "auto" => TimeReference::Auto,
-        "design" => TimeReference::Design,
-        h => TimeReference::Step(h.parse().with_context(|| {
-            format!("--reference takes auto, design or a time step, not `{h}`")
-        })?),
-    };
-    let study = TimeStudy {
-        integrators,
-        steps,
-        time: time.unwrap_or(model.time.end),
-        reference,
-        samples,
-    };
-    std::fs::create_dir_all(output)
-        .with_context(|| format!("cannot create {}", output.display()))?;
-    let result = study::time::time_study(&text, design, &study, |line| eprintln!("  {line}"))?;
-    let csv = output.join("time_steps.csv");
-    std::fs::write(&csv, study::time::time_csv(&result, &study, &model.name))
-        .with_context(|| format!("cannot write {}", csv.display()))?;
-    let [by_h, by_time] = study::time::time_charts(&result, &study, &model.name);
-    crate::io::chart::write_svg(&by_h, &output.join("error_vs_h.svg"))?;
-    crate::io::chart::write_svg(&by_time, &output.join("error_vs_time.svg"))?;
-    println!(
-        "{}: errors at t = {} against {}",
-        model.name, study.time, result.reference
-    );
-    for (integrator, order) in &result.orders {
-        match order {
-            Some(q) => println!("  {:<15} observed order {q:.2}", integrator.name()),
-            None => println!(
-                "  {:<15} observed order n/a (fewer than two runs with an error)",
-                integrator.name()
-            ),
-        }
-    }
-    println!(
-        "{} runs → {} (and error_vs_h.svg, error_vs_time.svg)",
-        result.rows.len(),
-        csv.display()
-    );
-    Ok(())
-}
-
-fn study_stability(output: &std::path::Path, maps: &[String]) -> anyhow::Result<()> {
-    use anyhow::Context;
-    use study::stability::{StabilityStudy, stability};
-    for m in maps {
-        anyhow::ensure!(
-            ["material", "bend45", "heating", "release"].contains(&m.as_str()),
-            "unknown map `{m}` (material, bend45, heating, release)"
-        );
-    }
-    let mut study = StabilityStudy::default();
-    let wanted = |name: &str| maps.iter().any(|m| m == name);
-    if !wanted("material") {
-        study.ratios.clear();
-    }
-    if !wanted("bend45") {
-        study.load_steps.clear();
-    }
-    if !wanted("heating") {
-        study.heating.clear();
-    }
-    if !wanted("release") {
-        study.release.clear();
-    }
-    std::fs::create_dir_all(output)
-        .with_context(|| format!("cannot create {}", output.display()))?;
-    let summary = stability(&study, output, |line| eprintln!("  {line}"))?;
-    println!("{summary}");
-    println!("→ {}", output.join("stability.md").display());
     Ok(())
 }

@@ -4,10 +4,10 @@
 use crate::mesh::TempDir;
 use std::path::Path;
 use std::process::Command;
-use stentkit::cli::study::fit_log_slope;
-use stentkit::cli::study::stability::{MaterialScenario, material_point};
 use stentkit::material::Integrator;
 use stentkit::math::Real;
+use stentkit::study::fit_log_slope;
+use stentkit::study::stability::material::{MaterialScenario, material_point};
 
 fn repo(relative: &str) -> String {
     Path::new(env!("CARGO_MANIFEST_DIR"))

@@ -1,4 +1,4 @@
-//! `stentkit study time`: error against the time step `h` for each internal-variable integrator (DESIGN §6).
+//! Error against the time step `h` for each internal-variable integrator (DESIGN §6; `stentkit study time`).
 //!
 //! Every integrator asked for (trapezoidal, backward Euler, exponential) runs the design with every step `h`
 //! asked for, up to a time `T`; the displacement on the study grid at `T` is compared with a self-converged
@@ -8,15 +8,15 @@
 //! least-squares slope of `log err` against `log h`. Steps are nominal: the solver lands on every schedule
 //! breakpoint and may cut a step, so a run's steps are `≤ h`.
 
-use super::{
-    ErrorChartLabels, ErrorCurve, error_charts, fit_log_slope, relative_error, sample_run,
-};
+use super::charts::{ErrorChartLabels, ErrorCurve, error_charts};
+use super::fit::{fit_log_slope, relative_error};
+use super::sample::sample_run;
+use super::{StudyError, error_chain};
 use crate::io::chart::LineChart;
 use crate::io::design::DesignOverrides;
 use crate::io::design::dto::IntegratorDto;
 use crate::material::Integrator;
 use crate::math::Real;
-use anyhow::Context;
 use std::fmt::Write as _;
 use std::path::Path;
 
@@ -86,32 +86,21 @@ fn dto(integrator: Integrator) -> IntegratorDto {
     }
 }
 
-/// Parses an integrator's design-file name (`trapezoidal`, `backward-euler`, `exponential`).
-pub fn parse_integrator(name: &str) -> Result<Integrator, String> {
-    [
-        Integrator::Trapezoidal,
-        Integrator::BackwardEuler,
-        Integrator::Exponential,
-    ]
-    .into_iter()
-    .find(|i| i.name() == name)
-    .ok_or_else(|| {
-        format!("unknown integrator `{name}` (trapezoidal, backward-euler or exponential)")
-    })
-}
-
 /// Runs the study; `progress` is told about each finished run.
 pub fn time_study(
     text: &str,
     path: &Path,
     study: &TimeStudy,
     mut progress: impl FnMut(&str),
-) -> anyhow::Result<TimeStudyResult> {
+) -> Result<TimeStudyResult, StudyError> {
     let smallest = study.steps.iter().copied().fold(Real::INFINITY, Real::min);
-    anyhow::ensure!(
-        smallest.is_finite() && smallest > 0.0,
-        "the steps must be positive numbers"
-    );
+    if !(smallest.is_finite() && smallest > 0.0) {
+        return Err(StudyError::InvalidSetting {
+            setting: "every time step h",
+            value: smallest,
+            expected: "a positive number",
+        });
+    }
     let mut reference_overrides = DesignOverrides {
         end_time: Some(study.time),
         ..DesignOverrides::default()
@@ -128,8 +117,8 @@ pub fn time_study(
         }
         TimeReference::Design => "the design's own time step and integrator".to_string(),
     };
-    let reference_run =
-        sample_run(text, path, &reference_overrides, study.samples).context("reference run")?;
+    let reference_run = sample_run(text, path, &reference_overrides, study.samples)
+        .map_err(|e| e.in_run("reference run"))?;
     progress(&format!(
         "reference ({reference}): {} steps, {:.2} s",
         reference_run.summary.steps, reference_run.wall
@@ -156,7 +145,7 @@ pub fn time_study(
                 Err(e) => TimePoint {
                     integrator,
                     step,
-                    error: Err(format!("{e:#}")),
+                    error: Err(error_chain(&e)),
                     wall: 0.0,
                     steps: 0,
                     iterations: 0,

@@ -1,0 +1,148 @@
+//! `p × n` convergence: the displacement error of a design against a self-converged reference run, for every
+//! degree `p` and number of control points `n` asked for, with the wall time of each run (DESIGN §6).
+//!
+//! Every run goes up to a time `t`; the error is measured on a grid of points per patch (9 equally spaced
+//! parameters by default) against a reference run (by default `p = 8`, `n = 150`), as the paper does for its
+//! Fig. conv_circ: `err = ‖u_ref − u_h‖ / ‖u_ref‖` over the grid ([`super::relative_error`]). The table, with
+//! the wall time of each run, charts error against `n` and against time (work–precision).
+
+use super::StudyError;
+use super::charts::{ErrorChartLabels, ErrorCurve, error_charts};
+use super::fit::relative_error;
+use super::sample::sample_run;
+use crate::io::chart::LineChart;
+use crate::io::design::DesignOverrides;
+use crate::math::Real;
+use std::fmt::Write as _;
+use std::path::Path;
+
+/// One run of a convergence study.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ConvergencePoint {
+    /// Degree.
+    pub degree: usize,
+    /// Control points per patch.
+    pub points: usize,
+    /// Unknowns of the global system.
+    pub unknowns: usize,
+    /// Relative displacement error against the reference.
+    pub error: Real,
+    /// Wall time of the run \[s\].
+    pub wall: Real,
+    /// Newton iterations of the run.
+    pub iterations: usize,
+}
+
+/// Settings of a convergence study.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ConvergenceStudy {
+    /// Degrees to run.
+    pub degrees: Vec<usize>,
+    /// Control points per patch to run (values `≤ p` are skipped for that `p`).
+    pub points: Vec<usize>,
+    /// Time at which errors are measured \[time\].
+    pub time: Real,
+    /// Reference `(p, n)`.
+    pub reference: (usize, usize),
+    /// Sampling points per patch.
+    pub samples: usize,
+}
+
+/// Runs the study and returns its rows; `progress` is told about each finished run.
+pub fn convergence_study(
+    text: &str,
+    path: &Path,
+    study: &ConvergenceStudy,
+    mut progress: impl FnMut(&str),
+) -> Result<Vec<ConvergencePoint>, StudyError> {
+    let (rp, rn) = study.reference;
+    let overrides = |p: usize, n: usize| DesignOverrides {
+        degree: Some(p),
+        points: Some(n),
+        end_time: Some(study.time),
+        ..DesignOverrides::default()
+    };
+    let reference = sample_run(text, path, &overrides(rp, rn), study.samples)
+        .map_err(|e| e.in_run("reference run"))?;
+    progress(&format!(
+        "reference p = {rp}, n = {rn}: {:.2} s",
+        reference.wall
+    ));
+    let mut rows = Vec::new();
+    for &p in &study.degrees {
+        for &n in study.points.iter().filter(|&&n| n > p) {
+            let run = sample_run(text, path, &overrides(p, n), study.samples)
+                .map_err(|e| e.in_run(format!("run with p = {p}, n = {n}")))?;
+            let error = relative_error(&run.grid, &reference.grid);
+            progress(&format!(
+                "p = {p}, n = {n}: error {error:.3e}, {:.2} s",
+                run.wall
+            ));
+            rows.push(ConvergencePoint {
+                degree: p,
+                points: n,
+                unknowns: run.unknowns,
+                error,
+                wall: run.wall,
+                iterations: run.summary.iterations,
+            });
+        }
+    }
+    Ok(rows)
+}
+
+/// The rows as CSV, with a comment header saying what the error is measured against.
+pub fn convergence_csv(
+    rows: &[ConvergencePoint],
+    study: &ConvergenceStudy,
+    design: &str,
+) -> String {
+    let mut s = String::new();
+    let _ = writeln!(
+        s,
+        "# convergence study of {design}: displacement error at t = {} on {} points per patch against a self-converged run with p = {}, n = {}",
+        study.time, study.samples, study.reference.0, study.reference.1
+    );
+    let _ = writeln!(s, "p,n,unknowns,error,wall_s,newton_iterations");
+    for r in rows {
+        let _ = writeln!(
+            s,
+            "{},{},{},{:.6e},{:.4},{}",
+            r.degree, r.points, r.unknowns, r.error, r.wall, r.iterations
+        );
+    }
+    s
+}
+
+/// The two charts of a convergence study: error against `n` and error against wall time (work–precision),
+/// one series per degree, on log–log axes.
+pub fn convergence_charts(
+    rows: &[ConvergencePoint],
+    study: &ConvergenceStudy,
+    design: &str,
+) -> [LineChart; 2] {
+    let reference = format!(
+        "against p = {}, n = {} at t = {}",
+        study.reference.0, study.reference.1, study.time
+    );
+    let curves: Vec<ErrorCurve> = study
+        .degrees
+        .iter()
+        .map(|&p| ErrorCurve {
+            label: format!("p = {p}"),
+            runs: rows
+                .iter()
+                .filter(|r| r.degree == p)
+                .map(|r| (r.points as Real, r.error, r.wall))
+                .collect(),
+        })
+        .collect();
+    error_charts(
+        &curves,
+        &ErrorChartLabels {
+            by_parameter: format!("{design}: displacement error vs n ({reference})"),
+            by_time: format!("{design}: work-precision ({reference})"),
+            parameter: "control points per patch n".into(),
+        },
+    )
+}

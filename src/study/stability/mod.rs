@@ -1,0 +1,144 @@
+//! The stability study: where each method fails and what the program does there (DESIGN §4, §6;
+//! `stentkit study stability`).
+//!
+//! Four maps, each a CSV, an SVG chart and a paragraph of `stability.md` ([`MapReport`]):
+//!
+//! * **material** ([`material`]) — one Maxwell branch (`E∞ = E₁ = 1`) after a unit strain jump, for `h/τ` from
+//!   `1e-2` to `1e4`, with the rod's own integrators, held at constant temperature or held while cooling, against
+//!   the exact branch stress: the largest deviation (the *amplitude*, in units of `E₁ Δε`) and the sign changes
+//!   of the computed branch stress (ringing).
+//! * **bend45** — the elastic 45° bend (designs/bend45.yaml) with 1 to 20 load steps: whether Newton converges
+//!   without cuts, cuts, failed attempts and iterations.
+//! * **heating** — the circular arch (designs/circular_arch.yaml; loads and heating 31.5 → 90 °C together):
+//!   fewer steps at the design's rate, and faster heating at a fixed step; temperature change per step against
+//!   iterations and cuts.
+//! * **release** — the release snap of a two-crown straight stent (designs/straight_stent.yaml with 2 crowns,
+//!   run to 2 s, released at 1.75 s): step size and release-ramp length against cuts and iterations.
+//!
+//! The last three are [`scenarios`] run through [`newton::newton_run`], which records what the solver did.
+
+pub mod material;
+pub mod newton;
+pub mod scenarios;
+
+use super::StudyError;
+use crate::io::chart::LineChart;
+use crate::material::Integrator;
+use crate::math::Real;
+
+/// The three integrators, in the order of the maps.
+pub const INTEGRATORS: [Integrator; 3] = [
+    Integrator::Trapezoidal,
+    Integrator::BackwardEuler,
+    Integrator::Exponential,
+];
+
+/// One finished map: its files (`<name>.csv`, `<name>.svg`) and its paragraph of `stability.md`.
+#[derive(Debug, Clone)]
+pub struct MapReport {
+    /// File stem (`material`, `bend45`, `heating`, `release`).
+    pub name: &'static str,
+    /// The map as CSV (with a comment header).
+    pub csv: String,
+    /// The map's chart.
+    pub chart: LineChart,
+    /// The map's paragraph of `stability.md` (Markdown).
+    pub summary: String,
+}
+
+/// Settings of the stability study.
+#[derive(Debug, Clone, PartialEq)]
+pub struct StabilityStudy {
+    /// `h/τ` of the material map.
+    pub ratios: Vec<Real>,
+    /// Load steps of the 45° bend.
+    pub load_steps: Vec<usize>,
+    /// `(heating duration [s], h [s])` of the arch.
+    pub heating: Vec<(Real, Real)>,
+    /// `(h [s], release ramp [s], control points per patch)` of the two-crown stent.
+    pub release: Vec<(Real, Real, usize)>,
+}
+
+impl Default for StabilityStudy {
+    /// The default maps (about a minute on one core).
+    fn default() -> Self {
+        Self {
+            ratios: (-4..=8).map(|k| 10f64.powf(k as Real / 2.0)).collect(),
+            load_steps: vec![1, 2, 3, 4, 5, 10, 20],
+            heating: vec![
+                (5.0, 5.0),
+                (5.0, 2.5),
+                (5.0, 1.0),
+                (5.0, 0.5),
+                (5.0, 0.25),
+                (5.0, 0.1),
+                (2.0, 0.1),
+                (0.5, 0.1),
+                (0.1, 0.1),
+            ],
+            release: vec![
+                (0.25, 0.001, 20),
+                (0.25, 0.25, 20),
+                (0.1, 0.001, 20),
+                (0.1, 0.1, 20),
+                (0.05, 0.05, 20),
+                (0.05, 0.2, 20),
+                (0.02, 0.001, 20),
+                (0.02, 0.02, 20),
+                (0.02, 0.2, 20),
+                (0.01, 0.001, 20),
+                (0.01, 0.01, 20),
+                (0.01, 0.2, 20),
+                (0.01, 0.01, 14),
+                (0.01, 0.3, 14),
+            ],
+        }
+    }
+}
+
+/// Runs every map of `study` whose list is not empty, in the order material, bend45, heating, release. Each
+/// finished map is handed to `done` (which writes it), so the maps finished before a failure are kept; the text
+/// of `stability.md` (a title and every map's paragraph) is returned. `progress` is told about each run.
+///
+/// # Errors
+/// The first error of a map (an out-of-range setting, a refused design) or of `done`.
+pub fn stability<E: From<StudyError>>(
+    study: &StabilityStudy,
+    mut done: impl FnMut(&MapReport) -> Result<(), E>,
+    mut progress: impl FnMut(&str),
+) -> Result<String, E> {
+    let mut summary = String::from(
+        "# Stability map\n\nWhere each method fails and what stentkit does there (`stentkit study stability`).\n\n",
+    );
+    if !study.ratios.is_empty() {
+        let rows = material::material_map(&study.ratios)?;
+        let report = MapReport {
+            name: "material",
+            csv: material::material_csv(&rows),
+            chart: material::material_chart(&rows),
+            summary: material::material_summary(&rows),
+        };
+        done(&report)?;
+        summary.push_str(&report.summary);
+        progress("material map done");
+    }
+    if !study.load_steps.is_empty() {
+        let map = scenarios::bend45_map(&study.load_steps, &mut progress)?;
+        let report = scenarios::bend45_report(&map);
+        done(&report)?;
+        summary.push_str(&report.summary);
+    }
+    if !study.heating.is_empty() {
+        let map = scenarios::heating_map(&study.heating, &mut progress)?;
+        let report = scenarios::heating_report(&map);
+        done(&report)?;
+        summary.push_str(&report.summary);
+    }
+    if !study.release.is_empty() {
+        let map = scenarios::release_map(&study.release, &mut progress)?;
+        let report = scenarios::release_report(&map);
+        done(&report)?;
+        summary.push_str(&report.summary);
+    }
+    Ok(summary)
+}

@@ -1,0 +1,285 @@
+//! What the solver does on one run of a design, and the solver maps built from such runs: whether Newton
+//! converges without cuts, how many iterations a step takes, where steps are cut or the run fails. The
+//! scenarios that make the maps are in [`super::scenarios`].
+
+use crate::io::chart::{LineChart, Scale, Series};
+use crate::io::design::{DesignOverrides, parse_design_with};
+use crate::math::Real;
+use crate::solver::{NewtonReport, Observer, Simulation, StepReport};
+use crate::study::StudyError;
+use std::fmt::Write as _;
+use std::ops::ControlFlow;
+use std::path::Path;
+use std::time::Instant;
+
+/// What one run of a design did, for the solver maps.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct NewtonRun {
+    /// The run reached its end time.
+    pub completed: bool,
+    /// Time reached \[time\].
+    pub time: Real,
+    /// Converged steps.
+    pub steps: usize,
+    /// Newton iterations of the converged steps.
+    pub iterations: usize,
+    /// Most Newton iterations in one converged step.
+    pub max_step_iterations: usize,
+    /// Step cuts (halvings after a failed attempt) of a completed run; 0 for a failed one (see
+    /// `failed_attempts`).
+    pub cuts: usize,
+    /// Failed Newton attempts (cuts, plus retries without the reused factorisation).
+    pub failed_attempts: usize,
+    /// Target times of the failed attempts \[time\].
+    pub failure_times: Vec<Real>,
+    /// Smallest step taken or attempted \[time\].
+    pub smallest_step: Real,
+    /// Wall time \[s\].
+    pub wall: Real,
+    /// Why the run stopped early.
+    pub failure: Option<String>,
+    /// The solver's notices (e.g. the WLF freeze).
+    pub notices: Vec<String>,
+}
+
+impl NewtonRun {
+    /// Mean Newton iterations per converged step.
+    pub fn iterations_per_step(&self) -> Real {
+        self.iterations as Real / self.steps.max(1) as Real
+    }
+
+    /// `yes`, `cut` (completed with cuts) or `FAILED`.
+    pub fn outcome(&self) -> &'static str {
+        match (self.completed, self.cuts) {
+            (false, _) => "FAILED",
+            (true, 0) => "yes",
+            (true, _) => "cut",
+        }
+    }
+}
+
+/// Counts what the solver does step by step.
+struct Watch(NewtonRun);
+
+impl Observer for Watch {
+    fn step(&mut self, _: &Simulation<'_>, report: &StepReport) -> ControlFlow<()> {
+        let r = &mut self.0;
+        r.steps += 1;
+        r.iterations += report.newton.iterations;
+        r.max_step_iterations = r.max_step_iterations.max(report.newton.iterations);
+        r.smallest_step = r.smallest_step.min(report.dt);
+        r.time = report.time;
+        ControlFlow::Continue(())
+    }
+
+    fn step_failed(&mut self, time: Real, dt: Real, _: &NewtonReport) {
+        self.0.failed_attempts += 1;
+        self.0.failure_times.push(time);
+        self.0.smallest_step = self.0.smallest_step.min(dt);
+    }
+}
+
+/// Runs `text` with `overrides` and records what the solver did; a solver failure is recorded, an invalid
+/// design is an error.
+pub fn newton_run(
+    text: &str,
+    path: &Path,
+    overrides: &DesignOverrides,
+) -> Result<NewtonRun, StudyError> {
+    let design = parse_design_with(text, path, overrides)?;
+    let model = &design.model;
+    let started = Instant::now();
+    let mut sim = Simulation::new(model)?;
+    let mut watch = Watch(NewtonRun {
+        smallest_step: Real::INFINITY,
+        ..NewtonRun::default()
+    });
+    let result = sim.run(&mut watch);
+    let mut run = watch.0;
+    run.wall = started.elapsed().as_secs_f64();
+    run.notices = sim.notices().to_vec();
+    match result {
+        Ok(summary) => {
+            run.completed = !summary.stopped;
+            run.cuts = summary.cuts;
+        }
+        Err(e) => {
+            // A failed run returns no summary: its cuts are not known apart from the retries with a fresh
+            // factorisation, so they are reported as failed attempts only.
+            run.cuts = 0;
+            run.failure = Some(e.to_string());
+        }
+    }
+    Ok(run)
+}
+
+/// One point of a solver map: its parameters (named) and the run.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SolverPoint {
+    /// Parameter values, in the map's column order.
+    pub parameters: Vec<Real>,
+    /// The run.
+    pub run: NewtonRun,
+}
+
+/// A solver map: its name, parameter column names and points.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SolverMap {
+    /// Map name (file stem).
+    pub name: &'static str,
+    /// Names of the parameter columns (with units).
+    pub columns: Vec<&'static str>,
+    /// The runs.
+    pub points: Vec<SolverPoint>,
+}
+
+/// One line about a run.
+pub fn describe(run: &NewtonRun) -> String {
+    let mut s = format!(
+        "{} steps, {} iterations ({:.1}/step, max {}), {} cuts, {} failed attempts, {:.2} s",
+        run.steps,
+        run.iterations,
+        run.iterations_per_step(),
+        run.max_step_iterations,
+        run.cuts,
+        run.failed_attempts,
+        run.wall
+    );
+    if let Some(f) = &run.failure {
+        let _ = write!(s, "; FAILED at t = {}: {}", run.time, first_sentence(f));
+    }
+    s
+}
+
+/// The message up to its first colon after `min_step` (the residual list is long).
+pub fn first_sentence(message: &str) -> &str {
+    message.split(": after").next().unwrap_or(message)
+}
+
+/// A solver map as CSV.
+pub fn solver_csv(map: &SolverMap, header: &str) -> String {
+    let mut s = String::new();
+    let _ = writeln!(s, "# {header}");
+    let _ = writeln!(
+        s,
+        "{},converged_without_cuts,completed,time_reached,steps,newton_iterations,iterations_per_step,max_step_iterations,cuts,failed_attempts,smallest_step,wall_s,failure",
+        map.columns.join(",")
+    );
+    for p in &map.points {
+        let r = &p.run;
+        let params: Vec<String> = p.parameters.iter().map(|v| format!("{v}")).collect();
+        let _ = writeln!(
+            s,
+            "{},{},{},{},{},{},{:.3},{},{},{},{:e},{:.3},{}",
+            params.join(","),
+            r.completed && r.cuts == 0,
+            r.completed,
+            r.time,
+            r.steps,
+            r.iterations,
+            r.iterations_per_step(),
+            r.max_step_iterations,
+            r.cuts,
+            r.failed_attempts,
+            r.smallest_step,
+            r.wall,
+            r.failure
+                .as_deref()
+                .map(|f| first_sentence(f).replace([',', '\n'], " "))
+                .unwrap_or_default()
+        );
+    }
+    s
+}
+
+/// A solver map's chart: iterations per step, most iterations in a step and cuts against the parameter in
+/// column `x` (log axis), one group of series per combination of the values in the columns `group`.
+pub fn solver_chart(
+    map: &SolverMap,
+    title: &str,
+    x: usize,
+    x_label: &str,
+    group: &[usize],
+) -> LineChart {
+    let mut chart = LineChart::new(title, x_label, "count");
+    chart.x_scale = Scale::Log;
+    let key = |p: &SolverPoint| -> Vec<Real> { group.iter().map(|&i| p.parameters[i]).collect() };
+    let mut groups: Vec<Vec<Real>> = Vec::new();
+    for p in &map.points {
+        if !groups.contains(&key(p)) {
+            groups.push(key(p));
+        }
+    }
+    for (k, g) in groups.iter().enumerate() {
+        let of: Vec<&SolverPoint> = map.points.iter().filter(|p| key(p) == *g).collect();
+        let prefix: String = group
+            .iter()
+            .zip(g)
+            .map(|(&i, v)| format!("{} = {v}: ", map.columns[i]))
+            .collect();
+        let line = |f: &dyn Fn(&NewtonRun) -> Real| -> Vec<(Real, Real)> {
+            of.iter().map(|p| (p.parameters[x], f(&p.run))).collect()
+        };
+        chart.series.push(
+            Series::new(
+                format!("{prefix}iterations per step"),
+                line(&|r| r.iterations_per_step()),
+            )
+            .with_markers()
+            .with_color(3 * k),
+        );
+        chart.series.push(
+            Series::new(
+                format!("{prefix}max iterations in a step"),
+                line(&|r| r.max_step_iterations as Real),
+            )
+            .dashed()
+            .with_color(3 * k + 1),
+        );
+        chart.series.push(
+            Series::new(format!("{prefix}cuts"), line(&|r| r.cuts as Real))
+                .with_markers()
+                .with_color(3 * k + 2),
+        );
+    }
+    chart
+}
+
+/// A solver map's paragraph of `stability.md`.
+pub fn solver_summary(
+    map: &SolverMap,
+    title: &str,
+    describe_point: impl Fn(&[Real]) -> String,
+) -> String {
+    let mut s = format!("## {title} ({0}.csv, {0}.svg)\n\n", map.name);
+    for p in &map.points {
+        let r = &p.run;
+        let what = match (&r.failure, r.cuts) {
+            (Some(f), _) => format!(
+                "**failed** at t = {} after {} failed Newton attempts (step cut down to {:.3e}): {}",
+                r.time,
+                r.failed_attempts,
+                r.smallest_step,
+                first_sentence(f)
+            ),
+            (None, 0) => format!(
+                "converged without cuts, {:.1} iterations per step (max {})",
+                r.iterations_per_step(),
+                r.max_step_iterations
+            ),
+            (None, c) => format!(
+                "completed with {c} cuts ({} failed attempts, smallest step {:.3e}), {:.1} iterations per step (max {})",
+                r.failed_attempts,
+                r.smallest_step,
+                r.iterations_per_step(),
+                r.max_step_iterations
+            ),
+        };
+        let _ = writeln!(s, "- {}: {what}.", describe_point(&p.parameters));
+        for n in &r.notices {
+            let _ = writeln!(s, "  - notice: {n}");
+        }
+    }
+    s.push('\n');
+    s
+}
