@@ -2,6 +2,7 @@
 //! ([`crate::study`]), its CSV and charts written into the output folder, and its progress and results printed.
 
 use crate::io::chart::write_svg;
+use crate::io::design::load_design;
 use crate::material::Integrator;
 use crate::study::convergence::{
     ConvergenceStudy, convergence_charts, convergence_csv, convergence_study,
@@ -37,9 +38,8 @@ pub fn convergence(
     reference: Vec<usize>,
     samples: usize,
 ) -> anyhow::Result<()> {
-    let text = std::fs::read_to_string(design)
-        .with_context(|| format!("cannot read {}", design.display()))?;
-    let model = crate::io::design::parse_design(&text, design)?.model;
+    let design = load_design(design)?;
+    let model = &design.model;
     let [rp, rn] = reference[..] else {
         anyhow::bail!("--reference takes two numbers, P,N");
     };
@@ -51,7 +51,7 @@ pub fn convergence(
         samples,
     };
     create(output)?;
-    let rows = convergence_study(&text, design, &study, progress)?;
+    let rows = convergence_study(&design, &study, progress)?;
     let csv = output.join("convergence.csv");
     write(&csv, &convergence_csv(&rows, &study, &model.name))?;
     let [by_n, by_time] = convergence_charts(&rows, &study, &model.name);
@@ -91,9 +91,8 @@ pub fn time(
     reference: &str,
     samples: usize,
 ) -> anyhow::Result<()> {
-    let text = std::fs::read_to_string(design)
-        .with_context(|| format!("cannot read {}", design.display()))?;
-    let model = crate::io::design::parse_design(&text, design)?.model;
+    let design = load_design(design)?;
+    let model = &design.model;
     let integrators = integrators
         .iter()
         .map(|name| parse_integrator(name).map_err(anyhow::Error::msg))
@@ -113,7 +112,7 @@ pub fn time(
         samples,
     };
     create(output)?;
-    let result = time_study(&text, design, &study, progress)?;
+    let result = time_study(model, &study, progress)?;
     let csv = output.join("time_steps.csv");
     write(&csv, &time_csv(&result, &study, &model.name))?;
     let [by_h, by_time] = time_charts(&result, &study, &model.name);

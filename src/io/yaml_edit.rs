@@ -1,7 +1,7 @@
-//! Edits of design texts at the YAML level, for studies and benchmarks that vary what
-//! [`crate::io::design::DesignOverrides`] does not cover (a stent's crown count, `time.release_ramp`, a
-//! temperature schedule): parse the text into a generic YAML tree, set a value at a key path, and write the
-//! tree back. Comments and key order of untouched maps are not kept, so the result is for the solver, not for
+//! Edits of design texts at the YAML level, for benchmarks that vary what
+//! [`crate::io::design::DesignOverrides`] does not cover: parse the text into a generic YAML tree, set a value
+//! at a key path, and write the tree back. (The studies vary built models instead, [`crate::study::variant`];
+//! this stays for `benches/support` until the model builder replaces it there.) Comments and key order of untouched maps are not kept, so the result is for the solver, not for
 //! people; validation (and its located errors) happens afterwards, when the edited text is parsed as a design.
 
 use serde_yaml::{Mapping, Value};

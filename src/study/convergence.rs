@@ -9,12 +9,12 @@
 use super::StudyError;
 use super::charts::{ErrorChartLabels, ErrorCurve, error_charts};
 use super::fit::relative_error;
-use super::sample::sample_run;
+use super::sample::{SampledRun, sample_run};
+use super::variant::{Remesh, TimeVariant, rebuild};
 use crate::io::chart::LineChart;
-use crate::io::design::DesignOverrides;
+use crate::io::design::Design;
 use crate::math::Real;
 use std::fmt::Write as _;
-use std::path::Path;
 
 /// One run of a convergence study.
 #[derive(Debug, Clone, PartialEq)]
@@ -48,22 +48,32 @@ pub struct ConvergenceStudy {
     pub samples: usize,
 }
 
-/// Runs the study and returns its rows; `progress` is told about each finished run.
+/// Runs the study on `design` (re-built for every `p` and `n`, [`rebuild`]) and returns its rows; `progress` is
+/// told about each finished run.
+///
+/// # Errors
+/// The first run that fails ([`StudyError::Run`] says which): every run must succeed for the rates to mean
+/// anything.
 pub fn convergence_study(
-    text: &str,
-    path: &Path,
+    design: &Design,
     study: &ConvergenceStudy,
     mut progress: impl FnMut(&str),
 ) -> Result<Vec<ConvergencePoint>, StudyError> {
     let (rp, rn) = study.reference;
-    let overrides = |p: usize, n: usize| DesignOverrides {
-        degree: Some(p),
-        points: Some(n),
-        end_time: Some(study.time),
-        ..DesignOverrides::default()
+    let run = |p: usize, n: usize| -> Result<SampledRun, StudyError> {
+        let remesh = Remesh {
+            degree: Some(p),
+            points: Some(n),
+            ..Remesh::default()
+        };
+        let until = TimeVariant {
+            end: Some(study.time),
+            ..TimeVariant::default()
+        };
+        let model = until.of(&rebuild(design, &remesh)?)?;
+        Ok(sample_run(&model, study.samples)?)
     };
-    let reference = sample_run(text, path, &overrides(rp, rn), study.samples)
-        .map_err(|e| e.in_run("reference run"))?;
+    let reference = run(rp, rn).map_err(|e| e.in_run("reference run"))?;
     progress(&format!(
         "reference p = {rp}, n = {rn}: {:.2} s",
         reference.wall
@@ -71,8 +81,7 @@ pub fn convergence_study(
     let mut rows = Vec::new();
     for &p in &study.degrees {
         for &n in study.points.iter().filter(|&&n| n > p) {
-            let run = sample_run(text, path, &overrides(p, n), study.samples)
-                .map_err(|e| e.in_run(format!("run with p = {p}, n = {n}")))?;
+            let run = run(p, n).map_err(|e| e.in_run(format!("run with p = {p}, n = {n}")))?;
             let error = relative_error(&run.grid, &reference.grid);
             progress(&format!(
                 "p = {p}, n = {n}: error {error:.3e}, {:.2} s",

@@ -8,7 +8,9 @@
 //!
 //! * [`fit`]: the relative error of a sampled displacement field and the least-squares slope of a log–log
 //!   relation (observed orders, growth exponents).
-//! * [`sample`]: one run of a design sampled on a grid of points per patch.
+//! * [`variant`]: the variants of a model a study runs — time stepping and integrator changed on the built
+//!   model, geometry (`p`, `n`, crowns) re-built from the design.
+//! * [`sample`]: one run of a model sampled on a grid of points per patch.
 //! * [`charts`]: the pair of log–log charts error-against-parameter and error-against-wall-time.
 //! * [`convergence`]: error against `p` and `n` (the paper's Fig. conv_circ) and work–precision.
 //! * [`time`]: error against the time step per internal-variable integrator, observed orders.
@@ -19,7 +21,8 @@
 //!
 //! `study` sits above `io` and below `cli`: `… → solver → post → io → study → cli`. It needs `io` for two
 //! things only: re-building a design whose geometry a study varies (the mesh `p`, `n` or a stent's crowns go
-//! through [`crate::io::design`], see [`sample`]) and the chart type its results are drawn in. Everything else
+//! through [`crate::io::design`] in one function, [`variant::rebuild`]) and the chart type its results are drawn
+//! in. Everything else
 //! it takes from the layers below: a built [`crate::model::Model`], the [`crate::solver::Simulation`] that runs
 //! it and the material's point integrators.
 
@@ -29,13 +32,14 @@ pub mod fit;
 pub mod sample;
 pub mod stability;
 pub mod time;
+pub mod variant;
 
 pub use fit::{fit_log_slope, relative_error};
 
 use crate::io::design::DesignError;
-use crate::io::yaml_edit::YamlEditError;
 use crate::material::MaterialError;
 use crate::math::Real;
+use crate::model::ScheduleError;
 use crate::solver::SolverError;
 
 /// Why a study could not be carried out. A run that fails inside a sweep meant to find failures (a time-step
@@ -51,9 +55,9 @@ pub enum StudyError {
     /// A material scenario's constants or its integration were refused.
     #[error(transparent)]
     Material(#[from] MaterialError),
-    /// A design text could not be edited into a variant.
+    /// A schedule a study sets (a temperature history) was refused.
     #[error(transparent)]
-    YamlEdit(#[from] YamlEditError),
+    Schedule(#[from] ScheduleError),
     /// A study setting is out of range.
     #[error("{setting} must be {expected}, got {value}")]
     InvalidSetting {
@@ -63,6 +67,14 @@ pub enum StudyError {
         value: Real,
         /// What it must be.
         expected: &'static str,
+    },
+    /// A variant's time step exceeds its end time.
+    #[error("the time step {step} exceeds the end time {end}")]
+    StepBeyondEnd {
+        /// The step \[time\].
+        step: Real,
+        /// The end time \[time\].
+        end: Real,
     },
     /// One run of a study failed: which one, and why.
     #[error("{run}")]

@@ -1,13 +1,10 @@
-//! One run of a design sampled for a study: the displacement on a grid of equally spaced parameters per patch,
+//! One run of a model sampled for a study: the displacement on a grid of equally spaced parameters per patch,
 //! with the run's wall time and the solver's totals.
 
-use super::StudyError;
-use crate::io::design::{DesignOverrides, parse_design_with};
 use crate::math::{Real, Vec3};
-use crate::model::ProbeLocation;
+use crate::model::{Model, ProbeLocation};
 use crate::solver::simulation::NoObserver;
-use crate::solver::{RunSummary, Simulation};
-use std::path::Path;
+use crate::solver::{RunSummary, Simulation, SolverError};
 use std::time::Instant;
 
 /// A finished run sampled on the study grid.
@@ -23,16 +20,11 @@ pub struct SampledRun {
     pub unknowns: usize,
 }
 
-/// Runs `text` (a design; `path` names it in errors) with `overrides` to its (overridden) end time and samples
-/// the displacement at `samples` equally spaced parameters per patch.
-pub fn sample_run(
-    text: &str,
-    path: &Path,
-    overrides: &DesignOverrides,
-    samples: usize,
-) -> Result<SampledRun, StudyError> {
-    let design = parse_design_with(text, path, overrides)?;
-    let model = &design.model;
+/// Runs `model` to its end time and samples the displacement at `samples` equally spaced parameters per patch.
+///
+/// # Errors
+/// The solver's, when the run fails.
+pub fn sample_run(model: &Model, samples: usize) -> Result<SampledRun, SolverError> {
     let started = Instant::now();
     let mut sim = Simulation::new(model)?;
     let summary = sim.run(&mut NoObserver)?;

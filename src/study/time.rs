@@ -10,15 +10,14 @@
 
 use super::charts::{ErrorChartLabels, ErrorCurve, error_charts};
 use super::fit::{fit_log_slope, relative_error};
-use super::sample::sample_run;
+use super::sample::{SampledRun, sample_run};
+use super::variant::TimeVariant;
 use super::{StudyError, error_chain};
 use crate::io::chart::LineChart;
-use crate::io::design::DesignOverrides;
-use crate::io::design::dto::IntegratorDto;
 use crate::material::Integrator;
 use crate::math::Real;
+use crate::model::Model;
 use std::fmt::Write as _;
-use std::path::Path;
 
 /// Which run the errors of a time-step study are measured against.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -77,19 +76,13 @@ pub struct TimeStudyResult {
     pub orders: Vec<(Integrator, Option<Real>)>,
 }
 
-/// The design-file spelling of an integrator, as an override.
-fn dto(integrator: Integrator) -> IntegratorDto {
-    match integrator {
-        Integrator::Trapezoidal => IntegratorDto::Trapezoidal,
-        Integrator::BackwardEuler => IntegratorDto::BackwardEuler,
-        Integrator::Exponential => IntegratorDto::Exponential,
-    }
-}
-
-/// Runs the study; `progress` is told about each finished run.
+/// Runs the study on variants of `model` ([`TimeVariant`]: end time, step and integrator); `progress` is told
+/// about each finished run. A run that fails is a row with its reason, not an error.
+///
+/// # Errors
+/// A step that is not positive, or a failed reference run.
 pub fn time_study(
-    text: &str,
-    path: &Path,
+    model: &Model,
     study: &TimeStudy,
     mut progress: impl FnMut(&str),
 ) -> Result<TimeStudyResult, StudyError> {
@@ -101,9 +94,12 @@ pub fn time_study(
             expected: "a positive number",
         });
     }
-    let mut reference_overrides = DesignOverrides {
-        end_time: Some(study.time),
-        ..DesignOverrides::default()
+    let run = |variant: &TimeVariant| -> Result<SampledRun, StudyError> {
+        Ok(sample_run(&variant.of(model)?, study.samples)?)
+    };
+    let mut reference_variant = TimeVariant {
+        end: Some(study.time),
+        ..TimeVariant::default()
     };
     let reference = match study.reference {
         TimeReference::Auto | TimeReference::Step(_) => {
@@ -111,14 +107,13 @@ pub fn time_study(
                 TimeReference::Step(h) => (h, "given"),
                 _ => (smallest / 2.0, "the smallest h halved"),
             };
-            reference_overrides.step = Some(h);
-            reference_overrides.integrator = Some(IntegratorDto::Exponential);
+            reference_variant.step = Some(h);
+            reference_variant.integrator = Some(Integrator::Exponential);
             format!("exponential integrator, h = {h:e} ({why})")
         }
         TimeReference::Design => "the design's own time step and integrator".to_string(),
     };
-    let reference_run = sample_run(text, path, &reference_overrides, study.samples)
-        .map_err(|e| e.in_run("reference run"))?;
+    let reference_run = run(&reference_variant).map_err(|e| e.in_run("reference run"))?;
     progress(&format!(
         "reference ({reference}): {} steps, {:.2} s",
         reference_run.summary.steps, reference_run.wall
@@ -126,13 +121,13 @@ pub fn time_study(
     let mut rows = Vec::new();
     for &integrator in &study.integrators {
         for &step in &study.steps {
-            let overrides = DesignOverrides {
-                end_time: Some(study.time),
+            let variant = TimeVariant {
+                end: Some(study.time),
                 step: Some(step),
-                integrator: Some(dto(integrator)),
-                ..DesignOverrides::default()
+                integrator: Some(integrator),
+                ..TimeVariant::default()
             };
-            let row = match sample_run(text, path, &overrides, study.samples) {
+            let row = match run(&variant) {
                 Ok(run) => TimePoint {
                     integrator,
                     step,

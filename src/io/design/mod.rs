@@ -235,6 +235,8 @@ pub struct DesignOverrides {
     pub step: Option<f64>,
     /// Internal-variable update (replaces `material.integrator`).
     pub integrator: Option<dto::IntegratorDto>,
+    /// Crowns of the generated stent (replaces `stent.crowns`); a design without a `stent` block is refused.
+    pub crowns: Option<usize>,
 }
 
 impl DesignOverrides {
@@ -258,6 +260,9 @@ impl DesignOverrides {
         }
         if let Some(i) = self.integrator {
             d.material.integrator = Some(i);
+        }
+        if let (Some(c), Some(stent)) = (self.crowns, d.stent.as_mut()) {
+            stent.crowns = c;
         }
     }
 }
@@ -317,6 +322,16 @@ pub fn parse_design_with(
         }
     })?;
     overrides.apply(&mut dto);
+    if overrides.crowns.is_some() && dto.stent.is_none() {
+        let pos = locator.find("stent");
+        return Err(DesignError::Invalid {
+            file,
+            line: pos.line,
+            column: pos.column,
+            field: "stent.crowns".into(),
+            message: "the crown count is overridden, but the design has no `stent` block".into(),
+        });
+    }
     let stem = path.file_stem().map_or_else(
         || "design".to_string(),
         |s| s.to_string_lossy().into_owned(),

@@ -3,13 +3,11 @@
 //! scenarios that make the maps are in [`super::scenarios`].
 
 use crate::io::chart::{LineChart, Scale, Series};
-use crate::io::design::{DesignOverrides, parse_design_with};
 use crate::math::Real;
-use crate::solver::{NewtonReport, Observer, Simulation, StepReport};
-use crate::study::StudyError;
+use crate::model::Model;
+use crate::solver::{NewtonReport, Observer, Simulation, SolverError, StepReport};
 use std::fmt::Write as _;
 use std::ops::ControlFlow;
-use std::path::Path;
 use std::time::Instant;
 
 /// What one run of a design did, for the solver maps.
@@ -79,15 +77,11 @@ impl Observer for Watch {
     }
 }
 
-/// Runs `text` with `overrides` and records what the solver did; a solver failure is recorded, an invalid
-/// design is an error.
-pub fn newton_run(
-    text: &str,
-    path: &Path,
-    overrides: &DesignOverrides,
-) -> Result<NewtonRun, StudyError> {
-    let design = parse_design_with(text, path, overrides)?;
-    let model = &design.model;
+/// Runs `model` and records what the solver did; a failure of the time stepping is recorded in the result.
+///
+/// # Errors
+/// The solver's when the model cannot be discretised or analysed (before any step).
+pub fn newton_run(model: &Model) -> Result<NewtonRun, SolverError> {
     let started = Instant::now();
     let mut sim = Simulation::new(model)?;
     let mut watch = Watch(NewtonRun {

@@ -1,16 +1,18 @@
 //! The scenarios of the solver maps: the elastic 45° bend in fewer and fewer load steps, the loaded arch heated
 //! faster and faster, and the release snap of a two-crown stent with several steps and release ramps. Each
-//! runs an embedded design ([`designs`]) through [`newton_run`] and presents its map ([`MapReport`]).
+//! varies the model of an embedded design ([`designs`]) — its time stepping ([`TimeVariant`]), its temperature
+//! schedule, and for the stent its crowns and mesh ([`rebuild`]) — runs it through [`newton_run`] and presents
+//! its map ([`MapReport`]).
 
 use super::MapReport;
 use super::newton::{
     SolverMap, SolverPoint, describe, newton_run, solver_chart, solver_csv, solver_summary,
 };
-use crate::io::design::DesignOverrides;
-use crate::io::yaml_edit::{YamlEditError, set_yaml_many};
+use crate::io::design::{Design, parse_design};
 use crate::math::Real;
+use crate::model::TimeFunction;
 use crate::study::StudyError;
-use serde_yaml::Value;
+use crate::study::variant::{Remesh, TimeVariant, rebuild};
 use std::path::Path;
 
 /// The designs the solver maps use, embedded so that the command runs from any folder.
@@ -23,11 +25,17 @@ pub mod designs {
     pub const STRAIGHT_STENT: &str = include_str!("../../../designs/straight_stent.yaml");
 }
 
+/// The embedded design `text`, named `file` in errors and as its default name.
+fn embedded(text: &str, file: &str) -> Result<Design, StudyError> {
+    Ok(parse_design(text, Path::new(file))?)
+}
+
 /// The 45° bend with each number of equal load steps.
 pub fn bend45_map(
     load_steps: &[usize],
     mut progress: impl FnMut(&str),
 ) -> Result<SolverMap, StudyError> {
+    let bend = embedded(designs::BEND45, "bend45.yaml")?.model;
     let mut points = Vec::new();
     for &n in load_steps {
         if n == 0 {
@@ -37,11 +45,12 @@ pub fn bend45_map(
                 expected: "positive",
             });
         }
-        let overrides = DesignOverrides {
+        let model = TimeVariant {
             step: Some(1.0 / n as Real),
-            ..DesignOverrides::default()
-        };
-        let run = newton_run(designs::BEND45, Path::new("bend45.yaml"), &overrides)?;
+            ..TimeVariant::default()
+        }
+        .of(&bend)?;
+        let run = newton_run(&model)?;
         progress(&format!("bend45, {n} load steps: {}", describe(&run)));
         points.push(SolverPoint {
             parameters: vec![n as Real],
@@ -55,6 +64,8 @@ pub fn bend45_map(
     })
 }
 
+/// Temperature of the arch before its heating \[°C\].
+const ARCH_COLD: Real = 31.5;
 /// Temperature change of the arch's heating \[K\] (31.5 → 90 °C).
 const ARCH_HEATING: Real = 58.5;
 /// The arch's load ramp and end time \[s\].
@@ -65,6 +76,7 @@ pub fn heating_map(
     cases: &[(Real, Real)],
     mut progress: impl FnMut(&str),
 ) -> Result<SolverMap, StudyError> {
+    let arch = embedded(designs::ARCH, "circular_arch.yaml")?.model;
     let mut points = Vec::new();
     for &(duration, h) in cases {
         if !(duration > 0.0 && duration <= ARCH_END) {
@@ -75,22 +87,17 @@ pub fn heating_map(
             });
         }
         positive("the time step h [s]", h)?;
-        let mut schedule = vec![vec![0.0, 31.5], vec![duration, 31.5 + ARCH_HEATING]];
+        let mut schedule = vec![(0.0, ARCH_COLD), (duration, ARCH_COLD + ARCH_HEATING)];
         if duration < ARCH_END {
-            schedule.push(vec![ARCH_END, 31.5 + ARCH_HEATING]);
+            schedule.push((ARCH_END, ARCH_COLD + ARCH_HEATING));
         }
-        let text = set_yaml_many(
-            designs::ARCH,
-            &[(
-                &["temperature"],
-                serde_yaml::to_value(schedule).map_err(YamlEditError::from)?,
-            )],
-        )?;
-        let overrides = DesignOverrides {
+        let mut model = TimeVariant {
             step: Some(h),
-            ..DesignOverrides::default()
-        };
-        let run = newton_run(&text, Path::new("circular_arch.yaml"), &overrides)?;
+            ..TimeVariant::default()
+        }
+        .of(&arch)?;
+        model.temperature = TimeFunction::try_table(schedule)?;
+        let run = newton_run(&model)?;
         let per_step = ARCH_HEATING * h.min(duration) / duration;
         progress(&format!(
             "arch heated over {duration} s, h = {h}: ΔT = {per_step:.3} K per step: {}",
@@ -119,25 +126,24 @@ pub fn release_map(
     cases: &[(Real, Real, usize)],
     mut progress: impl FnMut(&str),
 ) -> Result<SolverMap, StudyError> {
+    let stent = embedded(designs::STRAIGHT_STENT, "straight_stent.yaml")?;
     let mut points = Vec::new();
     for &(h, ramp, n) in cases {
         positive("the time step h [s]", h)?;
         positive("the release ramp [s]", ramp)?;
-        let text = set_yaml_many(
-            designs::STRAIGHT_STENT,
-            &[
-                (&["stent", "crowns"], Value::from(2)),
-                (&["time", "release_ramp"], Value::from(ramp)),
-            ],
-        )?;
-        let overrides = DesignOverrides {
-            step: Some(h),
-            end_time: Some(RELEASE_END),
+        let remesh = Remesh {
             degree: Some(release_mesh(n)),
             points: Some(n),
-            ..DesignOverrides::default()
+            crowns: Some(2),
         };
-        let run = newton_run(&text, Path::new("straight_stent.yaml"), &overrides)?;
+        let model = TimeVariant {
+            end: Some(RELEASE_END),
+            step: Some(h),
+            release_ramp: Some(ramp),
+            ..TimeVariant::default()
+        }
+        .of(&rebuild(&stent, &remesh)?)?;
+        let run = newton_run(&model)?;
         let at_release = run
             .failure_times
             .iter()
