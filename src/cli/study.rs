@@ -12,21 +12,6 @@ use crate::study::time::{TimeReference, TimeStudy, time_charts, time_csv, time_s
 use anyhow::Context;
 use std::path::Path;
 
-/// Prints a study's progress line (indented, on stderr: stdout holds the results).
-fn progress(line: &str) {
-    eprintln!("  {line}");
-}
-
-/// Creates the output folder.
-fn create(output: &Path) -> anyhow::Result<()> {
-    std::fs::create_dir_all(output).with_context(|| format!("cannot create {}", output.display()))
-}
-
-/// Writes `text` to `file`.
-fn write(file: &Path, text: &str) -> anyhow::Result<()> {
-    std::fs::write(file, text).with_context(|| format!("cannot write {}", file.display()))
-}
-
 /// `stentkit study convergence`: the `p × n` sweep of `design` against the reference `P,N`, measured at `time`
 /// (default: the design's end time).
 pub fn convergence(
@@ -176,4 +161,19 @@ pub fn stability_maps(output: &Path, maps: &[String]) -> anyhow::Result<()> {
     println!("{summary}");
     println!("→ {}", output.join("stability.md").display());
     Ok(())
+}
+
+/// Prints a study's progress line (indented, on stderr: stdout holds the results).
+fn progress(line: &str) {
+    eprintln!("  {line}");
+}
+
+/// Creates the output folder.
+fn create(output: &Path) -> anyhow::Result<()> {
+    std::fs::create_dir_all(output).with_context(|| format!("cannot create {}", output.display()))
+}
+
+/// Writes `text` to `file`.
+fn write(file: &Path, text: &str) -> anyhow::Result<()> {
+    std::fs::write(file, text).with_context(|| format!("cannot write {}", file.display()))
 }

@@ -121,3 +121,16 @@ pub fn error_chain(error: &(dyn std::error::Error + 'static)) -> String {
     }
     text
 }
+
+/// `value` when it is positive and finite, else the setting's error.
+pub(crate) fn positive(setting: &'static str, value: Real) -> Result<Real, StudyError> {
+    if value > 0.0 && value.is_finite() {
+        Ok(value)
+    } else {
+        Err(StudyError::InvalidSetting {
+            setting,
+            value,
+            expected: "positive and finite",
+        })
+    }
+}

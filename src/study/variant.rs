@@ -6,7 +6,7 @@
 //! from its source ([`rebuild`]) — the one place a study goes back to the design file's layer, to be swapped
 //! for the model builder when it exists.
 
-use super::StudyError;
+use super::{StudyError, positive};
 use crate::io::design::{Design, DesignOverrides, parse_design_with};
 use crate::material::Integrator;
 use crate::math::Real;
@@ -99,19 +99,6 @@ pub fn rebuild(design: &Design, remesh: &Remesh) -> Result<Model, StudyError> {
         ..DesignOverrides::default()
     };
     Ok(parse_design_with(&design.source, &design.path, &overrides)?.model)
-}
-
-/// `value` when it is positive and finite, else the setting's error.
-fn positive(setting: &'static str, value: Real) -> Result<Real, StudyError> {
-    if value > 0.0 && value.is_finite() {
-        Ok(value)
-    } else {
-        Err(StudyError::InvalidSetting {
-            setting,
-            value,
-            expected: "positive and finite",
-        })
-    }
 }
 
 #[cfg(test)]

@@ -40,6 +40,14 @@ pub const NOISE_FLOOR: Real = 1e-12;
 /// drawn at this floor.
 pub const CHART_FLOOR: Real = 1e-17;
 
+/// Equal parts per step of the reduced-time quadrature of [`exact_branch_stress`] (5-point Gauss–Legendre on
+/// each): 32 times a run's default two, so that the reference's own quadrature error is far below the
+/// integrators' deviations it measures.
+pub const REFERENCE_SUBINTERVALS: NonZeroUsize = match NonZeroUsize::new(64) {
+    Some(n) => n,
+    None => NonZeroUsize::MIN,
+};
+
 /// The material scenarios.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum MaterialScenario {
@@ -90,9 +98,6 @@ pub fn material_map(ratios: &[Real]) -> Result<Vec<MaterialPoint>, StudyError> {
     }
     Ok(rows)
 }
-
-/// A temperature history \[°C\] as a function of time.
-type TemperatureHistory = Box<dyn Fn(Real) -> Real>;
 
 /// One run of the material map.
 pub fn material_point(
@@ -176,14 +181,6 @@ pub fn material_point(
         last_exact: exact.last().copied().unwrap_or(0.0),
     })
 }
-
-/// Equal parts per step of the reduced-time quadrature of [`exact_branch_stress`] (5-point Gauss–Legendre on
-/// each): 32 times a run's default two, so that the reference's own quadrature error is far below the
-/// integrators' deviations it measures.
-pub const REFERENCE_SUBINTERVALS: NonZeroUsize = match NonZeroUsize::new(64) {
-    Some(n) => n,
-    None => NonZeroUsize::MIN,
-};
 
 /// The exact branch stress over `E₁ Δε` of one Maxwell branch (relaxation time `tau_g` at the glass
 /// transition \[time\], shifted by `material`'s WLF law) under a strain held from `t = times[0]`, at every
@@ -322,3 +319,6 @@ pub fn material_summary(rows: &[MaterialPoint]) -> String {
     );
     s
 }
+
+/// A temperature history \[°C\] as a function of time.
+type TemperatureHistory = Box<dyn Fn(Real) -> Real>;

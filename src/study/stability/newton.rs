@@ -56,25 +56,24 @@ impl NewtonRun {
     }
 }
 
-/// Counts what the solver does step by step.
-struct Watch(NewtonRun);
+/// One point of a solver map: its parameters (named) and the run.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SolverPoint {
+    /// Parameter values, in the map's column order.
+    pub parameters: Vec<Real>,
+    /// The run.
+    pub run: NewtonRun,
+}
 
-impl Observer for Watch {
-    fn step(&mut self, _: &Simulation<'_>, report: &StepReport) -> ControlFlow<()> {
-        let r = &mut self.0;
-        r.steps += 1;
-        r.iterations += report.newton.iterations;
-        r.max_step_iterations = r.max_step_iterations.max(report.newton.iterations);
-        r.smallest_step = r.smallest_step.min(report.dt);
-        r.time = report.time;
-        ControlFlow::Continue(())
-    }
-
-    fn step_failed(&mut self, time: Real, dt: Real, _: &NewtonReport) {
-        self.0.failed_attempts += 1;
-        self.0.failure_times.push(time);
-        self.0.smallest_step = self.0.smallest_step.min(dt);
-    }
+/// A solver map: its name, parameter column names and points.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SolverMap {
+    /// Map name (file stem).
+    pub name: &'static str,
+    /// Names of the parameter columns (with units).
+    pub columns: Vec<&'static str>,
+    /// The runs.
+    pub points: Vec<SolverPoint>,
 }
 
 /// Runs `model` and records what the solver did; a failure of the time stepping is recorded in the result.
@@ -105,26 +104,6 @@ pub fn newton_run(model: &Model) -> Result<NewtonRun, SolverError> {
         }
     }
     Ok(run)
-}
-
-/// One point of a solver map: its parameters (named) and the run.
-#[derive(Debug, Clone, PartialEq)]
-pub struct SolverPoint {
-    /// Parameter values, in the map's column order.
-    pub parameters: Vec<Real>,
-    /// The run.
-    pub run: NewtonRun,
-}
-
-/// A solver map: its name, parameter column names and points.
-#[derive(Debug, Clone, PartialEq)]
-pub struct SolverMap {
-    /// Map name (file stem).
-    pub name: &'static str,
-    /// Names of the parameter columns (with units).
-    pub columns: Vec<&'static str>,
-    /// The runs.
-    pub points: Vec<SolverPoint>,
 }
 
 /// One line about a run.
@@ -276,4 +255,25 @@ pub fn solver_summary(
     }
     s.push('\n');
     s
+}
+
+/// Counts what the solver does step by step.
+struct Watch(NewtonRun);
+
+impl Observer for Watch {
+    fn step(&mut self, _: &Simulation<'_>, report: &StepReport) -> ControlFlow<()> {
+        let r = &mut self.0;
+        r.steps += 1;
+        r.iterations += report.newton.iterations;
+        r.max_step_iterations = r.max_step_iterations.max(report.newton.iterations);
+        r.smallest_step = r.smallest_step.min(report.dt);
+        r.time = report.time;
+        ControlFlow::Continue(())
+    }
+
+    fn step_failed(&mut self, time: Real, dt: Real, _: &NewtonReport) {
+        self.0.failed_attempts += 1;
+        self.0.failure_times.push(time);
+        self.0.smallest_step = self.0.smallest_step.min(dt);
+    }
 }

@@ -11,8 +11,8 @@ use super::newton::{
 use crate::io::design::{Design, parse_design};
 use crate::math::Real;
 use crate::model::TimeFunction;
-use crate::study::StudyError;
 use crate::study::variant::{Remesh, TimeVariant, rebuild};
+use crate::study::{StudyError, positive};
 use std::path::Path;
 
 /// The designs the solver maps use, embedded so that the command runs from any folder.
@@ -23,11 +23,6 @@ pub mod designs {
     pub const ARCH: &str = include_str!("../../../designs/circular_arch.yaml");
     /// designs/straight_stent.yaml.
     pub const STRAIGHT_STENT: &str = include_str!("../../../designs/straight_stent.yaml");
-}
-
-/// The embedded design `text`, named `file` in errors and as its default name.
-fn embedded(text: &str, file: &str) -> Result<Design, StudyError> {
-    Ok(parse_design(text, Path::new(file))?)
 }
 
 /// The 45° bend with each number of equal load steps.
@@ -264,15 +259,7 @@ pub fn release_report(map: &SolverMap) -> MapReport {
     }
 }
 
-/// `Ok` when `value` is positive, else the setting's error.
-fn positive(setting: &'static str, value: Real) -> Result<(), StudyError> {
-    if value > 0.0 {
-        Ok(())
-    } else {
-        Err(StudyError::InvalidSetting {
-            setting,
-            value,
-            expected: "positive",
-        })
-    }
+/// The embedded design `text`, named `file` in errors and as its default name.
+fn embedded(text: &str, file: &str) -> Result<Design, StudyError> {
+    Ok(parse_design(text, Path::new(file))?)
 }
