@@ -1,0 +1,157 @@
+//! The analytic centreline of a generated patch — a crown wire or a bridge — in local coordinates placed on the
+//! axis (see the module documentation of [`super`] for the formulas), with its closed-form derivative.
+
+use super::CrownSpec;
+use super::axis::Axis;
+use crate::geometry::analytic::ParametricCurve;
+use crate::math::{Real, Vec3};
+use std::f64::consts::TAU;
+use std::sync::Arc;
+
+/// The local shape of a bridge across the axis.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(super) enum Offset {
+    None,
+    Circumferential { amplitude: Real, waves: Real },
+    Radial { amplitude: Real, waves: Real },
+}
+
+/// Which patch a [`StentCurve`] draws, with its angles and stations.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(super) enum CurveKind {
+    /// A crown wire from `from` to `to` (angles) at station `station`, crest at `phase`.
+    Crown {
+        station: Real,
+        phase: Real,
+        from: Real,
+        to: Real,
+    },
+    /// A bridge from station `from` to `to` at angle `angle`.
+    Bridge {
+        from: Real,
+        to: Real,
+        angle: Real,
+        offset: Offset,
+    },
+}
+
+/// The analytic centreline of a generated patch, `u ∈ [0, 1]` (see the module documentation for the formulas).
+#[derive(Debug, Clone)]
+pub struct StentCurve {
+    axis: Arc<Axis>,
+    radius: Real,
+    amplitude: Real,
+    peaks: Real,
+    kind: CurveKind,
+}
+
+impl StentCurve {
+    /// The curve `kind` of a device with crowns `crown` placed on `axis`.
+    pub(super) fn new(axis: &Arc<Axis>, crown: &CrownSpec, kind: CurveKind) -> Self {
+        Self {
+            axis: axis.clone(),
+            radius: crown.radius,
+            amplitude: crown.amplitude,
+            peaks: crown.peaks as Real,
+            kind,
+        }
+    }
+
+    /// The end points when the curve is an exact straight segment (a straight bridge on a straight
+    /// centreline), else `None`.
+    pub(super) fn straight_segment(&self) -> Option<(Vec3, Vec3)> {
+        match (&self.kind, self.axis.as_ref()) {
+            (
+                CurveKind::Bridge {
+                    offset: Offset::None,
+                    ..
+                },
+                Axis::Straight { .. },
+            ) => Some((self.point(0.0), self.point(1.0))),
+            _ => None,
+        }
+    }
+
+    /// Local coordinates `(x, r cos ϑ, r sin ϑ)`, their derivative in the curve parameter, the station and
+    /// its derivative.
+    fn local(&self, t: Real) -> (Vec3, Vec3, Real, Real) {
+        let (h, m, big_r) = (self.amplitude, self.peaks, self.radius);
+        match self.kind {
+            CurveKind::Crown {
+                station,
+                phase,
+                from,
+                to,
+            } => {
+                let a = from * (1.0 - t) + to * t;
+                let da = to - from;
+                let (sa, ca) = a.sin_cos();
+                let arg = m * (a - phase);
+                let p = Vec3::new(h * arg.cos(), big_r * ca, big_r * sa);
+                let dp = Vec3::new(-h * m * arg.sin(), -big_r * sa, big_r * ca) * da;
+                (p, dp, station, 0.0)
+            }
+            CurveKind::Bridge {
+                from,
+                to,
+                angle,
+                offset,
+            } => {
+                let sigma = from * (1.0 - t) + to * t;
+                let dsigma = to - from;
+                let x = h * (1.0 - 2.0 * t);
+                let dx = -2.0 * h;
+                let wave = |amplitude: Real, waves: Real| {
+                    let k = TAU * waves;
+                    (amplitude * (k * t).sin(), amplitude * k * (k * t).cos())
+                };
+                let (r, dr, a, da) = match offset {
+                    Offset::None => (big_r, 0.0, angle, 0.0),
+                    Offset::Circumferential { amplitude, waves } => {
+                        let (d, dd) = wave(amplitude, waves);
+                        (big_r, 0.0, angle + d / big_r, dd / big_r)
+                    }
+                    Offset::Radial { amplitude, waves } => {
+                        let (d, dd) = wave(amplitude, waves);
+                        (big_r + d, dd, angle, 0.0)
+                    }
+                };
+                let (sa, ca) = a.sin_cos();
+                let p = Vec3::new(x, r * ca, r * sa);
+                let dp = Vec3::new(dx, dr * ca - r * sa * da, dr * sa + r * ca * da);
+                (p, dp, sigma, dsigma)
+            }
+        }
+    }
+}
+
+impl ParametricCurve for StentCurve {
+    fn domain(&self) -> (Real, Real) {
+        (0.0, 1.0)
+    }
+
+    fn point(&self, t: Real) -> Vec3 {
+        let (p, _, s, _) = self.local(t);
+        let (c, r) = self.axis.frame(s);
+        c + r * p
+    }
+
+    fn derivative(&self, t: Real) -> Vec3 {
+        let (p, dp, s, ds) = self.local(t);
+        let (_, r) = self.axis.frame(s);
+        if ds == 0.0 {
+            return r * dp;
+        }
+        match self.axis.frame_derivative(s) {
+            Some((dc, drot)) => (dc + drot * p) * ds + r * dp,
+            None => {
+                // Fourth-order central difference, as the trait's default (the point-list frame has no closed
+                // form); the centreline continues straight beyond its ends, so the stencil stays valid there.
+                let h = 1e-3;
+                (self.point(t - 2.0 * h) - self.point(t + 2.0 * h)
+                    + (self.point(t + h) - self.point(t - h)) * 8.0)
+                    / (12.0 * h)
+            }
+        }
+    }
+}
