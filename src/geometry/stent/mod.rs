@@ -89,7 +89,7 @@ use std::collections::BTreeMap;
 use std::f64::consts::TAU;
 use std::sync::Arc;
 
-/// Tolerance on angles [rad] when testing whether a node lies on a symmetry plane, whether crests face
+/// Tolerance on angles \[rad\] when testing whether a node lies on a symmetry plane, whether crests face
 /// troughs and whether `m α` is a multiple of π. Angles are built from the design's numbers by a few
 /// operations, so they carry ~1e-15 rad of round-off; a rotation typed in degrees with ten significant digits is
 /// still recognised.
@@ -101,9 +101,9 @@ pub const PLANARITY_TOLERANCE: Real = 1e-9;
 /// The sinusoidal ring repeated along the device.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct CrownSpec {
-    /// Radius `R` of the cylinder the crown lies on [length], > 0.
+    /// Radius `R` of the cylinder the crown lies on \[length\], > 0.
     pub radius: Real,
-    /// Amplitude `h_c` (half the crown height `2 h_c`) [length], > 0.
+    /// Amplitude `h_c` (half the crown height `2 h_c`) \[length\], > 0.
     pub amplitude: Real,
     /// Number of peaks (crests) `m` per crown, ≥ 1.
     pub peaks: usize,
@@ -125,7 +125,7 @@ pub enum BridgeShape {
     Straight,
     /// A sine of the given amplitude and number of waves over the bridge.
     Sinusoidal {
-        /// Amplitude `h_b` [length], > 0.
+        /// Amplitude `h_b` \[length\], > 0.
         amplitude: Real,
         /// Waves over the bridge `w` [-], a positive multiple of 1/2 (so that the sine vanishes at both ends).
         waves: Real,
@@ -165,7 +165,7 @@ pub enum CentrelineSpec {
         start: Vec3,
         /// Rotation axis.
         axis: Vec3,
-        /// Swept angle [rad], `0 < |angle| ≤ 2π`.
+        /// Swept angle \[rad\], `0 < |angle| ≤ 2π`.
         angle: Real,
         /// Direction of `ϑ = 0` at the start; `None` = outward from the centre (the extrados).
         reference: Option<Vec3>,
@@ -208,10 +208,10 @@ pub struct StentSpec {
     pub crown: CrownSpec,
     /// Number of crowns `N`, ≥ 1.
     pub crowns: usize,
-    /// Crown spacing `d_c` along the centreline [length]; required on a straight centreline, optional
+    /// Crown spacing `d_c` along the centreline \[length\]; required on a straight centreline, optional
     /// otherwise (crowns spread over the whole centreline).
     pub spacing: Option<Real>,
-    /// Rotation `α` of each crown about the axis relative to the previous one [rad].
+    /// Rotation `α` of each crown about the axis relative to the previous one \[rad\].
     pub rotation: Real,
     /// Bridges between consecutive crowns; `None` = unconnected crowns.
     pub bridges: Option<BridgeSpec>,
@@ -228,7 +228,7 @@ pub struct StentSpec {
 pub struct TemporarySpec {
     /// The temporary centreline.
     pub centreline: TemporaryCentreline,
-    /// Crown radius in the temporary shape [length]; `None` keeps `R`.
+    /// Crown radius in the temporary shape \[length\]; `None` keeps `R`.
     pub radius: Option<Real>,
 }
 
@@ -318,7 +318,7 @@ pub struct GeneratedNode {
     /// Name `c<k>_n<i>`: crown `k` (1-based), node `i` counted from 1 at the first node at or after `ϑ = 0`
     /// by increasing angle (for symmetric devices node `i` is at `ϑ = (i − 1) π/m`).
     pub name: String,
-    /// Exact position [length].
+    /// Exact position \[length\].
     pub position: Vec3,
     /// The patch ends joined here.
     pub ends: Vec<(usize, WireEnd)>,
@@ -328,9 +328,9 @@ pub struct GeneratedNode {
     pub index: usize,
     /// Crest or trough.
     pub kind: NodeKind,
-    /// Angle `ϑ` in the crown's section plane [rad].
+    /// Angle `ϑ` in the crown's section plane \[rad\].
     pub angle: Real,
-    /// Station `s_k` of the crown [length].
+    /// Station `s_k` of the crown \[length\].
     pub station: Real,
     /// Centreline point `c_stent(s_k)`.
     pub axis_point: Vec3,
@@ -365,7 +365,7 @@ pub struct StentGeometry {
     pub node_sets: BTreeMap<String, Vec<usize>>,
     /// The cut planes (empty for a full model).
     pub symmetry_planes: Vec<SymmetryPlane>,
-    /// Station `s_k` of every crown [length].
+    /// Station `s_k` of every crown \[length\].
     pub stations: Vec<Real>,
 }
 
