@@ -1,6 +1,6 @@
 //! `stentkit check`: validate a design and describe what a run would solve.
 
-use crate::io::design::build::{MEMORY_LIMIT_BYTES, human_bytes};
+use crate::io::design::size::{MEMORY_LIMIT_BYTES, human_bytes};
 use crate::io::design::{Design, load_design};
 use crate::io::estimate::estimated_disk;
 use crate::model::Component;

@@ -20,7 +20,7 @@
 
 use super::signals;
 use super::{BadInput, Interrupted, error_text, short_time};
-use crate::io::design::build::human_bytes;
+use crate::io::design::size::human_bytes;
 use crate::io::design::{Design, load_design};
 use crate::io::history::HistoryWriter;
 use crate::io::mcap::{McapRecorder, RunInfo};

@@ -2,12 +2,15 @@
 //! patch ends, boundary conditions and loads per node in a local basis, distributed loads, the temperature
 //! schedule, time and solver settings, and named probes.
 //!
-//! A [`Model`] is built and validated by the `io` layer from a design file (or by hand in tests); it holds no
-//! file names or YAML positions. Every physical field is in the design's consistent unit system
+//! A [`Model`] is built and validated by [`builder::ModelBuilder`] (in Rust, or from a design file by the `io`
+//! layer, which translates YAML into builder calls); [`stent`] puts a generated stent and its programme into it.
+//! It holds no file names or YAML positions. Every physical field is in the design's consistent unit system
 //! ([`Units`]); temperatures are in °C.
 
+pub mod builder;
 pub mod programme;
 pub mod schedule;
+pub mod stent;
 
 pub use programme::{DrivenNode, Programme, ProgrammeError, ProgrammeKind};
 pub use schedule::{ScheduleError, TimeFunction};

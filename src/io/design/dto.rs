@@ -211,7 +211,7 @@ impl<'de> Visitor<'de> for ComponentVisitor {
         } else {
             Err(E::custom(format!(
                 "{} is not a component value; allowed: free, null, a number or a table [[t, v], …]",
-                super::quote::quoted(v)
+                crate::math::quote::quoted(v)
             )))
         }
     }
