@@ -2,7 +2,6 @@
 //! the file's line and column), shared by the builder of plain designs ([`super::build`]) and of stents
 //! ([`super::stent`]).
 
-
 /// A problem found while building the model, at a field path.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Issue {
