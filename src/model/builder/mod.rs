@@ -820,3 +820,173 @@ fn check_solver(s: &SolverSettings) -> Result<()> {
     }
     Ok(())
 }
+
+#[cfg(test)]
+mod tests {
+    //! Each check of the builder reports the field it is about; the positions of the design-file layer rest on
+    //! these fields (tests/data/bad_designs checks them end to end, with line and column).
+    use super::*;
+    use crate::material::{CircularSection, Prony};
+
+    fn elastic() -> ModelBuilder {
+        let material = Material::try_new(Prony::try_new(1e7, vec![]).expect("E > 0"), 0.3, None)
+            .expect("ν = 0.3");
+        let section = CircularSection::try_new(0.01).expect("d > 0").into();
+        let mut b = ModelBuilder::new("frame", material, Integrator::Trapezoidal, section);
+        let line = |from: Vec3, to: Vec3| PatchShape::Line { from, to };
+        b.patch("beam", line(Vec3::zeros(), Vec3::x()), 3, 6);
+        b.patch("post", line(Vec3::x(), Vec3::new(1.0, 1.0, 0.0)), 3, 6);
+        b.condition(ConditionSpec::clamp("beam.start"));
+        b
+    }
+
+    #[track_caller]
+    fn field_of(b: &ModelBuilder) -> Field {
+        b.build().expect_err("refused").field
+    }
+
+    #[test]
+    fn a_good_frame_builds_with_its_ends_joined_by_coincidence() {
+        let mut b = elastic();
+        b.node("knee", NodeEnds::At(Vec3::x()));
+        let model = b.build().expect("valid").model;
+        // beam.start (clamped), knee (beam.end + post.start), post.end.
+        assert_eq!(model.nodes.len(), 3);
+        assert_eq!(model.nodes[0].name, "knee");
+        assert_eq!(model.nodes[0].ends.len(), 2);
+        assert!(b.validate().is_ok());
+    }
+
+    #[test]
+    fn errors_name_the_input_they_are_about() {
+        let mut b = elastic();
+        b.node(
+            "knee",
+            NodeEnds::Named(vec!["beam.end".into(), "post.end".into()]),
+        );
+        assert_eq!(
+            field_of(&b),
+            Field::Node {
+                index: 0,
+                field: NodeField::End(1)
+            },
+            "post.end is 1 away from beam.end"
+        );
+
+        let mut b = elastic();
+        b.condition(ConditionSpec::at("nowhere"));
+        assert_eq!(
+            field_of(&b),
+            Field::Condition {
+                index: 1,
+                field: ConditionField::Node
+            }
+        );
+
+        let mut b = elastic();
+        b.condition(ConditionSpec::at("beam.start").with_displacement(1, TimeFunction::zero()));
+        assert_eq!(
+            field_of(&b),
+            Field::Condition {
+                index: 1,
+                field: ConditionField::Displacement(1)
+            },
+            "u2 of beam.start is already clamped"
+        );
+
+        let mut b = elastic();
+        b.condition(
+            ConditionSpec::at("post.end")
+                .with_displacement(0, TimeFunction::zero())
+                .with_force(0, TimeFunction::constant(1.0)),
+        );
+        assert_eq!(
+            field_of(&b),
+            Field::Condition {
+                index: 1,
+                field: ConditionField::Force(0)
+            },
+            "prescribed and loaded without a release"
+        );
+
+        let mut b = elastic();
+        b.patch(
+            "hook",
+            PatchShape::Arc {
+                centre: Vec3::zeros(),
+                start: Vec3::y(),
+                axis: Vec3::z(),
+                angle: 3.0,
+            },
+            3,
+            6,
+        );
+        assert_eq!(
+            field_of(&b),
+            Field::Patch {
+                index: 2,
+                field: PatchField::Angle
+            },
+            "172° is more than one patch holds"
+        );
+
+        let mut b = elastic();
+        b.patch(
+            "bad.name",
+            PatchShape::Line {
+                from: Vec3::zeros(),
+                to: Vec3::y(),
+            },
+            3,
+            6,
+        );
+        assert_eq!(
+            field_of(&b),
+            Field::Patch {
+                index: 2,
+                field: PatchField::Name
+            }
+        );
+
+        let mut b = elastic();
+        b.patch(
+            "stub",
+            PatchShape::Line {
+                from: Vec3::zeros(),
+                to: Vec3::y(),
+            },
+            3,
+            3,
+        );
+        assert_eq!(
+            field_of(&b),
+            Field::Patch {
+                index: 2,
+                field: PatchField::ControlPoints
+            }
+        );
+
+        let mut b = elastic();
+        b.time(TimeSpec::new(1.0, 2.0));
+        assert_eq!(field_of(&b), Field::Time(TimeField::Step));
+
+        let mut b = elastic();
+        b.probe("tip", ProbeAt::Patch("post".into(), 1.5));
+        assert_eq!(
+            field_of(&b),
+            Field::Probe {
+                index: 0,
+                field: ProbeField::U
+            }
+        );
+
+        let mut b = elastic();
+        b.programme(ProgrammeSpec {
+            target: stent_model::ProgrammeTarget::RadialContraction { delta_r: 1.0 },
+            node_set: "all_joints".into(),
+            ramp: (0.0, 1.0),
+            release: None,
+        });
+        assert_eq!(field_of(&b), Field::Programme(ProgrammeField::Whole));
+    }
+}
