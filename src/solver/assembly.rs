@@ -747,15 +747,21 @@ pub fn point_position(disc: &Discretisation, control: &[Vec3], g: usize) -> Vec3
         .sum()
 }
 
-/// Arc length of a curve by 5-point Gauss–Legendre on each knot span, subdivided 8 times (round-off accurate
-/// for the smooth analysis splines; used only for residual scales).
+/// Parts of each knot span in [`curve_length`]'s quadrature: 5-point Gauss–Legendre is exact for polynomials of
+/// degree 9, and eight parts of a span of a smooth analysis spline bring the speed `|c'(u)|` (not a polynomial)
+/// within round-off; the length only scales residuals, so any accuracy near that is enough.
+const LENGTH_PARTS_PER_SPAN: usize = 8;
+
+/// Arc length of a curve by 5-point Gauss–Legendre on [`LENGTH_PARTS_PER_SPAN`] parts of each knot span (used
+/// only for residual scales).
 fn curve_length(curve: &crate::math::NurbsCurve) -> Real {
     let breaks = curve.knots().breakpoints();
+    let parts = LENGTH_PARTS_PER_SPAN as Real;
     let mut total = 0.0;
     for w in breaks.windows(2) {
-        for k in 0..8 {
-            let a = w[0] + (w[1] - w[0]) * k as Real / 8.0;
-            let b = w[0] + (w[1] - w[0]) * (k + 1) as Real / 8.0;
+        for k in 0..LENGTH_PARTS_PER_SPAN {
+            let a = w[0] + (w[1] - w[0]) * k as Real / parts;
+            let b = w[0] + (w[1] - w[0]) * (k + 1) as Real / parts;
             total += crate::geometry::analytic::gauss_legendre_5(a, b, |u| {
                 curve.derivatives(u, 1)[1].norm()
             });

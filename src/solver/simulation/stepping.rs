@@ -15,6 +15,11 @@ use crate::solver::state::State;
 /// taking (at `t = 1e3` s, 4 ulps are 5e-13 s).
 pub const STEP_ROUND_OFF_ULPS: Real = 4.0;
 
+/// A failed step is retried with its size divided by this factor (down to `time.min_step`); after a converged
+/// step a cut step size grows back by it (up to `time.step`). Halving and doubling keep the sizes on the grid
+/// `time.step / 2^k`, so a run of cut steps lands on the nominal grid again.
+pub const STEP_FACTOR: Real = 2.0;
+
 /// Unit in the last place of `x`: the gap from `|x|` to the next larger float.
 fn ulp(x: Real) -> Real {
     let x = x.abs();
@@ -31,7 +36,7 @@ fn is_smallest_step(dt: Real, min_step: Real, target: Real) -> bool {
 /// and `min_step` exactly when half of it is `min_step` up to rounding (so the next attempt is recognised as
 /// the smallest by [`is_smallest_step`]).
 fn halved_step(dt: Real, min_step: Real, target: Real) -> Real {
-    let half = dt / 2.0;
+    let half = dt / STEP_FACTOR;
     if is_smallest_step(half, min_step, target) {
         min_step
     } else {
@@ -156,7 +161,7 @@ impl Simulation<'_> {
                     };
                     cuts = 0;
                     if h < nominal {
-                        h = (2.0 * h).min(nominal);
+                        h = (STEP_FACTOR * h).min(nominal);
                     }
                     if observer.step(self, &report).is_break() {
                         summary.stopped = true;
