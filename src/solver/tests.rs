@@ -5,6 +5,7 @@ use super::assembly::{Actions, Assembler, Linearisation, Sink, StepMaterial};
 use super::discretisation::Discretisation;
 use super::state::State;
 use crate::io::design::parse_design;
+use crate::material::{ConstitutiveLaw, SectionLaw};
 use crate::math::Real;
 use crate::model::Model;
 use std::path::Path;
@@ -115,10 +116,15 @@ fn tangent_matches_central_differences_of_the_residual() {
     let disc = Discretisation::new(&model).expect("discretisation");
     let asm = Assembler::new(&model, &disc);
     let actions = Actions::at(&model, 1.0, &[]);
-    let material = StepMaterial {
-        modulus: model.material.prony().e_inf(),
-        history: &[],
-    };
+    let laws: Vec<SectionLaw> = disc
+        .points
+        .iter()
+        .map(|p| {
+            let law = &model.materials[model.patches[p.patch].material];
+            law.section_law(&law.new_state(vec![disc.shapes[p.shape]]), 0)
+        })
+        .collect();
+    let material = StepMaterial { laws: &laws };
     let n = disc.num_unknowns();
     // A deformed state: a smooth finite increment (translations ~5 % of the size, rotations ~0.3 rad).
     let mut state = State::reference(&disc);

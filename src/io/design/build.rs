@@ -183,8 +183,10 @@ pub fn build(dto: &DesignDto, default_name: &str) -> Result<Built> {
     let model = Model {
         name,
         units,
-        material,
-        integrator,
+        // The design's one material, used by every patch (`Patch::material` 0).
+        materials: vec![crate::material::MaterialLaw::from_material(
+            material, integrator,
+        )],
         sections,
         patches,
         nodes,
@@ -967,6 +969,7 @@ fn patches(
             curve,
             normal_hint: pd.normal.as_ref().map(vec3),
             section,
+            material: 0,
             fit_error,
         });
     }

@@ -334,6 +334,7 @@ pub fn generate(
             curve,
             normal_hint: Some(g.normal_hint),
             section,
+            material: 0,
             fit_error,
         });
     }

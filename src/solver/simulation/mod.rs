@@ -55,9 +55,9 @@ use super::discretisation::Discretisation;
 use super::gauge::Gauge;
 use super::linear::LinearSystem;
 use super::state::State;
-use crate::material::{BranchHistory, SectionStrains, SectionStress, StepCoefficients};
 use crate::math::{Real, Vec3};
 use crate::model::{Model, ProbeLocation};
+use constitutive::PointMaterials;
 
 /// The increment norm's length of a patch whose ends coincide (a closed loop) is its chord floored at this
 /// fraction of the model size: a translation increment is measured against a length of the order of the
@@ -78,20 +78,10 @@ pub struct Simulation<'m> {
     delta: Vec<Real>,
     /// Length of the patch of each control point, for increment norms.
     control_length: Vec<Real>,
-    /// Converged total strains per collocation point at the current time.
-    strain_n: Vec<SectionStrains>,
-    /// Maxwell-branch strains per collocation point and branch at the current time.
-    branches: BranchHistory,
-    /// Internal-variable update coefficients of the step being solved (or last solved).
-    coeffs: StepCoefficients,
-    /// Effective modulus `Ē` of that step [stress].
-    modulus: Real,
-    /// History stresses `[H_N, H_N,s, H_M, H_M,s]` per collocation point for that step.
-    history: Vec<SectionStress>,
+    /// Every material's points and internal variables, and every point's section law for the step being solved.
+    materials: PointMaterials,
     /// Messages for the user, each said once (e.g. the WLF freeze).
     notices: Vec<String>,
-    /// Whether the WLF freeze has been reported.
-    freeze_reported: bool,
     /// Per node and local component: the release ramp, once the component has been released.
     ramps: Vec<[Option<ReleaseRamp>; 6]>,
     /// Gauge constraints after a programme's release, with their extended system and entry values.
@@ -145,14 +135,13 @@ impl<'m> Simulation<'m> {
         let mut pattern = Vec::new();
         let mut lin = Linearisation::default();
         let actions = Actions::at(model, 0.0, &[]);
-        let material = StepMaterial {
-            modulus: model.material.prony().e_inf(),
-            history: &[],
-        };
+        let materials = PointMaterials::new(model, &disc);
         assembler.assemble(
             &disc,
             &state,
-            material,
+            StepMaterial {
+                laws: &materials.laws,
+            },
             &actions,
             None,
             &mut lin,
@@ -178,8 +167,6 @@ impl<'m> Simulation<'m> {
             })
             .collect();
         let n = disc.num_unknowns();
-        let points = disc.points.len();
-        let branches = BranchHistory::new(points, model.material.num_branches());
         Ok(Self {
             model,
             disc,
@@ -192,13 +179,8 @@ impl<'m> Simulation<'m> {
             values,
             delta: vec![0.0; n],
             control_length,
-            strain_n: vec![SectionStrains::default(); points],
-            branches,
-            coeffs: StepCoefficients::identity(model.material.num_branches()),
-            modulus: model.material.prony().e_inf(),
-            history: vec![SectionStress::default(); points],
+            materials,
             notices: Vec::new(),
-            freeze_reported: false,
             ramps: vec![[None; 6]; model.nodes.len()],
             gauge: None,
             gauge_active: false,

@@ -180,8 +180,7 @@ impl Simulation<'_> {
     ) -> Result<Real, SolverError> {
         let start = Instant::now();
         let material = StepMaterial {
-            modulus: self.modulus,
-            history: &self.history,
+            laws: &self.materials.laws,
         };
         let (gauge, values) = match (&mut self.gauge, self.gauge_active) {
             (Some((g, _, v)), true) => (Some(&*g), v),

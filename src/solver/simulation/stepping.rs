@@ -3,7 +3,6 @@
 
 use super::newton::{NewtonFailure, round_off_notice};
 use super::{Observer, RunSummary, Simulation, StepReport};
-use crate::material::{SectionStress, StepCoefficients};
 use crate::math::Real;
 use crate::solver::SolverError;
 use crate::solver::state::State;
@@ -49,8 +48,6 @@ fn halved_step(dt: Real, min_step: Real, target: Real) -> Real {
 struct StepStart {
     /// The last converged state.
     state: State,
-    /// The constitutive data `(Ē, coefficients, history stresses)` of the last solved step.
-    material: (Real, StepCoefficients, Vec<SectionStress>),
     /// Whether the gauge constraints were active.
     gauge_active: bool,
 }
@@ -203,18 +200,17 @@ impl Simulation<'_> {
     fn step_start(&self) -> StepStart {
         StepStart {
             state: self.state.clone(),
-            material: (self.modulus, self.coeffs.clone(), self.history.clone()),
             gauge_active: self.gauge_active,
         }
     }
 
-    /// Undoes a step that failed or was interrupted: restores the last converged state and the constitutive
-    /// data and gauge activation of the last solved step, forgets the release reactions `captured` for it, and
-    /// invalidates the factorisations, which belong to the abandoned iterates. (The internal variables are
-    /// only advanced by a converged step, in `commit_step`.)
+    /// Undoes a step that failed or was interrupted: restores the last converged state, the materials' data of
+    /// the last converged step ([`crate::material::ConstitutiveLaw::roll_back`]) and the gauge activation,
+    /// forgets the release reactions `captured` for it, and invalidates the factorisations, which belong to the
+    /// abandoned iterates. (The internal variables are only advanced by a converged step, in `commit_step`.)
     fn roll_back(&mut self, start: StepStart, captured: &[(usize, usize)]) {
         self.state = start.state;
-        (self.modulus, self.coeffs, self.history) = start.material;
+        self.materials.roll_back(&self.model.materials);
         self.gauge_active = start.gauge_active;
         self.system.invalidate();
         if let Some((_, system, _)) = &mut self.gauge {
