@@ -180,7 +180,7 @@ pub fn solve(model: &Model) -> (Simulation<'_>, Recorder) {
     let mut sim = Simulation::new(model).unwrap_or_else(|e| panic!("{}: {e}", model.name));
     let mut recorder = Recorder::default();
     let summary = sim
-        .run(&mut recorder)
+        .run(&mut [&mut recorder])
         .unwrap_or_else(|e| panic!("{}: {e}", model.name));
     assert!(!summary.stopped);
     (sim, recorder)

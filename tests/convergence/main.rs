@@ -75,7 +75,7 @@ fn run(p: usize, n: usize) -> Run {
     let mut sim = Simulation::new(&model).expect("discretisation");
     let mut recorder = Recorder::default();
     let tip = sim
-        .run(&mut recorder)
+        .run(&mut [&mut recorder])
         .map(|_| node_displacement(&sim, "tip"))
         .map_err(|e| e.to_string());
     Run {

@@ -76,7 +76,7 @@ fn run(integrator: &str, step: Real) -> Vec<(Real, Real)> {
         tip_point,
         samples: Vec::new(),
     };
-    sim.run(&mut obs).expect("run completes");
+    sim.run(&mut [&mut obs]).expect("run completes");
     obs.samples
 }
 
@@ -166,7 +166,7 @@ fn the_cantilever_is_programmed_holds_its_temporary_shape_and_recovers() {
     let design = stentkit::io::design::load_design(&path).expect("design loads");
     let mut sim = Simulation::new(&design.model).expect("simulation");
     let mut tip = TipHistory(Vec::new());
-    let summary = sim.run(&mut tip).expect("run completes");
+    let summary = sim.run(&mut [&mut tip]).expect("run completes");
     let max = tip.0.iter().fold(0.0_f64, |m, s| m.max(s.1));
     let held = tip
         .0

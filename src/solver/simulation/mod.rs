@@ -42,9 +42,9 @@ mod stepping;
 pub mod timing;
 
 pub use newton::ROUND_OFF_TOLERANCE;
-pub use observer::{NoObserver, Observer};
+pub use observer::{NoObserver, Observer, Observers};
 pub use report::{NewtonReport, RunSummary, StepReport};
-pub use stepping::STEP_ROUND_OFF_ULPS;
+pub use stepping::{STEP_FACTOR, STEP_ROUND_OFF_ULPS, StepOutcome};
 pub use timing::SolverTiming;
 
 use super::SolverError;
@@ -96,6 +96,14 @@ pub struct Simulation<'m> {
     last_increment: Option<(Vec<Real>, Real)>,
     /// Whether a step accepted at the round-off floor has been reported.
     round_off_reported: bool,
+    /// The schedule breakpoints the steps land on ([`Model::schedule_breakpoints`]), sorted.
+    breakpoints: Vec<Real>,
+    /// The size of the next step's first attempt [time]: the nominal step, or less after a cut (doubled back
+    /// by converged steps).
+    step_size: Real,
+    /// Cuts of the step in progress (0 between steps; kept over an interruption, so that the continued step
+    /// reports them all).
+    step_cuts: usize,
 }
 
 impl<'m> Simulation<'m> {
@@ -188,6 +196,9 @@ impl<'m> Simulation<'m> {
             step_increment: Vec::new(),
             last_increment: None,
             round_off_reported: false,
+            breakpoints: model.schedule_breakpoints(),
+            step_size: model.time.step,
+            step_cuts: 0,
         })
     }
 }
@@ -238,6 +249,17 @@ impl Simulation<'_> {
     /// Time of the current state.
     pub fn time(&self) -> Real {
         self.time
+    }
+
+    /// Converged steps so far (0: the initial state).
+    pub fn step_count(&self) -> usize {
+        self.step
+    }
+
+    /// The size of the next step's first attempt \[time\]: the nominal `time.step`, or less while a cut step
+    /// size grows back ([`STEP_FACTOR`]).
+    pub fn step_size(&self) -> Real {
+        self.step_size
     }
 
     /// The linear system (solver, size, pattern).

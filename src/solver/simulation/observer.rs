@@ -1,4 +1,5 @@
-//! Who is told about a run: the [`Observer`] seam (the engine reports, observers record) and [`NoObserver`].
+//! Who is told about a run: the [`Observer`] seam (the engine reports, observers record), [`NoObserver`], and
+//! [`Observers`], a list of observers the caller owns, told in its order.
 
 use super::{NewtonReport, Simulation, StepReport};
 use crate::math::Real;
@@ -40,5 +41,50 @@ pub struct NoObserver;
 impl Observer for NoObserver {
     fn step(&mut self, _: &Simulation<'_>, _: &StepReport) -> ControlFlow<()> {
         ControlFlow::Continue(())
+    }
+}
+
+/// A list of observers, owned by the caller, that acts as one ([`super::Simulation::run`] takes the list): each
+/// is told of every event in the list's order — all of them, even after one asked to stop — and the run stops
+/// when any asked to; an interruption is asked of each until one answers yes.
+pub struct Observers<'a, 'o> {
+    list: &'a mut [&'o mut dyn Observer],
+}
+
+impl<'a, 'o> Observers<'a, 'o> {
+    /// The list `list`.
+    pub fn new(list: &'a mut [&'o mut dyn Observer]) -> Self {
+        Self { list }
+    }
+
+    /// Calls `f` on every observer; `Break` if any returned `Break`.
+    fn each(&mut self, mut f: impl FnMut(&mut dyn Observer) -> ControlFlow<()>) -> ControlFlow<()> {
+        let mut flow = ControlFlow::Continue(());
+        for observer in self.list.iter_mut() {
+            if f(&mut **observer).is_break() {
+                flow = ControlFlow::Break(());
+            }
+        }
+        flow
+    }
+}
+
+impl Observer for Observers<'_, '_> {
+    fn start(&mut self, sim: &Simulation<'_>) -> ControlFlow<()> {
+        self.each(|o| o.start(sim))
+    }
+
+    fn step(&mut self, sim: &Simulation<'_>, report: &StepReport) -> ControlFlow<()> {
+        self.each(|o| o.step(sim, report))
+    }
+
+    fn step_failed(&mut self, time: Real, dt: Real, newton: &NewtonReport) {
+        for observer in self.list.iter_mut() {
+            observer.step_failed(time, dt, newton);
+        }
+    }
+
+    fn interrupted(&self) -> bool {
+        self.list.iter().any(|o| o.interrupted())
     }
 }

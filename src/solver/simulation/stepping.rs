@@ -2,7 +2,8 @@
 //! back after a success), the reuse retry, and the roll-back of an abandoned step (module docs of [`super`]).
 
 use super::newton::{NewtonFailure, round_off_notice};
-use super::{Observer, RunSummary, Simulation, StepReport};
+use super::observer::Observers;
+use super::{NoObserver, Observer, RunSummary, Simulation, StepReport};
 use crate::math::Real;
 use crate::solver::SolverError;
 use crate::solver::state::State;
@@ -52,44 +53,75 @@ struct StepStart {
     gauge_active: bool,
 }
 
+/// What one call of [`Simulation::step_with`] did.
+#[derive(Debug, Clone, PartialEq)]
+pub enum StepOutcome {
+    /// One step converged (after the retries and cuts it needed): its report.
+    Stepped(StepReport),
+    /// The end time had been reached: nothing was done.
+    Finished,
+    /// The observer asked to stop within the step ([`Observer::interrupted`]), which was abandoned and rolled
+    /// back: the simulation is at the last converged step.
+    Interrupted,
+}
+
 impl Simulation<'_> {
-    /// Runs from the current time to the model's end time, reporting each converged step to `observer`.
+    /// Whether the simulation has reached the model's end time (within the landing tolerance): a further
+    /// [`Simulation::step`] does nothing.
+    pub fn is_finished(&self) -> bool {
+        self.time >= self.model.time.end - self.landing_tolerance()
+    }
+
+    /// Times closer than this to a breakpoint or the end are that breakpoint: the model's landing tolerance
+    /// ([`crate::model::LANDING_TOLERANCE`] of the nominal step) \[time\].
+    fn landing_tolerance(&self) -> Real {
+        crate::model::LANDING_TOLERANCE * self.model.time.step
+    }
+
+    /// Takes one step — the next converged one, with the retries and cuts it needed — and returns its report,
+    /// or `None` when the end time was already reached. The step lands on the next schedule breakpoint when it
+    /// would pass it; its size is the current step size ([`Simulation::step_size`]), which cuts halve and
+    /// converged steps double back to the nominal one.
     ///
-    /// Returns with [`RunSummary::stopped`] when the observer asked to stop, from [`Observer::start`] or
-    /// [`Observer::step`] (after that step) or from [`Observer::interrupted`] (within a step, which is then
-    /// abandoned: the simulation stays at the last converged step). Fails with [`SolverError::StepFailed`] when
-    /// Newton fails at the smallest step.
-    pub fn run(&mut self, observer: &mut dyn Observer) -> Result<RunSummary, SolverError> {
-        let mut summary = RunSummary {
-            time: self.time,
-            ..RunSummary::default()
-        };
-        if self.step == 0 && observer.start(self).is_break() {
-            summary.stopped = true;
-            return Ok(summary);
+    /// # Errors
+    /// [`SolverError::StepFailed`] when Newton fails at the smallest step, and the fatal errors of the
+    /// linear algebra and the material; the simulation is then at the last converged step.
+    pub fn step(&mut self) -> Result<Option<StepReport>, SolverError> {
+        Ok(match self.step_with(&mut NoObserver)? {
+            StepOutcome::Stepped(report) => Some(report),
+            StepOutcome::Finished | StepOutcome::Interrupted => None,
+        })
+    }
+
+    /// [`Simulation::step`] with an observer that is told of every failed attempt
+    /// ([`Observer::step_failed`]) and polled for an interruption ([`Observer::interrupted`]) before every
+    /// attempt and every Newton iteration. The observer's [`Observer::step`] is not called: the report is
+    /// returned to the caller, who tells whom it likes (as [`Simulation::run`] does).
+    ///
+    /// # Errors
+    /// As [`Simulation::step`].
+    pub fn step_with(&mut self, observer: &mut dyn Observer) -> Result<StepOutcome, SolverError> {
+        if self.is_finished() {
+            return Ok(StepOutcome::Finished);
         }
         let end = self.model.time.end;
         let nominal = self.model.time.step;
         let min_step = self.model.time.min_step;
-        let breakpoints = self.model.schedule_breakpoints();
-        // Times closer than this to a breakpoint or the end are that breakpoint (the model's landing tolerance).
-        let snap = crate::model::LANDING_TOLERANCE * nominal;
-        let mut h = nominal;
-        let mut cuts = 0;
-        while self.time < end - snap {
+        let snap = self.landing_tolerance();
+        loop {
             // Before every attempt: the first of a step, and each cut.
             if observer.interrupted() {
-                summary.stopped = true;
-                return Ok(summary);
+                return Ok(StepOutcome::Interrupted);
             }
             // Breakpoints are sorted: a binary search keeps a step's cost independent of their number (a table of
             // 10⁵ breakpoints made every step scan it).
+            let breakpoints = &self.breakpoints;
             let next_break = breakpoints
                 .get(breakpoints.partition_point(|&b| b <= self.time + snap))
                 .copied()
                 .unwrap_or(end)
                 .min(end);
-            let mut target = self.time + h;
+            let mut target = self.time + self.step_size;
             if target > next_break - snap {
                 target = next_break;
             }
@@ -128,6 +160,7 @@ impl Simulation<'_> {
                 Ok(newton) => {
                     self.commit_step();
                     // A schedule's rate changes at its breakpoints: no extrapolation across them.
+                    let breakpoints = &self.breakpoints;
                     let nearest = breakpoints.partition_point(|&b| b < target - snap);
                     let at_break = breakpoints
                         .get(nearest)
@@ -144,26 +177,18 @@ impl Simulation<'_> {
                             self.model.solver.tolerance,
                         ));
                     }
-                    summary.steps += 1;
-                    summary.iterations += newton.iterations;
-                    summary.factorisations += newton.factorisations;
-                    summary.time = target;
                     let report = StepReport {
                         step: self.step,
                         time: target,
                         dt,
                         temperature: self.model.temperature.value(target),
                         newton,
-                        cuts,
+                        cuts: std::mem::take(&mut self.step_cuts),
                     };
-                    cuts = 0;
-                    if h < nominal {
-                        h = (STEP_FACTOR * h).min(nominal);
+                    if self.step_size < nominal {
+                        self.step_size = (STEP_FACTOR * self.step_size).min(nominal);
                     }
-                    if observer.step(self, &report).is_break() {
-                        summary.stopped = true;
-                        return Ok(summary);
-                    }
+                    return Ok(StepOutcome::Stepped(report));
                 }
                 Err(NewtonFailure::Fatal(e)) => {
                     self.roll_back(start, &captured);
@@ -171,8 +196,7 @@ impl Simulation<'_> {
                 }
                 Err(NewtonFailure::Interrupted) => {
                     self.roll_back(start, &captured);
-                    summary.stopped = true;
-                    return Ok(summary);
+                    return Ok(StepOutcome::Interrupted);
                 }
                 Err(NewtonFailure::NotConverged(newton)) => {
                     self.roll_back(start, &captured);
@@ -187,13 +211,57 @@ impl Simulation<'_> {
                             diagnosis: newton.diagnosis,
                         });
                     }
-                    h = halved_step(dt, min_step, target);
-                    cuts += 1;
-                    summary.cuts += 1;
+                    self.step_size = halved_step(dt, min_step, target);
+                    self.step_cuts += 1;
                 }
             }
         }
-        Ok(summary)
+    }
+
+    /// Runs from the current time to the model's end time — a loop over [`Simulation::step_with`] — telling
+    /// every observer of `observers` (a list the caller owns, called in its order) of the initial state (when
+    /// at step 0) and of each converged step.
+    ///
+    /// Returns with [`RunSummary::stopped`] when an observer asked to stop, from [`Observer::start`] or
+    /// [`Observer::step`] (after that step; every observer is still told of it) or from
+    /// [`Observer::interrupted`] (within a step, which is then abandoned: the simulation stays at the last
+    /// converged step, and a later `run` or `step` continues exactly where the abandoned step was, with its step
+    /// size and cuts). Fails with [`SolverError::StepFailed`] when Newton fails at the smallest step.
+    pub fn run(&mut self, observers: &mut [&mut dyn Observer]) -> Result<RunSummary, SolverError> {
+        let mut observers = Observers::new(observers);
+        let mut summary = RunSummary {
+            time: self.time,
+            ..RunSummary::default()
+        };
+        if self.step == 0 && observers.start(self).is_break() {
+            summary.stopped = true;
+            return Ok(summary);
+        }
+        loop {
+            let outcome = self.step_with(&mut observers);
+            // Cuts of an attempt that failed for good or was abandoned count too.
+            let pending = self.step_cuts;
+            match outcome {
+                Ok(StepOutcome::Stepped(report)) => {
+                    summary.steps += 1;
+                    summary.iterations += report.newton.iterations;
+                    summary.factorisations += report.newton.factorisations;
+                    summary.cuts += report.cuts;
+                    summary.time = report.time;
+                    if observers.step(self, &report).is_break() {
+                        summary.stopped = true;
+                        return Ok(summary);
+                    }
+                }
+                Ok(StepOutcome::Finished) => return Ok(summary),
+                Ok(StepOutcome::Interrupted) => {
+                    summary.cuts += pending;
+                    summary.stopped = true;
+                    return Ok(summary);
+                }
+                Err(e) => return Err(e),
+            }
+        }
     }
 
     /// What a step is about to change, saved before it starts (see [`Self::roll_back`]).
