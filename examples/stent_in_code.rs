@@ -18,12 +18,11 @@ use std::path::Path;
 use stentkit::math::Real;
 use stentkit::model::Model;
 use stentkit::solver::Simulation;
-use stentkit::solver::simulation::NoObserver;
 
 /// Runs a model to its end and returns the final Δr (mean radial contraction of the driven nodes) [mm].
 fn final_delta_r(model: &Model) -> Result<Real, Box<dyn std::error::Error>> {
     let mut sim = Simulation::new(model)?;
-    sim.run(&mut NoObserver)?;
+    sim.run(&mut [])?;
     let recovery = stentkit::io::state::recovery(&sim).ok_or("the model has no programme")?;
     Ok(recovery
         .delta_r

@@ -52,7 +52,7 @@ impl Observer for OneStep {
 /// A simulation of `model` advanced [`WARM_UP_STEPS`] steps into the ramp.
 pub fn warmed_up(model: &Model) -> Simulation<'_> {
     let mut sim = Simulation::new(model).expect("simulation");
-    sim.run(&mut StopAfter(WARM_UP_STEPS))
+    sim.run(&mut [&mut StopAfter(WARM_UP_STEPS)])
         .expect("the first steps of the ramp converge");
     sim
 }

@@ -8,7 +8,7 @@
 use stentkit::geometry::stent::{
     BridgeShape, BridgeSpec, CentrelineSpec, CrownSpec, StentSpec, Symmetry,
 };
-use stentkit::material::{CircularSection, Integrator, Material};
+use stentkit::material::{CircularSection, Integrator, Material, MaterialLaw};
 use stentkit::math::Vec3;
 use stentkit::model::builder::{ModelBuilder, TimeSpec};
 use stentkit::model::stent::{ProgrammeSpec, ProgrammeTarget, StentMesh};
@@ -20,8 +20,7 @@ pub fn straight_stent(crowns: usize, (p, n): (usize, usize), step: f64) -> Model
     let wire = CircularSection::try_new(0.6).expect("a 0.6 mm wire is a valid section"); // diameter [mm]
     let mut b = ModelBuilder::new(
         "straight_stent",
-        Material::pla_van_manen_2021(),
-        Integrator::Trapezoidal,
+        MaterialLaw::from_material(Material::pla_van_manen_2021(), Integrator::Trapezoidal),
         wire.into(),
     );
     b.units(Units::MmNMpa);

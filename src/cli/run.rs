@@ -403,10 +403,10 @@ fn run_in(
     summary.summary.timing.setup_s = started.elapsed().as_secs_f64();
 
     let run_started = Instant::now();
-    let result = sim.run(&mut RunObserver {
+    let result = sim.run(&mut [&mut RunObserver {
         outputs: &mut outputs,
         summary: &mut summary,
-    });
+    }]);
     summary.summary.timing.run_s = run_started.elapsed().as_secs_f64();
     outputs.progress.bar.finish_and_clear();
     outputs.progress.notices(&sim);

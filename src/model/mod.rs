@@ -1,4 +1,4 @@
-//! The continuous problem: patches (reference centrelines), cross-sections and material, nodes that join
+//! The continuous problem: patches (reference centrelines), cross-sections and materials, nodes that join
 //! patch ends, boundary conditions and loads per node in a local basis, distributed loads, the temperature
 //! schedule, time and solver settings, and named probes.
 //!
@@ -15,7 +15,7 @@ pub mod stent;
 pub use programme::{DrivenNode, Programme, ProgrammeError, ProgrammeKind};
 pub use schedule::{ScheduleError, TimeFunction};
 
-use crate::material::{Integrator, Material, Section};
+use crate::material::{MaterialLaw, Section};
 use crate::math::{Mat3, NurbsCurve, Real, Vec3};
 use std::collections::BTreeMap;
 
@@ -79,6 +79,8 @@ pub struct Patch {
     pub normal_hint: Option<Vec3>,
     /// Index into [`Model::sections`].
     pub section: usize,
+    /// Index into [`Model::materials`].
+    pub material: usize,
     /// Largest deviation of `curve` from the analytic curve it was fitted to [length]; `None` when exact.
     pub fit_error: Option<Real>,
 }
@@ -343,10 +345,9 @@ pub struct Model {
     pub name: String,
     /// Unit system of every number.
     pub units: Units,
-    /// The thermo-viscoelastic material (one per design).
-    pub material: Material,
-    /// Internal-variable update of the Maxwell branches.
-    pub integrator: Integrator,
+    /// The materials (constitutive laws), referred to by [`Patch::material`]. A design file gives one, which
+    /// every patch uses.
+    pub materials: Vec<MaterialLaw>,
     /// Cross-sections, referred to by [`Patch::section`].
     pub sections: Vec<Section>,
     /// Rod patches.

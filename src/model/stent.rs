@@ -81,7 +81,7 @@ fn geometry_error(e: GeometryError) -> BuildError {
 }
 
 /// Generates the stent: fitted patches (section 0, or a half section for patches lying in a symmetry plane,
-/// appended to `sections`; `poisson` gives its shear factor), nodes with their symmetry conditions.
+/// appended to `sections`; `poisson` gives its shear factor), all of material 0, nodes with their symmetry conditions.
 pub fn generate(
     spec: &StentSpec,
     mesh: &StentMesh,
@@ -141,6 +141,7 @@ pub fn generate(
             curve,
             normal_hint: Some(g.normal_hint),
             section,
+            material: 0,
             fit_error,
         });
     }

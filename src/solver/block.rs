@@ -22,6 +22,7 @@
 //! failed factorisation, and the caller falls back to the general sparse LU.
 
 use super::SolverError;
+use super::linear::LinearError;
 use super::sparse::SparseSystem;
 use crate::math::Real;
 use rayon::prelude::*;
@@ -266,9 +267,12 @@ impl BlockSystem {
         let mut ku = vec![0usize; patches.len()];
         for &(r, c) in entries {
             if r >= n || c >= n {
-                return Err(SolverError::Linear(format!(
-                    "entry ({r}, {c}) outside a {n}×{n} system"
-                )));
+                return Err(LinearError::EntryOutside {
+                    row: r,
+                    column: c,
+                    size: n,
+                }
+                .into());
             }
             match (interior[r], interior[c]) {
                 (Some((kr, i)), Some((kc, j))) => {

@@ -17,6 +17,7 @@ pub mod simulation;
 pub mod sparse;
 pub mod state;
 
+pub use linear::LinearError;
 pub use simulation::{NewtonReport, Observer, RunSummary, Simulation, SolverTiming, StepReport};
 
 use crate::geometry::GeometryError;
@@ -38,7 +39,7 @@ pub enum SolverError {
     Material(#[from] crate::material::MaterialError),
     /// The sparse linear algebra failed for a reason other than singularity.
     #[error("linear solver: {0}")]
-    Linear(String),
+    Linear(#[from] linear::LinearError),
     /// The tangent is structurally singular: no pivot for an unknown.
     #[error(
         "the tangent matrix is singular: no pivot for unknown {column}{}: is that patch or node free to move as a rigid body?",

@@ -3,7 +3,9 @@
 
 use std::ops::ControlFlow;
 use std::path::Path;
-use stentkit::material::{CircularSection, Integrator, Material, Prony, PronyBranch, Wlf};
+use stentkit::material::{
+    CircularSection, Integrator, Material, MaterialLaw, Prony, PronyBranch, Wlf,
+};
 use stentkit::math::so3::log;
 use stentkit::math::{Real, Rot3, Vec3};
 use stentkit::model::builder::{ConditionSpec, ModelBuilder, PatchShape, TimeSpec};
@@ -39,7 +41,8 @@ fn bending_model(integrator: Integrator, step: Real) -> Model {
     let wlf = Wlf::try_new(14.59, 48.43, 70.0).expect("valid WLF constants");
     let material = Material::try_new(prony, 0.33, Some(wlf)).expect("valid material");
     let wire = CircularSection::try_new(0.05).expect("d > 0");
-    let mut b = ModelBuilder::new("bending", material, integrator, wire.into());
+    let law = MaterialLaw::from_material(material, integrator);
+    let mut b = ModelBuilder::new("bending", law, wire.into());
     let beam = PatchShape::Line {
         from: Vec3::zeros(),
         to: Vec3::x(),
@@ -99,7 +102,7 @@ fn run(integrator: Integrator, step: Real) -> Vec<(Real, Real)> {
         tip_point,
         samples: Vec::new(),
     };
-    sim.run(&mut obs).expect("run completes");
+    sim.run(&mut [&mut obs]).expect("run completes");
     obs.samples
 }
 
@@ -189,7 +192,7 @@ fn the_cantilever_is_programmed_holds_its_temporary_shape_and_recovers() {
     let design = stentkit::io::design::load_design(&path).expect("design loads");
     let mut sim = Simulation::new(&design.model).expect("simulation");
     let mut tip = TipHistory(Vec::new());
-    let summary = sim.run(&mut tip).expect("run completes");
+    let summary = sim.run(&mut [&mut tip]).expect("run completes");
     let max = tip.0.iter().fold(0.0_f64, |m, s| m.max(s.1));
     let held = tip
         .0

@@ -67,7 +67,7 @@ pub fn sample_run(
     let model = &design.model;
     let started = Instant::now();
     let mut sim = Simulation::new(model)?;
-    let summary = sim.run(&mut NoObserver)?;
+    let summary = sim.run(&mut [&mut NoObserver])?;
     let wall = started.elapsed().as_secs_f64();
     let grid = (0..model.patches.len())
         .flat_map(|patch| {

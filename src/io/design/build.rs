@@ -14,7 +14,7 @@ use crate::geometry::analytic::{
     Helix, RigidPlacement, SineWire, frame_from_axis, point_list_curve,
 };
 use crate::material::{
-    CircularSection, Integrator, Material, MaterialError, Prony, PronyBranch, Section,
+    CircularSection, Integrator, Material, MaterialError, MaterialLaw, Prony, PronyBranch, Section,
     SectionProperties, ShearFactor, Wlf,
 };
 use crate::math::quote::quoted;
@@ -70,7 +70,12 @@ pub fn build(dto: &DesignDto, default_name: &str) -> Result<Built> {
     // nominal steps; the steps landing on breakpoints are counted once the model exists, below).
     check_size(dto, &StepCount::nominal(&settings))?;
     let circular = matches!(section, Section::Circular(_));
-    let mut builder = ModelBuilder::new(name, material, integrator, section);
+    // The design's one material, used by every patch (material 0).
+    let mut builder = ModelBuilder::new(
+        name,
+        MaterialLaw::from_material(material, integrator),
+        section,
+    );
     builder.units(match dto.units {
         UnitsDto::Si => Units::Si,
         UnitsDto::MmNMpa => Units::MmNMpa,
@@ -232,6 +237,8 @@ pub fn field_path(field: &Field, dto: &DesignDto) -> String {
                 PatchField::Name => format!("{base}.name"),
                 PatchField::Degree => mesh_key(pd.p, base, "p"),
                 PatchField::ControlPoints => mesh_key(pd.n, base, "n"),
+                PatchField::Section => format!("{base}.diameter"),
+                PatchField::Material => base,
                 PatchField::Geometry | PatchField::Angle => {
                     let key = if pd.line.is_some() {
                         "line"
@@ -637,14 +644,12 @@ fn patches(
                 builder.section(c.into())
             }
         };
-        builder.patch_with_section(
-            pd.name.clone(),
-            shape,
-            p,
-            n,
+        let options = PatchOptions {
             section,
-            pd.normal.as_ref().map(vec3),
-        );
+            material: 0,
+            normal_hint: pd.normal.as_ref().map(vec3),
+        };
+        builder.patch_with(pd.name.clone(), shape, p, n, options);
     }
     Ok(())
 }

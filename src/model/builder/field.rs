@@ -93,6 +93,10 @@ pub enum PatchField {
     Geometry,
     /// The angle of its arc.
     Angle,
+    /// Its section.
+    Section,
+    /// Its material.
+    Material,
 }
 
 /// A part of the generated stent.

@@ -5,14 +5,13 @@
 //! ([`crate::io::design`]) is a translation of YAML into builder calls that maps fields back to lines.
 //!
 //! ```
-//! use stentkit::material::{CircularSection, Integrator, Material, Prony};
+//! use stentkit::material::{CircularSection, ElasticLaw};
 //! use stentkit::math::Vec3;
 //! use stentkit::model::TimeFunction;
 //! use stentkit::model::builder::{ConditionSpec, ModelBuilder, PatchShape, TimeSpec};
 //!
-//! let material = Material::try_new(Prony::try_new(1e7, vec![])?, 0.3, None)?;
 //! let section = CircularSection::try_new(0.01)?.into();
-//! let mut b = ModelBuilder::new("cantilever", material, Integrator::Trapezoidal, section);
+//! let mut b = ModelBuilder::new("cantilever", ElasticLaw::try_new(1e7, 0.3)?, section);
 //! b.patch("beam", PatchShape::Line { from: Vec3::zeros(), to: Vec3::x() }, 4, 12);
 //! b.condition(ConditionSpec::clamp("beam.start"));
 //! b.condition(ConditionSpec::at("beam.end").with_force(2, TimeFunction::constant(1e-3)));
@@ -38,7 +37,7 @@ use crate::geometry::analytic::ParametricCurve;
 use crate::geometry::fit::{FitSettings, fit_curve};
 use crate::geometry::stent::StentSpec;
 use crate::geometry::{GeometryError, Parameter, primitives};
-use crate::material::{Integrator, Material, Section};
+use crate::material::{ConstitutiveLaw, MaterialLaw, Section, Wlf};
 use crate::math::quote::quoted;
 use crate::math::{Mat3, Real, Vec3};
 use std::collections::{BTreeMap, HashMap};
@@ -81,14 +80,24 @@ pub enum PatchShape {
     Fitted(Box<dyn ParametricCurve + Send + Sync>),
 }
 
+/// What a patch is made of, beyond its shape and discretisation.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct PatchOptions {
+    /// Its section: an index from [`ModelBuilder::section`] (0: the builder's first section).
+    pub section: usize,
+    /// Its material: an index from [`ModelBuilder::material`] (0: the builder's first material).
+    pub material: usize,
+    /// A hint for the first section axis at its start (irrelevant to circular sections).
+    pub normal_hint: Option<Vec3>,
+}
+
 /// A patch to build.
 struct PatchInput {
     name: String,
     shape: PatchShape,
     degree: usize,
     points: usize,
-    section: usize,
-    normal_hint: Option<Vec3>,
+    options: PatchOptions,
 }
 
 /// How a node finds its patch ends.
@@ -323,8 +332,7 @@ pub struct Built {
 pub struct ModelBuilder {
     name: String,
     units: Units,
-    material: Material,
-    integrator: Integrator,
+    materials: Vec<MaterialLaw>,
     sections: Vec<Section>,
     stent: Option<(StentSpec, StentMesh)>,
     programme: Option<ProgrammeSpec>,
@@ -341,19 +349,17 @@ pub struct ModelBuilder {
 }
 
 impl ModelBuilder {
-    /// A model named `name` of one material, with `section` as section 0 (every patch's unless it says
-    /// otherwise), in [`Units::Si`], from 0 to 1 by 0.1, default solver settings.
+    /// A model named `name` with `material` as material 0 and `section` as section 0 (every patch's unless it
+    /// says otherwise; a generated stent's), in [`Units::Si`], from 0 to 1 by 0.1, default solver settings.
     pub fn new(
         name: impl Into<String>,
-        material: Material,
-        integrator: Integrator,
+        material: impl Into<MaterialLaw>,
         section: Section,
     ) -> Self {
         Self {
             name: name.into(),
             units: Units::Si,
-            material,
-            integrator,
+            materials: vec![material.into()],
             sections: vec![section],
             stent: None,
             programme: None,
@@ -379,10 +385,16 @@ impl ModelBuilder {
         self
     }
 
-    /// Adds a section; returns its index for [`ModelBuilder::patch_with_section`].
+    /// Adds a section; returns its index for [`PatchOptions::section`].
     pub fn section(&mut self, section: Section) -> usize {
         self.sections.push(section);
         self.sections.len() - 1
+    }
+
+    /// Adds a material; returns its index for [`PatchOptions::material`].
+    pub fn material(&mut self, material: impl Into<MaterialLaw>) -> usize {
+        self.materials.push(material.into());
+        self.materials.len() - 1
     }
 
     /// Generates a stent whose patches and nodes come first in the model, with its node sets (`all_joints`,
@@ -398,29 +410,26 @@ impl ModelBuilder {
         self
     }
 
-    /// Adds a patch of section 0 with degree `p` and `n` control points.
+    /// Adds a patch of section 0 and material 0 with degree `p` and `n` control points.
     pub fn patch(&mut self, name: impl Into<String>, shape: PatchShape, p: usize, n: usize) {
-        self.patch_with_section(name, shape, p, n, 0, None);
+        self.patch_with(name, shape, p, n, PatchOptions::default());
     }
 
-    /// Adds a patch with its section (an index from [`ModelBuilder::section`]) and an optional hint for the
-    /// first section axis at its start.
-    pub fn patch_with_section(
+    /// Adds a patch with its section, material and normal hint.
+    pub fn patch_with(
         &mut self,
         name: impl Into<String>,
         shape: PatchShape,
         p: usize,
         n: usize,
-        section: usize,
-        normal_hint: Option<Vec3>,
+        options: PatchOptions,
     ) {
         self.patches.push(PatchInput {
             name: name.into(),
             shape,
             degree: p,
             points: n,
-            section,
-            normal_hint,
+            options,
         });
     }
 
@@ -491,7 +500,7 @@ impl ModelBuilder {
                 spec,
                 mesh,
                 &mut sections,
-                self.material.poisson(),
+                self.materials[0].poisson(),
                 &mut warnings,
             )?),
             None => None,
@@ -557,17 +566,18 @@ impl ModelBuilder {
         };
         conditions::apply(&self.conditions, &patches, &mut nodes, &node_sets, &preset)?;
         let distributed_loads = self.distributed_loads(&patches)?;
-        let temperature = match (&self.temperature, self.material.wlf()) {
+        let shifts: Vec<&Wlf> = self.materials.iter().filter_map(wlf).collect();
+        let temperature = match (&self.temperature, shifts.is_empty()) {
             (Some(f), _) => f.clone(),
-            (None, None) => TimeFunction::constant(DEFAULT_TEMPERATURE),
-            (None, Some(_)) => {
+            (None, true) => TimeFunction::constant(DEFAULT_TEMPERATURE),
+            (None, false) => {
                 return Err(BuildError::new(
                     Field::Temperature,
                     "missing: a material with `wlf` needs a temperature schedule (a number or [[t, T], …] in °C)",
                 ));
             }
         };
-        if let Some(w) = self.material.wlf() {
+        for w in shifts {
             let freeze = w.frozen_below();
             let (lo, _) = temperature.range();
             if lo <= freeze {
@@ -580,8 +590,7 @@ impl ModelBuilder {
         let model = Model {
             name: self.name.clone(),
             units: self.units,
-            material: self.material.clone(),
-            integrator: self.integrator,
+            materials: self.materials.clone(),
             sections,
             patches,
             nodes,
@@ -674,16 +683,27 @@ impl ModelBuilder {
                     (fit.curve, Some(fit.max_deviation))
                 }
             };
-            let Some(section) = sections.get(input.section) else {
+            let options = input.options;
+            let Some(section) = sections.get(options.section) else {
                 return Err(BuildError::new(
-                    at(PatchField::Geometry),
+                    at(PatchField::Section),
                     format!(
                         "section {} does not exist ({} sections)",
-                        input.section,
+                        options.section,
                         sections.len()
                     ),
                 ));
             };
+            if options.material >= self.materials.len() {
+                return Err(BuildError::new(
+                    at(PatchField::Material),
+                    format!(
+                        "material {} does not exist ({} materials)",
+                        options.material,
+                        self.materials.len()
+                    ),
+                ));
+            }
             if let Some(dev) = fit_error {
                 let d = section.diameter();
                 if dev > FIT_WARNING_FRACTION * d {
@@ -697,8 +717,9 @@ impl ModelBuilder {
             out.push(Patch {
                 name: name.clone(),
                 curve,
-                normal_hint: input.normal_hint,
-                section: input.section,
+                normal_hint: options.normal_hint,
+                section: options.section,
+                material: options.material,
                 fit_error,
             });
         }
@@ -786,6 +807,14 @@ impl ModelBuilder {
     }
 }
 
+/// The WLF shift of a material law, if it has one (its temperature dependence).
+fn wlf(law: &MaterialLaw) -> Option<&Wlf> {
+    match law {
+        MaterialLaw::Maxwell(m) => m.material().wlf(),
+        _ => None,
+    }
+}
+
 /// Checks a discretisation: `p ≥ 2` (collocation of the strong form needs second derivatives), `n > p`.
 pub(super) fn check_discretisation(p: usize, n: usize, degree: Field, points: Field) -> Result<()> {
     if p < 2 {
@@ -826,13 +855,15 @@ mod tests {
     //! Each check of the builder reports the field it is about; the positions of the design-file layer rest on
     //! these fields (tests/data/bad_designs checks them end to end, with line and column).
     use super::*;
-    use crate::material::{CircularSection, Prony};
+    use crate::material::{CircularSection, ElasticLaw};
 
     fn elastic() -> ModelBuilder {
-        let material = Material::try_new(Prony::try_new(1e7, vec![]).expect("E > 0"), 0.3, None)
-            .expect("ν = 0.3");
         let section = CircularSection::try_new(0.01).expect("d > 0").into();
-        let mut b = ModelBuilder::new("frame", material, Integrator::Trapezoidal, section);
+        let mut b = ModelBuilder::new(
+            "frame",
+            ElasticLaw::try_new(1e7, 0.3).expect("valid"),
+            section,
+        );
         let line = |from: Vec3, to: Vec3| PatchShape::Line { from, to };
         b.patch("beam", line(Vec3::zeros(), Vec3::x()), 3, 6);
         b.patch("post", line(Vec3::x(), Vec3::new(1.0, 1.0, 0.0)), 3, 6);
