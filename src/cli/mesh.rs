@@ -1,6 +1,6 @@
 //! `stentkit mesh`: the reference shape of the full device as a closed tube surface.
 
-use crate::geometry::tube::TriangleMesh;
+use crate::geometry::mesh::TriangleMesh;
 use crate::io::design::load_design;
 use crate::io::device::{device_tube_mesh, reference_patch_shapes};
 use crate::io::{obj, stl};

@@ -4,13 +4,14 @@
 //! [`crate::geometry::stent`]; [`super::builder::ModelBuilder::stent`] and
 //! [`super::builder::ModelBuilder::programme`] put both into a model.
 
+use super::builder::checks::{FIT_WARNING_FRACTION, check_discretisation};
 use super::builder::field::{BuildError, Field, ProgrammeField, Result, StentField};
-use super::builder::{FIT_WARNING_FRACTION, check_discretisation};
 use super::{
     Component, DrivenNode, End, Node, NodeConditions, Patch, PatchEnd, Programme, ProgrammeKind,
 };
 use crate::geometry::GeometryError;
 use crate::geometry::fit::{FitSettings, best_fit_rigid, fit_curve};
+use crate::geometry::frame::basis_from_unit_axis;
 use crate::geometry::primitives;
 use crate::geometry::stent::{PatchRole, StentGeometry, StentSpec, TemporarySpec, WireEnd};
 use crate::material::{Section, SectionProperties};
@@ -160,8 +161,7 @@ pub fn generate(
         .map(|g| {
             let mut conditions = NodeConditions::default();
             if let Some(k) = g.symmetry_plane {
-                conditions.basis =
-                    super::builder::basis_from_unit_normal(&geometry.symmetry_planes[k].normal);
+                conditions.basis = basis_from_unit_axis(&geometry.symmetry_planes[k].normal);
                 for i in [0, 4, 5] {
                     conditions.components[i] = Component::fixed();
                 }

@@ -21,9 +21,8 @@
 //! interior only: a patch whose interior block is singular on its own (with its ends held) is reported as a
 //! failed factorisation, and the caller falls back to the general sparse LU.
 
-use super::SolverError;
-use super::linear::LinearError;
 use super::sparse::SparseSystem;
+use super::{LinearError, SolverError};
 use crate::math::Real;
 use rayon::prelude::*;
 

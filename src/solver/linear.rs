@@ -6,45 +6,6 @@ use super::block::BlockSystem;
 use super::sparse::SparseSystem;
 use crate::math::Real;
 use crate::model::LinearMethod;
-use faer::sparse::FaerError;
-
-/// Why the sparse linear algebra failed for a reason other than a singular tangent (which is
-/// [`SolverError::Singular`]): each variant carries what is needed to act on it.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, thiserror::Error)]
-pub enum LinearError {
-    /// An assembled entry lies outside the system: a programmer error in the assembly's numbering.
-    #[error("entry ({row}, {column}) outside a {size}×{size} system")]
-    EntryOutside {
-        /// Row of the entry.
-        row: usize,
-        /// Column of the entry.
-        column: usize,
-        /// Number of unknowns (and equations).
-        size: usize,
-    },
-    /// The symbolic LU analysis of the pattern failed (faer: an index overflow or out of memory).
-    #[error("symbolic LU: {reason:?}")]
-    Symbolic {
-        /// Number of unknowns.
-        size: usize,
-        /// faer's reason.
-        reason: FaerError,
-    },
-    /// The LU workspace could not be allocated.
-    #[error("LU workspace: {bytes} bytes cannot be allocated")]
-    Workspace {
-        /// The workspace asked for \[bytes\].
-        bytes: usize,
-    },
-    /// The numeric LU failed for a reason other than a missing pivot (faer: an index overflow or out of memory).
-    #[error("numeric LU: {reason:?}")]
-    Numeric {
-        /// Number of unknowns.
-        size: usize,
-        /// faer's reason.
-        reason: FaerError,
-    },
-}
 
 /// The Newton systems' solver: the block-bordered solver ([`BlockSystem`]) when the design asks for it and the
 /// pattern allows, with the general sparse LU as its fallback (a patch interior singular on its own) and as

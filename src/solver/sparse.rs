@@ -5,8 +5,7 @@
 //! Assembly pushes entries in a fixed order (repeats allowed, they are summed); the pattern maps each pushed
 //! entry to its slot in the compressed columns once, so refilling the values is one pass with no sorting.
 
-use super::SolverError;
-use super::linear::LinearError;
+use super::{LinearError, SolverError};
 use crate::math::Real;
 use faer::dyn_stack::{MemBuffer, MemStack, StackReq};
 use faer::sparse::linalg::LuError;

@@ -22,10 +22,6 @@ use crate::math::{Mat3, Real, Vec3};
 use crate::model::builder::*;
 use crate::model::*;
 
-pub(super) fn vec3(v: &Vector) -> Vec3 {
-    Vec3::new(v[0].0, v[1].0, v[2].0)
-}
-
 fn time_function(f: &TimeFn, path: &str) -> Result<TimeFunction> {
     match f {
         TimeFn::Constant(v) => Ok(TimeFunction::constant(*v)),

@@ -24,7 +24,6 @@
 //!   release: 1.75
 //! ```
 
-use super::build::vec3;
 use super::dto::*;
 use super::issue::{Result, issue};
 use crate::geometry::stent::{

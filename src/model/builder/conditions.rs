@@ -4,7 +4,7 @@
 
 use super::field::{BuildError, ConditionField, Field, Result};
 use super::{BasisSpec, ConditionSpec, Target, nodes};
-use crate::geometry::frame::normal_to;
+use crate::geometry::frame::basis_from_unit_axis;
 use crate::math::quote::quoted;
 use crate::math::{Mat3, Real, Vec3};
 use crate::model::{Component, Node, Patch, TimeFunction};
@@ -16,15 +16,9 @@ pub const BASIS_TOLERANCE: Real = 1e-6;
 /// The components' names in messages.
 const NAMES: [&str; 6] = ["u1", "u2", "u3", "θ1", "θ2", "θ3"];
 
-/// Completes an orthonormal right-handed basis whose first axis is the unit vector `e1`.
-pub(crate) fn basis_from_unit_normal(e1: &Vec3) -> Mat3 {
-    let e2 = normal_to(e1, None);
-    Mat3::from_columns(&[*e1, e2, e1.cross(&e2)])
-}
-
 /// Completes an orthonormal right-handed basis whose first axis is the direction of `n`.
 fn basis_from_normal(n: &Vec3) -> Mat3 {
-    basis_from_unit_normal(&n.normalize())
+    basis_from_unit_axis(&n.normalize())
 }
 
 /// The basis a condition gives, checked.

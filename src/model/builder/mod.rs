@@ -21,11 +21,13 @@
 //! # Ok::<(), Box<dyn std::error::Error>>(())
 //! ```
 
+pub(crate) mod checks;
 mod conditions;
-pub(crate) use conditions::basis_from_unit_normal;
 pub mod field;
 mod nodes;
 
+pub use checks::FIT_WARNING_FRACTION;
+use checks::check_discretisation;
 pub use field::{
     BuildError, ConditionField, Field, NodeField, PatchField, ProbeField, ProgrammeField, Result,
     SolverField, StentField, TimeField,
@@ -49,9 +51,6 @@ pub const DEFAULT_MIN_STEP_FRACTION: Real = 1.0 / 1024.0;
 /// diagonal are the same point. Fits and exact primitives place shared ends to ~1e-14 relative, so 1e-8
 /// separates coincident ends from distinct ones with a wide margin on both sides.
 pub const DEFAULT_JOINT_TOLERANCE: Real = 1e-8;
-
-/// Fit deviation, as a fraction of the wire diameter, above which a build warns.
-pub const FIT_WARNING_FRACTION: Real = 0.01;
 
 /// Temperature of a model without a temperature schedule whose material does not depend on it [°C].
 pub const DEFAULT_TEMPERATURE: Real = 20.0;
@@ -813,25 +812,6 @@ fn wlf(law: &MaterialLaw) -> Option<&Wlf> {
         MaterialLaw::Maxwell(m) => m.material().wlf(),
         _ => None,
     }
-}
-
-/// Checks a discretisation: `p ≥ 2` (collocation of the strong form needs second derivatives), `n > p`.
-pub(super) fn check_discretisation(p: usize, n: usize, degree: Field, points: Field) -> Result<()> {
-    if p < 2 {
-        return Err(BuildError::new(
-            degree,
-            format!(
-                "degree p = {p} is too low: collocation of the strong form needs second derivatives, so p ≥ 2"
-            ),
-        ));
-    }
-    if n <= p {
-        return Err(BuildError::new(
-            points,
-            format!("n = {n} control points cannot carry degree p = {p}: need n > p"),
-        ));
-    }
-    Ok(())
 }
 
 fn check_solver(s: &SolverSettings) -> Result<()> {
