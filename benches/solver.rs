@@ -43,7 +43,8 @@ fn solver(c: &mut Criterion) {
                 for _ in 0..iterations {
                     sim = stents::warmed_up(&model);
                     let start = Instant::now();
-                    sim.run(&mut stents::OneStep).expect("the step converges");
+                    sim.run(&mut [&mut stents::OneStep])
+                        .expect("the step converges");
                     total += start.elapsed();
                 }
                 total

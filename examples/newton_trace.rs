@@ -51,7 +51,7 @@ fn main() -> anyhow::Result<()> {
     };
     let design = parse_design_with(&text, Path::new(&path), &overrides)?;
     let mut sim = Simulation::new(&design.model)?;
-    let summary = sim.run(&mut Trace(every.max(1)))?;
+    let summary = sim.run(&mut [&mut Trace(every.max(1))])?;
     println!("{summary:?}");
     for (name, value) in sim.timing().entries() {
         println!("{name}: {value:.4}");

@@ -49,7 +49,8 @@ fn main() {
         });
         let steps = 3;
         let step = mean_ms(steps, || {
-            sim.run(&mut stents::OneStep).expect("step converges");
+            sim.run(&mut [&mut stents::OneStep])
+                .expect("step converges");
         });
         println!(
             "{crowns:>6} {:>9} {:>9} {residual:>12.3} {tangent:>12.3} {factor:>15.3} {step:>10.2}",

@@ -16,7 +16,7 @@
 //! |---|---|
 //! | [`math`] | vocabulary types, knot vectors, B-spline/NURBS basis, curves, SO(3) maps |
 //! | [`geometry`] | exact NURBS primitives, analytic curves and their spline fits, rotation-minimising frames, tube surfaces |
-//! | [`material`] | Prony series, WLF shift, section stiffness |
+//! | [`material`] | the constitutive interface and its laws (elastic, Maxwell/WLF), Prony series, WLF shift, section stiffness |
 //! | [`model`] | the continuous problem: patches, nodes, conditions, loads, schedules |
 //! | [`solver`] | collocation, residual and tangent, Newton, time stepping |
 //! | [`post`] | the full device from a (symmetry-reduced) model or state: sampled shapes, mirror copies, tube meshes |

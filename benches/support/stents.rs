@@ -1,11 +1,12 @@
 //! Generated straight stents for the solver benchmarks (`benches/solver.rs`) and the scaling table
-//! (`examples/scaling.rs`): designs/straight_stent.yaml with its crown count changed, on a moderate mesh so
-//! that 64 crowns stay feasible, and a simulation advanced a few steps into the contraction ramp.
+//! (`examples/scaling.rs`): the paper's straight stent built in code (`examples/common/straight_stent.rs`)
+//! with its crown count changed, on a moderate mesh so that 64 crowns stay feasible, and a simulation
+//! advanced a few steps into the contraction ramp.
+
+#[path = "../../examples/common/straight_stent.rs"]
+mod straight_stent;
 
 use std::ops::ControlFlow;
-use std::path::Path;
-use stentkit::io::design::{DesignOverrides, parse_design_with};
-use stentkit::io::yaml_edit::set_yaml;
 use stentkit::model::Model;
 use stentkit::solver::{Observer, Simulation, StepReport};
 
@@ -18,17 +19,10 @@ pub const STEP: f64 = 0.01;
 /// Steps taken before measuring, so that the state is deformed and the history non-trivial.
 pub const WARM_UP_STEPS: usize = 3;
 
-/// The straight stent of designs/straight_stent.yaml with `crowns` crowns on the benchmark mesh.
+/// The paper's straight stent with `crowns` crowns on the benchmark mesh and step.
 pub fn stent_model(crowns: usize) -> Model {
-    let text = include_str!("../../designs/straight_stent.yaml");
-    let text = set_yaml(text, &["stent", "crowns"], crowns.into()).expect("the design is YAML");
-    let overrides = DesignOverrides {
-        degree: Some(MESH.0),
-        points: Some(MESH.1),
-        step: Some(STEP),
-        ..DesignOverrides::default()
-    };
-    parse_design_with(&text, Path::new("straight_stent.yaml"), &overrides)
+    straight_stent::straight_stent(crowns, MESH, STEP)
+        .build()
         .expect("the generated stent is valid")
         .model
 }
@@ -58,7 +52,7 @@ impl Observer for OneStep {
 /// A simulation of `model` advanced [`WARM_UP_STEPS`] steps into the ramp.
 pub fn warmed_up(model: &Model) -> Simulation<'_> {
     let mut sim = Simulation::new(model).expect("simulation");
-    sim.run(&mut StopAfter(WARM_UP_STEPS))
+    sim.run(&mut [&mut StopAfter(WARM_UP_STEPS)])
         .expect("the first steps of the ramp converge");
     sim
 }

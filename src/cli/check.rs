@@ -1,8 +1,9 @@
 //! `stentkit check`: validate a design and describe what a run would solve.
 
-use crate::io::design::build::{MEMORY_LIMIT_BYTES, human_bytes};
+use crate::io::design::size::{MEMORY_LIMIT_BYTES, human_bytes};
 use crate::io::design::{Design, load_design};
 use crate::io::estimate::estimated_disk;
+use crate::material::{ConstitutiveLaw, MaterialLaw};
 use crate::model::Component;
 use std::fmt::Write as _;
 use std::path::Path;
@@ -20,37 +21,16 @@ pub fn describe(design: &Design, file: &str) -> String {
     let mut s = String::new();
     let u = model.units;
     let _ = writeln!(s, "design      {} ({file}), units {}", model.name, u.name());
-    let m = &model.material;
-    let _ = write!(
-        s,
-        "material    E_inf = {} {}, {} Maxwell branches (E0 = {} {}), nu = {}",
-        m.prony().e_inf(),
-        u.stress(),
-        m.num_branches(),
-        m.prony().instantaneous_modulus(),
-        u.stress(),
-        m.poisson()
-    );
-    match m.wlf() {
-        Some(w) => {
-            let _ = writeln!(
-                s,
-                ", WLF C1 = {}, C2 = {} K, Tg = {} °C (frozen at and below {} °C), integrator {}",
-                w.c1(),
-                w.c2(),
-                w.tg(),
-                w.frozen_below(),
-                model.integrator.name()
-            );
-        }
-        None => {
-            let _ = writeln!(
-                s,
-                ", no WLF shift (temperature-independent), integrator {}",
-                model.integrator.name()
-            );
-        }
+    for (k, law) in model.materials.iter().enumerate() {
+        let label = if model.materials.len() == 1 {
+            "material   ".to_string()
+        } else {
+            format!("material {k} ")
+        };
+        let _ = writeln!(s, "{label} {}", describe_material(law, u.stress()));
     }
+    // Shear factors with the first material's ν (the design's one material).
+    let poisson = model.materials.first().map_or(0.0, |m| m.poisson());
     for (k, sec) in model.sections.iter().enumerate() {
         let kind = match sec {
             crate::material::Section::Circular(_) => {
@@ -68,7 +48,7 @@ pub fn describe(design: &Design, file: &str) -> String {
         let _ = writeln!(
             s,
             "section {k}   {kind}, shear factor {:.4}",
-            sec.shear_factor(m.poisson())
+            sec.shear_factor(poisson)
         );
     }
     let _ = writeln!(s, "patches     {}", model.patches.len());
@@ -191,4 +171,38 @@ pub fn describe(design: &Design, file: &str) -> String {
         }
     }
     s
+}
+
+/// One line about a material: the elastic modulus, or the Prony series, the WLF shift and the integrator.
+fn describe_material(law: &MaterialLaw, stress: &str) -> String {
+    match law {
+        MaterialLaw::Elastic(e) => format!(
+            "elastic, E = {} {stress}, nu = {} (no Maxwell branches, no WLF shift)",
+            e.modulus(),
+            e.poisson()
+        ),
+        MaterialLaw::Maxwell(law) => {
+            let m = law.material();
+            let integrator = law.integrator().name();
+            let head = format!(
+                "E_inf = {} {stress}, {} Maxwell branches (E0 = {} {stress}), nu = {}",
+                m.prony().e_inf(),
+                m.num_branches(),
+                m.prony().instantaneous_modulus(),
+                m.poisson()
+            );
+            match m.wlf() {
+                Some(w) => format!(
+                    "{head}, WLF C1 = {}, C2 = {} K, Tg = {} °C (frozen at and below {} °C), integrator {integrator}",
+                    w.c1(),
+                    w.c2(),
+                    w.tg(),
+                    w.frozen_below(),
+                ),
+                None => format!(
+                    "{head}, no WLF shift (temperature-independent), integrator {integrator}"
+                ),
+            }
+        }
+    }
 }

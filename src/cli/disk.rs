@@ -4,8 +4,8 @@
 
 use super::BadInput;
 use crate::io::design::Design;
-use crate::io::design::build::human_bytes;
 use crate::io::design::locate::Locator;
+use crate::io::design::size::human_bytes;
 use crate::io::estimate::{DiskEstimate, estimated_disk};
 use crate::io::run_folder::FitFolder;
 use crate::math::Real;

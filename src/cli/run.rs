@@ -20,7 +20,7 @@
 
 use super::signals;
 use super::{BadInput, Interrupted, error_text, short_time};
-use crate::io::design::build::human_bytes;
+use crate::io::design::size::human_bytes;
 use crate::io::design::{Design, load_design};
 use crate::io::history::HistoryWriter;
 use crate::io::mcap::{McapRecorder, RunInfo};
@@ -403,10 +403,10 @@ fn run_in(
     summary.summary.timing.setup_s = started.elapsed().as_secs_f64();
 
     let run_started = Instant::now();
-    let result = sim.run(&mut RunObserver {
+    let result = sim.run(&mut [&mut RunObserver {
         outputs: &mut outputs,
         summary: &mut summary,
-    });
+    }]);
     summary.summary.timing.run_s = run_started.elapsed().as_secs_f64();
     outputs.progress.bar.finish_and_clear();
     outputs.progress.notices(&sim);

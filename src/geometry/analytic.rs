@@ -2,8 +2,8 @@
 //! lists (through their cubic interpolant) and any of them mapped by a placement
 //! `P = c(s) + R(s) P_local` along a centreline. [`super::fit`] turns them into analysis splines.
 
-use super::GeometryError;
 use super::frame::{FrameField, FrameSettings};
+use super::{GeometryError, Parameter};
 use crate::math::{KnotVector, Mat3, NurbsCurve, Real, Vec3, interp};
 
 /// A smooth parametric curve `t ∈ [t0, t1] ↦ c(t)`.
@@ -43,7 +43,7 @@ pub fn frame_from_axis(axis: &Vec3, x_hint: Option<Vec3>) -> Result<Mat3, Geomet
     let n = axis.norm();
     if !(n > 0.0) || !n.is_finite() {
         return Err(GeometryError::InvalidParameter {
-            what: "axis",
+            what: Parameter::Axis,
             reason: format!("must be a non-zero finite vector, got {axis:?}"),
         });
     }
@@ -187,7 +187,7 @@ impl ParametricCurve for NurbsCurve {
 pub fn point_list_curve(points: &[Vec3]) -> Result<NurbsCurve, GeometryError> {
     if points.len() < 2 {
         return Err(GeometryError::InvalidParameter {
-            what: "points",
+            what: Parameter::Points,
             reason: format!("need at least 2 points, got {}", points.len()),
         });
     }
@@ -197,7 +197,7 @@ pub fn point_list_curve(points: &[Vec3]) -> Result<NurbsCurve, GeometryError> {
         let d = (w[1] - w[0]).norm();
         if !(d > 0.0) || !d.is_finite() {
             return Err(GeometryError::InvalidParameter {
-                what: "points",
+                what: Parameter::Points,
                 reason: format!("points {k} and {} coincide or are not finite", k + 1),
             });
         }

@@ -3,8 +3,8 @@
 //! length (`u = s / L`), so the parametric speed of the fit is nearly constant — what collocation wants.
 //! The largest deviation from the analytic curve is measured and reported.
 
-use super::GeometryError;
 use super::analytic::{ArcLengthTable, ParametricCurve};
+use super::{GeometryError, Parameter};
 use crate::math::{KnotVector, NurbsCurve, Real, interp};
 
 /// Settings of a fit.
@@ -53,7 +53,7 @@ pub fn fit_curve(
     let length = table.length();
     if !(length > 0.0) || !length.is_finite() {
         return Err(GeometryError::InvalidParameter {
-            what: "curve",
+            what: Parameter::Curve,
             reason: format!("its length is {length}; it must be positive and finite"),
         });
     }
@@ -62,7 +62,7 @@ pub fn fit_curve(
     let points: Vec<_> = params.iter().map(|&u| on_curve(u)).collect();
     if let Some(k) = points.iter().position(|p| !p.iter().all(|x| x.is_finite())) {
         return Err(GeometryError::InvalidParameter {
-            what: "curve",
+            what: Parameter::Curve,
             reason: format!("its point at u = {} is not finite", params[k]),
         });
     }

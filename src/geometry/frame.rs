@@ -92,6 +92,13 @@ pub fn arc_length_derivatives(
     })
 }
 
+/// The orthonormal right-handed basis (as columns) whose first axis is the unit vector `e1`, the second
+/// [`normal_to`] it without a hint.
+pub fn basis_from_unit_axis(e1: &Vec3) -> Mat3 {
+    let e2 = normal_to(e1, None);
+    Mat3::from_columns(&[*e1, e2, e1.cross(&e2)])
+}
+
 /// A unit vector normal to `t`, as close as possible to `hint` (or to the global axis least aligned with `t`
 /// when no usable hint is given).
 pub fn normal_to(t: &Vec3, hint: Option<Vec3>) -> Vec3 {

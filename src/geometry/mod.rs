@@ -19,6 +19,55 @@ pub mod tube;
 
 use crate::math::{MathError, Real};
 
+/// The parameter of a primitive, analytic curve or fit that an [`GeometryError::InvalidParameter`] is about:
+/// a caller maps it to its own input (a design file's field) without reading the message.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Parameter {
+    /// The degree of a primitive.
+    Degree,
+    /// The number of control points of a primitive.
+    ControlPoints,
+    /// A line's start point.
+    LineStart,
+    /// A line's end point.
+    LineEnd,
+    /// A line's two end points together (they coincide).
+    LineEnds,
+    /// An arc's centre.
+    ArcCentre,
+    /// An arc's start point.
+    ArcStart,
+    /// An arc's axis.
+    ArcAxis,
+    /// An arc's angle.
+    ArcAngle,
+    /// The axis of a rigid placement.
+    Axis,
+    /// The points a curve passes through.
+    Points,
+    /// A curve to be fitted.
+    Curve,
+}
+
+impl std::fmt::Display for Parameter {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(match self {
+            Parameter::Degree => "degree",
+            Parameter::ControlPoints => "number of control points",
+            Parameter::LineStart => "line start point",
+            Parameter::LineEnd => "line end point",
+            Parameter::LineEnds => "line end points",
+            Parameter::ArcCentre => "arc centre",
+            Parameter::ArcStart => "arc start point",
+            Parameter::ArcAxis => "arc axis",
+            Parameter::ArcAngle => "arc angle",
+            Parameter::Axis => "axis",
+            Parameter::Points => "points",
+            Parameter::Curve => "curve",
+        })
+    }
+}
+
 /// Errors raised when geometric data cannot produce a valid curve, frame or surface.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum GeometryError {
@@ -29,7 +78,7 @@ pub enum GeometryError {
     #[error("invalid {what}: {reason}")]
     InvalidParameter {
         /// Which parameter.
-        what: &'static str,
+        what: Parameter,
         /// What is wrong, with the value.
         reason: String,
     },

@@ -7,7 +7,7 @@
 //! (A5.4). Elevation and insertion only form convex combinations of homogeneous control points, so the
 //! result is the same line or circle to rounding, and it is `C^{p−1}` inside the patch, as collocation needs.
 
-use crate::geometry::GeometryError;
+use crate::geometry::{GeometryError, Parameter};
 use crate::math::{KnotVector, NurbsCurve, Real, Vec3};
 
 /// Largest arc angle of one patch, in radians: 150°.
@@ -33,13 +33,13 @@ const ANGLE_SLACK: Real = 4.0 * Real::EPSILON;
 fn check_refinement(degree: usize, n: usize, min_degree: usize) -> Result<(), GeometryError> {
     if degree < min_degree {
         return Err(GeometryError::InvalidParameter {
-            what: "degree",
+            what: Parameter::Degree,
             reason: format!("this primitive needs degree ≥ {min_degree}, got {degree}"),
         });
     }
     if n < degree + 1 {
         return Err(GeometryError::InvalidParameter {
-            what: "number of control points",
+            what: Parameter::ControlPoints,
             reason: format!(
                 "degree {degree} needs at least {} control points, got {n}",
                 degree + 1
@@ -50,7 +50,7 @@ fn check_refinement(degree: usize, n: usize, min_degree: usize) -> Result<(), Ge
 }
 
 /// Fails unless every coordinate of `v` is finite.
-fn check_finite(what: &'static str, v: &Vec3) -> Result<(), GeometryError> {
+fn check_finite(what: Parameter, v: &Vec3) -> Result<(), GeometryError> {
     if v.iter().all(|x| x.is_finite()) {
         Ok(())
     } else {
@@ -69,11 +69,11 @@ fn check_finite(what: &'static str, v: &Vec3) -> Result<(), GeometryError> {
 /// the parametrisation stays linear.
 pub fn line(a: Vec3, b: Vec3, degree: usize, n: usize) -> Result<NurbsCurve, GeometryError> {
     check_refinement(degree, n, 1)?;
-    check_finite("line start point", &a)?;
-    check_finite("line end point", &b)?;
+    check_finite(Parameter::LineStart, &a)?;
+    check_finite(Parameter::LineEnd, &b)?;
     if a == b {
         return Err(GeometryError::InvalidParameter {
-            what: "line end points",
+            what: Parameter::LineEnds,
             reason: format!("start and end coincide at ({}, {}, {})", a.x, a.y, a.z),
         });
     }
@@ -104,18 +104,18 @@ pub fn arc(
     n: usize,
 ) -> Result<NurbsCurve, GeometryError> {
     check_refinement(degree, n, 2)?;
-    check_finite("arc centre", &center)?;
-    check_finite("arc start point", &start)?;
-    check_finite("arc axis", &axis)?;
+    check_finite(Parameter::ArcCentre, &center)?;
+    check_finite(Parameter::ArcStart, &start)?;
+    check_finite(Parameter::ArcAxis, &axis)?;
     if !angle.is_finite() || angle == 0.0 {
         return Err(GeometryError::InvalidParameter {
-            what: "arc angle",
+            what: Parameter::ArcAngle,
             reason: format!("must be finite and non-zero, got {angle}"),
         });
     }
     if angle.abs() > MAX_ARC_ANGLE * (1.0 + ANGLE_SLACK) {
         return Err(GeometryError::InvalidParameter {
-            what: "arc angle",
+            what: Parameter::ArcAngle,
             reason: format!(
                 "|angle| = {:.3}° exceeds the {:.0}° one patch can represent well; split the arc into \
                  several patches (e.g. {} of {:.3}°)",
@@ -129,7 +129,7 @@ pub fn arc(
     let axis_norm = axis.norm();
     if axis_norm == 0.0 {
         return Err(GeometryError::InvalidParameter {
-            what: "arc axis",
+            what: Parameter::ArcAxis,
             reason: "the axis is zero".into(),
         });
     }
@@ -140,7 +140,7 @@ pub fn arc(
     let radius = radial.norm();
     if radius == 0.0 || along.abs() > PERPENDICULAR_TOLERANCE * offset.norm() {
         return Err(GeometryError::InvalidParameter {
-            what: "arc start point",
+            what: Parameter::ArcStart,
             reason: format!(
                 "start − centre must be non-zero and perpendicular to the axis: its axial component is {along:e}, \
                  its radial length {radius:e}"

@@ -8,7 +8,7 @@
 use std::io::{self, Write};
 use std::path::Path;
 
-use crate::geometry::tube::TriangleMesh;
+use crate::geometry::mesh::TriangleMesh;
 use crate::io::stl::{MeshIoError, check_writable, write_atomically};
 
 /// Writes `mesh` to `path` as OBJ, atomically (see [`crate::io::stl`]); `header` (e.g. `"units: mm-N-MPa"`,
@@ -56,7 +56,9 @@ pub fn write_obj_to<W: Write>(w: &mut W, mesh: &TriangleMesh, header: &str) -> i
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::geometry::tube::{TubeSettings, parallel_transport_frames, sphere, sweep_tube};
+    use crate::geometry::polyline::parallel_transport_frames;
+    use crate::geometry::sphere::sphere;
+    use crate::geometry::tube::{TubeSettings, sweep_tube};
     use crate::math::{Real, Vec3};
     use std::fs;
     use std::path::PathBuf;

@@ -16,7 +16,7 @@ use std::io::{self, BufReader, BufWriter, Write};
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicU64, Ordering};
 
-use crate::geometry::tube::TriangleMesh;
+use crate::geometry::mesh::TriangleMesh;
 use crate::math::Vec3;
 
 /// Length of the binary STL header in bytes.
@@ -300,9 +300,10 @@ where
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::geometry::tube::{
-        MeshDefect, TubeSettings, parallel_transport_frames, sphere, sweep_tube,
-    };
+    use crate::geometry::mesh::MeshDefect;
+    use crate::geometry::polyline::parallel_transport_frames;
+    use crate::geometry::sphere::sphere;
+    use crate::geometry::tube::{TubeSettings, sweep_tube};
     use crate::math::{Mat3, Real};
 
     /// A fresh, empty scratch directory under the system temporary directory.

@@ -20,7 +20,7 @@ use crate::math::{Mat3, Real, Vec3};
 
 /// The section law `N = C̄_N Γ_N − H_N`, `M = C̄_M K_M − H_M` (and the same for the s-derivatives) of one
 /// point during one time step (module docs).
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct SectionLaw {
     /// Diagonal of `C̄_N = diag(S_N ⊙ Ē)` \[force\].
     force_stiffness: Vec3,

@@ -1,5 +1,14 @@
-//! Material: the generalized Maxwell (Prony) solid, the WLF shift of relaxation times, cross-section
-//! stiffnesses and the internal-variable updates.
+//! Material: the constitutive interface the solver calls ([`ConstitutiveLaw`], [`constitutive`]), its laws —
+//! the generalized Maxwell (Prony) solid with the WLF shift of relaxation times ([`MaxwellLaw`]) and the plain
+//! elastic material ([`ElasticLaw`]) —, cross-section stiffnesses and the internal-variable updates.
+//!
+//! # Laws
+//!
+//! The laws are registered in one list, the `register_laws!` invocation below, which makes [`MaterialLaw`] (the
+//! material of a model's patch) and [`MaterialState`] (its internal variables). **A new law is a new module
+//! plus one registration line**: write `material/<law>.rs` implementing [`ConstitutiveLaw`], declare it here
+//! (`pub mod <law>;`) and add `Name(<law>::Type),` to the list (see [`constitutive`] for the interface and why
+//! it is an enum).
 //!
 //! # Model (paper §2.2, §3.1)
 //!
@@ -43,14 +52,43 @@
 //! Constructors validate their data (`try_new`) and report the offending value in a [`MaterialError`];
 //! time stepping reports non-finite inputs (a temperature schedule returning NaN) rather than propagating NaN.
 
+pub mod constitutive;
+pub mod elastic;
 pub mod history;
 pub mod integrator;
 pub mod law;
+pub mod maxwell;
 pub mod point;
 pub mod prony;
 pub mod section;
 pub mod wlf;
 
+// The registry of constitutive laws: one line per law (module docs).
+constitutive::register_laws! {
+    /// Linear elastic: a modulus and a Poisson ratio, no internal variables ([`elastic`]).
+    Elastic(elastic::ElasticLaw),
+    /// Generalized Maxwell solid with WLF shift and a time integrator (paper §2.2, §3.1; [`maxwell`]).
+    Maxwell(maxwell::MaxwellLaw),
+}
+
+impl MaterialLaw {
+    /// The simplest law that represents `material` advanced by `integrator`: [`ElasticLaw`] with `E = E∞` when
+    /// the Prony series has no branches and there is no WLF shift (no internal variables, no temperature
+    /// dependence: the same numbers as the Maxwell law would give, with nothing to store or prepare), otherwise
+    /// [`MaxwellLaw`].
+    pub fn from_material(material: Material, integrator: Integrator) -> Self {
+        if material.num_branches() == 0 && material.wlf().is_none() {
+            // `Material` validated both: E0 = E∞ finite and > 0 without branches, −1 < ν < 0.5.
+            if let Ok(elastic) = ElasticLaw::try_new(material.prony().e_inf(), material.poisson()) {
+                return elastic.into();
+            }
+        }
+        MaxwellLaw::new(material, integrator).into()
+    }
+}
+
+pub use constitutive::{ConstitutiveLaw, MaterialNotice, StepInput};
+pub use elastic::{ElasticLaw, ElasticState};
 pub use history::{
     BranchHistory, SectionStrains, SectionStress, history_stress, update_branch_strains,
 };
@@ -59,6 +97,7 @@ pub use integrator::{
     reduced_time_increment, step_coefficients, step_coefficients_into,
 };
 pub use law::SectionLaw;
+pub use maxwell::{MaxwellLaw, MaxwellState};
 pub use point::{simulate_strain_history, simulate_stress_history};
 pub use prony::{Prony, PronyBranch};
 pub use section::{CircularSection, Section, SectionProperties, SectionShape, ShearFactor};
@@ -154,6 +193,21 @@ pub enum MaterialError {
         time: Real,
         /// What it returned.
         value: Real,
+    },
+    /// An elastic modulus is not positive or not finite.
+    #[error("elastic modulus E = {value} must be finite and > 0")]
+    ElasticModulus {
+        /// The rejected modulus \[stress\].
+        value: Real,
+    },
+    /// A saved material state has another length than the state it is restored into (a checkpoint of another
+    /// model or material).
+    #[error("a saved material state of {found} numbers cannot be restored into one of {expected}")]
+    StateLength {
+        /// Numbers the state saves.
+        expected: usize,
+        /// Numbers given.
+        found: usize,
     },
     /// Stress control is impossible: the step's effective modulus vanished (a Maxwell fluid, `E∞ = 0`, whose
     /// branches all relax completely within one step cannot carry a prescribed stress).

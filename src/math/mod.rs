@@ -1,6 +1,6 @@
 //! Mathematical vocabulary and kernels: the crate's small types, knot vectors, B-spline and NURBS basis
 //! functions with derivatives, curves (evaluation, knot insertion, degree elevation, interpolation) and the SO(3)
-//! maps the rod kinematics needs.
+//! maps the rod kinematics needs, and how numbers and user values are quoted in messages ([`quote`], [`Short`]).
 //!
 //! Everything here is pure and allocation-light; algorithms cite their source (Piegl & Tiller, *The NURBS
 //! Book*, 2nd ed., algorithm numbers A2.1 …).
@@ -9,6 +9,7 @@ pub mod basis;
 pub mod curve;
 pub mod interp;
 pub mod knots;
+pub mod quote;
 pub mod so3;
 
 pub use basis::BasisTable;

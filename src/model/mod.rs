@@ -1,18 +1,21 @@
-//! The continuous problem: patches (reference centrelines), cross-sections and material, nodes that join
+//! The continuous problem: patches (reference centrelines), cross-sections and materials, nodes that join
 //! patch ends, boundary conditions and loads per node in a local basis, distributed loads, the temperature
 //! schedule, time and solver settings, and named probes.
 //!
-//! A [`Model`] is built and validated by the `io` layer from a design file (or by hand in tests); it holds no
-//! file names or YAML positions. Every physical field is in the design's consistent unit system
+//! A [`Model`] is built and validated by [`builder::ModelBuilder`] (in Rust, or from a design file by the `io`
+//! layer, which translates YAML into builder calls); [`stent`] puts a generated stent and its programme into it.
+//! It holds no file names or YAML positions. Every physical field is in the design's consistent unit system
 //! ([`Units`]); temperatures are in °C.
 
+pub mod builder;
 pub mod programme;
 pub mod schedule;
+pub mod stent;
 
 pub use programme::{DrivenNode, Programme, ProgrammeError, ProgrammeKind};
 pub use schedule::{ScheduleError, TimeFunction};
 
-use crate::material::{Integrator, Material, Section};
+use crate::material::{MaterialLaw, Section};
 use crate::math::{Mat3, NurbsCurve, Real, Vec3};
 use std::collections::BTreeMap;
 
@@ -76,6 +79,8 @@ pub struct Patch {
     pub normal_hint: Option<Vec3>,
     /// Index into [`Model::sections`].
     pub section: usize,
+    /// Index into [`Model::materials`].
+    pub material: usize,
     /// Largest deviation of `curve` from the analytic curve it was fitted to [length]; `None` when exact.
     pub fit_error: Option<Real>,
 }
@@ -340,10 +345,9 @@ pub struct Model {
     pub name: String,
     /// Unit system of every number.
     pub units: Units,
-    /// The thermo-viscoelastic material (one per design).
-    pub material: Material,
-    /// Internal-variable update of the Maxwell branches.
-    pub integrator: Integrator,
+    /// The materials (constitutive laws), referred to by [`Patch::material`]. A design file gives one, which
+    /// every patch uses.
+    pub materials: Vec<MaterialLaw>,
     /// Cross-sections, referred to by [`Patch::section`].
     pub sections: Vec<Section>,
     /// Rod patches.

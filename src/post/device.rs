@@ -9,10 +9,10 @@
 //! rods ending on a plane are welded to their mirror images ([`device_mesh`]).
 
 use crate::geometry::GeometryError;
+use crate::geometry::device_tubes::{DeviceMeshError, RodTube, device_mesh, section_phase};
 use crate::geometry::frame::{FrameField, FrameSettings};
-use crate::geometry::tube::{
-    DeviceMeshError, RodTube, TriangleMesh, TubeError, TubeSettings, device_mesh, section_phase,
-};
+use crate::geometry::mesh::TriangleMesh;
+use crate::geometry::tube::{TubeError, TubeSettings};
 use crate::math::{Real, Vec3};
 use crate::model::Model;
 use crate::solver::Simulation;

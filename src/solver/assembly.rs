@@ -31,7 +31,7 @@
 use super::discretisation::{CollocationPoint, Discretisation};
 use super::gauge::Gauge;
 use super::state::State;
-use crate::material::{SectionLaw, SectionStrains, SectionStress};
+use crate::material::{ConstitutiveLaw, SectionLaw, SectionStrains};
 use crate::math::so3::{hat, log};
 use crate::math::{Mat3, Real, Rot3, Vec3};
 use crate::model::{Component, Model};
@@ -166,24 +166,20 @@ impl Actions {
     }
 }
 
-/// The constitutive data of one time step: the effective modulus of `C̄ = modulus · shape` and, per
-/// collocation point, the history stresses `H` (empty = all zero, elastic).
+/// The constitutive data of one time step: the section law of every collocation point (from its patch's
+/// material, [`crate::material::ConstitutiveLaw::section_law`]).
 #[derive(Debug, Clone, Copy)]
 pub struct StepMaterial<'a> {
-    /// Effective modulus of `C̄` [stress].
-    pub modulus: Real,
-    /// History stresses per collocation point.
-    pub history: &'a [SectionStress],
+    /// Section law per collocation point.
+    pub laws: &'a [SectionLaw],
 }
 
 impl StepMaterial<'_> {
     /// The section law of collocation point `g` (the one place the residual, tangent and resultants take `N`,
     /// `M` and `C̄` from).
     #[inline]
-    fn law(&self, disc: &Discretisation, g: usize) -> SectionLaw {
-        let shape = &disc.shapes[disc.points[g].shape];
-        let history = self.history.get(g).copied().unwrap_or_default();
-        SectionLaw::new(shape, self.modulus, history)
+    fn law(&self, g: usize) -> SectionLaw {
+        self.laws[g]
     }
 }
 
@@ -216,8 +212,8 @@ struct NodeRows {
 #[derive(Debug, Clone)]
 pub struct Assembler {
     nodes: Vec<NodeRows>,
-    /// Reference modulus for residual scales (instantaneous modulus) [stress].
-    modulus_scale: Real,
+    /// Reference modulus of each patch's material for residual scales (instantaneous modulus) [stress].
+    modulus_scale: Vec<Real>,
     /// Length of each patch [length].
     patch_length: Vec<Real>,
     /// Tangent entries pushed by each collocation point's interior equations (zero at patch ends), and their
@@ -278,7 +274,11 @@ impl Assembler {
                 }
             })
             .collect();
-        let modulus_scale = model.material.prony().instantaneous_modulus();
+        let modulus_scale = model
+            .patches
+            .iter()
+            .map(|p| model.materials[p.material].reference_modulus())
+            .collect();
         let patch_length = model
             .patches
             .iter()
@@ -440,7 +440,7 @@ impl Assembler {
                 let point = &disc.points[e.point];
                 let kin = kinematics(point, state, e.point);
                 let stress = material
-                    .law(disc, e.point)
+                    .law(e.point)
                     .stress(&strains(point, state, e.point, &kin));
                 let (N, M) = (stress.force, stress.moment);
                 let R = &state.rotation[e.point];
@@ -462,7 +462,7 @@ impl Assembler {
         row_scale: &mut [Real],
         sink: &mut Sink<'_>,
     ) {
-        let law = material.law(disc, g);
+        let law = material.law(g);
         let (CN, CM) = law.stiffness_matrices();
         let k = kinematics(point, state, g);
         let stress = law.stress(&strains(point, state, g, &k));
@@ -485,8 +485,9 @@ impl Assembler {
         residual[3..6].copy_from_slice(T.as_slice());
         let length = self.patch_length[point.patch];
         let shape = &disc.shapes[point.shape];
-        let force_scale = self.modulus_scale * shape.force.x / length;
-        let moment_scale = self.modulus_scale * shape.moment.y / (length * length);
+        let modulus_scale = self.modulus_scale[point.patch];
+        let force_scale = modulus_scale * shape.force.x / length;
+        let moment_scale = modulus_scale * shape.moment.y / (length * length);
         row_scale[..3].fill(force_scale);
         row_scale[3..6].fill(moment_scale);
         if matches!(sink, Sink::Discard) {
@@ -536,8 +537,9 @@ impl Assembler {
         let p1 = &disc.points[g1];
         let length = self.patch_length[p1.patch];
         let shape1 = &disc.shapes[p1.shape];
-        let force_scale = self.modulus_scale * shape1.force.x;
-        let moment_scale = self.modulus_scale * shape1.moment.y / length;
+        let modulus_scale = self.modulus_scale[p1.patch];
+        let force_scale = modulus_scale * shape1.force.x;
+        let moment_scale = modulus_scale * shape1.moment.y / length;
         // Equilibrium residual (spatial) and, per end and support control point, its 6×6 blocks in the local basis.
         let mut force = -actions.node_force[k];
         let mut moment = -actions.node_moment[k];
@@ -552,7 +554,7 @@ impl Assembler {
         let mut terms = Vec::with_capacity(node.ends.len());
         for e in &node.ends {
             let point = &disc.points[e.point];
-            let law = material.law(disc, e.point);
+            let law = material.law(e.point);
             let (CN, CM) = law.stiffness_matrices();
             let kin = kinematics(point, state, e.point);
             let stress = law.stress(&strains(point, state, e.point, &kin));
@@ -747,15 +749,21 @@ pub fn point_position(disc: &Discretisation, control: &[Vec3], g: usize) -> Vec3
         .sum()
 }
 
-/// Arc length of a curve by 5-point Gauss–Legendre on each knot span, subdivided 8 times (round-off accurate
-/// for the smooth analysis splines; used only for residual scales).
+/// Parts of each knot span in [`curve_length`]'s quadrature: 5-point Gauss–Legendre is exact for polynomials of
+/// degree 9, and eight parts of a span of a smooth analysis spline bring the speed `|c'(u)|` (not a polynomial)
+/// within round-off; the length only scales residuals, so any accuracy near that is enough.
+const LENGTH_PARTS_PER_SPAN: usize = 8;
+
+/// Arc length of a curve by 5-point Gauss–Legendre on [`LENGTH_PARTS_PER_SPAN`] parts of each knot span (used
+/// only for residual scales).
 fn curve_length(curve: &crate::math::NurbsCurve) -> Real {
     let breaks = curve.knots().breakpoints();
+    let parts = LENGTH_PARTS_PER_SPAN as Real;
     let mut total = 0.0;
     for w in breaks.windows(2) {
-        for k in 0..8 {
-            let a = w[0] + (w[1] - w[0]) * k as Real / 8.0;
-            let b = w[0] + (w[1] - w[0]) * (k + 1) as Real / 8.0;
+        for k in 0..LENGTH_PARTS_PER_SPAN {
+            let a = w[0] + (w[1] - w[0]) * k as Real / parts;
+            let b = w[0] + (w[1] - w[0]) * (k + 1) as Real / parts;
             total += crate::geometry::analytic::gauss_legendre_5(a, b, |u| {
                 curve.derivatives(u, 1)[1].norm()
             });

@@ -21,8 +21,8 @@
 //! interior only: a patch whose interior block is singular on its own (with its ends held) is reported as a
 //! failed factorisation, and the caller falls back to the general sparse LU.
 
-use super::SolverError;
 use super::sparse::SparseSystem;
+use super::{LinearError, SolverError};
 use crate::math::Real;
 use rayon::prelude::*;
 
@@ -266,9 +266,12 @@ impl BlockSystem {
         let mut ku = vec![0usize; patches.len()];
         for &(r, c) in entries {
             if r >= n || c >= n {
-                return Err(SolverError::Linear(format!(
-                    "entry ({r}, {c}) outside a {n}×{n} system"
-                )));
+                return Err(LinearError::EntryOutside {
+                    row: r,
+                    column: c,
+                    size: n,
+                }
+                .into());
             }
             match (interior[r], interior[c]) {
                 (Some((kr, i)), Some((kc, j))) => {

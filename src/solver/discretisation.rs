@@ -9,7 +9,7 @@
 
 use super::SolverError;
 use crate::geometry::frame::{FrameField, FrameSettings};
-use crate::material::SectionShape;
+use crate::material::{ConstitutiveLaw, SectionShape};
 use crate::math::basis::nurbs_basis;
 use crate::math::{Mat3, Real, Vec3};
 use crate::model::{End, Model, PatchEnd};
@@ -37,7 +37,7 @@ pub struct CollocationPoint {
     pub kappa0: Vec3,
     /// `K0,s`.
     pub kappa0_s: Vec3,
-    /// Index into [`Discretisation::shapes`].
+    /// Index into [`Discretisation::shapes`]: the shape of its patch's section and material.
     pub shape: usize,
     /// Index of the patch.
     pub patch: usize,
@@ -71,7 +71,8 @@ pub struct Discretisation {
     pub patches: Vec<PatchRange>,
     /// All collocation points, globally numbered.
     pub points: Vec<CollocationPoint>,
-    /// Section stiffness shapes (one per model section).
+    /// Section stiffness shapes, one per model material and section: material `m`, section `s` at
+    /// `m · sections + s` ([`Discretisation::shape_index`]).
     pub shapes: Vec<SectionShape>,
     /// Reference control points, globally numbered.
     pub control0: Vec<Vec3>,
@@ -83,14 +84,22 @@ impl Discretisation {
     /// Builds the collocation points, basis tables and reference kinematics of every patch.
     pub fn new(model: &Model) -> Result<Self, SolverError> {
         let shapes = model
-            .sections
+            .materials
             .iter()
-            .map(|s| model.material.section_shape(s))
+            .flat_map(|law| model.sections.iter().map(|s| law.section_shape(s)))
             .collect();
         let mut patches = Vec::with_capacity(model.patches.len());
         let mut points = Vec::with_capacity(model.num_collocation_points());
         let mut control0 = Vec::with_capacity(model.num_collocation_points());
         for (k, patch) in model.patches.iter().enumerate() {
+            assert!(
+                patch.material < model.materials.len(),
+                "patch `{}` refers to material {} of {}",
+                patch.name,
+                patch.material,
+                model.materials.len()
+            );
+            let shape = Self::shape_index(model, patch.material, patch.section);
             let curve = &patch.curve;
             let offset = control0.len();
             let p = curve.degree();
@@ -141,7 +150,7 @@ impl Discretisation {
                     gamma0_s,
                     kappa0: frame.curvature,
                     kappa0_s: frame.curvature_s,
-                    shape: patch.section,
+                    shape,
                     patch: k,
                 });
             }
@@ -162,6 +171,11 @@ impl Discretisation {
             control0,
             length_scale,
         })
+    }
+
+    /// The index into [`Discretisation::shapes`] of material `material` and section `section` of `model`.
+    pub fn shape_index(model: &Model, material: usize, section: usize) -> usize {
+        material * model.sections.len() + section
     }
 
     /// Number of unknowns (= equations).

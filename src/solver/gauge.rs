@@ -38,10 +38,15 @@ pub struct Gauge {
     pub scale: Real,
 }
 
+/// A unit vector whose projection off the vectors already spanned is shorter than this is taken as dependent on
+/// them (Gram–Schmidt in [`complement`]). Symmetry normals are either parallel (the same plane given twice,
+/// projections at round-off, ~1e-16) or at a stent's sector angle (at least a few degrees, projections ≳ 0.05):
+/// 1e-8 separates the two with margins of eight orders and more.
+const DEPENDENT: Real = 1e-8;
+
 /// Unit vectors spanning the orthogonal complement of `normals` (Gram–Schmidt: the normals first, then the
-/// global axes against them; vectors shorter than this after projection are dependent).
+/// global axes against them; vectors shorter than [`DEPENDENT`] after projection are dependent).
 fn complement(normals: &[Vec3]) -> Vec<Vec3> {
-    const DEPENDENT: Real = 1e-8;
     let mut spanned: Vec<Vec3> = Vec::new();
     for n in normals {
         let w = spanned.iter().fold(*n, |w, q| w - q * q.dot(&w));

@@ -21,6 +21,7 @@ pub use simulation::{NewtonReport, Observer, RunSummary, Simulation, SolverTimin
 
 use crate::geometry::GeometryError;
 use crate::math::Real;
+use faer::sparse::FaerError;
 
 /// Why a simulation could not proceed.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
@@ -38,7 +39,7 @@ pub enum SolverError {
     Material(#[from] crate::material::MaterialError),
     /// The sparse linear algebra failed for a reason other than singularity.
     #[error("linear solver: {0}")]
-    Linear(String),
+    Linear(#[from] LinearError),
     /// The tangent is structurally singular: no pivot for an unknown.
     #[error(
         "the tangent matrix is singular: no pivot for unknown {column}{}: is that patch or node free to move as a rigid body?",
@@ -84,6 +85,44 @@ pub enum SolverError {
         /// Why the last attempt was abandoned at once, if it was: where a NaN or infinity first appeared, or
         /// where an increment too large for a regular tangent was largest.
         diagnosis: Option<String>,
+    },
+}
+
+/// Why the sparse linear algebra failed for a reason other than a singular tangent (which is
+/// [`SolverError::Singular`]): each variant carries what is needed to act on it.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, thiserror::Error)]
+pub enum LinearError {
+    /// An assembled entry lies outside the system: a programmer error in the assembly's numbering.
+    #[error("entry ({row}, {column}) outside a {size}×{size} system")]
+    EntryOutside {
+        /// Row of the entry.
+        row: usize,
+        /// Column of the entry.
+        column: usize,
+        /// Number of unknowns (and equations).
+        size: usize,
+    },
+    /// The symbolic LU analysis of the pattern failed (faer: an index overflow or out of memory).
+    #[error("symbolic LU: {reason:?}")]
+    Symbolic {
+        /// Number of unknowns.
+        size: usize,
+        /// faer's reason.
+        reason: FaerError,
+    },
+    /// The LU workspace could not be allocated.
+    #[error("LU workspace: {bytes} bytes cannot be allocated")]
+    Workspace {
+        /// The workspace asked for \[bytes\].
+        bytes: usize,
+    },
+    /// The numeric LU failed for a reason other than a missing pivot (faer: an index overflow or out of memory).
+    #[error("numeric LU: {reason:?}")]
+    Numeric {
+        /// Number of unknowns.
+        size: usize,
+        /// faer's reason.
+        reason: FaerError,
     },
 }
 

@@ -5,7 +5,7 @@
 //! Assembly pushes entries in a fixed order (repeats allowed, they are summed); the pattern maps each pushed
 //! entry to its slot in the compressed columns once, so refilling the values is one pass with no sorting.
 
-use super::SolverError;
+use super::{LinearError, SolverError};
 use crate::math::Real;
 use faer::dyn_stack::{MemBuffer, MemStack, StackReq};
 use faer::sparse::linalg::LuError;
@@ -52,9 +52,12 @@ impl SparseSystem {
         for &k in &order {
             let (r, c) = entries[k];
             if r >= n || c >= n {
-                return Err(SolverError::Linear(format!(
-                    "entry ({r}, {c}) outside a {n}×{n} system"
-                )));
+                return Err(LinearError::EntryOutside {
+                    row: r,
+                    column: c,
+                    size: n,
+                }
+                .into());
             }
             if last != Some((r, c)) {
                 row_idx.push(r);
@@ -68,12 +71,14 @@ impl SparseSystem {
         }
         let pattern = SymbolicSparseColMatRef::new_checked(n, n, &col_ptr, None, &row_idx);
         let symbolic = factorize_symbolic_lu(pattern, Default::default())
-            .map_err(|e| SolverError::Linear(format!("symbolic LU: {e:?}")))?;
+            .map_err(|reason| LinearError::Symbolic { size: n, reason })?;
         let factor_req =
             symbolic.factorize_numeric_lu_scratch::<Real>(Par::Seq, Default::default());
         let solve_req = symbolic.solve_in_place_scratch::<Real>(1, Par::Seq);
         let alloc = |req: StackReq| {
-            MemBuffer::try_new(req).map_err(|e| SolverError::Linear(format!("LU workspace: {e:?}")))
+            MemBuffer::try_new(req).map_err(|_| LinearError::Workspace {
+                bytes: req.size_bytes(),
+            })
         };
         let factor_scratch = alloc(factor_req)?;
         let solve_scratch = alloc(solve_req)?;
@@ -159,7 +164,11 @@ impl SparseSystem {
                     location: String::new(),
                 })
             }
-            Err(LuError::Generic(e)) => Err(SolverError::Linear(format!("numeric LU: {e:?}"))),
+            Err(LuError::Generic(reason)) => Err(LinearError::Numeric {
+                size: self.n,
+                reason,
+            }
+            .into()),
         }
     }
 

@@ -4,38 +4,62 @@
 use super::assembly::{Actions, Assembler, Linearisation, Sink, StepMaterial};
 use super::discretisation::Discretisation;
 use super::state::State;
-use crate::io::design::parse_design;
-use crate::math::Real;
-use crate::model::Model;
-use std::path::Path;
+use crate::material::{CircularSection, ConstitutiveLaw, ElasticLaw, SectionLaw};
+use crate::math::{Real, Vec3};
+use crate::model::builder::{
+    ConditionSpec, DistributedLoadSpec, JointRule, ModelBuilder, PatchShape, PatchTarget, TimeSpec,
+};
+use crate::model::{Model, TimeFunction};
 
 /// A curved, loaded, two-patch test structure: a 60° arc (NURBS, so the rational basis is exercised) clamped at
 /// its start and joined at an angle to a straight patch whose free end carries a force and a couple; a
 /// distributed load acts on the arc. Elastic, ν = 0.3.
 fn test_model() -> Model {
-    let text = r#"
-units: SI
-material: {E_inf: 2.0e5, nu: 0.3}
-section: {diameter: 0.1}
-mesh: {p: 4, n: 9}
-patches:
-  - name: arc
-    arc: {center: [0, 1, 0], start: [0, 0, 0], axis: [0.2, 0, 1], angle_deg: 60}
-  - name: leg
-    line: {from: [0.84920778, 0.5, -0.16984156], to: [1.2, 0.9, 0.4]}
-joints: {tolerance: 1.0e-6}
-conditions:
-  - {node: arc.start, clamp: true}
-  - node: leg.end
-    force: [3, -2, 5]
-    moment: [0.5, 1, -0.7]
-distributed_loads:
-  - {patch: arc, force: [0, 0, -4], couple: [0.3, 0, 0]}
-time: {end: 1, step: 1}
-"#;
-    let model = parse_design(text, Path::new("tangent_test.yaml"))
-        .expect("valid test design")
-        .model;
+    let material = ElasticLaw::try_new(2.0e5, 0.3).expect("E > 0, ν = 0.3");
+    let section = CircularSection::try_new(0.1).expect("d > 0").into();
+    let mut b = ModelBuilder::new("tangent_test", material, section);
+    b.patch(
+        "arc",
+        PatchShape::Arc {
+            centre: Vec3::new(0.0, 1.0, 0.0),
+            start: Vec3::zeros(),
+            axis: Vec3::new(0.2, 0.0, 1.0),
+            angle: 60.0_f64.to_radians(),
+        },
+        4,
+        9,
+    );
+    b.patch(
+        "leg",
+        PatchShape::Line {
+            from: Vec3::new(0.84920778, 0.5, -0.16984156),
+            to: Vec3::new(1.2, 0.9, 0.4),
+        },
+        4,
+        9,
+    );
+    b.joints(JointRule {
+        automatic: true,
+        tolerance: Some(1e-6),
+    });
+    b.condition(ConditionSpec::clamp("arc.start"));
+    let constant = TimeFunction::constant;
+    b.condition(
+        ConditionSpec::at("leg.end")
+            .with_force(0, constant(3.0))
+            .with_force(1, constant(-2.0))
+            .with_force(2, constant(5.0))
+            .with_moment(0, constant(0.5))
+            .with_moment(1, constant(1.0))
+            .with_moment(2, constant(-0.7)),
+    );
+    b.distributed_load(DistributedLoadSpec {
+        patches: PatchTarget::Named("arc".into()),
+        force: [constant(0.0), constant(0.0), constant(-4.0)],
+        couple: [constant(0.3), constant(0.0), constant(0.0)],
+    });
+    b.time(TimeSpec::new(1.0, 1.0));
+    let model = b.build().expect("valid test model").model;
     assert_eq!(
         model.nodes.len(),
         3,
@@ -115,10 +139,15 @@ fn tangent_matches_central_differences_of_the_residual() {
     let disc = Discretisation::new(&model).expect("discretisation");
     let asm = Assembler::new(&model, &disc);
     let actions = Actions::at(&model, 1.0, &[]);
-    let material = StepMaterial {
-        modulus: model.material.prony().e_inf(),
-        history: &[],
-    };
+    let laws: Vec<SectionLaw> = disc
+        .points
+        .iter()
+        .map(|p| {
+            let law = &model.materials[model.patches[p.patch].material];
+            law.section_law(&law.new_state(vec![disc.shapes[p.shape]]), 0)
+        })
+        .collect();
+    let material = StepMaterial { laws: &laws };
     let n = disc.num_unknowns();
     // A deformed state: a smooth finite increment (translations ~5 % of the size, rotations ~0.3 rad).
     let mut state = State::reference(&disc);

@@ -3,7 +3,6 @@
 
 use crate::math::{Real, Vec3};
 use crate::model::{Model, ProbeLocation};
-use crate::solver::simulation::NoObserver;
 use crate::solver::{RunSummary, Simulation, SolverError};
 use std::time::Instant;
 
@@ -27,7 +26,7 @@ pub struct SampledRun {
 pub fn sample_run(model: &Model, samples: usize) -> Result<SampledRun, SolverError> {
     let started = Instant::now();
     let mut sim = Simulation::new(model)?;
-    let summary = sim.run(&mut NoObserver)?;
+    let summary = sim.run(&mut [])?;
     let wall = started.elapsed().as_secs_f64();
     let grid = (0..model.patches.len())
         .flat_map(|patch| {

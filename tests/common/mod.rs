@@ -180,7 +180,7 @@ pub fn solve(model: &Model) -> (Simulation<'_>, Recorder) {
     let mut sim = Simulation::new(model).unwrap_or_else(|e| panic!("{}: {e}", model.name));
     let mut recorder = Recorder::default();
     let summary = sim
-        .run(&mut recorder)
+        .run(&mut [&mut recorder])
         .unwrap_or_else(|e| panic!("{}: {e}", model.name));
     assert!(!summary.stopped);
     (sim, recorder)
@@ -249,4 +249,50 @@ pub fn bend45_shooting_displacement() -> Vec3 {
         .collect();
     assert_eq!(v.len(), 3);
     Vec3::new(v[0], v[1], v[2])
+}
+
+/// One span of a cantilever made of spans of different materials, from the clamp outwards: length `L`
+/// [length], Young's modulus `E` [stress] and shear modulus times shear factor `k_s G` [stress].
+#[derive(Debug, Clone, Copy)]
+pub struct CantileverSpan {
+    /// Length `L_i` [length].
+    pub length: Real,
+    /// Young's modulus `E_i` [stress].
+    pub modulus: Real,
+    /// `k_s G_i` [stress].
+    pub shear_modulus: Real,
+}
+
+/// Tip deflection [length] of a straight cantilever of spans `spans` (clamp first) with a common section (area
+/// `A`, second moment `I`) under a transverse tip force `P`, by linear Timoshenko beam theory (small
+/// deflections; e.g. Timoshenko & Gere, *Mechanics of Materials*, §9 and §10.10, unit-load method):
+/// `M(x) = P (L − x)`, `V = P`, and the unit-load integral gives
+/// `δ = P Σ_i [ ((L − x_i)³ − (L − x_{i+1})³) / (3 E_i I) + L_i / (k_s G_i A) ]`
+/// with `x_i` the start of span `i` and `L` the total length (for one span: `P L³/(3EI) + P L/(k_s G A)`).
+pub fn cantilever_tip_deflection(
+    spans: &[CantileverSpan],
+    area: Real,
+    inertia: Real,
+    force: Real,
+) -> Real {
+    let total: Real = spans.iter().map(|s| s.length).sum();
+    let mut x = 0.0;
+    let mut deflection = 0.0;
+    for s in spans {
+        let (a, b) = (total - x, total - x - s.length);
+        deflection += force * (a.powi(3) - b.powi(3)) / (3.0 * s.modulus * inertia)
+            + force * s.length / (s.shear_modulus * area);
+        x += s.length;
+    }
+    deflection
+}
+
+/// Tip elongation [length] of a bar of spans `spans` in series with a common area `A` under an axial tip force
+/// `F`: `δ = F Σ_i L_i / (E_i A)` (the rod's axial strain is linear in `N`, so this is exact for it at any `F`
+/// that leaves the bar straight).
+pub fn series_bar_elongation(spans: &[CantileverSpan], area: Real, force: Real) -> Real {
+    spans
+        .iter()
+        .map(|s| force * s.length / (s.modulus * area))
+        .sum()
 }

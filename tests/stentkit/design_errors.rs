@@ -115,9 +115,7 @@ fn temperature_below_the_wlf_singularity_is_a_warning_with_the_freeze() {
             .any(|w| w.contains("WLF singularity"))
     );
     let mut sim = stentkit::solver::Simulation::new(&design.model).expect("simulation");
-    let summary = sim
-        .run(&mut stentkit::solver::simulation::NoObserver)
-        .expect("the run passes the singularity");
+    let summary = sim.run(&mut []).expect("the run passes the singularity");
     assert_eq!(summary.steps, 10);
     let notices = sim.notices();
     assert_eq!(notices.len(), 1, "said once: {notices:?}");

@@ -414,7 +414,7 @@ fn snapshots_of(
 ) -> Vec<stentkit::io::snapshots::Snapshot> {
     let mut sim = Simulation::new(model).expect("simulation");
     let mut writer = SnapshotWriter::create(dir, settings, model).expect("snapshot folder");
-    sim.run(&mut writer).expect("run");
+    sim.run(&mut [&mut writer]).expect("run");
     writer.finish(&sim).expect("final snapshot");
     assert!(writer.take_error().is_none());
     writer.snapshots().to_vec()

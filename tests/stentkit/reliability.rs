@@ -19,7 +19,7 @@ use std::process::Command;
 use stentkit::io::design::parse_design;
 use stentkit::math::Real;
 use stentkit::model::Model;
-use stentkit::solver::simulation::{NoObserver, ROUND_OFF_TOLERANCE, STEP_ROUND_OFF_ULPS};
+use stentkit::solver::simulation::{ROUND_OFF_TOLERANCE, STEP_ROUND_OFF_ULPS};
 use stentkit::solver::{NewtonReport, Observer, RunSummary, Simulation, SolverError, StepReport};
 
 fn bend45() -> String {
@@ -45,9 +45,7 @@ fn a_non_finite_residual_is_located_in_its_equation() {
         .replace("step: 0.1}", "step: 0.1, min_step: 0.1}");
     let design = parse_design(&text, Path::new("overflow.yaml")).expect("a valid design");
     let mut sim = Simulation::new(&design.model).expect("simulation");
-    let error = sim
-        .run(&mut NoObserver)
-        .expect_err("the step cannot converge");
+    let error = sim.run(&mut []).expect_err("the step cannot converge");
     let SolverError::StepFailed {
         step,
         iterations,
@@ -152,7 +150,7 @@ fn a_weakly_held_rod_gets_a_singular_tangent_diagnosis() {
     );
     let design = parse_design(&text, Path::new("pinned.yaml")).expect("a valid design");
     let mut sim = Simulation::new(&design.model).expect("a component is prescribed");
-    let error = sim.run(&mut NoObserver).expect_err("no equilibrium");
+    let error = sim.run(&mut []).expect_err("no equilibrium");
     let SolverError::StepFailed { ref diagnosis, .. } = error else {
         panic!("expected StepFailed, got {error}");
     };
@@ -267,7 +265,7 @@ fn run_guarded<'m>(
 ) -> (Simulation<'m>, Result<RunSummary, SolverError>) {
     script.poll_cap = poll_cap;
     let mut sim = Simulation::new(model).expect("simulation");
-    let result = sim.run(script);
+    let result = sim.run(&mut [script]);
     (sim, result)
 }
 
@@ -568,9 +566,10 @@ fn an_interrupt_is_honoured_within_a_step_and_rolled_back() {
     ] {
         let mut sim = check_interrupt(&model, &events, stop_at, 1, &at_step1, "root");
         // Resumed, the run repeats the uninterrupted one exactly: the resumed step starts from step 1's state
-        // with the step size reset to the nominal 0.5 and no factorisation, and so does the uninterrupted run's
-        // step 2 once its first attempt (at 0.75, also the resumed one's) has failed and been rolled back.
-        let resumed = sim.run(&mut NoObserver).expect("resumes");
+        // with the step size the abandoned attempt had (the nominal 0.5, or 0.25 once it was cut: the
+        // simulation keeps it) and no factorisation, as the uninterrupted run's attempt after a failed and
+        // rolled-back one does.
+        let resumed = sim.run(&mut []).expect("resumes");
         assert!(!resumed.stopped);
         assert_eq!(sim.time(), 1.0);
         assert_eq!(1 + resumed.steps, full_summary.steps, "{case}");
@@ -638,7 +637,7 @@ fn planned_steps_are_the_steps_a_run_takes() {
         let plan = design.model.planned_steps();
         assert_eq!((plan.full, plan.shortened), (full, shortened), "{text}");
         let mut sim = Simulation::new(&design.model).expect("simulation");
-        let summary = sim.run(&mut NoObserver).expect("the bend converges");
+        let summary = sim.run(&mut []).expect("the bend converges");
         assert_eq!(summary.steps, plan.total(), "{text}");
     }
 }

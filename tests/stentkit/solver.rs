@@ -6,9 +6,67 @@
 use crate::common::{
     BATHE_BOLOURCHI_1979_TIP, SIMO_VU_QUOC_1986_TIP, bend45_reference_tip,
     bend45_shooting_displacement, centreline_point, design_text, log_log_slope, model_from_text,
-    node_displacement, node_index, replace_block, replace_line, rollup_centreline, solve,
+    node_displacement, node_index, replace_line, rollup_centreline, solve,
 };
+use stentkit::material::{ElasticLaw, Section, SectionProperties};
 use stentkit::math::{Real, Vec3};
+use stentkit::model::builder::{
+    ConditionSpec, ModelBuilder, NodeEnds, PatchShape, ProbeAt, TimeSpec,
+};
+use stentkit::model::{Model, SolverSettings, TimeFunction};
+
+/// The 45° bend of designs/bend45.yaml built in code, split into `patches` exact arcs of `45° / patches`
+/// each (joined end to start), degree `p` and `n` control points per patch, in `steps` load steps.
+fn bend45_in_code(patches: usize, p: usize, n: usize, steps: usize) -> ModelBuilder {
+    let material = ElasticLaw::try_new(1e7, 0.0).expect("E > 0, ν = 0");
+    let section = Section::try_from_properties(SectionProperties {
+        area: 1.0,
+        second_moment: 1.0 / 12.0,
+        polar_moment: 1.0 / 6.0,
+        shear_factor: 5.0 / 6.0,
+        drawing_diameter: (4.0 / std::f64::consts::PI).sqrt(),
+    })
+    .expect("positive properties");
+    let mut b = ModelBuilder::new("bend45", material, section);
+    let angle = 45.0 / patches as Real;
+    for k in 0..patches {
+        let a = (k as Real * angle).to_radians();
+        // Start of arc k on the circle of radius 100 about (0, 100, 0), starting at the origin.
+        let start = Vec3::new(100.0 * a.sin(), 100.0 - 100.0 * a.cos(), 0.0);
+        let arc = PatchShape::Arc {
+            centre: Vec3::new(0.0, 100.0, 0.0),
+            start,
+            axis: Vec3::z(),
+            angle: angle.to_radians(),
+        };
+        b.patch(format!("b{k}"), arc, p, n);
+    }
+    b.node("root", NodeEnds::Named(vec!["b0.start".into()]));
+    for k in 1..patches {
+        b.node(
+            format!("j{k}"),
+            NodeEnds::Named(vec![format!("b{}.end", k - 1), format!("b{k}.start")]),
+        );
+    }
+    b.node(
+        "tip",
+        NodeEnds::Named(vec![format!("b{}.end", patches - 1)]),
+    );
+    b.condition(ConditionSpec::clamp("root"));
+    let ramp = TimeFunction::try_table(vec![(0.0, 0.0), (1.0, 600.0)]).expect("increasing times");
+    b.condition(ConditionSpec::at("tip").with_force(2, ramp));
+    b.time(TimeSpec::new(1.0, 1.0 / steps as Real));
+    b.probe("tip", ProbeAt::Node("tip".into()));
+    b
+}
+
+/// A model the builder accepts without warnings.
+#[track_caller]
+fn built(b: &ModelBuilder) -> Model {
+    let built = b.build().unwrap_or_else(|e| panic!("{e}"));
+    assert!(built.warnings.is_empty(), "{:?}", built.warnings);
+    built.model
+}
 
 /// The 45° bend (designs/bend45.yaml) at degree `p` with `n` control points, in `steps` load steps.
 fn bend45_text(p: usize, n: usize, steps: usize) -> String {
@@ -45,11 +103,13 @@ fn bend45_text(p: usize, n: usize, steps: usize) -> String {
 fn newton_converges_quadratically() {
     // Newton's method proper from the last converged state: a factorisation per iteration (the default reuses it
     // while it contracts) and no extrapolated start (which puts the first iterate inside the quadratic basin).
-    let text = format!(
-        "{}\nsolver: {{reuse_factorisation: false, extrapolate: false}}\n",
-        bend45_text(6, 20, 50)
-    );
-    let model = model_from_text(&text, "bend45_newton.yaml");
+    let mut b = bend45_in_code(1, 6, 20, 50);
+    b.solver(SolverSettings {
+        reuse_factorisation: false,
+        extrapolate: false,
+        ..SolverSettings::default()
+    });
+    let model = built(&b);
     let (_, rec) = solve(&model);
     let pre_round_off = 1e-9;
     let mut orders = Vec::new();
@@ -263,7 +323,7 @@ fn splitting_the_bend_into_patches_changes_only_the_discretisation_error() {
     let reference = bend45_shooting_displacement();
     let mut results = Vec::new();
     for (patches, n) in [(1usize, 60usize), (2, 30), (5, 12)] {
-        let model = model_from_text(&split_bend45(patches, n), "bend45_split.yaml");
+        let model = built(&bend45_in_code(patches, 6, n, 10));
         assert_eq!(model.patches.len(), patches);
         let (sim, rec) = solve(&model);
         let u = node_displacement(&sim, "tip");
@@ -293,28 +353,6 @@ fn splitting_the_bend_into_patches_changes_only_the_discretisation_error() {
     }
 }
 
-/// The 45° bend as `patches` exact arcs of `45° / patches` each, with `n` control points per patch.
-fn split_bend45(patches: usize, n: usize) -> String {
-    let text = bend45_text(6, n, 10);
-    let angle = 45.0 / patches as Real;
-    let mut block = String::from("patches:\n");
-    for k in 0..patches {
-        let a = (k as Real * angle).to_radians();
-        // Start of arc k on the circle of radius 100 about (0, 100, 0), starting at the origin.
-        let (x, y) = (100.0 * a.sin(), 100.0 - 100.0 * a.cos());
-        block += &format!(
-            "  - name: b{k}\n    arc: {{center: [0, 100, 0], start: [{x:.17e}, {y:.17e}, 0], axis: [0, 0, 1], \
-             angle_deg: {angle:.17e}}}\n"
-        );
-    }
-    block += "nodes:\n  - {name: root, ends: [b0.start]}\n";
-    for k in 1..patches {
-        block += &format!("  - {{name: j{k}, ends: [b{}.end, b{k}.start]}}\n", k - 1);
-    }
-    block += &format!("  - {{name: tip, ends: [b{}.end]}}\n", patches - 1);
-    replace_block(&text, "patches:", "conditions:", &block)
-}
-
 // ---------------------------------------------------------------------------------------------------------
 // 5. Equilibrium of an L-shaped frame.
 //
@@ -333,30 +371,47 @@ fn split_bend45(patches: usize, n: usize) -> String {
 //     measured imbalance is printed and the tolerance is 1e-6 of |F| and of |M| + L|F|.
 #[test]
 fn l_frame_joint_and_clamp_balance_the_loads() {
-    let text = r#"
-version: 1
-name: l_frame
-units: SI
-material: {E_inf: 2.0e9, nu: 0.3}
-section: {diameter: 0.05}
-mesh: {p: 6, n: 20}
-patches:
-  - name: a
-    line: {from: [0, 0, 0], to: [1, 0, 0]}
-  - name: b
-    line: {from: [1, 0, 0], to: [1, 0.8, 0]}
-nodes:
-  - {name: clamp, ends: [a.start]}
-  - {name: knee, ends: [a.end, b.start]}
-  - {name: tip, ends: [b.end]}
-conditions:
-  - {node: clamp, clamp: true}
-  - node: tip
-    force: [[[0, 0], [1, 30]], [[0, 0], [1, -40]], [[0, 0], [1, 60]]]
-    moment: [[[0, 0], [1, 5]], [[0, 0], [1, -8]], [[0, 0], [1, 12]]]
-time: {end: 1.0, step: 0.1}
-"#;
-    let model = model_from_text(text, "l_frame.yaml");
+    let material = ElasticLaw::try_new(2.0e9, 0.3).expect("E > 0, ν = 0.3");
+    let wire = stentkit::material::CircularSection::try_new(0.05).expect("d > 0");
+    let mut b = ModelBuilder::new("l_frame", material, wire.into());
+    let (clamp, knee, tip) = (Vec3::zeros(), Vec3::x(), Vec3::new(1.0, 0.8, 0.0));
+    b.patch(
+        "a",
+        PatchShape::Line {
+            from: clamp,
+            to: knee,
+        },
+        6,
+        20,
+    );
+    b.patch(
+        "b",
+        PatchShape::Line {
+            from: knee,
+            to: tip,
+        },
+        6,
+        20,
+    );
+    b.node("clamp", NodeEnds::Named(vec!["a.start".into()]));
+    b.node(
+        "knee",
+        NodeEnds::Named(vec!["a.end".into(), "b.start".into()]),
+    );
+    b.node("tip", NodeEnds::Named(vec!["b.end".into()]));
+    b.condition(ConditionSpec::clamp("clamp"));
+    let ramp = |v: Real| TimeFunction::try_table(vec![(0.0, 0.0), (1.0, v)]).expect("increasing");
+    b.condition(
+        ConditionSpec::at("tip")
+            .with_force(0, ramp(30.0))
+            .with_force(1, ramp(-40.0))
+            .with_force(2, ramp(60.0))
+            .with_moment(0, ramp(5.0))
+            .with_moment(1, ramp(-8.0))
+            .with_moment(2, ramp(12.0)),
+    );
+    b.time(TimeSpec::new(1.0, 0.1));
+    let model = built(&b);
     let (sim, rec) = solve(&model);
     let f = Vec3::new(30.0, -40.0, 60.0);
     let m = Vec3::new(5.0, -8.0, 12.0);
@@ -413,4 +468,97 @@ time: {end: 1.0, step: 0.1}
         (tm - m).norm()
     );
     assert!((tf - f).norm() < force_tol && (tm - m).norm() < moment_tol);
+}
+
+// ---------------------------------------------------------------------------------------------------------
+// Materials per patch: a cantilever of two patches of different materials.
+//
+// Source: linear Timoshenko beam theory and the series bar (closed forms in tests/common,
+// `cantilever_tip_deflection`, `series_bar_elongation`). Sketch: patch a from the clamp at (0, 0, 0) to the
+// joint at (0.6, 0, 0), patch b from there to the tip at (1, 0, 0); circular section d = 0.05 m (SI); patch a
+// of E1 = 2e9 Pa, ν1 = 0.3, patch b of E2 = 5e8 Pa, ν2 = 0.35 (its own shear modulus and Cowper factor). The
+// design file gives one material; the second is set in code (`Model::materials`, `Patch::material`), which is
+// the data structure under test. Two runs: a transverse tip force P = 0.02 N along z (tip deflection 1.3e-5 of
+// the length) and an axial tip force F = 5 kN (strain 1.3e-6 … 5e-6; the rod's axial law is exactly linear).
+// The exact linear solutions are cubic in each span, which a degree-6 spline represents exactly; Newton is
+// driven to the round-off floor (tolerance 1e-13, a factorisation per iteration), so what is left is the
+// geometric nonlinearity, O((δ/L)²): measured 2.2e-10 relative for the deflection, growing as P² (2.2e-8 at
+// P = 0.2 N, 2.2e-6 at 2 N), and 1.5e-13 for the elongation. Tolerance 1e-8 for both. Each patch with the
+// other's material gives a deflection 16 % (E1 everywhere) or far (E2 everywhere) off, so the test sees whether
+// each patch takes its own material.
+#[test]
+fn a_cantilever_of_two_materials_deflects_as_beam_theory_says() {
+    use crate::common::{CantileverSpan, cantilever_tip_deflection, series_bar_elongation};
+    use stentkit::material::{ConstitutiveLaw, ElasticLaw, MaterialLaw};
+    let text = |force: &str| {
+        format!(
+            r#"
+version: 1
+name: two_materials
+units: SI
+material: {{E_inf: 2.0e9, nu: 0.3}}
+section: {{diameter: 0.05}}
+mesh: {{p: 6, n: 10}}
+patches:
+  - name: a
+    line: {{from: [0, 0, 0], to: [0.6, 0, 0]}}
+  - name: b
+    line: {{from: [0.6, 0, 0], to: [1, 0, 0]}}
+nodes:
+  - {{name: clamp, ends: [a.start]}}
+  - {{name: joint, ends: [a.end, b.start]}}
+  - {{name: tip, ends: [b.end]}}
+conditions:
+  - {{node: clamp, clamp: true}}
+  - {{node: tip, force: {force}}}
+time: {{end: 1.0, step: 1.0}}
+solver: {{tolerance: 1.0e-13, reuse_factorisation: false}}
+"#
+        )
+    };
+    let (e1, nu1, e2, nu2) = (2.0e9, 0.3, 5.0e8, 0.35);
+    let d: Real = 0.05;
+    let area = std::f64::consts::PI * d * d / 4.0;
+    let inertia = std::f64::consts::PI * d.powi(4) / 64.0;
+    let cowper = |nu: Real| 6.0 * (1.0 + nu) / (7.0 + 6.0 * nu);
+    let span = |length: Real, e: Real, nu: Real| CantileverSpan {
+        length,
+        modulus: e,
+        shear_modulus: cowper(nu) * e / (2.0 * (1.0 + nu)),
+    };
+    let spans = [span(0.6, e1, nu1), span(0.4, e2, nu2)];
+    for (force, direction, expected) in [
+        (
+            "[0, 0, 0.02]",
+            Vec3::z(),
+            cantilever_tip_deflection(&spans, area, inertia, 0.02),
+        ),
+        (
+            "[5000.0, 0, 0]",
+            Vec3::x(),
+            series_bar_elongation(&spans, area, 5000.0),
+        ),
+    ] {
+        let mut model = model_from_text(&text(force), "two_materials.yaml");
+        assert_eq!(model.materials.len(), 1, "the design gives one material");
+        model.materials.push(MaterialLaw::from(
+            ElasticLaw::try_new(e2, nu2).expect("valid"),
+        ));
+        model.patches[1].material = 1;
+        assert_eq!(model.materials[0].poisson(), nu1);
+        let (sim, _) = solve(&model);
+        let tip = node_displacement(&sim, "tip");
+        let measured = tip.dot(&direction);
+        let error = (measured - expected).abs() / expected.abs();
+        // The same model with one material everywhere, to show the test tells the materials apart.
+        let mut single = model.clone();
+        single.patches[1].material = 0;
+        let (sim1, _) = solve(&single);
+        let one = node_displacement(&sim1, "tip").dot(&direction);
+        println!(
+            "two materials, tip force {force}: δ = {measured:.9e} m, beam theory {expected:.9e} m, relative error {error:.2e} (material 0 everywhere: {one:.6e} m)"
+        );
+        assert!(error < 1e-8, "relative error {error:e}");
+        assert!((one - expected).abs() > 0.1 * expected.abs());
+    }
 }

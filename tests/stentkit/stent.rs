@@ -10,7 +10,6 @@ use stentkit::io::stl::{read_stl, write_stl};
 use stentkit::math::{Real, Vec3};
 use stentkit::model::{Model, ProbeLocation};
 use stentkit::post::device::reference_device_mesh;
-use stentkit::solver::simulation::NoObserver;
 use stentkit::solver::{Observer, Simulation, StepReport};
 
 fn design(name: &str) -> PathBuf {
@@ -321,7 +320,7 @@ time: {{end: 1, step: 0.25}}
 /// Runs the model and returns the displacement at every node and at u = 1/4, 1/2, 3/4 of every patch, by name.
 fn solve(model: &Model) -> Vec<(String, Vec3, Vec3)> {
     let mut sim = Simulation::new(model).unwrap_or_else(|e| panic!("{e}"));
-    let summary = sim.run(&mut NoObserver).unwrap_or_else(|e| panic!("{e}"));
+    let summary = sim.run(&mut []).unwrap_or_else(|e| panic!("{e}"));
     assert!((summary.time - model.time.end).abs() < 1e-12);
     let mut out = Vec::new();
     for (k, n) in model.nodes.iter().enumerate() {
@@ -744,7 +743,8 @@ fn block_solver_matches_the_sparse_lu() {
         .map(|model| {
             let mut sim = Simulation::new(model).unwrap_or_else(|e| panic!("{e}"));
             let mut histories = Histories(Vec::new(), 0.757);
-            sim.run(&mut histories).unwrap_or_else(|e| panic!("{e}"));
+            sim.run(&mut [&mut histories])
+                .unwrap_or_else(|e| panic!("{e}"));
             times.push(sim.time());
             sim.assemble(sim.time() + 0.01, true)
                 .unwrap_or_else(|e| panic!("{e}"));

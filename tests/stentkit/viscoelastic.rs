@@ -3,36 +3,64 @@
 
 use std::ops::ControlFlow;
 use std::path::Path;
-use stentkit::io::design::parse_design;
+use stentkit::material::{
+    CircularSection, Integrator, Material, MaterialLaw, Prony, PronyBranch, Wlf,
+};
 use stentkit::math::so3::log;
-use stentkit::math::{Real, Rot3};
+use stentkit::math::{Real, Rot3, Vec3};
+use stentkit::model::builder::{ConditionSpec, ModelBuilder, PatchShape, TimeSpec};
+use stentkit::model::{Model, TimeFunction};
 use stentkit::solver::{Observer, Simulation, StepReport};
 
 /// A straight PLA cantilever (L = 1 m along x, d = 0.05 m, paper Table PLA and WLF row 1) under a dead end
 /// couple about z and the programme of `scripts/maxwell_bending_reference.py`.
-fn bending_design(integrator: &str, step: Real) -> String {
-    format!(
-        r#"
-units: SI
-material:
-  E_inf: 80.59e6
-  prony: [[20.12e6, 1.0e-10], [50.31e6, 1.0e-9], [81.37e6, 1.0e-8], [97.02e6, 1.0e-7], [173.70e6, 1.0e-6],
-          [225.60e6, 1.0e-5], [292.64e6, 1.0e-4], [474.56e6, 1.0e-3], [449.43e6, 1.0e-2], [237.98e6, 1.0e-1],
-          [114.16e6, 1.0e+0], [51.82e6, 1.0e+1], [29.98e6, 1.0e+2], [14.40e6, 1.0e+3], [0.72e6, 1.0e+5]]
-  nu: 0.33
-  wlf: {{C1: 14.59, C2: 48.43, Tg: 70.0}}
-  integrator: {integrator}
-section: {{diameter: 0.05}}
-mesh: {{p: 6, n: 16}}
-patches:
-  - {{name: beam, line: {{from: [0, 0, 0], to: [1, 0, 0]}}}}
-conditions:
-  - {{node: beam.start, clamp: true}}
-  - {{node: beam.end, moment: [0, 0, [[0, 0], [0.5, 10], [0.75, 10], [1.0, 0]]]}}
-temperature: [[0, 90], [0.5, 90], [0.75, 31.5], [1.625, 31.5], [2.5, 90]]
-time: {{end: 3.0, step: {step}}}
-"#
-    )
+fn bending_model(integrator: Integrator, step: Real) -> Model {
+    // Paper Table PLA in Pa (van Manen et al. 2021): [E_α, τ_G,α].
+    const TABLE: [(Real, Real); 15] = [
+        (20.12e6, 1.0e-10),
+        (50.31e6, 1.0e-9),
+        (81.37e6, 1.0e-8),
+        (97.02e6, 1.0e-7),
+        (173.70e6, 1.0e-6),
+        (225.60e6, 1.0e-5),
+        (292.64e6, 1.0e-4),
+        (474.56e6, 1.0e-3),
+        (449.43e6, 1.0e-2),
+        (237.98e6, 1.0e-1),
+        (114.16e6, 1.0e+0),
+        (51.82e6, 1.0e+1),
+        (29.98e6, 1.0e+2),
+        (14.40e6, 1.0e+3),
+        (0.72e6, 1.0e+5),
+    ];
+    let branches = TABLE
+        .iter()
+        .map(|&(modulus, tau_g)| PronyBranch { modulus, tau_g })
+        .collect();
+    let prony = Prony::try_new(80.59e6, branches).expect("valid Prony series");
+    let wlf = Wlf::try_new(14.59, 48.43, 70.0).expect("valid WLF constants");
+    let material = Material::try_new(prony, 0.33, Some(wlf)).expect("valid material");
+    let wire = CircularSection::try_new(0.05).expect("d > 0");
+    let law = MaterialLaw::from_material(material, integrator);
+    let mut b = ModelBuilder::new("bending", law, wire.into());
+    let beam = PatchShape::Line {
+        from: Vec3::zeros(),
+        to: Vec3::x(),
+    };
+    b.patch("beam", beam, 6, 16);
+    b.condition(ConditionSpec::clamp("beam.start"));
+    let table = |points: &[(Real, Real)]| TimeFunction::try_table(points.to_vec()).expect("table");
+    let couple = table(&[(0.0, 0.0), (0.5, 10.0), (0.75, 10.0), (1.0, 0.0)]);
+    b.condition(ConditionSpec::at("beam.end").with_moment(2, couple));
+    b.temperature(table(&[
+        (0.0, 90.0),
+        (0.5, 90.0),
+        (0.75, 31.5),
+        (1.625, 31.5),
+        (2.5, 90.0),
+    ]));
+    b.time(TimeSpec::new(3.0, step));
+    b.build().expect("valid model").model
 }
 
 /// Reads `(t, κ)` from the reference CSV.
@@ -66,17 +94,15 @@ impl Observer for Curvature {
     }
 }
 
-fn run(integrator: &str, step: Real) -> Vec<(Real, Real)> {
-    let design = parse_design(&bending_design(integrator, step), Path::new("bending.yaml"))
-        .expect("valid design");
-    let model = design.model;
+fn run(integrator: Integrator, step: Real) -> Vec<(Real, Real)> {
+    let model = bending_model(integrator, step);
     let mut sim = Simulation::new(&model).expect("simulation");
     let tip_point = sim.discretisation().points.len() - 1;
     let mut obs = Curvature {
         tip_point,
         samples: Vec::new(),
     };
-    sim.run(&mut obs).expect("run completes");
+    sim.run(&mut [&mut obs]).expect("run completes");
     obs.samples
 }
 
@@ -110,21 +136,21 @@ fn pure_bending_follows_the_one_dimensional_maxwell_law_through_a_shape_memory_c
     let reference = reference();
     let steps = [2e-3, 1e-3, 5e-4];
     for (integrator, bound) in [
-        ("trapezoidal", 2e-5),
-        ("exponential", 2e-5),
-        ("backward-euler", 1e-3),
+        (Integrator::Trapezoidal, 2e-5),
+        (Integrator::Exponential, 2e-5),
+        (Integrator::BackwardEuler, 1e-3),
     ] {
         let errors: Vec<Real> = steps
             .iter()
             .map(|&h| error(&run(integrator, h), &reference))
             .collect();
-        eprintln!("{integrator}: errors at h = {steps:?}: {errors:?}");
+        eprintln!("{integrator:?}: errors at h = {steps:?}: {errors:?}");
         assert!(
             errors.windows(2).all(|w| w[1] < w[0]),
-            "{integrator}: errors must fall with h: {errors:?}"
+            "{integrator:?}: errors must fall with h: {errors:?}"
         );
         let average_order = (errors[0] / errors[2]).log2() / 2.0;
-        if integrator == "backward-euler" {
+        if integrator == Integrator::BackwardEuler {
             assert!(
                 (average_order - 1.0).abs() < 0.1,
                 "backward Euler order {average_order:.2}"
@@ -132,12 +158,12 @@ fn pure_bending_follows_the_one_dimensional_maxwell_law_through_a_shape_memory_c
         } else {
             assert!(
                 average_order >= 1.5,
-                "{integrator}: average order {average_order:.2}"
+                "{integrator:?}: average order {average_order:.2}"
             );
         }
         assert!(
             errors[2] < bound,
-            "{integrator}: error {:.3e} at h = 0.5 ms",
+            "{integrator:?}: error {:.3e} at h = 0.5 ms",
             errors[2]
         );
     }
@@ -166,7 +192,7 @@ fn the_cantilever_is_programmed_holds_its_temporary_shape_and_recovers() {
     let design = stentkit::io::design::load_design(&path).expect("design loads");
     let mut sim = Simulation::new(&design.model).expect("simulation");
     let mut tip = TipHistory(Vec::new());
-    let summary = sim.run(&mut tip).expect("run completes");
+    let summary = sim.run(&mut [&mut tip]).expect("run completes");
     let max = tip.0.iter().fold(0.0_f64, |m, s| m.max(s.1));
     let held = tip
         .0

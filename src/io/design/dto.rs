@@ -123,6 +123,11 @@ impl<'de> Deserialize<'de> for NonNegative {
 /// A 3-vector of finite numbers, written `[x, y, z]`.
 pub type Vector = [Finite; 3];
 
+/// A design's vector as the model's.
+pub fn vec3(v: &Vector) -> crate::math::Vec3 {
+    crate::math::Vec3::new(v[0].0, v[1].0, v[2].0)
+}
+
 /// A function of time: a number (constant) or a table `[[t0, v0], [t1, v1], …]` (piecewise linear).
 #[derive(Debug, Clone, PartialEq)]
 pub enum TimeFn {
@@ -211,7 +216,7 @@ impl<'de> Visitor<'de> for ComponentVisitor {
         } else {
             Err(E::custom(format!(
                 "{} is not a component value; allowed: free, null, a number or a table [[t, v], …]",
-                super::quote::quoted(v)
+                crate::math::quote::quoted(v)
             )))
         }
     }

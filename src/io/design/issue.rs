@@ -1,8 +1,6 @@
-//! What the model builder reports about a design: an [`Issue`] at a field path (which [`super::locate`] maps to
+//! What building a design reports: an [`Issue`] at a field path (which [`super::locate`] maps to
 //! the file's line and column), shared by the builder of plain designs ([`super::build`]) and of stents
 //! ([`super::stent`]).
-
-use crate::math::Real;
 
 /// A problem found while building the model, at a field path.
 #[derive(Debug, Clone, PartialEq)]
@@ -23,6 +21,3 @@ pub(super) fn issue(path: impl Into<String>, message: impl Into<String>) -> Issu
 
 /// A result whose error is an [`Issue`].
 pub(super) type Result<T> = std::result::Result<T, Issue>;
-
-/// Fit deviation, as a fraction of the wire diameter, above which the design gets a warning.
-pub(super) const FIT_WARNING_FRACTION: Real = 0.01;

@@ -12,10 +12,12 @@ pub mod dto;
 pub mod guard;
 pub mod issue;
 pub mod locate;
-pub mod quote;
+pub mod size;
+
 pub mod stent;
 
 use crate::math::Real;
+use crate::math::quote;
 use crate::model::Model;
 use std::fmt;
 use std::path::{Path, PathBuf};
@@ -89,8 +91,8 @@ pub struct Design {
     pub output: OutputSettings,
     /// Things worth knowing that do not stop a run.
     pub warnings: Vec<String>,
-    /// The memory a run is estimated to need (below [`build::MEMORY_LIMIT_BYTES`]: larger designs are refused).
-    pub memory: build::MemoryEstimate,
+    /// The memory a run is estimated to need (below [`size::MEMORY_LIMIT_BYTES`]: larger designs are refused).
+    pub memory: size::MemoryEstimate,
     /// The steps a run takes when no step is cut ([`Model::planned_steps`], computed once here: it sorts every
     /// breakpoint).
     pub steps: crate::model::StepPlan,

@@ -1,7 +1,8 @@
 //! The `stent:` and `programme:` blocks of a design: a generated stent (crowns, bridges, centreline, symmetry)
-//! and the programme that drives its nodes to a temporary shape. The geometry itself is
-//! [`crate::geometry::stent`]; this module reads the parameters, fits the patches, makes the nodes with their
-//! symmetry conditions and node sets, and builds the [`Programme`].
+//! and the programme that drives its nodes to a temporary shape. The geometry is [`crate::geometry::stent`] and
+//! its place in the model [`crate::model::stent`]; this module translates the blocks into a [`StentSpec`],
+//! a [`StentMesh`] and a [`ProgrammeSpec`] with the checks of the blocks' form, and names the design field of a
+//! stent [`StentField`].
 //!
 //! ```yaml
 //! stent:
@@ -24,79 +25,15 @@
 //! ```
 
 use super::dto::*;
-use super::issue::{FIT_WARNING_FRACTION, Issue, Result, issue};
-use crate::geometry::GeometryError;
-use crate::geometry::fit::{FitSettings, best_fit_rigid, fit_curve};
-use crate::geometry::frame::normal_to;
-use crate::geometry::primitives;
+use super::issue::{Result, issue};
 use crate::geometry::stent::{
-    BridgeDirection, BridgeShape, BridgeSpec, CentrelineSpec, CrownSpec, PatchRole, StentGeometry,
-    StentParameter, StentSpec, Symmetry, TemporaryCentreline, TemporarySpec, WireEnd,
+    BridgeDirection, BridgeShape, BridgeSpec, CentrelineSpec, CrownSpec, StentParameter, StentSpec,
+    Symmetry, TemporaryCentreline, TemporarySpec,
 };
-use crate::material::{Section, SectionProperties};
-use crate::math::{Mat3, Real, Vec3};
-use crate::model::{
-    Component, DrivenNode, End, Node, NodeConditions, Patch, PatchEnd, Programme, ProgrammeKind,
-};
-use std::collections::BTreeMap;
+use crate::math::{Real, Vec3};
+use crate::model::builder::StentField;
+use crate::model::stent::{ProgrammeSpec, ProgrammeTarget, StentMesh};
 
-/// The temporary node positions moved by the rigid motion that best fits the driven nodes (`set`) of the FULL
-/// device — every node mirrored about every combination of symmetry planes, weights shared among the copies —
-/// onto their permanent positions ([`best_fit_rigid`]). A free device has no preferred placement once released;
-/// placing the temporary shape this way gives its displacement `η_temp = P_temp − P_0` no rigid part, so the
-/// gauge that fixes the free device's rigid motion at the release ([`crate::solver::gauge`]) holds it where a full
-/// recovery brings every node back to `P_0`. By symmetry of the mirrored point sets the fitted motion respects
-/// the symmetry planes.
-fn align_temporary(
-    geometry: &StentGeometry,
-    positions: &[Vec3],
-    set: &[usize],
-) -> Option<Vec<Vec3>> {
-    let planes: Vec<(Vec3, Vec3)> = geometry
-        .symmetry_planes
-        .iter()
-        .map(|p| (p.point, p.normal.normalize()))
-        .collect();
-    let reflect = |x: Vec3, mask: usize| {
-        planes.iter().enumerate().fold(x, |x, (i, (p, n))| {
-            if mask >> i & 1 == 1 {
-                x - n * (2.0 * n.dot(&(x - p)))
-            } else {
-                x
-            }
-        })
-    };
-    let copies = 1usize << planes.len();
-    let (mut from, mut to, mut weights) = (Vec::new(), Vec::new(), Vec::new());
-    for &k in set {
-        for mask in 0..copies {
-            from.push(reflect(positions[k], mask));
-            to.push(reflect(geometry.nodes[k].position, mask));
-            weights.push(geometry.nodes[k].multiplicity as Real / copies as Real);
-        }
-    }
-    let (r, t) = best_fit_rigid(&from, &to, &weights)?;
-    Some(positions.iter().map(|p| r * p + t).collect())
-}
-
-fn vec3(v: &Vector) -> Vec3 {
-    Vec3::new(v[0].0, v[1].0, v[2].0)
-}
-
-/// The generated stent, ready to be merged into the model (its patches and nodes come first).
-#[derive(Debug, Clone)]
-pub struct GeneratedStent {
-    /// The specification it was generated from.
-    pub spec: StentSpec,
-    /// The analytic device.
-    pub geometry: StentGeometry,
-    /// Fitted patches, in the order of `geometry.patches`.
-    pub patches: Vec<Patch>,
-    /// Nodes, in the order of `geometry.nodes`, with their symmetry conditions.
-    pub nodes: Vec<Node>,
-}
-
-/// Maps a generator parameter name to its field path under `stent` (or `programme`).
 /// The field of a stent parameter.
 fn spec_path(parameter: StentParameter) -> &'static str {
     use StentParameter as P;
@@ -121,10 +58,33 @@ fn spec_path(parameter: StentParameter) -> &'static str {
     }
 }
 
-fn geometry_issue(e: GeometryError) -> Issue {
-    match e {
-        GeometryError::InvalidStent { parameter, reason } => issue(spec_path(parameter), reason),
-        e => issue("stent", e.to_string()),
+/// The design field path of a stent field: a parameter's, or the key the crown or bridge mesh came from.
+pub(super) fn field_path(field: StentField, dto: &DesignDto) -> String {
+    let own = |bridge: bool| {
+        dto.stent.as_ref().and_then(|s| {
+            if bridge {
+                s.bridge_mesh.as_ref()
+            } else {
+                s.crown_mesh.as_ref()
+            }
+        })
+    };
+    let mesh_key = |bridge: bool, given: fn(&MeshDto) -> Option<usize>, key: &str| {
+        let own_path = if bridge {
+            "stent.bridge_mesh"
+        } else {
+            "stent.crown_mesh"
+        };
+        match own(bridge).and_then(given) {
+            Some(_) => format!("{own_path}.{key}"),
+            None => format!("mesh.{key}"),
+        }
+    };
+    match field {
+        StentField::Whole => "stent".into(),
+        StentField::Parameter(p) => spec_path(p).into(),
+        StentField::Degree { bridge } => mesh_key(bridge, |m| m.p, "p"),
+        StentField::ControlPoints { bridge } => mesh_key(bridge, |m| m.n, "n"),
     }
 }
 
@@ -238,233 +198,31 @@ pub fn spec(dto: &StentDto) -> Result<StentSpec> {
     })
 }
 
-/// `(p, n)` of a role: its own mesh, else the design's.
-fn discretisation(
-    own: Option<&MeshDto>,
-    own_path: &str,
-    mesh: Option<&MeshDto>,
-) -> Result<(usize, usize)> {
-    let pick = |f: fn(&MeshDto) -> Option<usize>, key: &str| -> Result<(usize, String)> {
-        match (own.and_then(f), mesh.and_then(f)) {
-            (Some(v), _) => Ok((v, format!("{own_path}.{key}"))),
-            (None, Some(v)) => Ok((v, format!("mesh.{key}"))),
-            (None, None) => Err(issue(
-                "stent",
-                format!(
-                    "no `{key}` for the stent's patches: give `mesh.{key}` or `{own_path}.{key}`"
-                ),
-            )),
-        }
+/// The crown and bridge discretisations: each role's own mesh, else the design's.
+pub fn mesh(dto: &StentDto, mesh: Option<&MeshDto>) -> Result<StentMesh> {
+    let pick = |own: Option<&MeshDto>, own_path: &str| -> Result<(usize, usize)> {
+        let one = |f: fn(&MeshDto) -> Option<usize>, key: &str| {
+            own.and_then(f).or(mesh.and_then(f)).ok_or_else(|| {
+                issue(
+                    "stent",
+                    format!(
+                        "no `{key}` for the stent's patches: give `mesh.{key}` or `{own_path}.{key}`"
+                    ),
+                )
+            })
+        };
+        Ok((one(|m| m.p, "p")?, one(|m| m.n, "n")?))
     };
-    let (p, p_path) = pick(|m| m.p, "p")?;
-    let (n, n_path) = pick(|m| m.n, "n")?;
-    if p < 2 {
-        return Err(issue(
-            p_path,
-            format!("degree p = {p} is too low: collocation of the strong form needs p ≥ 2"),
-        ));
-    }
-    if n <= p {
-        return Err(issue(
-            n_path,
-            format!("n = {n} control points cannot carry degree p = {p}: need n > p"),
-        ));
-    }
-    Ok((p, n))
-}
-
-/// Completes an orthonormal right-handed basis whose first axis is the unit `n`.
-fn basis_from_normal(n: &Vec3) -> Mat3 {
-    let e2 = normal_to(n, None);
-    Mat3::from_columns(&[*n, e2, n.cross(&e2)])
-}
-
-/// Generates the stent of a `stent:` block: fitted patches (section 0, or a half section for patches lying in
-/// a symmetry plane, appended to `sections`), nodes with their symmetry conditions.
-pub fn generate(
-    dto: &StentDto,
-    mesh: Option<&MeshDto>,
-    sections: &mut Vec<Section>,
-    poisson: Real,
-    warnings: &mut Vec<String>,
-) -> Result<GeneratedStent> {
-    let spec = spec(dto)?;
-    let geometry = spec.generate().map_err(geometry_issue)?;
-    let crown_pn = discretisation(dto.crown_mesh.as_ref(), "stent.crown_mesh", mesh)?;
-    let bridge_pn = discretisation(dto.bridge_mesh.as_ref(), "stent.bridge_mesh", mesh)?;
-    let full = sections[0];
-    let mut half_section = None;
-    let mut patches = Vec::with_capacity(geometry.patches.len());
-    let mut worst: Option<(Real, &str)> = None;
-    for g in &geometry.patches {
-        let (p, n) = match g.role {
-            PatchRole::Crown { .. } => crown_pn,
-            PatchRole::Bridge { .. } => bridge_pn,
-        };
-        let (curve, fit_error) = match g.straight_segment() {
-            Some((a, b)) => (
-                primitives::line(a, b, p, n).map_err(|e| issue("stent", e.to_string()))?,
-                None,
-            ),
-            None => {
-                let fit = fit_curve(&g.curve, p, n, &FitSettings::default())
-                    .map_err(|e| issue("stent", format!("patch `{}`: {e}", g.name)))?;
-                if worst.is_none_or(|(w, _)| fit.max_deviation > w) {
-                    worst = Some((fit.max_deviation, &g.name));
-                }
-                (fit.curve, Some(fit.max_deviation))
-            }
-        };
-        let section = match g.in_plane {
-            None => 0,
-            Some(_) => *half_section.get_or_insert_with(|| {
-                // Half of every stiffness: the two halves of the full model share this rod.
-                sections.push(Section::Properties(SectionProperties {
-                    area: 0.5 * full.area(),
-                    second_moment: 0.5 * full.second_moment(),
-                    polar_moment: 0.5 * full.polar_moment(),
-                    shear_factor: full.shear_factor(poisson),
-                    drawing_diameter: full.diameter(),
-                }));
-                sections.len() - 1
-            }),
-        };
-        patches.push(Patch {
-            name: g.name.clone(),
-            curve,
-            normal_hint: Some(g.normal_hint),
-            section,
-            fit_error,
-        });
-    }
-    if let Some((dev, name)) = worst {
-        let d = full.diameter();
-        if dev > FIT_WARNING_FRACTION * d {
-            warnings.push(format!(
-                "stent patch `{name}`: the spline fit deviates up to {dev:.3e} from the curve, {:.1}% of the wire diameter; raise n",
-                100.0 * dev / d
-            ));
-        }
-    }
-    let nodes = geometry
-        .nodes
-        .iter()
-        .map(|g| {
-            let mut conditions = NodeConditions::default();
-            if let Some(k) = g.symmetry_plane {
-                conditions.basis = basis_from_normal(&geometry.symmetry_planes[k].normal);
-                for i in [0, 4, 5] {
-                    conditions.components[i] = Component::fixed();
-                }
-            }
-            Node {
-                name: g.name.clone(),
-                ends: g
-                    .ends
-                    .iter()
-                    .map(|&(patch, end)| PatchEnd {
-                        patch,
-                        end: match end {
-                            WireEnd::Start => End::Start,
-                            WireEnd::End => End::End,
-                        },
-                    })
-                    .collect(),
-                position: g.position,
-                conditions,
-            }
-        })
-        .collect();
-    Ok(GeneratedStent {
-        spec,
-        geometry,
-        patches,
-        nodes,
+    Ok(StentMesh {
+        crown: pick(dto.crown_mesh.as_ref(), "stent.crown_mesh")?,
+        bridge: pick(dto.bridge_mesh.as_ref(), "stent.bridge_mesh")?,
     })
 }
 
-/// The node sets of a generated stent (node indices are the same in the model: the stent's nodes come first).
-pub fn node_sets(stent: &GeneratedStent) -> BTreeMap<String, Vec<usize>> {
-    stent.geometry.node_sets.clone()
-}
-
-/// The symmetry planes of a generated stent as `(point, normal)`.
-pub fn symmetry_planes(stent: &GeneratedStent) -> Vec<(Vec3, Vec3)> {
-    stent
-        .geometry
-        .symmetry_planes
-        .iter()
-        .map(|p| (p.point, p.normal))
-        .collect()
-}
-
-/// Builds the programme of a `programme:` block and applies it to the stent's nodes.
-pub fn programme(
-    dto: &ProgrammeDto,
-    stent: Option<&GeneratedStent>,
-    nodes: &mut [Node],
-    end_time: Real,
-    warnings: &mut Vec<String>,
-) -> Result<Programme> {
+/// The programme of a `programme:` block, with the checks of its form (which fields go with which kind).
+pub fn programme(dto: &ProgrammeDto) -> Result<ProgrammeSpec> {
     let base = "programme";
-    let Some(stent) = stent else {
-        return Err(issue(
-            base,
-            "a programme drives the nodes of a generated stent: add a `stent` block",
-        ));
-    };
-    let set_name = dto.nodes.clone().unwrap_or_else(|| "all_joints".into());
-    let sets = &stent.geometry.node_sets;
-    let Some(set) = sets.get(&set_name) else {
-        let known: Vec<&str> = sets.keys().map(String::as_str).collect();
-        return Err(issue(
-            format!("{base}.nodes"),
-            format!(
-                "no node set {}; the stent has: {}",
-                super::quote::quoted(&set_name),
-                known.join(", ")
-            ),
-        ));
-    };
-    if set.is_empty() {
-        return Err(issue(
-            format!("{base}.nodes"),
-            format!("node set {} is empty", super::quote::quoted(&set_name)),
-        ));
-    }
-    let (t0, t1) = (dto.ramp[0].0, dto.ramp[1].0);
-    if t1 <= t0 {
-        return Err(issue(
-            format!("{base}.ramp[1]"),
-            format!(
-                "programme times must increase: the ramp ends at t = {t1}, not after its start t = {t0}"
-            ),
-        ));
-    }
-    let release = dto.release.map(|r| r.0);
-    if let Some(r) = release {
-        if r < t1 {
-            return Err(issue(
-                format!("{base}.release"),
-                format!(
-                    "programme times must increase: the release at t = {r} comes before the end of the ramp (t = {t1})"
-                ),
-            ));
-        }
-        if r >= end_time {
-            warnings.push(format!(
-                "the programme releases at t = {r}, at or after the end of the run ({end_time}): the nodes are never released"
-            ));
-        }
-    }
-    if t1 > end_time {
-        warnings.push(format!(
-            "the programme's ramp ends at t = {t1}, after the end of the run ({end_time})"
-        ));
-    }
-    let geometry = &stent.geometry;
-    let radius = stent.spec.crown.radius;
-    let (kind, targets): (ProgrammeKind, Vec<Vec3>) = match dto.kind {
+    let target = match dto.kind {
         ProgrammeKindDto::RadialContraction => {
             if dto.temporary.is_some() {
                 return Err(issue(
@@ -478,18 +236,7 @@ pub fn programme(
                     "a radial contraction needs `delta_r` (the radius change, in the design's length unit)",
                 ));
             };
-            if delta_r >= radius {
-                return Err(issue(
-                    format!("{base}.delta_r"),
-                    format!(
-                        "Δr = {delta_r} must be smaller than the crown radius R = {radius}: the nodes would reach or cross the axis"
-                    ),
-                ));
-            }
-            (
-                ProgrammeKind::RadialContraction { delta_r },
-                geometry.nodes.iter().map(|n| -n.radial * delta_r).collect(),
-            )
+            ProgrammeTarget::RadialContraction { delta_r }
         }
         ProgrammeKindDto::TargetShape => {
             if dto.delta_r.is_some() {
@@ -524,57 +271,19 @@ pub fn programme(
                     "the temporary shape equals the permanent one: give `straighten: true`, a `centreline` or a `radius`",
                 ));
             }
-            let temporary = TemporarySpec {
-                centreline,
-                radius: t.radius.map(|r| r.0),
-            };
-            let positions = stent
-                .spec
-                .temporary_node_positions(geometry, &temporary)
-                .map_err(geometry_issue)?;
-            let positions = if t.align.unwrap_or(true) {
-                align_temporary(geometry, &positions, set).ok_or_else(|| {
-                    issue(
-                        format!("{tpath}.align"),
-                        "the driven nodes do not define a rigid placement",
-                    )
-                })?
-            } else {
-                positions
-            };
-            (
-                ProgrammeKind::TargetShape,
-                positions
-                    .iter()
-                    .zip(&geometry.nodes)
-                    .map(|(p, n)| p - n.position)
-                    .collect(),
-            )
+            ProgrammeTarget::TargetShape {
+                temporary: TemporarySpec {
+                    centreline,
+                    radius: t.radius.map(|r| r.0),
+                },
+                align: t.align.unwrap_or(true),
+            }
         }
     };
-    let programme = Programme {
-        kind,
-        node_set: set_name,
-        nodes: set
-            .iter()
-            .map(|&k| {
-                let g = &geometry.nodes[k];
-                DrivenNode {
-                    node: k,
-                    position: g.position,
-                    target: targets[k],
-                    axis_point: g.axis_point,
-                    axis_direction: g.axis_tangent,
-                    radius,
-                    weight: g.multiplicity as Real,
-                }
-            })
-            .collect(),
-        ramp: (t0, t1),
-        release,
-    };
-    programme
-        .apply(nodes)
-        .map_err(|e| issue(format!("{base}.temporary"), e.to_string()))?;
-    Ok(programme)
+    Ok(ProgrammeSpec {
+        target,
+        node_set: dto.nodes.clone().unwrap_or_else(|| "all_joints".into()),
+        ramp: (dto.ramp[0].0, dto.ramp[1].0),
+        release: dto.release.map(|r| r.0),
+    })
 }

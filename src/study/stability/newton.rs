@@ -87,7 +87,7 @@ pub fn newton_run(model: &Model) -> Result<NewtonRun, SolverError> {
         smallest_step: Real::INFINITY,
         ..NewtonRun::default()
     });
-    let result = sim.run(&mut watch);
+    let result = sim.run(&mut [&mut watch]);
     let mut run = watch.0;
     run.wall = started.elapsed().as_secs_f64();
     run.notices = sim.notices().to_vec();

@@ -1,0 +1,1003 @@
+//! Building a [`Model`] in Rust: patches from geometry, a generated stent and its programme, nodes and joints
+//! (by end or by coincidence), conditions, loads, temperature, material, time and solver settings, probes.
+//! [`ModelBuilder::build`] makes and checks the model; every check that involves more than one value is made
+//! here, and a failed one is a [`BuildError`] naming the input [`Field`]. The design-file layer
+//! ([`crate::io::design`]) is a translation of YAML into builder calls that maps fields back to lines.
+//!
+//! ```
+//! use stentkit::material::{CircularSection, ElasticLaw};
+//! use stentkit::math::Vec3;
+//! use stentkit::model::TimeFunction;
+//! use stentkit::model::builder::{ConditionSpec, ModelBuilder, PatchShape, TimeSpec};
+//!
+//! let section = CircularSection::try_new(0.01)?.into();
+//! let mut b = ModelBuilder::new("cantilever", ElasticLaw::try_new(1e7, 0.3)?, section);
+//! b.patch("beam", PatchShape::Line { from: Vec3::zeros(), to: Vec3::x() }, 4, 12);
+//! b.condition(ConditionSpec::clamp("beam.start"));
+//! b.condition(ConditionSpec::at("beam.end").with_force(2, TimeFunction::constant(1e-3)));
+//! b.time(TimeSpec::new(1.0, 0.25));
+//! let model = b.build()?.model;
+//! assert_eq!(model.nodes.len(), 2);
+//! # Ok::<(), Box<dyn std::error::Error>>(())
+//! ```
+
+pub(crate) mod checks;
+mod conditions;
+pub mod field;
+mod nodes;
+
+pub use checks::FIT_WARNING_FRACTION;
+use checks::check_discretisation;
+pub use field::{
+    BuildError, ConditionField, Field, NodeField, PatchField, ProbeField, ProgrammeField, Result,
+    SolverField, StentField, TimeField,
+};
+
+use super::stent::{self as stent_model, ProgrammeSpec, StentMesh};
+use super::*;
+use crate::geometry::analytic::ParametricCurve;
+use crate::geometry::fit::{FitSettings, fit_curve};
+use crate::geometry::stent::StentSpec;
+use crate::geometry::{GeometryError, Parameter, primitives};
+use crate::material::{ConstitutiveLaw, MaterialLaw, Section, Wlf};
+use crate::math::quote::quoted;
+use crate::math::{Mat3, Real, Vec3};
+use std::collections::{BTreeMap, HashMap};
+
+/// Default smallest step, as a fraction of the nominal step: ten halvings.
+pub const DEFAULT_MIN_STEP_FRACTION: Real = 1.0 / 1024.0;
+
+/// Relative size of the default joint tolerance: ends closer than this fraction of the model's bounding-box
+/// diagonal are the same point. Fits and exact primitives place shared ends to ~1e-14 relative, so 1e-8
+/// separates coincident ends from distinct ones with a wide margin on both sides.
+pub const DEFAULT_JOINT_TOLERANCE: Real = 1e-8;
+
+/// Temperature of a model without a temperature schedule whose material does not depend on it [°C].
+pub const DEFAULT_TEMPERATURE: Real = 20.0;
+
+/// The reference centreline of a patch.
+pub enum PatchShape {
+    /// A straight segment (exact).
+    Line {
+        /// Start point.
+        from: Vec3,
+        /// End point.
+        to: Vec3,
+    },
+    /// A circular arc (exact), [`primitives::arc`].
+    Arc {
+        /// Centre.
+        centre: Vec3,
+        /// Start point.
+        start: Vec3,
+        /// Axis (right-hand rule).
+        axis: Vec3,
+        /// Angle [rad].
+        angle: Real,
+    },
+    /// Any curve, fitted by a spline of the patch's degree and control points ([`fit_curve`]).
+    Fitted(Box<dyn ParametricCurve + Send + Sync>),
+}
+
+/// What a patch is made of, beyond its shape and discretisation.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct PatchOptions {
+    /// Its section: an index from [`ModelBuilder::section`] (0: the builder's first section).
+    pub section: usize,
+    /// Its material: an index from [`ModelBuilder::material`] (0: the builder's first material).
+    pub material: usize,
+    /// A hint for the first section axis at its start (irrelevant to circular sections).
+    pub normal_hint: Option<Vec3>,
+}
+
+/// A patch to build.
+struct PatchInput {
+    name: String,
+    shape: PatchShape,
+    degree: usize,
+    points: usize,
+    options: PatchOptions,
+}
+
+/// How a node finds its patch ends.
+#[derive(Debug, Clone, PartialEq)]
+pub enum NodeEnds {
+    /// The named ends (`patch.start`, `patch.end`), which must coincide.
+    Named(Vec<String>),
+    /// Every patch end within the joint tolerance of the point.
+    At(Vec3),
+}
+
+/// The local basis of a condition.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum BasisSpec {
+    /// Columns `e1, e2, e3`: orthonormal and right-handed.
+    Axes(Mat3),
+    /// A symmetry plane of the given normal: `e1` is the normal, and `u1, θ2, θ3` are held at zero.
+    SymmetryPlane(Vec3),
+}
+
+/// Which nodes a condition acts on.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Target {
+    /// One node: its name, or `patch.start` / `patch.end` of an end it holds.
+    Node(String),
+    /// Every node of a named set (a generated stent's `all_joints`, `crown_1`, …).
+    Set(String),
+}
+
+/// Boundary conditions and loads on one node or a node set, components in the condition's basis.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ConditionSpec {
+    /// The nodes.
+    pub target: Target,
+    /// The local basis (global axes when `None`).
+    pub basis: Option<BasisSpec>,
+    /// Hold all six components at zero.
+    pub clamp: bool,
+    /// Prescribed displacements `u1, u2, u3` [length].
+    pub displacement: [Option<TimeFunction>; 3],
+    /// Prescribed rotations `θ1, θ2, θ3` [rad].
+    pub rotation: [Option<TimeFunction>; 3],
+    /// Forces on free components (or on prescribed ones after the release).
+    pub force: [Option<TimeFunction>; 3],
+    /// Moments on free components (or on prescribed ones after the release).
+    pub moment: [Option<TimeFunction>; 3],
+    /// Time from which the prescribed components are free.
+    pub release: Option<Real>,
+}
+
+impl ConditionSpec {
+    /// Nothing prescribed or loaded at the named node yet.
+    pub fn at(node: impl Into<String>) -> Self {
+        Self {
+            target: Target::Node(node.into()),
+            basis: None,
+            clamp: false,
+            displacement: Default::default(),
+            rotation: Default::default(),
+            force: Default::default(),
+            moment: Default::default(),
+            release: None,
+        }
+    }
+
+    /// Nothing prescribed or loaded on the named node set yet.
+    pub fn on_set(set: impl Into<String>) -> Self {
+        Self {
+            target: Target::Set(set.into()),
+            ..Self::at("")
+        }
+    }
+
+    /// The named node clamped (all six components held at zero).
+    pub fn clamp(node: impl Into<String>) -> Self {
+        Self {
+            clamp: true,
+            ..Self::at(node)
+        }
+    }
+
+    /// With displacement component `i` prescribed.
+    pub fn with_displacement(mut self, i: usize, f: TimeFunction) -> Self {
+        self.displacement[i] = Some(f);
+        self
+    }
+
+    /// With rotation component `i` prescribed.
+    pub fn with_rotation(mut self, i: usize, f: TimeFunction) -> Self {
+        self.rotation[i] = Some(f);
+        self
+    }
+
+    /// With force component `i`.
+    pub fn with_force(mut self, i: usize, f: TimeFunction) -> Self {
+        self.force[i] = Some(f);
+        self
+    }
+
+    /// With moment component `i`.
+    pub fn with_moment(mut self, i: usize, f: TimeFunction) -> Self {
+        self.moment[i] = Some(f);
+        self
+    }
+}
+
+/// Which patches a distributed load acts on.
+#[derive(Debug, Clone, PartialEq)]
+pub enum PatchTarget {
+    /// The named patch.
+    Named(String),
+    /// Every patch.
+    All,
+}
+
+/// A distributed dead load, global components.
+#[derive(Debug, Clone, PartialEq)]
+pub struct DistributedLoadSpec {
+    /// The patches.
+    pub patches: PatchTarget,
+    /// Force per unit length [force/length].
+    pub force: [TimeFunction; 3],
+    /// Couple per unit length [force].
+    pub couple: [TimeFunction; 3],
+}
+
+/// Where a probe reads.
+#[derive(Debug, Clone, PartialEq)]
+pub enum ProbeAt {
+    /// At the named node (or `patch.start` / `patch.end`).
+    Node(String),
+    /// On the named patch at the curve parameter `u ∈ [0, 1]`.
+    Patch(String, Real),
+}
+
+/// Time stepping as asked for; [`TimeSettings`] once built.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct TimeSpec {
+    /// End time.
+    pub end: Real,
+    /// Nominal step.
+    pub step: Real,
+    /// Smallest step (default: [`DEFAULT_MIN_STEP_FRACTION`] of the step).
+    pub min_step: Option<Real>,
+    /// Release ramp (default: one step).
+    pub release_ramp: Option<Real>,
+}
+
+impl TimeSpec {
+    /// From 0 to `end` by `step`, with the default smallest step and release ramp.
+    pub fn new(end: Real, step: Real) -> Self {
+        Self {
+            end,
+            step,
+            min_step: None,
+            release_ramp: None,
+        }
+    }
+
+    /// The settings, checked: `0 < step ≤ end`, `0 < min_step ≤ step`, `release_ramp ≥ 0`.
+    pub fn settings(&self) -> Result<TimeSettings> {
+        let (end, step) = (self.end, self.step);
+        let positive = |v: Real| v > 0.0 && v.is_finite();
+        if !positive(end) {
+            return Err(BuildError::new(
+                Field::Time(TimeField::End),
+                format!("{end} must be > 0 and finite"),
+            ));
+        }
+        if !positive(step) {
+            return Err(BuildError::new(
+                Field::Time(TimeField::Step),
+                format!("{step} must be > 0 and finite"),
+            ));
+        }
+        if step > end {
+            return Err(BuildError::new(
+                Field::Time(TimeField::Step),
+                format!("the step {step} exceeds the end time {end}"),
+            ));
+        }
+        let min_step = self.min_step.unwrap_or(step * DEFAULT_MIN_STEP_FRACTION);
+        if !positive(min_step) {
+            return Err(BuildError::new(
+                Field::Time(TimeField::MinStep),
+                format!("{min_step} must be > 0 and finite"),
+            ));
+        }
+        if min_step > step {
+            return Err(BuildError::new(
+                Field::Time(TimeField::MinStep),
+                format!("min_step {min_step} exceeds the step {step}"),
+            ));
+        }
+        let release_ramp = self.release_ramp.unwrap_or(step);
+        if !(release_ramp >= 0.0 && release_ramp.is_finite()) {
+            return Err(BuildError::new(
+                Field::Time(TimeField::ReleaseRamp),
+                format!("{release_ramp} must be ≥ 0 and finite"),
+            ));
+        }
+        Ok(TimeSettings {
+            end,
+            step,
+            min_step,
+            release_ramp,
+        })
+    }
+}
+
+/// How patch ends that no node names are joined.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct JointRule {
+    /// Join every group of coincident free ends automatically (otherwise each is a node of its own).
+    pub automatic: bool,
+    /// Distance within which ends coincide [length]; default [`DEFAULT_JOINT_TOLERANCE`] of the model's
+    /// bounding-box diagonal.
+    pub tolerance: Option<Real>,
+}
+
+/// A built model with what is worth knowing about it.
+#[derive(Debug, Clone)]
+pub struct Built {
+    /// The model.
+    pub model: Model,
+    /// Things worth knowing that do not stop a run (a coarse fit, a temperature below the WLF singularity, a
+    /// programme that outlasts the run).
+    pub warnings: Vec<String>,
+}
+
+/// Builds a [`Model`]: add what the model holds, then [`ModelBuilder::build`].
+pub struct ModelBuilder {
+    name: String,
+    units: Units,
+    materials: Vec<MaterialLaw>,
+    sections: Vec<Section>,
+    stent: Option<(StentSpec, StentMesh)>,
+    programme: Option<ProgrammeSpec>,
+    patches: Vec<PatchInput>,
+    nodes: Vec<(String, NodeEnds)>,
+    joints: JointRule,
+    conditions: Vec<ConditionSpec>,
+    distributed: Vec<DistributedLoadSpec>,
+    temperature: Option<TimeFunction>,
+    time: TimeSpec,
+    solver: SolverSettings,
+    probes: Vec<(String, ProbeAt)>,
+    record_times: Vec<Real>,
+}
+
+impl ModelBuilder {
+    /// A model named `name` with `material` as material 0 and `section` as section 0 (every patch's unless it
+    /// says otherwise; a generated stent's), in [`Units::Si`], from 0 to 1 by 0.1, default solver settings.
+    pub fn new(
+        name: impl Into<String>,
+        material: impl Into<MaterialLaw>,
+        section: Section,
+    ) -> Self {
+        Self {
+            name: name.into(),
+            units: Units::Si,
+            materials: vec![material.into()],
+            sections: vec![section],
+            stent: None,
+            programme: None,
+            patches: Vec::new(),
+            nodes: Vec::new(),
+            joints: JointRule {
+                automatic: false,
+                tolerance: None,
+            },
+            conditions: Vec::new(),
+            distributed: Vec::new(),
+            temperature: None,
+            time: TimeSpec::new(1.0, 0.1),
+            solver: SolverSettings::default(),
+            probes: Vec::new(),
+            record_times: Vec::new(),
+        }
+    }
+
+    /// The unit system every number is in.
+    pub fn units(&mut self, units: Units) -> &mut Self {
+        self.units = units;
+        self
+    }
+
+    /// Adds a section; returns its index for [`PatchOptions::section`].
+    pub fn section(&mut self, section: Section) -> usize {
+        self.sections.push(section);
+        self.sections.len() - 1
+    }
+
+    /// Adds a material; returns its index for [`PatchOptions::material`].
+    pub fn material(&mut self, material: impl Into<MaterialLaw>) -> usize {
+        self.materials.push(material.into());
+        self.materials.len() - 1
+    }
+
+    /// Generates a stent whose patches and nodes come first in the model, with its node sets (`all_joints`,
+    /// `crown_<k>`, …), symmetry planes and the symmetry conditions of its cut nodes ([`stent_model`]).
+    pub fn stent(&mut self, spec: StentSpec, mesh: StentMesh) -> &mut Self {
+        self.stent = Some((spec, mesh));
+        self
+    }
+
+    /// Drives a node set of the generated stent to a temporary shape ([`ProgrammeSpec`]).
+    pub fn programme(&mut self, programme: ProgrammeSpec) -> &mut Self {
+        self.programme = Some(programme);
+        self
+    }
+
+    /// Adds a patch of section 0 and material 0 with degree `p` and `n` control points.
+    pub fn patch(&mut self, name: impl Into<String>, shape: PatchShape, p: usize, n: usize) {
+        self.patch_with(name, shape, p, n, PatchOptions::default());
+    }
+
+    /// Adds a patch with its section, material and normal hint.
+    pub fn patch_with(
+        &mut self,
+        name: impl Into<String>,
+        shape: PatchShape,
+        p: usize,
+        n: usize,
+        options: PatchOptions,
+    ) {
+        self.patches.push(PatchInput {
+            name: name.into(),
+            shape,
+            degree: p,
+            points: n,
+            options,
+        });
+    }
+
+    /// Adds a named node joining the given ends.
+    pub fn node(&mut self, name: impl Into<String>, ends: NodeEnds) {
+        self.nodes.push((name.into(), ends));
+    }
+
+    /// How the ends no node names are joined.
+    pub fn joints(&mut self, rule: JointRule) -> &mut Self {
+        self.joints = rule;
+        self
+    }
+
+    /// Adds boundary conditions and loads; one condition per node component.
+    pub fn condition(&mut self, condition: ConditionSpec) {
+        self.conditions.push(condition);
+    }
+
+    /// Adds a distributed load.
+    pub fn distributed_load(&mut self, load: DistributedLoadSpec) {
+        self.distributed.push(load);
+    }
+
+    /// The temperature schedule [°C] (required by a material with WLF; [`DEFAULT_TEMPERATURE`] otherwise).
+    pub fn temperature(&mut self, temperature: TimeFunction) -> &mut Self {
+        self.temperature = Some(temperature);
+        self
+    }
+
+    /// Time stepping.
+    pub fn time(&mut self, time: TimeSpec) -> &mut Self {
+        self.time = time;
+        self
+    }
+
+    /// Newton settings.
+    pub fn solver(&mut self, solver: SolverSettings) -> &mut Self {
+        self.solver = solver;
+        self
+    }
+
+    /// Adds a probe.
+    pub fn probe(&mut self, name: impl Into<String>, at: ProbeAt) {
+        self.probes.push((name.into(), at));
+    }
+
+    /// Times within `(0, end]` at which the state is recorded; time stepping lands on each.
+    pub fn record_times(&mut self, times: Vec<Real>) -> &mut Self {
+        self.record_times = times;
+        self
+    }
+
+    /// Checks everything [`ModelBuilder::build`] checks, without keeping the model.
+    pub fn validate(&self) -> Result<()> {
+        self.build().map(|_| ())
+    }
+
+    /// Makes the model: generates and fits the geometry, joins the ends, resolves every name, applies the
+    /// symmetry conditions, the programme and the conditions, and checks them.
+    pub fn build(&self) -> Result<Built> {
+        let mut warnings = Vec::new();
+        let time = self.time.settings()?;
+        check_solver(&self.solver)?;
+        let mut sections = self.sections.clone();
+        let stent = match &self.stent {
+            Some((spec, mesh)) => Some(stent_model::generate(
+                spec,
+                mesh,
+                &mut sections,
+                self.materials[0].poisson(),
+                &mut warnings,
+            )?),
+            None => None,
+        };
+        let generated = stent.as_ref().map_or_else(Vec::new, |s| s.patches.clone());
+        let patches = self.patches(generated, &sections, &mut warnings)?;
+        let tolerance = self.joints.tolerance.unwrap_or_else(|| {
+            let (mut lo, mut hi) = (
+                Vec3::repeat(Real::INFINITY),
+                Vec3::repeat(Real::NEG_INFINITY),
+            );
+            for q in patches.iter().flat_map(|p| p.curve.points()) {
+                lo = lo.inf(q);
+                hi = hi.sup(q);
+            }
+            DEFAULT_JOINT_TOLERANCE * (hi - lo).norm()
+        });
+        let initial = stent.as_ref().map_or_else(Vec::new, |s| s.nodes.clone());
+        let mut nodes = nodes::nodes(
+            &self.nodes,
+            &patches,
+            tolerance,
+            self.joints.automatic,
+            initial,
+        )?;
+        let node_sets = stent
+            .as_ref()
+            .map_or_else(BTreeMap::new, |s| s.geometry.node_sets.clone());
+        let symmetry_planes = stent
+            .as_ref()
+            .map_or_else(Vec::new, stent_model::symmetry_planes);
+        // Components set by the stent's symmetry planes and the programme, which conditions must not override.
+        let mut preset: HashMap<(usize, usize), String> = HashMap::new();
+        if let Some(s) = &stent {
+            for (k, g) in s.geometry.nodes.iter().enumerate() {
+                if g.symmetry_plane.is_some() {
+                    for i in [0, 4, 5] {
+                        preset.insert((k, i), "the stent's symmetry plane".into());
+                    }
+                }
+            }
+        }
+        let programme = match &self.programme {
+            Some(p) => {
+                let Some(stent) = &stent else {
+                    return Err(BuildError::new(
+                        Field::Programme(ProgrammeField::Whole),
+                        "a programme drives the nodes of a generated stent: add a `stent` block",
+                    ));
+                };
+                let programme =
+                    stent_model::programme(p, stent, &mut nodes, time.end, &mut warnings)?;
+                for d in &programme.nodes {
+                    for i in 0..3 {
+                        preset
+                            .entry((d.node, i))
+                            .or_insert_with(|| "the programme".into());
+                    }
+                }
+                Some(programme)
+            }
+            None => None,
+        };
+        conditions::apply(&self.conditions, &patches, &mut nodes, &node_sets, &preset)?;
+        let distributed_loads = self.distributed_loads(&patches)?;
+        let shifts: Vec<&Wlf> = self.materials.iter().filter_map(wlf).collect();
+        let temperature = match (&self.temperature, shifts.is_empty()) {
+            (Some(f), _) => f.clone(),
+            (None, true) => TimeFunction::constant(DEFAULT_TEMPERATURE),
+            (None, false) => {
+                return Err(BuildError::new(
+                    Field::Temperature,
+                    "missing: a material with `wlf` needs a temperature schedule (a number or [[t, T], …] in °C)",
+                ));
+            }
+        };
+        for w in shifts {
+            let freeze = w.frozen_below();
+            let (lo, _) = temperature.range();
+            if lo <= freeze {
+                warnings.push(format!(
+                    "temperature reaches {lo} °C, at or below the WLF singularity Tg − C2 = {freeze} °C: relaxation freezes there (instantaneous moduli)"
+                ));
+            }
+        }
+        let probes = self.probes(&patches, &nodes)?;
+        let model = Model {
+            name: self.name.clone(),
+            units: self.units,
+            materials: self.materials.clone(),
+            sections,
+            patches,
+            nodes,
+            distributed_loads,
+            temperature,
+            time,
+            solver: self.solver.clone(),
+            probes,
+            node_sets,
+            programme,
+            symmetry_planes,
+            record_times: self.record_times.clone(),
+        };
+        Ok(Built { model, warnings })
+    }
+
+    /// The model's patches: `generated` (a stent's) first, then the added ones, fitted.
+    fn patches(
+        &self,
+        generated: Vec<Patch>,
+        sections: &[Section],
+        warnings: &mut Vec<String>,
+    ) -> Result<Vec<Patch>> {
+        if self.patches.is_empty() && generated.is_empty() {
+            return Err(BuildError::new(
+                Field::Patches,
+                "a design needs at least one patch: give `patches` or a `stent` block",
+            ));
+        }
+        let mut names: HashMap<&str, usize> = HashMap::new();
+        let mut out = generated;
+        for (k, input) in self.patches.iter().enumerate() {
+            let at = |field| Field::Patch { index: k, field };
+            let name = &input.name;
+            if name.is_empty() || name.contains('.') || name.contains(char::is_whitespace) {
+                return Err(BuildError::new(
+                    at(PatchField::Name),
+                    format!(
+                        "{} is not a valid patch name: use a non-empty name without dots or spaces",
+                        quoted(name)
+                    ),
+                ));
+            }
+            if out.iter().any(|p| &p.name == name) && !names.contains_key(name.as_str()) {
+                return Err(BuildError::new(
+                    at(PatchField::Name),
+                    format!(
+                        "patch name {} is already used by the generated stent",
+                        quoted(name)
+                    ),
+                ));
+            }
+            if let Some(first) = names.insert(name, k) {
+                return Err(BuildError::new(
+                    at(PatchField::Name),
+                    format!(
+                        "patch name {} is already used by patches[{first}]",
+                        quoted(name)
+                    ),
+                ));
+            }
+            let (p, n) = (input.degree, input.points);
+            check_discretisation(p, n, at(PatchField::Degree), at(PatchField::ControlPoints))?;
+            let geometry = |e: GeometryError| {
+                let field = match e {
+                    GeometryError::InvalidParameter {
+                        what: Parameter::ArcAngle,
+                        ..
+                    } => PatchField::Angle,
+                    _ => PatchField::Geometry,
+                };
+                BuildError::new(at(field), e.to_string())
+            };
+            let (curve, fit_error) = match &input.shape {
+                PatchShape::Line { from, to } => {
+                    (primitives::line(*from, *to, p, n).map_err(geometry)?, None)
+                }
+                PatchShape::Arc {
+                    centre,
+                    start,
+                    axis,
+                    angle,
+                } => (
+                    primitives::arc(*centre, *start, *axis, *angle, p, n).map_err(geometry)?,
+                    None,
+                ),
+                PatchShape::Fitted(curve) => {
+                    let fit = fit_curve(curve.as_ref(), p, n, &FitSettings::default())
+                        .map_err(geometry)?;
+                    (fit.curve, Some(fit.max_deviation))
+                }
+            };
+            let options = input.options;
+            let Some(section) = sections.get(options.section) else {
+                return Err(BuildError::new(
+                    at(PatchField::Section),
+                    format!(
+                        "section {} does not exist ({} sections)",
+                        options.section,
+                        sections.len()
+                    ),
+                ));
+            };
+            if options.material >= self.materials.len() {
+                return Err(BuildError::new(
+                    at(PatchField::Material),
+                    format!(
+                        "material {} does not exist ({} materials)",
+                        options.material,
+                        self.materials.len()
+                    ),
+                ));
+            }
+            if let Some(dev) = fit_error {
+                let d = section.diameter();
+                if dev > FIT_WARNING_FRACTION * d {
+                    warnings.push(format!(
+                        "patch {}: the spline fit deviates up to {dev:.3e} from the curve, {:.1}% of the wire diameter; raise n",
+                        quoted(name),
+                        100.0 * dev / d
+                    ));
+                }
+            }
+            out.push(Patch {
+                name: name.clone(),
+                curve,
+                normal_hint: options.normal_hint,
+                section: options.section,
+                material: options.material,
+                fit_error,
+            });
+        }
+        Ok(out)
+    }
+
+    fn distributed_loads(&self, patches: &[Patch]) -> Result<Vec<DistributedLoad>> {
+        let mut out = Vec::new();
+        for (k, d) in self.distributed.iter().enumerate() {
+            let targets: Vec<usize> = match &d.patches {
+                PatchTarget::All => (0..patches.len()).collect(),
+                PatchTarget::Named(name) => {
+                    vec![
+                        patches
+                            .iter()
+                            .position(|p| &p.name == name)
+                            .ok_or_else(|| {
+                                BuildError::new(
+                                    Field::DistributedLoad { index: k },
+                                    format!(
+                                        "no patch {}: name a patch or write `all`",
+                                        quoted(name)
+                                    ),
+                                )
+                            })?,
+                    ]
+                }
+            };
+            out.extend(targets.into_iter().map(|patch| DistributedLoad {
+                patch,
+                force: d.force.clone(),
+                couple: d.couple.clone(),
+            }));
+        }
+        Ok(out)
+    }
+
+    fn probes(&self, patches: &[Patch], nodes: &[Node]) -> Result<Vec<Probe>> {
+        let mut out: Vec<Probe> = Vec::new();
+        for (k, (name, at)) in self.probes.iter().enumerate() {
+            let field = |field| Field::Probe { index: k, field };
+            if name.is_empty() || name.contains([',', '"', '\n']) {
+                return Err(BuildError::new(
+                    field(ProbeField::Name),
+                    "a probe name must be non-empty, without commas or quotes",
+                ));
+            }
+            if out.iter().any(|q| &q.name == name) {
+                return Err(BuildError::new(
+                    field(ProbeField::Name),
+                    format!("probe name {} is used twice", quoted(name)),
+                ));
+            }
+            let location = match at {
+                ProbeAt::Node(n) => {
+                    ProbeLocation::Node(nodes::find(n, patches, nodes).ok_or_else(|| {
+                        BuildError::new(field(ProbeField::Node), format!("no node {}", quoted(n)))
+                    })?)
+                }
+                ProbeAt::Patch(patch_name, u) => {
+                    let patch = patches
+                        .iter()
+                        .position(|q| &q.name == patch_name)
+                        .ok_or_else(|| {
+                            BuildError::new(
+                                field(ProbeField::Patch),
+                                format!("no patch {}", quoted(patch_name)),
+                            )
+                        })?;
+                    if !(0.0..=1.0).contains(u) {
+                        return Err(BuildError::new(
+                            field(ProbeField::U),
+                            format!("u = {u} must lie in [0, 1]"),
+                        ));
+                    }
+                    ProbeLocation::Patch { patch, u: *u }
+                }
+            };
+            out.push(Probe {
+                name: name.clone(),
+                location,
+            });
+        }
+        Ok(out)
+    }
+}
+
+/// The WLF shift of a material law, if it has one (its temperature dependence).
+fn wlf(law: &MaterialLaw) -> Option<&Wlf> {
+    match law {
+        MaterialLaw::Maxwell(m) => m.material().wlf(),
+        _ => None,
+    }
+}
+
+fn check_solver(s: &SolverSettings) -> Result<()> {
+    if !(s.tolerance > 0.0 && s.tolerance.is_finite()) {
+        return Err(BuildError::new(
+            Field::Solver(SolverField::Tolerance),
+            format!("{} must be > 0 and finite", s.tolerance),
+        ));
+    }
+    if s.max_iterations == 0 {
+        return Err(BuildError::new(
+            Field::Solver(SolverField::MaxIterations),
+            "must be ≥ 1",
+        ));
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    //! Each check of the builder reports the field it is about; the positions of the design-file layer rest on
+    //! these fields (tests/data/bad_designs checks them end to end, with line and column).
+    use super::*;
+    use crate::material::{CircularSection, ElasticLaw};
+
+    fn elastic() -> ModelBuilder {
+        let section = CircularSection::try_new(0.01).expect("d > 0").into();
+        let mut b = ModelBuilder::new(
+            "frame",
+            ElasticLaw::try_new(1e7, 0.3).expect("valid"),
+            section,
+        );
+        let line = |from: Vec3, to: Vec3| PatchShape::Line { from, to };
+        b.patch("beam", line(Vec3::zeros(), Vec3::x()), 3, 6);
+        b.patch("post", line(Vec3::x(), Vec3::new(1.0, 1.0, 0.0)), 3, 6);
+        b.condition(ConditionSpec::clamp("beam.start"));
+        b
+    }
+
+    #[track_caller]
+    fn field_of(b: &ModelBuilder) -> Field {
+        b.build().expect_err("refused").field
+    }
+
+    #[test]
+    fn a_good_frame_builds_with_its_ends_joined_by_coincidence() {
+        let mut b = elastic();
+        b.node("knee", NodeEnds::At(Vec3::x()));
+        let model = b.build().expect("valid").model;
+        // beam.start (clamped), knee (beam.end + post.start), post.end.
+        assert_eq!(model.nodes.len(), 3);
+        assert_eq!(model.nodes[0].name, "knee");
+        assert_eq!(model.nodes[0].ends.len(), 2);
+        assert!(b.validate().is_ok());
+    }
+
+    #[test]
+    fn errors_name_the_input_they_are_about() {
+        let mut b = elastic();
+        b.node(
+            "knee",
+            NodeEnds::Named(vec!["beam.end".into(), "post.end".into()]),
+        );
+        assert_eq!(
+            field_of(&b),
+            Field::Node {
+                index: 0,
+                field: NodeField::End(1)
+            },
+            "post.end is 1 away from beam.end"
+        );
+
+        let mut b = elastic();
+        b.condition(ConditionSpec::at("nowhere"));
+        assert_eq!(
+            field_of(&b),
+            Field::Condition {
+                index: 1,
+                field: ConditionField::Node
+            }
+        );
+
+        let mut b = elastic();
+        b.condition(ConditionSpec::at("beam.start").with_displacement(1, TimeFunction::zero()));
+        assert_eq!(
+            field_of(&b),
+            Field::Condition {
+                index: 1,
+                field: ConditionField::Displacement(1)
+            },
+            "u2 of beam.start is already clamped"
+        );
+
+        let mut b = elastic();
+        b.condition(
+            ConditionSpec::at("post.end")
+                .with_displacement(0, TimeFunction::zero())
+                .with_force(0, TimeFunction::constant(1.0)),
+        );
+        assert_eq!(
+            field_of(&b),
+            Field::Condition {
+                index: 1,
+                field: ConditionField::Force(0)
+            },
+            "prescribed and loaded without a release"
+        );
+
+        let mut b = elastic();
+        b.patch(
+            "hook",
+            PatchShape::Arc {
+                centre: Vec3::zeros(),
+                start: Vec3::y(),
+                axis: Vec3::z(),
+                angle: 3.0,
+            },
+            3,
+            6,
+        );
+        assert_eq!(
+            field_of(&b),
+            Field::Patch {
+                index: 2,
+                field: PatchField::Angle
+            },
+            "172° is more than one patch holds"
+        );
+
+        let mut b = elastic();
+        b.patch(
+            "bad.name",
+            PatchShape::Line {
+                from: Vec3::zeros(),
+                to: Vec3::y(),
+            },
+            3,
+            6,
+        );
+        assert_eq!(
+            field_of(&b),
+            Field::Patch {
+                index: 2,
+                field: PatchField::Name
+            }
+        );
+
+        let mut b = elastic();
+        b.patch(
+            "stub",
+            PatchShape::Line {
+                from: Vec3::zeros(),
+                to: Vec3::y(),
+            },
+            3,
+            3,
+        );
+        assert_eq!(
+            field_of(&b),
+            Field::Patch {
+                index: 2,
+                field: PatchField::ControlPoints
+            }
+        );
+
+        let mut b = elastic();
+        b.time(TimeSpec::new(1.0, 2.0));
+        assert_eq!(field_of(&b), Field::Time(TimeField::Step));
+
+        let mut b = elastic();
+        b.probe("tip", ProbeAt::Patch("post".into(), 1.5));
+        assert_eq!(
+            field_of(&b),
+            Field::Probe {
+                index: 0,
+                field: ProbeField::U
+            }
+        );
+
+        let mut b = elastic();
+        b.programme(ProgrammeSpec {
+            target: stent_model::ProgrammeTarget::RadialContraction { delta_r: 1.0 },
+            node_set: "all_joints".into(),
+            ramp: (0.0, 1.0),
+            release: None,
+        });
+        assert_eq!(field_of(&b), Field::Programme(ProgrammeField::Whole));
+    }
+}

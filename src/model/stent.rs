@@ -1,0 +1,374 @@
+//! A generated stent in the model: its patches fitted at the crown and bridge discretisations (half a section
+//! for patches lying in a symmetry plane), its nodes with their symmetry conditions, node sets and symmetry
+//! planes, and the [`Programme`] that drives a node set to the temporary shape. The geometry itself is
+//! [`crate::geometry::stent`]; [`super::builder::ModelBuilder::stent`] and
+//! [`super::builder::ModelBuilder::programme`] put both into a model.
+
+use super::builder::checks::{FIT_WARNING_FRACTION, check_discretisation};
+use super::builder::field::{BuildError, Field, ProgrammeField, Result, StentField};
+use super::{
+    Component, DrivenNode, End, Node, NodeConditions, Patch, PatchEnd, Programme, ProgrammeKind,
+};
+use crate::geometry::GeometryError;
+use crate::geometry::fit::{FitSettings, best_fit_rigid, fit_curve};
+use crate::geometry::frame::basis_from_unit_axis;
+use crate::geometry::primitives;
+use crate::geometry::stent::{PatchRole, StentGeometry, StentSpec, TemporarySpec, WireEnd};
+use crate::material::{Section, SectionProperties};
+use crate::math::quote::quoted;
+use crate::math::{Real, Vec3};
+
+/// Degree and control points of the stent's wires.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct StentMesh {
+    /// `(p, n)` of each crown wire.
+    pub crown: (usize, usize),
+    /// `(p, n)` of each bridge.
+    pub bridge: (usize, usize),
+}
+
+/// Where the programme takes the driven nodes.
+#[derive(Debug, Clone, PartialEq)]
+pub enum ProgrammeTarget {
+    /// Every driven node moves towards the axis by `delta_r` (paper §4.3, straight stent).
+    RadialContraction {
+        /// Radius change Δr [length], `0 < Δr < R`.
+        delta_r: Real,
+    },
+    /// Every driven node moves to its place in a temporary shape of the same crowns (paper §4.3, curved
+    /// stent).
+    TargetShape {
+        /// The temporary shape.
+        temporary: TemporarySpec,
+        /// Place the temporary shape by the rigid motion that best fits it onto the permanent one (see
+        /// [`align_temporary`]); `false` keeps it where the generator puts it.
+        align: bool,
+    },
+}
+
+/// A programme as asked for: which node set goes where, over which ramp, released when.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ProgrammeSpec {
+    /// Where the nodes go.
+    pub target: ProgrammeTarget,
+    /// The driven node set (`all_joints` by default in designs).
+    pub node_set: String,
+    /// Start and end of the linear ramp to the temporary shape [time].
+    pub ramp: (Real, Real),
+    /// Time at which the driven components are released; `None` = never.
+    pub release: Option<Real>,
+}
+
+/// The generated stent, ready to be merged into the model (its patches and nodes come first).
+#[derive(Debug, Clone)]
+pub struct GeneratedStent {
+    /// The specification it was generated from.
+    pub spec: StentSpec,
+    /// The analytic device.
+    pub geometry: StentGeometry,
+    /// Fitted patches, in the order of `geometry.patches`.
+    pub patches: Vec<Patch>,
+    /// Nodes, in the order of `geometry.nodes`, with their symmetry conditions.
+    pub nodes: Vec<Node>,
+}
+
+fn geometry_error(e: GeometryError) -> BuildError {
+    match e {
+        GeometryError::InvalidStent { parameter, reason } => {
+            BuildError::new(Field::Stent(StentField::Parameter(parameter)), reason)
+        }
+        e => BuildError::new(Field::Stent(StentField::Whole), e.to_string()),
+    }
+}
+
+/// Generates the stent: fitted patches (section 0, or a half section for patches lying in a symmetry plane,
+/// appended to `sections`; `poisson` gives its shear factor), all of material 0, nodes with their symmetry conditions.
+pub fn generate(
+    spec: &StentSpec,
+    mesh: &StentMesh,
+    sections: &mut Vec<Section>,
+    poisson: Real,
+    warnings: &mut Vec<String>,
+) -> Result<GeneratedStent> {
+    let geometry = spec.generate().map_err(geometry_error)?;
+    for (bridge, (p, n)) in [(false, mesh.crown), (true, mesh.bridge)] {
+        check_discretisation(
+            p,
+            n,
+            Field::Stent(StentField::Degree { bridge }),
+            Field::Stent(StentField::ControlPoints { bridge }),
+        )?;
+    }
+    let full = sections[0];
+    let mut half_section = None;
+    let mut patches = Vec::with_capacity(geometry.patches.len());
+    let mut worst: Option<(Real, &str)> = None;
+    let whole = |message: String| BuildError::new(Field::Stent(StentField::Whole), message);
+    for g in &geometry.patches {
+        let (p, n) = match g.role {
+            PatchRole::Crown { .. } => mesh.crown,
+            PatchRole::Bridge { .. } => mesh.bridge,
+        };
+        let (curve, fit_error) = match g.straight_segment() {
+            Some((a, b)) => (
+                primitives::line(a, b, p, n).map_err(|e| whole(e.to_string()))?,
+                None,
+            ),
+            None => {
+                let fit = fit_curve(&g.curve, p, n, &FitSettings::default())
+                    .map_err(|e| whole(format!("patch `{}`: {e}", g.name)))?;
+                if worst.is_none_or(|(w, _)| fit.max_deviation > w) {
+                    worst = Some((fit.max_deviation, &g.name));
+                }
+                (fit.curve, Some(fit.max_deviation))
+            }
+        };
+        let section = match g.in_plane {
+            None => 0,
+            Some(_) => *half_section.get_or_insert_with(|| {
+                // Half of every stiffness: the two halves of the full model share this rod.
+                sections.push(Section::Properties(SectionProperties {
+                    area: 0.5 * full.area(),
+                    second_moment: 0.5 * full.second_moment(),
+                    polar_moment: 0.5 * full.polar_moment(),
+                    shear_factor: full.shear_factor(poisson),
+                    drawing_diameter: full.diameter(),
+                }));
+                sections.len() - 1
+            }),
+        };
+        patches.push(Patch {
+            name: g.name.clone(),
+            curve,
+            normal_hint: Some(g.normal_hint),
+            section,
+            material: 0,
+            fit_error,
+        });
+    }
+    if let Some((dev, name)) = worst {
+        let d = full.diameter();
+        if dev > FIT_WARNING_FRACTION * d {
+            warnings.push(format!(
+                "stent patch `{name}`: the spline fit deviates up to {dev:.3e} from the curve, {:.1}% of the wire diameter; raise n",
+                100.0 * dev / d
+            ));
+        }
+    }
+    let nodes = geometry
+        .nodes
+        .iter()
+        .map(|g| {
+            let mut conditions = NodeConditions::default();
+            if let Some(k) = g.symmetry_plane {
+                conditions.basis = basis_from_unit_axis(&geometry.symmetry_planes[k].normal);
+                for i in [0, 4, 5] {
+                    conditions.components[i] = Component::fixed();
+                }
+            }
+            Node {
+                name: g.name.clone(),
+                ends: g
+                    .ends
+                    .iter()
+                    .map(|&(patch, end)| PatchEnd {
+                        patch,
+                        end: match end {
+                            WireEnd::Start => End::Start,
+                            WireEnd::End => End::End,
+                        },
+                    })
+                    .collect(),
+                position: g.position,
+                conditions,
+            }
+        })
+        .collect();
+    Ok(GeneratedStent {
+        spec: spec.clone(),
+        geometry,
+        patches,
+        nodes,
+    })
+}
+
+/// The symmetry planes of a generated stent as `(point, normal)`.
+pub fn symmetry_planes(stent: &GeneratedStent) -> Vec<(Vec3, Vec3)> {
+    stent
+        .geometry
+        .symmetry_planes
+        .iter()
+        .map(|p| (p.point, p.normal))
+        .collect()
+}
+
+/// The temporary node positions moved by the rigid motion that best fits the driven nodes (`set`) of the FULL
+/// device — every node mirrored about every combination of symmetry planes, weights shared among the copies —
+/// onto their permanent positions ([`best_fit_rigid`]). A free device has no preferred placement once released;
+/// placing the temporary shape this way gives its displacement `η_temp = P_temp − P_0` no rigid part, so the
+/// gauge that fixes the free device's rigid motion at the release ([`crate::solver::gauge`]) holds it where a full
+/// recovery brings every node back to `P_0`. By symmetry of the mirrored point sets the fitted motion respects
+/// the symmetry planes.
+pub fn align_temporary(
+    geometry: &StentGeometry,
+    positions: &[Vec3],
+    set: &[usize],
+) -> Option<Vec<Vec3>> {
+    let planes: Vec<(Vec3, Vec3)> = geometry
+        .symmetry_planes
+        .iter()
+        .map(|p| (p.point, p.normal.normalize()))
+        .collect();
+    let reflect = |x: Vec3, mask: usize| {
+        planes.iter().enumerate().fold(x, |x, (i, (p, n))| {
+            if mask >> i & 1 == 1 {
+                x - n * (2.0 * n.dot(&(x - p)))
+            } else {
+                x
+            }
+        })
+    };
+    let copies = 1usize << planes.len();
+    let (mut from, mut to, mut weights) = (Vec::new(), Vec::new(), Vec::new());
+    for &k in set {
+        for mask in 0..copies {
+            from.push(reflect(positions[k], mask));
+            to.push(reflect(geometry.nodes[k].position, mask));
+            weights.push(geometry.nodes[k].multiplicity as Real / copies as Real);
+        }
+    }
+    let (r, t) = best_fit_rigid(&from, &to, &weights)?;
+    Some(positions.iter().map(|p| r * p + t).collect())
+}
+
+/// Builds the programme and applies it to the stent's nodes (the first of `nodes`).
+pub fn programme(
+    spec: &ProgrammeSpec,
+    stent: &GeneratedStent,
+    nodes: &mut [Node],
+    end_time: Real,
+    warnings: &mut Vec<String>,
+) -> Result<Programme> {
+    let at = |field| Field::Programme(field);
+    let sets = &stent.geometry.node_sets;
+    let set_name = &spec.node_set;
+    let Some(set) = sets.get(set_name) else {
+        let known: Vec<&str> = sets.keys().map(String::as_str).collect();
+        return Err(BuildError::new(
+            at(ProgrammeField::Nodes),
+            format!(
+                "no node set {}; the stent has: {}",
+                quoted(set_name),
+                known.join(", ")
+            ),
+        ));
+    };
+    if set.is_empty() {
+        return Err(BuildError::new(
+            at(ProgrammeField::Nodes),
+            format!("node set {} is empty", quoted(set_name)),
+        ));
+    }
+    let (t0, t1) = spec.ramp;
+    if t1 <= t0 {
+        return Err(BuildError::new(
+            at(ProgrammeField::RampEnd),
+            format!(
+                "programme times must increase: the ramp ends at t = {t1}, not after its start t = {t0}"
+            ),
+        ));
+    }
+    if let Some(r) = spec.release {
+        if r < t1 {
+            return Err(BuildError::new(
+                at(ProgrammeField::Release),
+                format!(
+                    "programme times must increase: the release at t = {r} comes before the end of the ramp (t = {t1})"
+                ),
+            ));
+        }
+        if r >= end_time {
+            warnings.push(format!(
+                "the programme releases at t = {r}, at or after the end of the run ({end_time}): the nodes are never released"
+            ));
+        }
+    }
+    if t1 > end_time {
+        warnings.push(format!(
+            "the programme's ramp ends at t = {t1}, after the end of the run ({end_time})"
+        ));
+    }
+    let geometry = &stent.geometry;
+    let radius = stent.spec.crown.radius;
+    let (kind, targets): (ProgrammeKind, Vec<Vec3>) = match &spec.target {
+        &ProgrammeTarget::RadialContraction { delta_r } => {
+            if !(delta_r > 0.0 && delta_r.is_finite()) {
+                return Err(BuildError::new(
+                    at(ProgrammeField::DeltaR),
+                    format!("Δr = {delta_r} must be > 0 and finite"),
+                ));
+            }
+            if delta_r >= radius {
+                return Err(BuildError::new(
+                    at(ProgrammeField::DeltaR),
+                    format!(
+                        "Δr = {delta_r} must be smaller than the crown radius R = {radius}: the nodes would reach or cross the axis"
+                    ),
+                ));
+            }
+            (
+                ProgrammeKind::RadialContraction { delta_r },
+                geometry.nodes.iter().map(|n| -n.radial * delta_r).collect(),
+            )
+        }
+        ProgrammeTarget::TargetShape { temporary, align } => {
+            let positions = stent
+                .spec
+                .temporary_node_positions(geometry, temporary)
+                .map_err(geometry_error)?;
+            let positions = if *align {
+                align_temporary(geometry, &positions, set).ok_or_else(|| {
+                    BuildError::new(
+                        at(ProgrammeField::Align),
+                        "the driven nodes do not define a rigid placement",
+                    )
+                })?
+            } else {
+                positions
+            };
+            (
+                ProgrammeKind::TargetShape,
+                positions
+                    .iter()
+                    .zip(&geometry.nodes)
+                    .map(|(p, n)| p - n.position)
+                    .collect(),
+            )
+        }
+    };
+    let programme = Programme {
+        kind,
+        node_set: set_name.clone(),
+        nodes: set
+            .iter()
+            .map(|&k| {
+                let g = &geometry.nodes[k];
+                DrivenNode {
+                    node: k,
+                    position: g.position,
+                    target: targets[k],
+                    axis_point: g.axis_point,
+                    axis_direction: g.axis_tangent,
+                    radius,
+                    weight: g.multiplicity as Real,
+                }
+            })
+            .collect(),
+        ramp: (t0, t1),
+        release: spec.release,
+    };
+    programme
+        .apply(nodes)
+        .map_err(|e| BuildError::new(at(ProgrammeField::Temporary), e.to_string()))?;
+    Ok(programme)
+}

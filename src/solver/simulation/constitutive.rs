@@ -1,0 +1,146 @@
+//! The materials at the collocation points: each patch's points use that patch's material
+//! ([`crate::model::Patch::material`]); the solver calls the constitutive interface
+//! ([`crate::material::ConstitutiveLaw`]) once per material for a step's preparation, its commit and a
+//! roll-back, and keeps the [`SectionLaw`] of every point for the assembly (paper §3.1).
+
+use super::{Simulation, SolverTiming};
+use crate::material::{
+    ConstitutiveLaw, MaterialLaw, MaterialState, SectionLaw, SectionStrains, StepInput,
+};
+use crate::math::Real;
+use crate::model::Model;
+use crate::solver::SolverError;
+use crate::solver::assembly::{StepMaterial, point_strains};
+use crate::solver::discretisation::Discretisation;
+use rayon::prelude::*;
+use std::time::Instant;
+
+/// The points of one material and their state.
+#[derive(Debug, Clone)]
+pub(super) struct MaterialPoints {
+    /// Index into [`Model::materials`].
+    pub(super) material: usize,
+    /// The global collocation points made of it, ascending (point `i` of the state is `points[i]`).
+    pub(super) points: Vec<usize>,
+    /// The law's internal variables at those points.
+    pub(super) state: MaterialState,
+    /// The converged strains at those points, for the commit (kept to reuse its memory).
+    strains: Vec<SectionStrains>,
+}
+
+/// Every material's points and state, and the section law of every collocation point for the step being solved
+/// (or the last converged step).
+#[derive(Debug, Clone)]
+pub(super) struct PointMaterials {
+    /// One entry per material that some patch uses, in material order.
+    pub(super) groups: Vec<MaterialPoints>,
+    /// The section law per global collocation point.
+    pub(super) laws: Vec<SectionLaw>,
+    /// The notices said, as `(material, kind)` ([`crate::material::MaterialNotice::kind`]): each once.
+    pub(super) said: Vec<(usize, String)>,
+}
+
+impl PointMaterials {
+    /// The states of the model's materials at rest, and their laws before the first step.
+    pub(super) fn new(model: &Model, disc: &Discretisation) -> Self {
+        let mut groups: Vec<MaterialPoints> = Vec::new();
+        for (material, law) in model.materials.iter().enumerate() {
+            let points: Vec<usize> = (0..disc.points.len())
+                .filter(|&g| model.patches[disc.points[g].patch].material == material)
+                .collect();
+            if points.is_empty() {
+                continue;
+            }
+            let shapes = points
+                .iter()
+                .map(|&g| disc.shapes[disc.points[g].shape])
+                .collect();
+            groups.push(MaterialPoints {
+                material,
+                state: law.new_state(shapes),
+                strains: vec![SectionStrains::default(); points.len()],
+                points,
+            });
+        }
+        let mut out = Self {
+            groups,
+            laws: vec![SectionLaw::default(); disc.points.len()],
+            said: Vec::new(),
+        };
+        out.refresh_laws(&model.materials);
+        out
+    }
+
+    /// Reads every point's section law from its material's state.
+    pub(super) fn refresh_laws(&mut self, materials: &[MaterialLaw]) {
+        for group in &self.groups {
+            let law = &materials[group.material];
+            for (i, &g) in group.points.iter().enumerate() {
+                self.laws[g] = law.section_law(&group.state, i);
+            }
+        }
+    }
+
+    /// Every material back to the data of its last converged step.
+    pub(super) fn roll_back(&mut self, materials: &[MaterialLaw]) {
+        for group in &mut self.groups {
+            materials[group.material].roll_back(&mut group.state);
+        }
+        self.refresh_laws(materials);
+    }
+}
+
+impl Simulation<'_> {
+    /// Prepares the constitutive data of the step `t_n → t_np1` (paper §3.1) for every material: its step
+    /// coefficients, effective modulus and history stresses per point (the Ψ-terms of N/M_constitutive_disc for
+    /// the Maxwell law), then every point's section law. A material's notice is said once per kind.
+    pub(super) fn prepare_step(&mut self, t_n: Real, t_np1: Real) -> Result<(), SolverError> {
+        let start = Instant::now();
+        let model = self.model;
+        let temperature = |t: Real| model.temperature.value(t);
+        let step = StepInput {
+            t_n,
+            t_np1,
+            temperature: &temperature,
+        };
+        let materials = &mut self.materials;
+        for group in &mut materials.groups {
+            let notice = model.materials[group.material].prepare_step(&mut group.state, &step)?;
+            if let Some(notice) = notice {
+                let key = (group.material, notice.kind().to_string());
+                if !materials.said.contains(&key) {
+                    materials.said.push(key);
+                    self.notices.push(notice.to_string());
+                }
+            }
+        }
+        materials.refresh_laws(&model.materials);
+        SolverTiming::add(&mut self.timing.material, start);
+        Ok(())
+    }
+
+    /// After a converged step: every material advances its internal variables with the converged strains of
+    /// its points.
+    pub(super) fn commit_step(&mut self) {
+        let start = Instant::now();
+        let (disc, state) = (&self.disc, &self.state);
+        for group in &mut self.materials.groups {
+            // Per collocation point and independent: in parallel.
+            group
+                .strains
+                .par_iter_mut()
+                .zip(&group.points)
+                .for_each(|(strain, &g)| *strain = point_strains(disc, state, g));
+            self.model.materials[group.material].commit_step(&mut group.state, &group.strains);
+        }
+        // Counted with the step's preparation.
+        self.timing.material.1 += start.elapsed().as_secs_f64();
+    }
+
+    /// The constitutive data of the current (or last solved) step: every point's section law.
+    pub(super) fn step_material(&self) -> StepMaterial<'_> {
+        StepMaterial {
+            laws: &self.materials.laws,
+        }
+    }
+}

@@ -1,0 +1,306 @@
+//! Time stepping with Newton's method and automatic step cutting.
+//!
+//! A step from `t_n` to `t_{n+1}` (landing on every schedule breakpoint) solves the collocated equations by
+//! Newton's method from the last converged state. Convergence is judged on normalised per-field norms
+//! (DESIGN §4; deal.II step-44 style): the largest scaled residual of force rows, of moment rows and of
+//! kinematic rows, and the largest translation increment over the patch length and rotation increment in
+//! radians, must all be below the tolerance. A NaN or infinity anywhere stops the iteration at once. When
+//! Newton fails the last converged state is restored and the step halved, down to `min_step`; after a success
+//! the step grows back by doubling.
+//!
+//! **Progress.** A step's size is computed as `(t + h) − t`, which rounds to within half an ulp of `t + h`: at
+//! `t = 1.75` a step meant to be `min_step = 2.44e-6` can come out larger by ~1e-10 of itself. The smallest step
+//! is therefore recognised with an allowance of [`STEP_ROUND_OFF_ULPS`] ulps of the time reached (not a relative
+//! `1e-12` of `min_step`, which round-off exceeds once `t/min_step ≳ 1e4`), and a halved step within that
+//! allowance of `min_step` is `min_step` exactly. Every failure thus either halves the step or ends the run with
+//! [`SolverError::StepFailed`]: a run makes progress or fails with a report, never retries the same step forever.
+//!
+//! **Round-off.** The normalised residual and increment cannot fall below their round-off floors (measured:
+//! residuals 4e-13 … 1.5e-10, increments 2e-13 … 3e-10 on the 45° bend and the straight stent, growing with
+//! `p² n²`). A tolerance below [`ROUND_OFF_TOLERANCE`] may be below that floor: there Newton accepts an iterate
+//! that meets the stopping rule at [`ROUND_OFF_TOLERANCE`] once the residual stopped falling (an iteration with a
+//! fresh tangent did not halve it), and says so once in [`Simulation::notices`] (time, residual reached,
+//! tolerance asked); [`NewtonReport::at_round_off`] marks each such step. At tolerances from
+//! [`ROUND_OFF_TOLERANCE`] up (the default is 1e-9) this rule never applies: the stopping rule is unchanged.
+//!
+//! **Interruption.** [`Observer::interrupted`] is polled by Newton before every iteration and by `run` before
+//! every attempt of a step (first, retried with a fresh tangent, or cut). When it answers true the step in
+//! progress is abandoned and rolled back exactly as a failed step is, and `run` returns at the last converged
+//! step with [`RunSummary::stopped`] set.
+//!
+//! The concepts live in their own files: [`report`] (what a step and a run report), [`observer`] (who is told),
+//! [`timing`] (where the wall time went), `stepping` (the step loop, step-size control and roll-back), `newton`
+//! (Newton's method on normalised norms and its diagnostics), `releases` (release ramps and gauge constraints)
+//! and `constitutive` (the material's step preparation and commit).
+
+mod constitutive;
+mod newton;
+pub mod observer;
+mod releases;
+pub mod report;
+mod stepping;
+pub mod timing;
+
+pub use newton::ROUND_OFF_TOLERANCE;
+pub use observer::{NoObserver, Observer, Observers};
+pub use report::{NewtonReport, RunSummary, StepReport};
+pub use stepping::{STEP_FACTOR, STEP_ROUND_OFF_ULPS, StepOutcome};
+pub use timing::SolverTiming;
+
+use super::SolverError;
+use super::assembly::{
+    Actions, Assembler, Linearisation, ReleaseRamp, Sink, StepMaterial, point_position,
+};
+use super::discretisation::Discretisation;
+use super::gauge::Gauge;
+use super::linear::LinearSystem;
+use super::state::State;
+use crate::math::{Real, Vec3};
+use crate::model::{Model, ProbeLocation};
+use constitutive::PointMaterials;
+
+/// The increment norm's length of a patch whose ends coincide (a closed loop) is its chord floored at this
+/// fraction of the model size: a translation increment is measured against a length of the order of the
+/// patch, never against zero.
+const CLOSED_PATCH_LENGTH_FRACTION: Real = 1e-3;
+
+/// A running simulation of one model.
+pub struct Simulation<'m> {
+    model: &'m Model,
+    disc: Discretisation,
+    assembler: Assembler,
+    system: LinearSystem,
+    state: State,
+    time: Real,
+    step: usize,
+    lin: Linearisation,
+    values: Vec<Real>,
+    delta: Vec<Real>,
+    /// Length of the patch of each control point, for increment norms.
+    control_length: Vec<Real>,
+    /// Every material's points and internal variables, and every point's section law for the step being solved.
+    materials: PointMaterials,
+    /// Messages for the user, each said once (e.g. the WLF freeze).
+    notices: Vec<String>,
+    /// Per node and local component: the release ramp, once the component has been released.
+    ramps: Vec<[Option<ReleaseRamp>; 6]>,
+    /// Gauge constraints after a programme's release, with their extended system and entry values.
+    gauge: Option<(Gauge, LinearSystem, Vec<Real>)>,
+    /// Whether the gauge constraints apply to the step being solved.
+    gauge_active: bool,
+    /// Where the time went so far.
+    timing: SolverTiming,
+    /// Sum of the increments applied in the step being solved (prediction and Newton corrections).
+    step_increment: Vec<Real>,
+    /// The last converged step's total increment and its size, for the next step's prediction.
+    last_increment: Option<(Vec<Real>, Real)>,
+    /// Whether a step accepted at the round-off floor has been reported.
+    round_off_reported: bool,
+    /// The schedule breakpoints the steps land on ([`Model::schedule_breakpoints`]), sorted.
+    breakpoints: Vec<Real>,
+    /// The size of the next step's first attempt [time]: the nominal step, or less after a cut (doubled back
+    /// by converged steps).
+    step_size: Real,
+    /// Cuts of the step in progress (0 between steps; kept over an interruption, so that the continued step
+    /// reports them all).
+    step_cuts: usize,
+}
+
+impl<'m> Simulation<'m> {
+    /// Discretises the model, builds the sparsity pattern and analyses it.
+    pub fn new(model: &'m Model) -> Result<Self, SolverError> {
+        let free = super::diagnose::free_bodies(model);
+        if !free.is_empty() {
+            let parts = free
+                .iter()
+                .map(|b| {
+                    let names: Vec<String> = b
+                        .patches
+                        .iter()
+                        .map(|&k| format!("`{}`", model.patches[k].name))
+                        .collect();
+                    if names.len() == 1 {
+                        format!("patch {}", names[0])
+                    } else {
+                        format!("patches {}", names.join(", "))
+                    }
+                })
+                .collect();
+            let nodes = free
+                .iter()
+                .flat_map(|b| b.nodes.iter().map(|&k| model.nodes[k].name.clone()))
+                .collect();
+            let free_patches: usize = free.iter().map(|b| b.patches.len()).sum();
+            return Err(SolverError::FreeBody {
+                parts,
+                nodes,
+                rest_held: free_patches < model.patches.len(),
+            });
+        }
+        let disc = Discretisation::new(model)?;
+        let assembler = Assembler::new(model, &disc);
+        let state = State::reference(&disc);
+        let mut pattern = Vec::new();
+        let mut lin = Linearisation::default();
+        let actions = Actions::at(model, 0.0, &[]);
+        let materials = PointMaterials::new(model, &disc);
+        assembler.assemble(
+            &disc,
+            &state,
+            StepMaterial {
+                laws: &materials.laws,
+            },
+            &actions,
+            None,
+            &mut lin,
+            &mut Sink::Pattern(&mut pattern),
+        );
+        let system = LinearSystem::new(
+            disc.num_unknowns(),
+            &pattern,
+            &patch_ranges(&disc),
+            model.solver.linear,
+        )?;
+        let values = vec![0.0; pattern.len()];
+        let control_length = disc
+            .patches
+            .iter()
+            .flat_map(|r| {
+                let length = (disc.control0[r.offset + r.n - 1] - disc.control0[r.offset]).norm();
+                // Chord length, floored by the model size for closed patches.
+                std::iter::repeat_n(
+                    length.max(CLOSED_PATCH_LENGTH_FRACTION * disc.length_scale),
+                    r.n,
+                )
+            })
+            .collect();
+        let n = disc.num_unknowns();
+        Ok(Self {
+            model,
+            disc,
+            assembler,
+            system,
+            state,
+            time: 0.0,
+            step: 0,
+            lin,
+            values,
+            delta: vec![0.0; n],
+            control_length,
+            materials,
+            notices: Vec::new(),
+            ramps: vec![[None; 6]; model.nodes.len()],
+            gauge: None,
+            gauge_active: false,
+            timing: SolverTiming::default(),
+            step_increment: Vec::new(),
+            last_increment: None,
+            round_off_reported: false,
+            breakpoints: model.schedule_breakpoints(),
+            step_size: model.time.step,
+            step_cuts: 0,
+        })
+    }
+}
+
+impl Simulation<'_> {
+    /// Messages worth telling the user, each added once (e.g. that relaxation froze below `Tg − C2`), in the
+    /// order they arose.
+    pub fn notices(&self) -> &[String] {
+        &self.notices
+    }
+
+    /// Assembles the residual (and with `with_tangent` the tangent) at the current state for time `t` and
+    /// returns the normalised residual norm: one piece of a Newton iteration, for benchmarks and diagnostics.
+    pub fn assemble(&mut self, t: Real, with_tangent: bool) -> Result<Real, SolverError> {
+        let actions = Actions::at(self.model, t, &self.ramps);
+        self.linearise(&actions, with_tangent)
+    }
+
+    /// Factorises the last assembled tangent and solves for the Newton increment of the last assembled
+    /// residual, which is returned (not applied): the linear-algebra part of a Newton iteration, for benchmarks
+    /// and diagnostics.
+    pub fn factor_and_solve(&mut self) -> Result<&[Real], SolverError> {
+        self.factor_tangent()?;
+        self.solve_increment();
+        Ok(&self.delta)
+    }
+
+    /// Where the solver's time went so far.
+    pub fn timing(&self) -> &SolverTiming {
+        &self.timing
+    }
+
+    /// The model.
+    pub fn model(&self) -> &Model {
+        self.model
+    }
+
+    /// The discretisation.
+    pub fn discretisation(&self) -> &Discretisation {
+        &self.disc
+    }
+
+    /// The current (last converged) state.
+    pub fn state(&self) -> &State {
+        &self.state
+    }
+
+    /// Time of the current state.
+    pub fn time(&self) -> Real {
+        self.time
+    }
+
+    /// Converged steps so far (0: the initial state).
+    pub fn step_count(&self) -> usize {
+        self.step
+    }
+
+    /// The size of the next step's first attempt \[time\]: the nominal `time.step`, or less while a cut step
+    /// size grows back ([`STEP_FACTOR`]).
+    pub fn step_size(&self) -> Real {
+        self.step_size
+    }
+
+    /// The linear system (solver, size, pattern).
+    pub fn system(&self) -> &LinearSystem {
+        &self.system
+    }
+
+    /// Displacement of a probe in the current state.
+    pub fn probe_displacement(&self, location: &ProbeLocation) -> Vec3 {
+        match *location {
+            ProbeLocation::Node(k) => {
+                let g = self.disc.end_point(self.model.nodes[k].ends[0]);
+                point_position(&self.disc, &self.state.control, g)
+                    - point_position(&self.disc, &self.disc.control0, g)
+            }
+            ProbeLocation::Patch { patch, u } => {
+                let curve = &self.model.patches[patch].curve;
+                let range = &self.disc.patches[patch];
+                let table = crate::math::basis::nurbs_basis(curve.knots(), curve.weights(), u, 0);
+                table.ders[0]
+                    .iter()
+                    .enumerate()
+                    .map(|(a, n)| {
+                        let j = range.offset + table.first + a;
+                        (self.state.control[j] - self.disc.control0[j]) * *n
+                    })
+                    .sum()
+            }
+        }
+    }
+
+    /// The stress resultants that the rod ends of node `k` exert on the node, in the current state: per end
+    /// `(σ R N, σ R M)` (spatial force and moment, outward sign σ), in the order of the node's ends. At
+    /// equilibrium their sums equal the node's applied load (or its reaction, at prescribed components).
+    pub fn node_end_resultants(&self, k: usize) -> Vec<(Vec3, Vec3)> {
+        self.assembler
+            .node_end_resultants(&self.disc, &self.state, self.step_material(), k)
+    }
+}
+
+/// Each patch's first control point and count, for the block solver.
+fn patch_ranges(disc: &Discretisation) -> Vec<(usize, usize)> {
+    disc.patches.iter().map(|r| (r.offset, r.n)).collect()
+}

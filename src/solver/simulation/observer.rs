@@ -1,0 +1,90 @@
+//! Who is told about a run: the [`Observer`] seam (the engine reports, observers record), [`NoObserver`], and
+//! [`Observers`], a list of observers the caller owns, told in its order.
+
+use super::{NewtonReport, Simulation, StepReport};
+use crate::math::Real;
+use std::ops::ControlFlow;
+
+/// Receives the initial state and every converged step; may stop the run.
+pub trait Observer {
+    /// Called once with the initial state (step 0).
+    fn start(&mut self, sim: &Simulation<'_>) -> ControlFlow<()> {
+        let _ = sim;
+        ControlFlow::Continue(())
+    }
+
+    /// Called after each converged step.
+    fn step(&mut self, sim: &Simulation<'_>, report: &StepReport) -> ControlFlow<()>;
+
+    /// Called when Newton fails on a step that is then cut (`time` is the target that was not reached).
+    fn step_failed(&mut self, time: Real, dt: Real, newton: &NewtonReport) {
+        let _ = (time, dt, newton);
+    }
+
+    /// Whether the run should stop now, within the step in progress: the seam for an interrupt (Ctrl-C) that
+    /// should not wait for a long step and its cuts to finish. Polled (cheaply and often: keep it an atomic
+    /// load or a counter) by Newton before every iteration and by [`Simulation::run`] before every attempt of a
+    /// step: the first, the retry with a fresh tangent, and each cut. When it answers true, the step in progress
+    /// is abandoned and rolled back exactly as a failed step is (positions, rotations, curvatures, gauge
+    /// multipliers, captured release reactions, the step's history stresses; the factorisations of the abandoned
+    /// iterates are invalidated), [`Observer::step`] and [`Observer::step_failed`] are not called for it, and
+    /// `run` returns `Ok` with [`RunSummary::stopped`] at the last converged step, which is the simulation's
+    /// state. A later `run` resumes from there. The default never interrupts.
+    fn interrupted(&self) -> bool {
+        false
+    }
+}
+
+/// An observer that records nothing.
+pub struct NoObserver;
+
+impl Observer for NoObserver {
+    fn step(&mut self, _: &Simulation<'_>, _: &StepReport) -> ControlFlow<()> {
+        ControlFlow::Continue(())
+    }
+}
+
+/// A list of observers, owned by the caller, that acts as one ([`super::Simulation::run`] takes the list): each
+/// is told of every event in the list's order — all of them, even after one asked to stop — and the run stops
+/// when any asked to; an interruption is asked of each until one answers yes.
+pub struct Observers<'a, 'o> {
+    list: &'a mut [&'o mut dyn Observer],
+}
+
+impl<'a, 'o> Observers<'a, 'o> {
+    /// The list `list`.
+    pub fn new(list: &'a mut [&'o mut dyn Observer]) -> Self {
+        Self { list }
+    }
+
+    /// Calls `f` on every observer; `Break` if any returned `Break`.
+    fn each(&mut self, mut f: impl FnMut(&mut dyn Observer) -> ControlFlow<()>) -> ControlFlow<()> {
+        let mut flow = ControlFlow::Continue(());
+        for observer in self.list.iter_mut() {
+            if f(&mut **observer).is_break() {
+                flow = ControlFlow::Break(());
+            }
+        }
+        flow
+    }
+}
+
+impl Observer for Observers<'_, '_> {
+    fn start(&mut self, sim: &Simulation<'_>) -> ControlFlow<()> {
+        self.each(|o| o.start(sim))
+    }
+
+    fn step(&mut self, sim: &Simulation<'_>, report: &StepReport) -> ControlFlow<()> {
+        self.each(|o| o.step(sim, report))
+    }
+
+    fn step_failed(&mut self, time: Real, dt: Real, newton: &NewtonReport) {
+        for observer in self.list.iter_mut() {
+            observer.step_failed(time, dt, newton);
+        }
+    }
+
+    fn interrupted(&self) -> bool {
+        self.list.iter().any(|o| o.interrupted())
+    }
+}
