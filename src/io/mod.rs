@@ -15,4 +15,3 @@ pub mod snapshots;
 pub mod state;
 pub mod stl;
 pub mod summary;
-pub mod yaml_edit;
