@@ -18,7 +18,10 @@ pub mod sparse;
 pub mod state;
 
 pub use linear::LinearError;
-pub use simulation::{NewtonReport, Observer, RunSummary, Simulation, SolverTiming, StepReport};
+pub use simulation::{
+    Checkpoint, CheckpointError, NewtonReport, Observer, Observers, RunSummary, Simulation,
+    SolverTiming, StepOutcome, StepReport,
+};
 
 use crate::geometry::GeometryError;
 use crate::math::Real;

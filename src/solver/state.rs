@@ -33,6 +33,15 @@ impl State {
         }
     }
 
+    /// Overwrites this state with `other`, reusing its memory (no allocation once the sizes match).
+    pub fn copy_from(&mut self, other: &State) {
+        self.control.clone_from(&other.control);
+        self.rotation.clone_from(&other.rotation);
+        self.kappa.clone_from(&other.kappa);
+        self.kappa_s.clone_from(&other.kappa_s);
+        self.multipliers.clone_from(&other.multipliers);
+    }
+
     /// Applies a Newton increment `δ` (6 per control point: `δη` then `δθ`):
     /// `p_j ← p_j + δη_j` and, at each collocation point with `δΘ = Σ N_j δθ_j` (and its s-derivatives),
     /// `R ← R Λ`, `K ← Λᵀ K + w`, `K,s ← Λᵀ K,s − w × (Λᵀ K) + w,s` with `Λ = exp(δΘ̃)`, `w = T(δΘ) δΘ,s`.

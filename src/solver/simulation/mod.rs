@@ -33,6 +33,7 @@
 //! (Newton's method on normalised norms and its diagnostics), `releases` (release ramps and gauge constraints)
 //! and `constitutive` (the material's step preparation and commit).
 
+pub mod checkpoint;
 mod constitutive;
 mod newton;
 pub mod observer;
@@ -41,6 +42,7 @@ pub mod report;
 mod stepping;
 pub mod timing;
 
+pub use checkpoint::{Checkpoint, CheckpointError, TangentOrigin, model_fingerprint};
 pub use newton::ROUND_OFF_TOLERANCE;
 pub use observer::{NoObserver, Observer, Observers};
 pub use report::{NewtonReport, RunSummary, StepReport};
@@ -104,6 +106,8 @@ pub struct Simulation<'m> {
     /// Cuts of the step in progress (0 between steps; kept over an interruption, so that the continued step
     /// reports them all).
     step_cuts: usize,
+    /// What the current factorisation was computed from, for checkpoints ([`checkpoint`]).
+    tangent: checkpoint::TangentRecord,
 }
 
 impl<'m> Simulation<'m> {
@@ -199,6 +203,7 @@ impl<'m> Simulation<'m> {
             breakpoints: model.schedule_breakpoints(),
             step_size: model.time.step,
             step_cuts: 0,
+            tangent: checkpoint::TangentRecord::default(),
         })
     }
 }
