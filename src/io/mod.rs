@@ -2,6 +2,7 @@
 //! charts, summary), SVG charts.
 
 pub mod chart;
+pub mod checkpoint;
 pub mod design;
 pub mod device;
 pub mod estimate;

@@ -11,6 +11,7 @@ mod fuzz;
 mod mesh;
 mod outputs;
 mod reliability;
+mod resume;
 mod run_folder;
 mod solver;
 mod stent;

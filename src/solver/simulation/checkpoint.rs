@@ -123,10 +123,16 @@ pub enum CheckpointError {
 /// the same fingerprint are the same model for all practical purposes (a collision of two different models
 /// has probability ~2⁻⁶⁴).
 pub fn model_fingerprint(model: &Model) -> u64 {
+    debug_fingerprint(model)
+}
+
+/// 64-bit FNV-1a of the `Debug` text of `value` (see [`model_fingerprint`]), for anything else a checkpoint
+/// must match (e.g. a run's output settings).
+pub fn debug_fingerprint(value: &dyn std::fmt::Debug) -> u64 {
     use std::fmt::Write as _;
     let mut hasher = Fnv1a::default();
     // (Writing into a hasher cannot fail.)
-    let _ = write!(hasher, "{model:?}");
+    let _ = write!(hasher, "{value:?}");
     hasher.0
 }
 
