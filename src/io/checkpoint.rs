@@ -16,7 +16,7 @@
 //! back exactly; a `usize` is a `u64`; a vector or string is its length (`u64`) then its items; an option is a
 //! byte 0/1 then the value. The payload is the model fingerprint of the outputs' settings, the solver's
 //! checkpoint (time, step, state, materials, ramps, gauge, tangent origin, notices, timing) and the outputs'
-//! positions, in the order [`write`] writes them.
+//! positions, in the order [`write()`] writes them.
 //!
 //! Why this format: a checkpoint must restore every number bit for bit (a text format would need round-trip
 //! formatting for millions of floats and be three times larger); it is read only by the version of stentkit

@@ -8,7 +8,8 @@
 //! piece shows as a differing residual sequence. Designs: the straight stent with two crowns to t = 2 s in steps
 //! of 0.01 s (Maxwell/WLF, 15 branches; the programme's release at 1.75 s captures reaction ramps and switches on
 //! gauge constraints with Lagrange multipliers) and the 45° bend (elastic) in steps of 0.5, whose first step is
-//! cut twice (the step size grows back over the next). Exact comparisons: no tolerance.
+//! cut twice (the step size grows back over the next), also with the extrapolated start of each step (which
+//! reads the last step's increment). Exact comparisons: no tolerance.
 
 use crate::common::{design_text, model_from_text, replace_line};
 use stentkit::model::Model;
@@ -42,7 +43,11 @@ fn cut_bend() -> Model {
 
 #[test]
 fn a_restored_simulation_continues_bit_for_bit() {
-    for model in [small_stent(), cut_bend()] {
+    // The bend again with the extrapolated start (`solver.extrapolate`), which reads the last step's increment.
+    let mut extrapolated = cut_bend();
+    extrapolated.solver.extrapolate = true;
+    extrapolated.name = "bend45_extrapolated".into();
+    for model in [small_stent(), cut_bend(), extrapolated] {
         let mut full = Simulation::new(&model).expect("simulation");
         let reports = finish(&mut full);
         assert!(full.is_finished(), "{}", model.name);
