@@ -48,7 +48,14 @@ pub enum Command {
     /// second signal skips the final snapshot and charts; a third quits at once (then `stentkit repair`).
     /// Exit status: 0 completed, 1 failed, 2 bad input, 130 interrupted.
     ///
+    /// A run writes a checkpoint (checkpoint.bin) every --checkpoint-every seconds of wall time and when it is
+    /// interrupted; `--resume RUN_DIR` continues a killed (even by SIGKILL) or interrupted run from its last
+    /// checkpoint with the same design, and ends with the files an uninterrupted run writes (history.csv
+    /// identical, the recording continued, the snapshots after the checkpoint written again).
+    ///
     /// Example: stentkit run designs/straight_stent.yaml -o runs/straight_stent
+    ///
+    /// Example: stentkit run designs/straight_stent.yaml --resume runs/straight_stent
     Run {
         /// The design file (YAML).
         design: PathBuf,
@@ -65,6 +72,14 @@ pub enum Command {
         /// Report every failed Newton attempt (before the step is cut).
         #[arg(short, long)]
         verbose: bool,
+        /// Continue the run in RUN_DIR from its last checkpoint instead of starting one: RUN_DIR must hold a run
+        /// of the same design that was killed or interrupted (not one that completed or failed).
+        #[arg(long, value_name = "RUN_DIR", conflicts_with_all = ["output", "force"])]
+        resume: Option<PathBuf>,
+        /// Wall time between checkpoints, in seconds (0: after every step). A checkpoint costs a write of the
+        /// state (a few MB for a large stent) and closes the recording's chunk.
+        #[arg(long, value_name = "SECONDS", default_value_t = 60.0)]
+        checkpoint_every: f64,
     },
     /// Make the folder of a run that was killed (SIGKILL, power loss, crash) whole: cut history.csv back to its
     /// last complete row, finish run.mcap after its last complete chunk, remove unfinished temporaries, and mark
@@ -263,6 +278,8 @@ pub fn main() -> ExitCode {
             force,
             quiet,
             verbose,
+            resume,
+            checkpoint_every,
         } => run::run(
             &design,
             run::RunOptions {
@@ -270,6 +287,8 @@ pub fn main() -> ExitCode {
                 force,
                 quiet,
                 verbose,
+                resume,
+                checkpoint_every,
             },
         ),
         Command::Schema => schema(),

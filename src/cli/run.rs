@@ -17,9 +17,23 @@
 //! its next Newton iteration) or is stopped by an output error (a full disk: the history is cut back to its
 //! last complete row, the recording salvaged up to its last complete chunk, and the error lists which files
 //! are complete): the last state gets a snapshot and the summary says where the run stopped.
+//!
+//! **Checkpoints and `--resume`.** Every `--checkpoint-every` seconds of wall time (default 60), right after a
+//! heartbeat (so the recording's chunks hold every state up to it), and when a signal stops the run, the run
+//! writes `checkpoint.bin` ([`crate::io::checkpoint`]: the simulation's [`crate::solver::Checkpoint`] and where
+//! each output stood), atomically, listed in the manifest; a completed run removes it. `run DESIGN --resume
+//! DIR` takes the folder of a killed or interrupted run ([`RunFolder::open_for_resume`]), refuses another
+//! design (model and output fingerprints), a run that completed or failed and a folder without a checkpoint
+//! (exit status 2), restores the simulation and continues every output from the checkpoint: `history.csv` is
+//! cut back to the checkpoint's row and continued; the snapshots after it are removed and written again as
+//! their steps come; the recording (salvaged first if the run was killed) is copied up to the checkpoint's
+//! last message into a new file built beside it, which then replaces it, and continues; the charts and the
+//! summary's counts go on from the checkpoint's. The result is the uninterrupted run's: the same history.csv
+//! byte for byte.
 
 use super::signals;
 use super::{BadInput, Interrupted, error_text, short_time};
+use crate::io::checkpoint::{self, OutputsCheckpoint, RunCheckpoint};
 use crate::io::design::size::human_bytes;
 use crate::io::design::{Design, load_design};
 use crate::io::history::HistoryWriter;
@@ -32,6 +46,7 @@ use crate::io::summary::{
     FailureReport, FinalState, OutputState, RunStatus, RunSummaryFile, peak_memory_mib,
 };
 use crate::math::{Real, Short};
+use crate::solver::simulation::model_fingerprint;
 use crate::solver::{NewtonReport, Observer, Simulation, SolverError, StepReport};
 use anyhow::Context;
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
@@ -167,6 +182,21 @@ impl Outputs {
         flow
     }
 
+    /// Where every output stands, for a checkpoint; `wall_time_s` is the run's wall time so far.
+    fn checkpoint(&self, settings: u64, wall_time_s: Real) -> OutputsCheckpoint {
+        OutputsCheckpoint {
+            settings,
+            history: self.history.position(),
+            snapshots: self.snapshots.snapshots().to_vec(),
+            snapshots_last: self.snapshots.last_seen(),
+            recording: self.recorder.position(),
+            samples: self.charts.samples().to_vec(),
+            totals: self.totals.clone(),
+            spent: self.spent.map(|d| d.as_secs_f64()),
+            wall_time_s,
+        }
+    }
+
     /// Puts what the run did so far into `s`: counts, the time reached, snapshots, the last state, notices and
     /// the solver's time split.
     fn fill(&self, s: &mut RunSummaryFile, sim: &Simulation<'_>) {
@@ -192,10 +222,66 @@ impl Outputs {
     }
 }
 
-/// The observer of a run: the outputs, and the running summary every [`HEARTBEAT`].
+/// The observer of a run: the outputs, the running summary every [`HEARTBEAT`] and the checkpoints.
 struct RunObserver<'a> {
     outputs: &'a mut Outputs,
     summary: &'a mut SummaryFile,
+    checkpoints: &'a mut Checkpoints,
+}
+
+/// Writes the run's checkpoints (module docs).
+struct Checkpoints {
+    /// `DIR/checkpoint.bin`.
+    path: PathBuf,
+    /// Wall time between checkpoints.
+    every: Duration,
+    /// When the last was written (or the run started).
+    last: Instant,
+    /// Fingerprint of the design's output settings.
+    settings: u64,
+    /// Whether `checkpoint.bin` is listed in the manifest yet.
+    claimed: bool,
+    /// Checkpoints are no longer written (one could not be: said once).
+    disabled: bool,
+}
+
+impl Checkpoints {
+    /// Whether a checkpoint is due.
+    fn due(&self) -> bool {
+        !self.disabled && self.last.elapsed() >= self.every
+    }
+
+    /// Writes the checkpoint of `sim` and `outputs` now: listed in `manifest` first, written atomically. A
+    /// failure is said once and ends the checkpoints, not the run.
+    fn write(
+        &mut self,
+        sim: &Simulation<'_>,
+        outputs: &Outputs,
+        wall_time_s: Real,
+        manifest: &Manifest,
+    ) {
+        self.last = Instant::now();
+        let written = (|| -> std::io::Result<()> {
+            if !self.claimed {
+                manifest.claim(Path::new(checkpoint::FILE_NAME))?;
+                self.claimed = true;
+            }
+            let file = RunCheckpoint {
+                solver: sim.checkpoint(),
+                outputs: outputs.checkpoint(self.settings, wall_time_s),
+            };
+            checkpoint::write(&self.path, &file)
+        })();
+        if let Err(e) = written {
+            self.disabled = true;
+            outputs.progress.bar.suspend(|| {
+                eprintln!(
+                    "warning: cannot write the checkpoint {}: {e}; the run goes on without checkpoints",
+                    self.path.display()
+                )
+            });
+        }
+    }
 }
 
 impl RunObserver<'_> {
@@ -235,8 +321,15 @@ impl Observer for RunObserver<'_> {
         totals.cuts += report.cuts;
         totals.time = report.time;
         let flow = self.outputs.observe(|o| o.step(sim, report));
-        if self.heartbeat(sim, false).is_break() {
+        // A checkpoint follows a heartbeat: the recording's closed chunks then hold every state up to it.
+        let checkpoint = flow.is_continue() && self.checkpoints.due();
+        if self.heartbeat(sim, checkpoint).is_break() {
             return ControlFlow::Break(());
+        }
+        if checkpoint {
+            let wall = self.summary.wall_time_s();
+            let manifest = self.summary.manifest.clone();
+            self.checkpoints.write(sim, self.outputs, wall, &manifest);
         }
         flow
     }
@@ -256,16 +349,25 @@ struct SummaryFile {
     summary: RunSummaryFile,
     /// The command's start.
     started: Instant,
+    /// Wall time of the run before this command (a resumed run's, up to its checkpoint) \[s\].
+    earlier_wall_s: Real,
+    /// The run folder's manifest (for the checkpoints).
+    manifest: Manifest,
     /// The first problem met while the run went on (writing the summary or closing a chunk).
     problem: Option<anyhow::Error>,
 }
 
 impl SummaryFile {
+    /// The run's wall time so far, over every command that ran it \[s\].
+    fn wall_time_s(&self) -> Real {
+        self.earlier_wall_s + self.started.elapsed().as_secs_f64()
+    }
+
     /// Updates the summary with `update` (and the time, wall time and peak memory) and writes it.
     fn write(&mut self, update: impl FnOnce(&mut RunSummaryFile)) -> anyhow::Result<()> {
         update(&mut self.summary);
         self.summary.updated = crate::io::run_folder::utc_timestamp(std::time::SystemTime::now());
-        self.summary.wall_time_s = self.started.elapsed().as_secs_f64();
+        self.summary.wall_time_s = self.wall_time_s();
         self.summary.peak_memory_mib = peak_memory_mib();
         self.summary
             .write(&self.path)
@@ -303,6 +405,10 @@ pub struct RunOptions {
     pub quiet: bool,
     /// Report every failed Newton attempt.
     pub verbose: bool,
+    /// Continue the run in this folder from its checkpoint instead of starting one.
+    pub resume: Option<PathBuf>,
+    /// Wall time between checkpoints \[s\] (0: after every step).
+    pub checkpoint_every: Real,
 }
 
 /// Simulates the design and writes the run folder.
@@ -324,17 +430,97 @@ pub fn run(design_path: &Path, options: RunOptions) -> anyhow::Result<()> {
         ))
         .into());
     }
+    if !(options.checkpoint_every.is_finite() && options.checkpoint_every >= 0.0) {
+        return Err(BadInput(format!(
+            "--checkpoint-every {}: give a number of seconds ≥ 0",
+            options.checkpoint_every
+        ))
+        .into());
+    }
+    if let Some(dir) = &options.resume {
+        return resume(&design, dir, &options, started);
+    }
     let dir = run_dir(options.output.clone(), &design.model.name);
-    let refused = |e: RunFolderError| match e {
-        RunFolderError::Refused { .. } => anyhow::Error::new(BadInput(e.to_string())),
-        e => e.into(),
-    };
     // Nothing is written before the folder and the disk are found fit for the run.
     let fit = run_folder::check(&dir, design_path, options.force).map_err(refused)?;
     super::disk::check_space(&design, &fit)?;
     let mut folder = fit.open()?;
     folder.clear_previous()?;
-    run_in(&design, &folder, &options, started)
+    run_in(&design, &folder, &options, started, None)
+}
+
+/// A folder refused for the run is bad input (exit status 2).
+fn refused(e: RunFolderError) -> anyhow::Error {
+    match e {
+        RunFolderError::Refused { .. } => anyhow::Error::new(BadInput(e.to_string())),
+        e => e.into(),
+    }
+}
+
+/// `run DESIGN --resume DIR`: checks that `dir` holds a killed or interrupted run of this design with a
+/// checkpoint, then continues it (module docs).
+fn resume(
+    design: &Design,
+    dir: &Path,
+    options: &RunOptions,
+    started: Instant,
+) -> anyhow::Result<()> {
+    // The summary's word first: a completed run has no checkpoint left, and that is why.
+    match previous_status(dir).as_deref() {
+        Some("completed") => {
+            return Err(BadInput(format!(
+                "{}: the run there completed (summary.json says `completed`): there is nothing to resume",
+                dir.display()
+            ))
+            .into());
+        }
+        Some("failed") => {
+            return Err(BadInput(format!(
+                "{}: the run there failed (summary.json says `failed`, with the reason); resuming would fail \
+                 the same way: change the design and run it again with --force",
+                dir.display()
+            ))
+            .into());
+        }
+        _ => {}
+    }
+    let folder =
+        RunFolder::open_for_resume(dir, Path::new(checkpoint::FILE_NAME)).map_err(refused)?;
+    let file = dir.join(checkpoint::FILE_NAME);
+    let saved = checkpoint::read(&file).map_err(|e| BadInput(e.to_string()))?;
+    if saved.solver.model != model_fingerprint(&design.model) {
+        return Err(BadInput(format!(
+            "{}: its checkpoint is of another model than {} (another design, or this one since changed): \
+             resume it with the design it was started with, or start this one with -o DIR --force",
+            dir.display(),
+            design.path.display()
+        ))
+        .into());
+    }
+    if saved.outputs.settings != checkpoint::settings_fingerprint(&design.output) {
+        return Err(BadInput(format!(
+            "{}: the run there wrote other outputs (the design's `output` settings changed): resume it with \
+             the design it was started with",
+            dir.display()
+        ))
+        .into());
+    }
+    if !options.quiet {
+        eprintln!(
+            "stentkit run: resuming {} from its checkpoint at step {} (t = {} s)",
+            dir.display(),
+            saved.solver.step,
+            short_time(saved.solver.time)
+        );
+    }
+    run_in(design, &folder, options, started, Some(saved))
+}
+
+/// The `status` of the run folder's `summary.json`, if it can be read.
+fn previous_status(dir: &Path) -> Option<String> {
+    let text = std::fs::read_to_string(dir.join("summary.json")).ok()?;
+    let value: serde_json::Value = serde_json::from_str(&text).ok()?;
+    value.get("status")?.as_str().map(str::to_string)
 }
 
 fn run_in(
@@ -342,6 +528,7 @@ fn run_in(
     folder: &RunFolder,
     options: &RunOptions,
     started: Instant,
+    resumed: Option<RunCheckpoint>,
 ) -> anyhow::Result<()> {
     let model = &design.model;
     let dir = folder.dir();
@@ -361,12 +548,18 @@ fn run_in(
             design.warnings.clone(),
         ),
         started,
+        earlier_wall_s: resumed.as_ref().map_or(0.0, |c| c.outputs.wall_time_s),
+        manifest: manifest.clone(),
         problem: None,
     };
     summary.write(|_| {})?;
     let reserve = folder.reserve(super::disk::FINISHING_RESERVE)?;
     let setup = (|| -> anyhow::Result<_> {
-        let sim = Simulation::new(model)?;
+        let mut sim = Simulation::new(model)?;
+        if let Some(saved) = &resumed {
+            sim.restore(&saved.solver)
+                .with_context(|| format!("cannot restore {}", checkpoint::FILE_NAME))?;
+        }
         if !options.quiet {
             eprintln!(
                 "stentkit run: {} — {} patches, {} unknowns, {} steps of {} s to {} s → {}",
@@ -379,7 +572,10 @@ fn run_in(
                 dir.display()
             );
         }
-        let outputs = create_outputs(design, folder, &info, &sim, options)?;
+        let outputs = match &resumed {
+            None => create_outputs(design, folder, &info, &sim, options)?,
+            Some(saved) => resume_outputs(design, folder, &info, &sim, options, &saved.outputs)?,
+        };
         Ok((sim, outputs))
     })();
     let (mut sim, mut outputs) = match setup {
@@ -402,14 +598,35 @@ fn run_in(
     }
     summary.summary.timing.setup_s = started.elapsed().as_secs_f64();
 
+    let mut checkpoints = Checkpoints {
+        path: dir.join(checkpoint::FILE_NAME),
+        every: Duration::from_secs_f64(options.checkpoint_every),
+        last: Instant::now(),
+        settings: checkpoint::settings_fingerprint(&design.output),
+        claimed: false,
+        disabled: false,
+    };
     let run_started = Instant::now();
     let result = sim.run(&mut [&mut RunObserver {
         outputs: &mut outputs,
         summary: &mut summary,
+        checkpoints: &mut checkpoints,
     }]);
     summary.summary.timing.run_s = run_started.elapsed().as_secs_f64();
     outputs.progress.bar.finish_and_clear();
     outputs.progress.notices(&sim);
+
+    // A run stopped by a signal keeps its last converged step as a checkpoint (before `finish` adds the final
+    // snapshot and mesh, which an uninterrupted run does not have); a completed run needs its checkpoint no more.
+    let interrupted = signals::stop_requested();
+    let stopped = result.as_ref().is_ok_and(|s| s.stopped);
+    if stopped && interrupted && sim.step_count() > 0 && !checkpoints.disabled {
+        checkpoints.write(&sim, &outputs, summary.wall_time_s(), manifest);
+    }
+    if result.as_ref().is_ok_and(|s| !s.stopped) && sim.is_finished() {
+        // Best effort: a checkpoint left behind is listed, and `--force` removes it.
+        let _ = std::fs::remove_file(&checkpoints.path);
+    }
 
     let finish_started = Instant::now();
     reserve.release();
@@ -419,8 +636,6 @@ fn run_in(
     }
     summary.summary.timing.finish_s = finish_started.elapsed().as_secs_f64();
 
-    let interrupted = signals::stop_requested();
-    let stopped = result.as_ref().is_ok_and(|s| s.stopped);
     let first_problem = finished.problems.first().map(error_text);
     let (status, error) = match (&result, first_problem) {
         (Err(e), _) => (RunStatus::Failed, Some(e.to_string())),
@@ -557,6 +772,100 @@ fn create_outputs(
         beat: Instant::now(),
         totals: crate::solver::RunSummary::default(),
     })
+}
+
+/// The writers of a resumed run, each continued from the checkpoint's `saved` positions (module docs): the
+/// history cut back and appended to, the snapshots after the checkpoint removed (they are written again), the
+/// recording copied up to the checkpoint into a new file that replaces the old one, the charts' states and the
+/// run's totals carried over.
+fn resume_outputs(
+    design: &Design,
+    folder: &RunFolder,
+    info: &RunInfo,
+    sim: &Simulation<'_>,
+    options: &RunOptions,
+    saved: &OutputsCheckpoint,
+) -> anyhow::Result<Outputs> {
+    let model = &design.model;
+    let dir = folder.dir();
+    let manifest = folder.manifest();
+    let history_path = dir.join("history.csv");
+    let history = HistoryWriter::resume(&history_path, saved.history)
+        .with_context(|| format!("cannot continue {}", history_path.display()))?;
+    // Snapshots the checkpoint does not list are from after it (or the final one of an interrupted run).
+    let kept: std::collections::BTreeSet<&Path> = saved
+        .snapshots
+        .iter()
+        .flat_map(|s| [s.stl.as_path(), s.obj.as_path()])
+        .collect();
+    for listed in manifest.listed() {
+        if listed.starts_with(SnapshotWriter::FOLDER) && !kept.contains(listed.as_path()) {
+            let path = dir.join(&listed);
+            if path.exists() {
+                std::fs::remove_file(&path)
+                    .with_context(|| format!("cannot remove {}", path.display()))?;
+            }
+        }
+    }
+    let snapshots = SnapshotWriter::create(dir, &design.output.snapshots, model)?
+        .with_manifest(manifest.clone())
+        .resumed(saved.snapshots.clone(), saved.snapshots_last);
+    let recorder = resume_recording(design, dir, info, &saved.recording)?;
+    let mut progress = Progress::new(model.time.end, options.quiet, options.verbose);
+    progress.said = sim.notices().len();
+    Ok(Outputs {
+        history,
+        snapshots,
+        recorder,
+        charts: RunCharts::new(model).resumed(saved.samples.clone()),
+        progress,
+        spent: saved.spent.map(|s| Duration::from_secs_f64(s.max(0.0))),
+        beat: Instant::now(),
+        totals: saved.totals.clone(),
+    })
+}
+
+/// The recording of a resumed run: the killed or interrupted run's `run.mcap` (salvaged, if it was cut short)
+/// is copied up to the checkpoint's last message into a new recording built in a temporary file beside it,
+/// which then replaces it. A recording that cannot be read is started afresh with a warning (its states before
+/// the checkpoint are lost; the other outputs are whole).
+fn resume_recording(
+    design: &Design,
+    dir: &Path,
+    info: &RunInfo,
+    position: &crate::io::mcap::RecordingPosition,
+) -> anyhow::Result<McapRecorder> {
+    let path = dir.join("run.mcap");
+    let temporary = dir.join(crate::io::stl::temporary_name(std::ffi::OsStr::new(
+        "run.mcap",
+    )));
+    let mut recorder = McapRecorder::create(&temporary, design, info, &design.output.snapshots)?;
+    let previous = salvage(&path)
+        .map_err(anyhow::Error::from)
+        .and_then(|_| std::fs::read(&path).map_err(anyhow::Error::from));
+    let copied = match previous {
+        Ok(bytes) => recorder
+            .resume(&bytes, &path, position)
+            .map_err(|e| e.to_string()),
+        Err(e) => Err(error_text(&e)),
+    };
+    match copied {
+        Ok(n) if n as u64 == u64::from(position.sequence) => {}
+        Ok(n) => eprintln!(
+            "warning: {} kept {n} of the {} messages recorded up to the checkpoint; the recording has a gap before it",
+            path.display(),
+            position.sequence
+        ),
+        Err(e) => eprintln!(
+            "warning: the recording {} cannot be continued ({e}); it holds the states from the checkpoint on",
+            path.display()
+        ),
+    }
+    recorder.flush_chunk()?;
+    recorder
+        .rename(&path)
+        .with_context(|| format!("cannot replace {}", path.display()))?;
+    Ok(recorder)
 }
 
 /// A signal arrived while the run was set up: the (empty) outputs are closed and the summary says so.

@@ -14,6 +14,17 @@ use std::io::{BufWriter, Write};
 use std::ops::ControlFlow;
 use std::path::{Path, PathBuf};
 
+/// How far `history.csv` was written: what a checkpoint records and a resumed run continues from.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct HistoryPosition {
+    /// Length of the file up to its last complete row \[bytes\].
+    pub bytes: u64,
+    /// Complete rows (the initial state is row 0).
+    pub rows: usize,
+    /// Time of the last row.
+    pub last_time: Option<f64>,
+}
+
 /// Writes `history.csv` as the simulation reports steps.
 pub struct HistoryWriter {
     path: PathBuf,
@@ -58,6 +69,46 @@ impl HistoryWriter {
             last_time: None,
             error: None,
         })
+    }
+
+    /// Continues the history of a resumed run at `position` (a checkpoint's): the file is cut back to the rows
+    /// written up to the checkpoint — a killed run may have written more — and rows are appended after them.
+    ///
+    /// # Errors
+    /// The I/O error, or [`std::io::ErrorKind::InvalidData`] when the file is shorter than the checkpoint says.
+    pub fn resume(path: &Path, position: HistoryPosition) -> std::io::Result<Self> {
+        let file = std::fs::OpenOptions::new().write(true).open(path)?;
+        let length = file.metadata()?.len();
+        if length < position.bytes {
+            return Err(std::io::Error::new(
+                std::io::ErrorKind::InvalidData,
+                format!(
+                    "{} holds {length} bytes, fewer than the {} it held at the checkpoint",
+                    path.display(),
+                    position.bytes
+                ),
+            ));
+        }
+        file.set_len(position.bytes)?;
+        let mut file = file;
+        std::io::Seek::seek(&mut file, std::io::SeekFrom::End(0))?;
+        Ok(Self {
+            path: path.to_path_buf(),
+            complete: position.bytes,
+            out: Some(BufWriter::new(file)),
+            rows: position.rows,
+            last_time: position.last_time,
+            error: None,
+        })
+    }
+
+    /// How far the file is written (for a checkpoint).
+    pub fn position(&self) -> HistoryPosition {
+        HistoryPosition {
+            bytes: self.complete,
+            rows: self.rows,
+            last_time: self.last_time,
+        }
     }
 
     /// The time of the last complete row (`None`: the header only).

@@ -3,6 +3,7 @@
 //! reduced model) is computed in [`crate::post`]; this layer writes it.
 
 pub mod chart;
+pub mod checkpoint;
 pub mod design;
 pub mod estimate;
 pub mod history;

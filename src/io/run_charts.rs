@@ -43,6 +43,12 @@ impl RunCharts {
         &self.samples
     }
 
+    /// Continues the charts of a resumed run with the states recorded up to its checkpoint.
+    pub fn resumed(mut self, samples: Vec<StateSample>) -> Self {
+        self.samples = samples;
+        self
+    }
+
     /// The charts of the states recorded so far (see the module documentation).
     pub fn charts(&self, model: &Model) -> Vec<(&'static str, LineChart)> {
         let name = &model.name;

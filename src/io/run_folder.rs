@@ -341,6 +341,45 @@ impl RunFolder {
         check(dir, design_file, force)?.open()
     }
 
+    /// Takes the folder of an earlier run to continue it (`stentkit run --resume`): `dir` must be a stentkit
+    /// run folder whose manifest lists `checkpoint` (a path inside it) and where that file exists. Nothing is
+    /// removed but the hidden temporaries of listed files (what a killed run leaves); the manifest keeps its
+    /// list, and the continued run appends to it.
+    ///
+    /// # Errors
+    /// [`RunFolderError::Refused`] (bad input) for a folder that is not a run folder or holds no checkpoint,
+    /// [`RunFolderError::Busy`] when a run holds it, [`RunFolderError::Io`].
+    pub fn open_for_resume(dir: &Path, checkpoint: &Path) -> Result<Self, RunFolderError> {
+        let refuse = |reason: String| RunFolderError::Refused {
+            path: dir.to_path_buf(),
+            reason,
+        };
+        let files = match classify(dir)? {
+            FolderKind::Run(files) => files,
+            FolderKind::Empty => {
+                return Err(refuse(
+                    "is empty or missing: there is no run to resume; start one without --resume"
+                        .into(),
+                ));
+            }
+            FolderKind::Foreign => {
+                return Err(refuse(
+                    "is not a stentkit run folder (it has no .stentkit-run manifest): there is no run to resume"
+                        .into(),
+                ));
+            }
+        };
+        if !files.contains(checkpoint) || !dir.join(checkpoint).is_file() {
+            return Err(refuse(format!(
+                "holds no checkpoint ({}): the run wrote none (it ran for less than --checkpoint-every, or with a stentkit without checkpoints), so it cannot be resumed; run it again with --force",
+                checkpoint.display()
+            )));
+        }
+        let folder = Self::take(dir.to_path_buf(), BTreeSet::new())?;
+        remove_stale_temporaries(dir, &files)?;
+        Ok(folder)
+    }
+
     fn take(dir: PathBuf, previous: BTreeSet<PathBuf>) -> Result<Self, RunFolderError> {
         let dir = dir.as_path();
         fs::create_dir_all(dir).map_err(io_error(dir))?;

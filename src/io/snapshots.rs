@@ -178,6 +178,19 @@ impl SnapshotWriter {
         &self.written
     }
 
+    /// The last state seen `(step, time)`, for a checkpoint.
+    pub fn last_seen(&self) -> Option<(usize, Real)> {
+        self.last
+    }
+
+    /// Continues the snapshots of a resumed run: the snapshots written up to its checkpoint (whose files are in
+    /// the run folder) and the last state it saw.
+    pub fn resumed(mut self, written: Vec<Snapshot>, last: Option<(usize, Real)>) -> Self {
+        self.written = written;
+        self.last = last;
+        self
+    }
+
     /// The first error, if any (writing stops there and the run is asked to stop).
     pub fn take_error(&mut self) -> Option<SnapshotError> {
         self.error.take()

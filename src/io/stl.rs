@@ -243,6 +243,19 @@ pub fn write_bytes_atomically(path: &Path, bytes: &[u8]) -> io::Result<()> {
     })
 }
 
+/// A fresh temporary file name for `file_name`, `.<name>.<pid>.<n>.tmp` (unique within the process; what
+/// [`crate::io::run_folder::remove_stale_temporaries`] recognises and removes after a killed run).
+pub(crate) fn temporary_name(file_name: &std::ffi::OsStr) -> OsString {
+    let mut name = OsString::from(".");
+    name.push(file_name);
+    name.push(format!(
+        ".{}.{}.tmp",
+        std::process::id(),
+        TEMPORARY_COUNTER.fetch_add(1, Ordering::Relaxed)
+    ));
+    name
+}
+
 /// Writes a file atomically: `write` fills a temporary file `.<name>.<pid>.<n>.tmp` in the target's
 /// directory, which is then flushed, synced to disk and renamed over `path` (an atomic replacement on
 /// POSIX and Windows file systems). On any error the temporary file is removed and the target is untouched.
@@ -267,14 +280,7 @@ where
         .parent()
         .filter(|d| !d.as_os_str().is_empty())
         .unwrap_or(Path::new("."));
-    let mut temporary_name = OsString::from(".");
-    temporary_name.push(file_name);
-    temporary_name.push(format!(
-        ".{}.{}.tmp",
-        std::process::id(),
-        TEMPORARY_COUNTER.fetch_add(1, Ordering::Relaxed)
-    ));
-    let temporary = directory.join(temporary_name);
+    let temporary = directory.join(temporary_name(file_name));
     let file = OpenOptions::new()
         .write(true)
         .create_new(true)

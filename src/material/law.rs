@@ -18,6 +18,9 @@
 use super::{SectionShape, SectionStrains, SectionStress};
 use crate::math::{Mat3, Real, Vec3};
 
+/// Numbers of a [`SectionLaw`] ([`SectionLaw::to_numbers`]).
+pub const LAW_NUMBERS: usize = 18;
+
 /// The section law `N = C̄_N Γ_N − H_N`, `M = C̄_M K_M − H_M` (and the same for the s-derivatives) of one
 /// point during one time step (module docs).
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
@@ -58,6 +61,42 @@ impl SectionLaw {
             moment: c_m.component_mul(&strain.moment) - h.moment,
             force_ds: c_n.component_mul(&strain.force_ds) - h.force_ds,
             moment_ds: c_m.component_mul(&strain.moment_ds) - h.moment_ds,
+        }
+    }
+
+    /// The law as 18 plain numbers (for checkpoints): the diagonals of `C̄_N` and `C̄_M`, then `H_N`, `H_M`,
+    /// `H_N,s`, `H_M,s`. [`SectionLaw::from_numbers`] inverts it exactly.
+    pub fn to_numbers(&self) -> [Real; LAW_NUMBERS] {
+        let h = &self.history;
+        let mut out = [0.0; LAW_NUMBERS];
+        for (k, v) in [
+            &self.force_stiffness,
+            &self.moment_stiffness,
+            &h.force,
+            &h.moment,
+            &h.force_ds,
+            &h.moment_ds,
+        ]
+        .into_iter()
+        .enumerate()
+        {
+            out[3 * k..3 * k + 3].copy_from_slice(v.as_slice());
+        }
+        out
+    }
+
+    /// The law of numbers written by [`SectionLaw::to_numbers`].
+    pub fn from_numbers(numbers: &[Real; LAW_NUMBERS]) -> Self {
+        let v = |k: usize| Vec3::new(numbers[3 * k], numbers[3 * k + 1], numbers[3 * k + 2]);
+        Self {
+            force_stiffness: v(0),
+            moment_stiffness: v(1),
+            history: SectionStress {
+                force: v(2),
+                moment: v(3),
+                force_ds: v(4),
+                moment_ds: v(5),
+            },
         }
     }
 

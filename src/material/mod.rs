@@ -96,7 +96,7 @@ pub use integrator::{
     Integrator, MAX_STEP_RATE, ReducedTimeQuadrature, StepCoefficients, exponential_coefficients,
     reduced_time_increment, step_coefficients, step_coefficients_into,
 };
-pub use law::SectionLaw;
+pub use law::{LAW_NUMBERS, SectionLaw};
 pub use maxwell::{MaxwellLaw, MaxwellState};
 pub use point::{simulate_strain_history, simulate_stress_history};
 pub use prony::{Prony, PronyBranch};

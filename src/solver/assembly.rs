@@ -85,9 +85,9 @@ impl Sink<'_> {
 pub struct ReleaseRamp {
     /// The reaction component that held the node at the release, in the node's local basis [force or moment].
     pub reaction: Real,
-    /// Release time [time].
+    /// Release time \[time\].
     pub start: Real,
-    /// Ramp duration [time].
+    /// Ramp duration \[time\].
     pub duration: Real,
 }
 
@@ -212,9 +212,9 @@ struct NodeRows {
 #[derive(Debug, Clone)]
 pub struct Assembler {
     nodes: Vec<NodeRows>,
-    /// Reference modulus of each patch's material for residual scales (instantaneous modulus) [stress].
+    /// Reference modulus of each patch's material for residual scales (instantaneous modulus) \[stress\].
     modulus_scale: Vec<Real>,
-    /// Length of each patch [length].
+    /// Length of each patch \[length\].
     patch_length: Vec<Real>,
     /// Tangent entries pushed by each collocation point's interior equations (zero at patch ends), and their
     /// total: the interior points come first in the push order, so point `g`'s entries are a known slice.

@@ -76,7 +76,7 @@ pub struct Discretisation {
     pub shapes: Vec<SectionShape>,
     /// Reference control points, globally numbered.
     pub control0: Vec<Vec3>,
-    /// A length scale of the model (bounding-box diagonal) used to normalise norms [length].
+    /// A length scale of the model (bounding-box diagonal) used to normalise norms \[length\].
     pub length_scale: Real,
 }
 

@@ -34,7 +34,7 @@ pub struct Gauge {
     pub rows: Vec<GaugeRow>,
     /// Positions of the constrained nodes at the release, `c_l^rel`, by node index.
     pub frozen: Vec<(usize, Vec3)>,
-    /// Row scale of the constraint equations [length].
+    /// Row scale of the constraint equations \[length\].
     pub scale: Real,
 }
 

@@ -17,7 +17,10 @@ pub mod simulation;
 pub mod sparse;
 pub mod state;
 
-pub use simulation::{NewtonReport, Observer, RunSummary, Simulation, SolverTiming, StepReport};
+pub use simulation::{
+    Checkpoint, CheckpointError, NewtonReport, Observer, Observers, RunSummary, Simulation,
+    SolverTiming, StepOutcome, StepReport,
+};
 
 use crate::geometry::GeometryError;
 use crate::math::Real;

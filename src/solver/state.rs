@@ -9,15 +9,15 @@ use crate::math::{Mat3, Vec3};
 /// The configuration at one instant.
 #[derive(Debug, Clone, PartialEq)]
 pub struct State {
-    /// Control points `p_j` (global numbering) [length].
+    /// Control points `p_j` (global numbering) \[length\].
     pub control: Vec<Vec3>,
     /// Section rotation `R` at each collocation point.
     pub rotation: Vec<Mat3>,
-    /// Material curvature `K` at each collocation point [1/length].
+    /// Material curvature `K` at each collocation point \[1/length\].
     pub kappa: Vec<Vec3>,
-    /// Its arc-length derivative `K,s` [1/length²].
+    /// Its arc-length derivative `K,s` \[1/length²\].
     pub kappa_s: Vec<Vec3>,
-    /// Lagrange multipliers of the active gauge constraints ([`super::gauge`]) [force].
+    /// Lagrange multipliers of the active gauge constraints ([`super::gauge`]) \[force\].
     pub multipliers: Vec<f64>,
 }
 
@@ -31,6 +31,15 @@ impl State {
             kappa_s: disc.points.iter().map(|p| p.kappa0_s).collect(),
             multipliers: Vec::new(),
         }
+    }
+
+    /// Overwrites this state with `other`, reusing its memory (no allocation once the sizes match).
+    pub fn copy_from(&mut self, other: &State) {
+        self.control.clone_from(&other.control);
+        self.rotation.clone_from(&other.rotation);
+        self.kappa.clone_from(&other.kappa);
+        self.kappa_s.clone_from(&other.kappa_s);
+        self.multipliers.clone_from(&other.multipliers);
     }
 
     /// Applies a Newton increment `δ` (6 per control point: `δη` then `δθ`):

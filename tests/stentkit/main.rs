@@ -3,6 +3,7 @@
 #[path = "../common/mod.rs"]
 mod common;
 
+mod checkpoint;
 mod cli;
 mod design_errors;
 mod designs;
@@ -10,6 +11,7 @@ mod fuzz;
 mod mesh;
 mod outputs;
 mod reliability;
+mod resume;
 mod run_folder;
 mod solver;
 mod stent;

@@ -82,6 +82,15 @@ pub enum McapError {
         #[source]
         source: ::mcap::McapError,
     },
+    /// An earlier recording to continue could not be read.
+    #[error("cannot read {path}: {source}")]
+    Read {
+        /// The file.
+        path: PathBuf,
+        /// The MCAP error.
+        #[source]
+        source: ::mcap::McapError,
+    },
     /// Flushing the finished file failed.
     #[error("cannot write {path}: {source}")]
     Flush {
@@ -102,6 +111,17 @@ pub enum McapError {
         #[source]
         source: crate::geometry::tube::TubeError,
     },
+}
+
+/// How far a recording has got: what a checkpoint records and a resumed run continues from.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct RecordingPosition {
+    /// Sequence number of the last message written (messages are numbered from 1 across channels).
+    pub sequence: u32,
+    /// Log time \[ns\], step and time of the last state recorded.
+    pub last: Option<(u64, usize, Real)>,
+    /// Step of the last mesh recorded.
+    pub last_mesh: Option<usize>,
 }
 
 /// Records a run into an MCAP file as the simulation reports its steps.
@@ -278,6 +298,88 @@ impl McapRecorder {
     /// The first error, if any (recording stops there and the run is asked to stop).
     pub fn take_error(&mut self) -> Option<McapError> {
         self.error.take()
+    }
+
+    /// How far the recording has got (for a checkpoint).
+    pub fn position(&self) -> RecordingPosition {
+        RecordingPosition {
+            sequence: self.sequence,
+            last: self.last,
+            last_mesh: self.last_mesh,
+        }
+    }
+
+    /// Continues the recording of a resumed run: copies the messages of `previous` (the bytes of the killed or
+    /// interrupted run's recording, a valid MCAP file — salvaged if need be) numbered up to `position.sequence`
+    /// into this recording, each onto the channel of the same topic with its sequence number and times, and
+    /// continues from `position`. Returns the number of messages copied: fewer than `position.sequence` when
+    /// the previous recording lost some (its last chunks, before a salvage).
+    ///
+    /// # Errors
+    /// [`McapError::Read`] when `previous` cannot be read, [`McapError::Write`].
+    pub fn resume(
+        &mut self,
+        previous: &[u8],
+        previous_path: &Path,
+        position: &RecordingPosition,
+    ) -> Result<usize, McapError> {
+        let read_error = |source| McapError::Read {
+            path: previous_path.to_path_buf(),
+            source,
+        };
+        let channels: BTreeMap<&str, u16> = [
+            (STATE_TOPIC, Some(self.state_channel)),
+            (CENTRELINE_TOPIC, Some(self.centreline_channel)),
+            (DEVICE_TOPIC, self.device_channel),
+        ]
+        .into_iter()
+        .filter_map(|(topic, id)| id.map(|id| (topic, id)))
+        .collect();
+        // The position is taken over whatever the copy finds: the continued messages are numbered after the
+        // checkpoint's in any case.
+        self.sequence = position.sequence;
+        self.last = position.last;
+        self.last_mesh = position.last_mesh;
+        let mut copied = 0;
+        for message in ::mcap::MessageStream::new(previous).map_err(read_error)? {
+            let message = message.map_err(read_error)?;
+            if message.sequence > position.sequence {
+                continue;
+            }
+            let Some(&channel) = channels.get(message.channel.topic.as_str()) else {
+                continue;
+            };
+            let Some(writer) = &mut self.writer else {
+                break;
+            };
+            writer
+                .write_to_known_channel(
+                    &::mcap::records::MessageHeader {
+                        channel_id: channel,
+                        sequence: message.sequence,
+                        log_time: message.log_time,
+                        publish_time: message.publish_time,
+                    },
+                    &message.data,
+                )
+                .map_err(|source| McapError::Write {
+                    path: self.path.clone(),
+                    source,
+                })?;
+            copied += 1;
+        }
+        Ok(copied)
+    }
+
+    /// Moves the file being written to `to` (a rename in the same folder: the open file is kept), e.g. a
+    /// recording built in a temporary file over the one it replaces.
+    ///
+    /// # Errors
+    /// The I/O error of the rename; the recording is then still at its old path.
+    pub fn rename(&mut self, to: &Path) -> std::io::Result<()> {
+        std::fs::rename(&self.path, to)?;
+        self.path = to.to_path_buf();
+        Ok(())
     }
 
     /// The simulated time of the last state recorded \[s\].

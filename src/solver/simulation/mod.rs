@@ -23,16 +23,27 @@
 //! tolerance asked); [`NewtonReport::at_round_off`] marks each such step. At tolerances from
 //! [`ROUND_OFF_TOLERANCE`] up (the default is 1e-9) this rule never applies: the stopping rule is unchanged.
 //!
-//! **Interruption.** [`Observer::interrupted`] is polled by Newton before every iteration and by `run` before
-//! every attempt of a step (first, retried with a fresh tangent, or cut). When it answers true the step in
-//! progress is abandoned and rolled back exactly as a failed step is, and `run` returns at the last converged
-//! step with [`RunSummary::stopped`] set.
+//! **Stepping as an API.** [`Simulation::step`] takes one converged step (with the retries and cuts it needs)
+//! and returns its [`StepReport`]; the caller reads the state between steps ([`Simulation::state`],
+//! [`Simulation::probe_displacement`], [`Simulation::node_end_resultants`]). [`Simulation::run`] is the loop over
+//! [`Simulation::step_with`] that tells a list of observers the caller owns ([`Observers`]) of each step.
+//! [`Simulation::checkpoint`] and [`Simulation::restore`] save and restore the whole state, so that a restored
+//! simulation continues bit for bit ([`checkpoint`]).
+//!
+//! **Interruption.** [`Observer::interrupted`] is polled by Newton before every iteration and by
+//! [`Simulation::step_with`] before every attempt of a step (first, retried with a fresh tangent, or cut). When
+//! it answers true the step in progress is abandoned and rolled back exactly as a failed step is, `step_with`
+//! returns [`StepOutcome::Interrupted`] and `run` returns at the last converged step with
+//! [`RunSummary::stopped`] set; the step size and cuts of the abandoned step are kept, so a later `step` or
+//! `run` continues exactly.
 //!
 //! The concepts live in their own files: [`report`] (what a step and a run report), [`observer`] (who is told),
 //! [`timing`] (where the wall time went), `stepping` (the step loop, step-size control and roll-back), `newton`
-//! (Newton's method on normalised norms and its diagnostics), `releases` (release ramps and gauge constraints)
-//! and `constitutive` (the material's step preparation and commit).
+//! (Newton's method on normalised norms and its diagnostics), `releases` (release ramps and gauge constraints),
+//! `constitutive` (the materials at the points: step preparation, commit, roll-back) and [`checkpoint`] (the
+//! whole state as a value, and its restore).
 
+pub mod checkpoint;
 mod constitutive;
 mod newton;
 pub mod observer;
@@ -41,6 +52,7 @@ pub mod report;
 mod stepping;
 pub mod timing;
 
+pub use checkpoint::{Checkpoint, CheckpointError, TangentOrigin, model_fingerprint};
 pub use newton::ROUND_OFF_TOLERANCE;
 pub use observer::{NoObserver, Observer, Observers};
 pub use report::{NewtonReport, RunSummary, StepReport};
@@ -98,12 +110,14 @@ pub struct Simulation<'m> {
     round_off_reported: bool,
     /// The schedule breakpoints the steps land on ([`Model::schedule_breakpoints`]), sorted.
     breakpoints: Vec<Real>,
-    /// The size of the next step's first attempt [time]: the nominal step, or less after a cut (doubled back
+    /// The size of the next step's first attempt \[time\]: the nominal step, or less after a cut (doubled back
     /// by converged steps).
     step_size: Real,
     /// Cuts of the step in progress (0 between steps; kept over an interruption, so that the continued step
     /// reports them all).
     step_cuts: usize,
+    /// What the current factorisation was computed from, for checkpoints ([`checkpoint`]).
+    tangent: checkpoint::TangentRecord,
 }
 
 impl<'m> Simulation<'m> {
@@ -199,6 +213,7 @@ impl<'m> Simulation<'m> {
             breakpoints: model.schedule_breakpoints(),
             step_size: model.time.step,
             step_cuts: 0,
+            tangent: checkpoint::TangentRecord::default(),
         })
     }
 }

@@ -201,6 +201,7 @@ impl Simulation<'_> {
             &mut sink,
         );
         let slot = if with_tangent {
+            self.tangent.assembled(actions);
             &mut self.timing.tangent
         } else {
             &mut self.timing.residual
@@ -254,6 +255,8 @@ impl Simulation<'_> {
             },
             e => e,
         })?;
+        self.tangent
+            .factorised(&self.state, &self.materials.laws, self.gauge_active);
         SolverTiming::add(&mut self.timing.factorisation, start);
         Ok(())
     }

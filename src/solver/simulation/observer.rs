@@ -28,7 +28,7 @@ pub trait Observer {
     /// is abandoned and rolled back exactly as a failed step is (positions, rotations, curvatures, gauge
     /// multipliers, captured release reactions, the step's history stresses; the factorisations of the abandoned
     /// iterates are invalidated), [`Observer::step`] and [`Observer::step_failed`] are not called for it, and
-    /// `run` returns `Ok` with [`RunSummary::stopped`] at the last converged step, which is the simulation's
+    /// `run` returns `Ok` with [`super::RunSummary::stopped`] at the last converged step, which is the simulation's
     /// state. A later `run` resumes from there. The default never interrupts.
     fn interrupted(&self) -> bool {
         false

@@ -74,31 +74,7 @@ impl Simulation<'_> {
                     )
                 })
                 .collect();
-            if let Some(gauge) =
-                Gauge::new(self.model, &positions, self.disc.length_scale).filter(|g| !g.is_empty())
-            {
-                let mut pattern = Vec::new();
-                let actions = Actions::at(self.model, t_np1, &self.ramps);
-                let material = self.step_material();
-                let mut lin = Linearisation::default();
-                self.assembler.assemble(
-                    &self.disc,
-                    &self.state,
-                    material,
-                    &actions,
-                    Some(&gauge),
-                    &mut lin,
-                    &mut Sink::Pattern(&mut pattern),
-                );
-                let system = LinearSystem::new(
-                    self.disc.num_unknowns() + gauge.len(),
-                    &pattern,
-                    &patch_ranges(&self.disc),
-                    self.model.solver.linear,
-                )?;
-                let values = vec![0.0; pattern.len()];
-                self.gauge = Some((gauge, system, values));
-            }
+            self.build_gauge(&positions, t_np1)?;
         }
         self.gauge_active = active && self.gauge.is_some();
         let m = if self.gauge_active {
@@ -107,6 +83,39 @@ impl Simulation<'_> {
             0
         };
         self.state.multipliers.resize(m, 0.0);
+        Ok(())
+    }
+
+    /// Builds the gauge constraints freezing the node positions `positions` (by node), and their extended
+    /// system (its pattern analysed once), unless the model has nothing to constrain; `t` is the time whose
+    /// loads the pattern's assembly sees (the pattern does not depend on them).
+    pub(super) fn build_gauge(&mut self, positions: &[Vec3], t: Real) -> Result<(), SolverError> {
+        let Some(gauge) =
+            Gauge::new(self.model, positions, self.disc.length_scale).filter(|g| !g.is_empty())
+        else {
+            return Ok(());
+        };
+        let mut pattern = Vec::new();
+        let actions = Actions::at(self.model, t, &self.ramps);
+        let material = self.step_material();
+        let mut lin = Linearisation::default();
+        self.assembler.assemble(
+            &self.disc,
+            &self.state,
+            material,
+            &actions,
+            Some(&gauge),
+            &mut lin,
+            &mut Sink::Pattern(&mut pattern),
+        );
+        let system = LinearSystem::new(
+            self.disc.num_unknowns() + gauge.len(),
+            &pattern,
+            &patch_ranges(&self.disc),
+            self.model.solver.linear,
+        )?;
+        let values = vec![0.0; pattern.len()];
+        self.gauge = Some((gauge, system, values));
         Ok(())
     }
 }

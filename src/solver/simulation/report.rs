@@ -19,8 +19,8 @@ pub struct NewtonReport {
     /// tangent must be (nearly) singular is largest.
     pub diagnosis: Option<String>,
     /// True when the step was accepted at the round-off floor: the tolerance asked (below
-    /// [`ROUND_OFF_TOLERANCE`]) was not met, the residual stopped falling, and the iterate met the stopping rule
-    /// at [`ROUND_OFF_TOLERANCE`] (see the module docs).
+    /// [`super::ROUND_OFF_TOLERANCE`]) was not met, the residual stopped falling, and the iterate met the stopping rule
+    /// at [`super::ROUND_OFF_TOLERANCE`] (see the module docs).
     pub at_round_off: bool,
 }
 
@@ -33,7 +33,7 @@ pub struct StepReport {
     pub time: Real,
     /// Step size taken.
     pub dt: Real,
-    /// Temperature at `time` [°C].
+    /// Temperature at `time` \[°C\].
     pub temperature: Real,
     /// Newton history of the step.
     pub newton: NewtonReport,

@@ -284,6 +284,7 @@ impl Simulation<'_> {
         if let Some((_, system, _)) = &mut self.gauge {
             system.invalidate();
         }
+        self.tangent.invalidate();
         for &(k, i) in captured {
             self.ramps[k][i] = None;
         }

@@ -8,15 +8,15 @@ use std::time::Instant;
 /// after a step). Counts include the work of abandoned attempts (cut steps, retried reuse).
 #[derive(Debug, Clone, PartialEq, Default)]
 pub struct SolverTiming {
-    /// Residual-only assemblies and their time [s].
+    /// Residual-only assemblies and their time \[s\].
     pub residual: (usize, Real),
-    /// Residual-and-tangent assemblies and their time [s].
+    /// Residual-and-tangent assemblies and their time \[s\].
     pub tangent: (usize, Real),
-    /// Numeric LU factorisations and their time [s].
+    /// Numeric LU factorisations and their time \[s\].
     pub factorisation: (usize, Real),
-    /// Solves with a factorisation (forward and back substitution) and their time [s].
+    /// Solves with a factorisation (forward and back substitution) and their time \[s\].
     pub solve: (usize, Real),
-    /// Step preparation (integrator coefficients, history stresses) and commits (internal variables) [s].
+    /// Step preparation (integrator coefficients, history stresses) and commits (internal variables) \[s\].
     pub material: (usize, Real),
 }
 

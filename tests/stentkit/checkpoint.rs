@@ -1,0 +1,135 @@
+//! Stepping as an API and checkpoints (issue 13 item 4): a simulation restored from a checkpoint continues
+//! **bit for bit** as the uninterrupted one — the same Newton residuals, increments and factorisations in every
+//! step and the same final state — whether the checkpoint is restored into a new simulation or into the one
+//! it came from after that went on; and a checkpoint of another model is refused.
+//!
+//! Source: the contract itself (`solver::simulation::checkpoint`): the restored simulation must reuse the
+//! same factorisation, release ramps, gauge constraints and material history as the original, so any missing
+//! piece shows as a differing residual sequence. Designs: the straight stent with two crowns to t = 2 s in steps
+//! of 0.01 s (Maxwell/WLF, 15 branches; the programme's release at 1.75 s captures reaction ramps and switches on
+//! gauge constraints with Lagrange multipliers) and the 45° bend (elastic) in steps of 0.5, whose first step is
+//! cut twice (the step size grows back over the next), also with the extrapolated start of each step (which
+//! reads the last step's increment). Exact comparisons: no tolerance.
+
+use crate::common::{design_text, model_from_text, replace_line};
+use stentkit::model::Model;
+use stentkit::solver::{CheckpointError, Simulation, StepReport};
+
+/// Steps a simulation to the end, returning its reports.
+fn finish(sim: &mut Simulation<'_>) -> Vec<StepReport> {
+    let mut reports = Vec::new();
+    while let Some(report) = sim.step().unwrap_or_else(|e| panic!("{e}")) {
+        reports.push(report);
+    }
+    reports
+}
+
+/// The straight stent with two crowns, to t = 2 s in steps of 0.01 s (release at 1.75 s: step 175).
+fn small_stent() -> Model {
+    let text = replace_line(&design_text("straight_stent.yaml"), "crowns:", "crowns: 2");
+    let text = replace_line(&text, "time:", "time: {end: 2.0, step: 0.01}");
+    model_from_text(&text, "straight_stent_2_crowns.yaml")
+}
+
+/// The 45° bend in steps of 0.5: the first is cut twice, so the step size is below the nominal one for a step.
+fn cut_bend() -> Model {
+    let text = replace_line(
+        &design_text("bend45.yaml"),
+        "time:",
+        "time: {end: 1.0, step: 0.5}",
+    );
+    model_from_text(&text, "bend45_cut.yaml")
+}
+
+#[test]
+fn a_restored_simulation_continues_bit_for_bit() {
+    // The bend again with the extrapolated start (`solver.extrapolate`), which reads the last step's increment.
+    let mut extrapolated = cut_bend();
+    extrapolated.solver.extrapolate = true;
+    extrapolated.name = "bend45_extrapolated".into();
+    for model in [small_stent(), cut_bend(), extrapolated] {
+        let mut full = Simulation::new(&model).expect("simulation");
+        let reports = finish(&mut full);
+        assert!(full.is_finished(), "{}", model.name);
+        let n = reports.len();
+        // At the start, early, around the release (the stent's at 1.75 s, step 175 of 200), near the end.
+        let mut at_steps = vec![0, 1, n / 3, n * 7 / 8 - 1, n * 7 / 8 + 1, n - 1];
+        at_steps.retain(|&k| k < n);
+        at_steps.dedup();
+        for at in at_steps {
+            let mut first = Simulation::new(&model).expect("simulation");
+            for _ in 0..at {
+                first.step().expect("steps").expect("not at the end");
+            }
+            let checkpoint = first.checkpoint();
+            assert_eq!(checkpoint.step, at);
+            // The original goes on (its factorisation, state and history change), then is rewound.
+            let ahead = finish(&mut first);
+            assert_eq!(
+                ahead,
+                reports[at..],
+                "{} from step {at}: uninterrupted",
+                model.name
+            );
+            first.restore(&checkpoint).expect("same model");
+            let rewound = finish(&mut first);
+            assert_eq!(
+                rewound,
+                reports[at..],
+                "{} from step {at}: rewound",
+                model.name
+            );
+            assert!(first.state() == full.state());
+            // A new simulation of the same model.
+            let mut second = Simulation::new(&model).expect("simulation");
+            second.restore(&checkpoint).expect("same model");
+            assert_eq!(second.time(), checkpoint.time);
+            assert_eq!(second.checkpoint(), checkpoint, "restoring changes nothing");
+            let resumed = finish(&mut second);
+            assert_eq!(
+                resumed,
+                reports[at..],
+                "{} from step {at}: new simulation",
+                model.name
+            );
+            assert!(
+                second.state() == full.state(),
+                "{} from step {at}",
+                model.name
+            );
+            assert_eq!(second.notices(), full.notices());
+            println!(
+                "{}: restored at step {at} (t = {}, factorisation {}), {} more steps bit for bit",
+                model.name,
+                checkpoint.time,
+                if checkpoint.tangent.is_some() {
+                    "rebuilt"
+                } else {
+                    "none"
+                },
+                resumed.len()
+            );
+        }
+    }
+}
+
+#[test]
+fn a_checkpoint_of_another_model_is_refused() {
+    let stent = small_stent();
+    let bend = model_from_text(&design_text("bend45.yaml"), "bend45.yaml");
+    let checkpoint = Simulation::new(&bend).expect("simulation").checkpoint();
+    let mut sim = Simulation::new(&stent).expect("simulation");
+    let error = sim.restore(&checkpoint).expect_err("another model");
+    assert!(
+        matches!(error, CheckpointError::ModelMismatch { .. }),
+        "{error}"
+    );
+    // The same geometry with another load is another model too.
+    let mut heavier = bend.clone();
+    heavier.time.end *= 2.0;
+    let mut sim = Simulation::new(&heavier).expect("simulation");
+    assert!(matches!(
+        sim.restore(&checkpoint),
+        Err(CheckpointError::ModelMismatch { .. })
+    ));
+}

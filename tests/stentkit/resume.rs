@@ -1,0 +1,244 @@
+//! `stentkit run --resume` (issue 13 item 4): a run killed by SIGKILL, or stopped by SIGINT, after a
+//! checkpoint continues from it to the uninterrupted run's result — history.csv byte for byte, the same
+//! snapshot files, the recording's messages (topic, sequence number, log time, body) all equal — and resuming
+//! with another design, a run that completed, or a folder without a checkpoint is refused with exit status 2.
+//!
+//! Source: the contract (`cli::run` module docs; `solver::simulation::checkpoint` restores the simulation bit
+//! for bit). Design: the straight stent of designs/straight_stent.yaml with two crowns (1301 steps of 2.5 ms,
+//! about a second and a half of solving: long enough to be killed in the middle), with checkpoints every
+//! 0.1 s of wall time (`--checkpoint-every`, a test interval; the default is 60 s). Exact comparisons.
+
+use crate::common::{design_text, replace_line};
+use crate::outputs::{check_recording, path_str, stentkit, summary, text};
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+use std::process::{Child, Command, Stdio};
+use std::time::{Duration, Instant};
+
+/// A fresh scratch folder for test `name`.
+fn scratch(name: &str) -> PathBuf {
+    let dir = Path::new(env!("CARGO_TARGET_TMPDIR"))
+        .join("resume-tests")
+        .join(name);
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).expect("scratch folder");
+    dir
+}
+
+/// The two-crown straight stent, written into `dir`.
+fn two_crown_stent(dir: &Path) -> PathBuf {
+    let text = replace_line(&design_text("straight_stent.yaml"), "crowns:", "crowns: 2");
+    let path = dir.join("two_crowns.yaml");
+    std::fs::write(&path, text).expect("design written");
+    path
+}
+
+/// Starts `stentkit run DESIGN -o DIR --quiet --checkpoint-every 0.1`.
+fn spawn(design: &Path, dir: &Path) -> Child {
+    Command::new(env!("CARGO_BIN_EXE_stentkit"))
+        .args(["run", path_str(design), "-o", path_str(dir), "--quiet"])
+        .args(["--checkpoint-every", "0.1"])
+        .stdout(Stdio::null())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("stentkit starts")
+}
+
+/// Waits (at most two minutes) until `dir` holds a checkpoint and `rows` history rows, while `child` runs;
+/// panics if the run ended first.
+fn wait_for_checkpoint(child: &mut Child, dir: &Path, rows: usize) {
+    let started = Instant::now();
+    loop {
+        let history = std::fs::read_to_string(dir.join("history.csv")).unwrap_or_default();
+        if dir.join("checkpoint.bin").exists() && history.lines().count() >= rows {
+            return;
+        }
+        assert!(
+            child.try_wait().expect("status").is_none(),
+            "the run ended before it could be stopped"
+        );
+        assert!(
+            started.elapsed() < Duration::from_secs(120),
+            "no checkpoint in 2 min"
+        );
+        std::thread::sleep(Duration::from_millis(5));
+    }
+}
+
+/// Every message of a recording: (topic, sequence, log time, body).
+fn messages(dir: &Path) -> Vec<(String, u32, u64, Vec<u8>)> {
+    let bytes = std::fs::read(dir.join("run.mcap")).expect("run.mcap");
+    mcap::MessageStream::new(&bytes)
+        .expect("stream")
+        .map(|m| {
+            let m = m.expect("message");
+            (
+                m.channel.topic.clone(),
+                m.sequence,
+                m.log_time,
+                m.data.into_owned(),
+            )
+        })
+        .collect()
+}
+
+/// The files of `dir/snapshots`, by name.
+fn snapshot_files(dir: &Path) -> BTreeMap<String, Vec<u8>> {
+    std::fs::read_dir(dir.join("snapshots"))
+        .expect("snapshots/")
+        .map(|e| {
+            let e = e.expect("entry");
+            (
+                e.file_name().to_string_lossy().into_owned(),
+                std::fs::read(e.path()).expect("file"),
+            )
+        })
+        .collect()
+}
+
+/// Resumes `dir` with `design`: the status and the standard error.
+fn resume(design: &Path, dir: &Path) -> (Option<i32>, String) {
+    let out = stentkit(&[
+        "run",
+        path_str(design),
+        "--resume",
+        path_str(dir),
+        "--quiet",
+    ]);
+    (out.status.code(), text(&out.stderr))
+}
+
+#[test]
+fn a_killed_or_interrupted_run_resumes_to_the_uninterrupted_result() {
+    let root = scratch("equal");
+    let design = two_crown_stent(&root);
+    let full = root.join("full");
+    let out = stentkit(&["run", path_str(&design), "-o", path_str(&full), "--quiet"]);
+    assert_eq!(out.status.code(), Some(0), "{}", text(&out.stderr));
+    assert!(
+        !full.join("checkpoint.bin").exists(),
+        "a completed run removes its checkpoint"
+    );
+    let history = std::fs::read(full.join("history.csv")).expect("history");
+    let rows = history.split(|&b| b == b'\n').count();
+
+    for (case, signal) in [("killed", "KILL"), ("interrupted", "INT")] {
+        let dir = root.join(case);
+        let mut child = spawn(&design, &dir);
+        wait_for_checkpoint(&mut child, &dir, rows / 4);
+        let status = Command::new("kill")
+            .args([&format!("-{signal}"), &child.id().to_string()])
+            .status()
+            .expect("kill runs");
+        assert!(status.success());
+        let ended = child.wait_with_output().expect("reaped");
+        let before = summary(&dir);
+        let written = std::fs::read(dir.join("history.csv")).expect("history");
+        println!(
+            "{case}: stopped with {:?} at {} of {rows} history rows (summary: {}, {} steps)",
+            ended.status.code(),
+            written.split(|&b| b == b'\n').count(),
+            before["status"],
+            before["steps"]
+        );
+        if case == "interrupted" {
+            assert_eq!(ended.status.code(), Some(130), "{}", text(&ended.stderr));
+        }
+
+        let (code, stderr) = resume(&design, &dir);
+        assert_eq!(code, Some(0), "{case}: {stderr}");
+        let after = summary(&dir);
+        assert_eq!(after["status"], "completed", "{case}");
+        assert_eq!(
+            std::fs::read(dir.join("history.csv")).expect("history"),
+            history,
+            "{case}: history.csv differs from the uninterrupted run's"
+        );
+        assert_eq!(
+            snapshot_files(&dir),
+            snapshot_files(&full),
+            "{case}: snapshots"
+        );
+        assert_eq!(messages(&dir), messages(&full), "{case}: recorded messages");
+        check_recording(&dir, &design);
+        for key in [
+            "steps",
+            "newton_iterations",
+            "step_cuts",
+            "snapshots",
+            "final_state",
+        ] {
+            assert_eq!(after[key], summary(&full)[key], "{case}: summary {key}");
+        }
+        assert!(
+            !dir.join("checkpoint.bin").exists(),
+            "{case}: checkpoint removed at the end"
+        );
+        // The resumed run's files are all listed, so `--force` can replace it.
+        let again = stentkit(&[
+            "run",
+            path_str(&design),
+            "-o",
+            path_str(&dir),
+            "--quiet",
+            "--force",
+        ]);
+        assert_eq!(again.status.code(), Some(0), "{}", text(&again.stderr));
+    }
+}
+
+#[test]
+fn resuming_the_wrong_run_is_refused_with_status_2() {
+    let root = scratch("refused");
+    let design = two_crown_stent(&root);
+    let dir = root.join("run");
+    let mut child = spawn(&design, &dir);
+    wait_for_checkpoint(&mut child, &dir, 50);
+    child.kill().expect("SIGKILL");
+    child.wait().expect("reaped");
+
+    // Another design.
+    let bend = Path::new(env!("CARGO_MANIFEST_DIR")).join("designs/bend45.yaml");
+    let (code, stderr) = resume(&bend, &dir);
+    assert_eq!(code, Some(2), "{stderr}");
+    assert!(stderr.contains("another model"), "{stderr}");
+    // The same design with another load: another model too.
+    let changed = root.join("changed.yaml");
+    let text = std::fs::read_to_string(&design).expect("design");
+    std::fs::write(&changed, text.replace("delta_r: 15", "delta_r: 14")).expect("written");
+    let (code, stderr) = resume(&changed, &dir);
+    assert_eq!(code, Some(2), "{stderr}");
+    // A folder that is not a run folder, and one that does not exist.
+    let (code, stderr) = resume(&design, &root);
+    assert_eq!(code, Some(2), "{stderr}");
+    assert!(stderr.contains("not a stentkit run folder"), "{stderr}");
+    let (code, stderr) = resume(&design, &root.join("missing"));
+    assert_eq!(code, Some(2), "{stderr}");
+    // A damaged checkpoint.
+    let checkpoint = dir.join("checkpoint.bin");
+    let good = std::fs::read(&checkpoint).expect("checkpoint");
+    let mut bad = good.clone();
+    let middle = bad.len() / 2;
+    bad[middle] ^= 1;
+    std::fs::write(&checkpoint, &bad).expect("damaged");
+    let (code, stderr) = resume(&design, &dir);
+    assert_eq!(code, Some(2), "{stderr}");
+    assert!(stderr.contains("damaged"), "{stderr}");
+    std::fs::write(&checkpoint, &good).expect("restored");
+    // The right design finishes the run; then there is nothing to resume.
+    let (code, stderr) = resume(&design, &dir);
+    assert_eq!(code, Some(0), "{stderr}");
+    let (code, stderr) = resume(&design, &dir);
+    assert_eq!(code, Some(2), "{stderr}");
+    assert!(stderr.contains("completed"), "{stderr}");
+    // A run folder without a checkpoint (a run that ended before its first one).
+    let short = root.join("short");
+    let out = stentkit(&["run", path_str(&bend), "-o", path_str(&short), "--quiet"]);
+    assert_eq!(out.status.code(), Some(0));
+    let summary_path = short.join("summary.json");
+    let s = std::fs::read_to_string(&summary_path).expect("summary");
+    std::fs::write(&summary_path, s.replace("\"completed\"", "\"killed\"")).expect("written");
+    let (code, stderr) = resume(&bend, &short);
+    assert_eq!(code, Some(2), "{stderr}");
+    assert!(stderr.contains("no checkpoint"), "{stderr}");
+}
