@@ -796,7 +796,7 @@ fn resume_outputs(
     let kept: std::collections::BTreeSet<&Path> = saved
         .snapshots
         .iter()
-        .flat_map(|s| [s.stl.as_path(), s.obj.as_path()])
+        .flat_map(|s| s.files.iter().map(PathBuf::as_path))
         .collect();
     for listed in manifest.listed() {
         if listed.starts_with(SnapshotWriter::FOLDER) && !kept.contains(listed.as_path()) {
@@ -1140,7 +1140,8 @@ fn failure_report(failure: &FailureReport, summary: &RunSummaryFile) -> String {
         .snapshots
         .last()
         .filter(|s| s.step == failure.last_converged_step)
-        .map(|s| format!(", snapshot {}", s.stl))
+        .and_then(|s| s.files.get(crate::io::snapshots::FORMATS[0].extension()))
+        .map(|f| format!(", snapshot {f}"))
         .unwrap_or_default();
     lines.push(format!(
         "  last converged: step {}, t = {} s (history.csv and run.mcap end there{snapshot})",

@@ -596,8 +596,7 @@ fn encode_outputs(e: &mut Encoder, o: &OutputsCheckpoint) {
     e.list(&o.snapshots, |e, s| {
         e.usize(s.step);
         e.f64(s.time);
-        e.str(&s.stl.to_string_lossy());
-        e.str(&s.obj.to_string_lossy());
+        e.list(&s.files, |e, f| e.str(&f.to_string_lossy()));
         e.usize(s.triangles);
         e.f64(s.volume);
     });
@@ -637,8 +636,7 @@ fn decode_outputs(d: &mut Decoder<'_>) -> Result<OutputsCheckpoint, Problem> {
             Ok(Snapshot {
                 step: d.usize()?,
                 time: d.f64()?,
-                stl: PathBuf::from(d.str()?),
-                obj: PathBuf::from(d.str()?),
+                files: d.list(8, |d| Ok(PathBuf::from(d.str()?)))?,
                 triangles: d.usize()?,
                 volume: d.f64()?,
             })
@@ -737,8 +735,10 @@ mod tests {
             snapshots: vec![Snapshot {
                 step: 0,
                 time: 0.0,
-                stl: "snapshots/step_00000.stl".into(),
-                obj: "snapshots/step_00000.obj".into(),
+                files: vec![
+                    "snapshots/step_00000.stl".into(),
+                    "snapshots/step_00000.obj".into(),
+                ],
                 triangles: 88,
                 volume: 1.5,
             }],

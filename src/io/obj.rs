@@ -11,6 +11,32 @@ use std::path::Path;
 use crate::geometry::mesh::TriangleMesh;
 use crate::io::stl::{MeshIoError, check_writable, write_atomically};
 
+/// OBJ snapshots ([`super::snapshots::FORMATS`]): a comment naming the design, step, time and units.
+pub struct Obj;
+
+impl super::snapshots::MeshFormat for Obj {
+    fn extension(&self) -> &'static str {
+        "obj"
+    }
+
+    fn write(
+        &self,
+        path: &Path,
+        mesh: &TriangleMesh,
+        s: &super::snapshots::SnapshotState<'_>,
+    ) -> Result<(), MeshIoError> {
+        let header = format!(
+            "{}: full device at step {}, t = {} s; units {} (lengths in {})",
+            s.model.name,
+            s.step,
+            s.time,
+            s.model.units.name(),
+            s.model.units.length()
+        );
+        write_obj(path, mesh, &header)
+    }
+}
+
 /// Writes `mesh` to `path` as OBJ, atomically (see [`crate::io::stl`]); `header` (e.g. `"units: mm-N-MPa"`,
 /// possibly several lines) goes into comment lines after the `# stentkit …` line.
 ///

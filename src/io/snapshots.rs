@@ -1,7 +1,12 @@
 //! Snapshots of a run: the full device as closed tubes swept along the deformed centrelines with the solver's
-//! section frames, written as binary STL and OBJ (`snapshots/step_NNNNN.stl`, `.obj`) at the initial state, at
-//! the final one, every `every` steps and at the requested times (time stepping lands on those: they are the
-//! model's record times).
+//! section frames, written in every registered [`MeshFormat`] — binary STL and OBJ (`snapshots/step_NNNNN.stl`,
+//! `.obj`) — at the initial state, at the final one, every `every` steps and at the requested times (time
+//! stepping lands on those: they are the model's record times).
+//!
+//! **A new snapshot file format is a new module plus one registration line**: write `io/<format>.rs` with a
+//! type implementing [`MeshFormat`] (its extension and how it writes a mesh), declare the module in `io/mod.rs`,
+//! and add the type to [`FORMATS`]. Each snapshot then lists its file under the extension as key in
+//! summary.json, the run folder's manifest claims it, and `--resume` keeps or rewrites it with the others.
 
 use super::design::SnapshotSettings;
 use super::run_folder::Manifest;
@@ -56,6 +61,37 @@ impl SnapshotSchedule {
     }
 }
 
+/// What a snapshot file says about the state it holds (for its header).
+#[derive(Debug, Clone, Copy)]
+pub struct SnapshotState<'a> {
+    /// The model.
+    pub model: &'a Model,
+    /// Step number (0: the initial state).
+    pub step: usize,
+    /// Time [time].
+    pub time: Real,
+}
+
+/// A file format of snapshot meshes.
+pub trait MeshFormat: Sync {
+    /// The file extension, also the snapshot's key in summary.json (`stl`).
+    fn extension(&self) -> &'static str;
+
+    /// Writes the device mesh of `state` to `path` (atomically: a reader sees the old file or the new one).
+    ///
+    /// # Errors
+    /// [`MeshIoError`] when the file cannot be written.
+    fn write(
+        &self,
+        path: &Path,
+        mesh: &TriangleMesh,
+        state: &SnapshotState<'_>,
+    ) -> Result<(), MeshIoError>;
+}
+
+/// The formats every snapshot is written in, in this order: the registration list of [`MeshFormat`]s.
+pub const FORMATS: &[&dyn MeshFormat] = &[&stl::Stl, &obj::Obj];
+
 /// One written snapshot.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Snapshot {
@@ -63,10 +99,9 @@ pub struct Snapshot {
     pub step: usize,
     /// Time [time].
     pub time: Real,
-    /// The STL file, relative to the run folder.
-    pub stl: PathBuf,
-    /// The OBJ file, relative to the run folder.
-    pub obj: PathBuf,
+    /// Its files relative to the run folder, one per format of [`FORMATS`] in that order, each with its
+    /// format's extension.
+    pub files: Vec<PathBuf>,
     /// Triangles of the mesh.
     pub triangles: usize,
     /// Enclosed volume [length³].
@@ -221,31 +256,23 @@ impl SnapshotWriter {
             }
         })?;
         let name = format!("step_{step:05}");
-        let stl_path = Path::new(Self::FOLDER).join(format!("{name}.stl"));
-        let obj_path = Path::new(Self::FOLDER).join(format!("{name}.obj"));
+        let files: Vec<PathBuf> = FORMATS
+            .iter()
+            .map(|f| Path::new(Self::FOLDER).join(format!("{name}.{}", f.extension())))
+            .collect();
         if let Some(manifest) = &self.manifest {
-            for path in [&stl_path, &obj_path] {
+            for path in &files {
                 manifest.claim(path).map_err(SnapshotError::Manifest)?;
             }
         }
-        let header = format!(
-            "{} step {step} t={time:.6} {}",
-            model.name,
-            model.units.name()
-        );
-        stl::write_stl_with_header(&self.run_dir.join(&stl_path), &mesh, &header)?;
-        let obj_header = format!(
-            "{}: full device at step {step}, t = {time} s; units {} (lengths in {})",
-            model.name,
-            model.units.name(),
-            model.units.length()
-        );
-        obj::write_obj(&self.run_dir.join(&obj_path), &mesh, &obj_header)?;
+        let state = SnapshotState { model, step, time };
+        for (format, path) in FORMATS.iter().zip(&files) {
+            format.write(&self.run_dir.join(path), &mesh, &state)?;
+        }
         self.written.push(Snapshot {
             step,
             time,
-            stl: stl_path,
-            obj: obj_path,
+            files,
             triangles: mesh.triangles.len(),
             volume: mesh.volume(),
         });

@@ -56,6 +56,32 @@ pub fn write_stl(path: &Path, mesh: &TriangleMesh) -> Result<(), MeshIoError> {
     write_stl_with_header(path, mesh, "")
 }
 
+/// Binary STL snapshots ([`super::snapshots::FORMATS`]): an 80-byte header naming the design, step, time and
+/// unit system.
+pub struct Stl;
+
+impl super::snapshots::MeshFormat for Stl {
+    fn extension(&self) -> &'static str {
+        "stl"
+    }
+
+    fn write(
+        &self,
+        path: &Path,
+        mesh: &TriangleMesh,
+        s: &super::snapshots::SnapshotState<'_>,
+    ) -> Result<(), MeshIoError> {
+        let header = format!(
+            "{} step {} t={:.6} {}",
+            s.model.name,
+            s.step,
+            s.time,
+            s.model.units.name()
+        );
+        write_stl_with_header(path, mesh, &header)
+    }
+}
+
 /// Writes `mesh` to `path` as binary STL, atomically, with `header` (e.g. `"units: mm-N-MPa"`) after the
 /// `stentkit binary STL` prefix in the 80-byte header (truncated to fit; control characters become spaces).
 ///

@@ -180,10 +180,9 @@ pub struct SnapshotEntry {
     pub step: usize,
     /// Time [s].
     pub time: Real,
-    /// Binary STL, relative to the run folder.
-    pub stl: String,
-    /// OBJ, relative to the run folder.
-    pub obj: String,
+    /// Its files relative to the run folder by format ([`crate::io::snapshots::FORMATS`]): `"stl"`, `"obj"`.
+    #[serde(flatten)]
+    pub files: std::collections::BTreeMap<&'static str, String>,
     /// Triangles.
     pub triangles: usize,
     /// Enclosed volume [length³].
@@ -195,8 +194,11 @@ impl From<&Snapshot> for SnapshotEntry {
         Self {
             step: s.step,
             time: s.time,
-            stl: s.stl.display().to_string(),
-            obj: s.obj.display().to_string(),
+            files: crate::io::snapshots::FORMATS
+                .iter()
+                .zip(&s.files)
+                .map(|(f, path)| (f.extension(), path.display().to_string()))
+                .collect(),
             triangles: s.triangles,
             volume: s.volume,
         }

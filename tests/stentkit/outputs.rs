@@ -445,7 +445,7 @@ fn curved_stent_half_model_snapshots_are_closed() {
         "⌈2/20⌉ = 1: every step"
     );
     for s in &written {
-        let mesh = read_stl(&dir.join(&s.stl)).expect("STL");
+        let mesh = read_stl(&dir.join(&s.files[0])).expect("STL");
         mesh.check_closed()
             .unwrap_or_else(|e| panic!("step {}: {e}", s.step));
         assert!(mesh.volume() > 0.0);
