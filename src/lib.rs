@@ -7,7 +7,8 @@
 //! ## Layers
 //!
 //! Dependencies point one way, left to right never imported from the right:
-//! `math → geometry → material → model → solver → post → io → study → cli`.
+//! `math → geometry → material → model → solver → post → io → study → cli`, and no two modules import each
+//! other, directly or through others (`scripts/module_cycles.py`, run by CI, checks both from the source).
 //! `math`, `geometry`, `material`, `model`, `solver` and `post` are pure: no files, no printing, no serde.
 //! `study` writes no file and prints nothing either, but sits above `io`: it re-builds designs whose geometry it
 //! varies through `io::design` and draws its results as `io::chart` charts, which `cli` writes.
@@ -17,10 +18,10 @@
 //! | [`math`] | vocabulary types, knot vectors, B-spline/NURBS basis, curves, SO(3) maps |
 //! | [`geometry`] | exact NURBS primitives, analytic curves and their spline fits, rotation-minimising frames, tube surfaces |
 //! | [`material`] | the constitutive interface and its laws (elastic, Maxwell/WLF), Prony series, WLF shift, section stiffness |
-//! | [`model`] | the continuous problem: patches, nodes, conditions, loads, schedules |
-//! | [`solver`] | collocation, residual and tangent, Newton, time stepping |
+//! | [`model`] | the continuous problem: patches, nodes, conditions, loads, schedules; [`model::builder`], which makes and checks one in Rust, and [`model::stent`], a generated stent and its programme in it |
+//! | [`solver`] | collocation, residual and tangent, Newton, time stepping as an API (step, checkpoint, restore) |
 //! | [`post`] | the full device from a (symmetry-reduced) model or state: sampled shapes, mirror copies, tube meshes |
-//! | [`io`] | YAML design files; writers of STL/OBJ, the run folder, charts |
+//! | [`io`] | YAML design files (a translation into [`model::builder`] calls); writers of STL/OBJ, the run folder, checkpoints, charts |
 //! | [`study`] | accuracy against cost: scenarios, exact references, error measures and fits, sweeps over variants of a model |
 //! | [`cli`] | the `stentkit` command line |
 //!
