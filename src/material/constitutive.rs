@@ -110,6 +110,10 @@ impl fmt::Display for MaterialNotice {
     }
 }
 
+/// The converged strains of a point, by its index: what [`ConstitutiveLaw::commit_step`] advances the internal
+/// variables with (the solver computes them from the configuration when asked).
+pub type PointStrains<'a> = &'a (dyn Fn(usize) -> SectionStrains + Sync);
+
 /// A section constitutive law over time steps, at a set of points (module docs).
 ///
 /// Every method that takes a state takes one this law made with [`ConstitutiveLaw::new_state`]; points are
@@ -151,9 +155,10 @@ pub trait ConstitutiveLaw: Clone + fmt::Debug + PartialEq + Send + Sync {
     /// converged step after a commit or roll-back. Panics if `point` is out of range.
     fn section_law(&self, state: &Self::State, point: usize) -> SectionLaw;
 
-    /// After the step converged with total strains `strains` (`Γ_N`, `K_M` and their s-derivatives, one per
-    /// point): advances the internal variables to `t_{n+1}`. Panics if `strains` has not one entry per point.
-    fn commit_step(&self, state: &mut Self::State, strains: &[SectionStrains]);
+    /// After the step converged: advances the internal variables to `t_{n+1}`, with `strains(i)` the converged
+    /// total strains of point `i` (`Γ_N`, `K_M` and their s-derivatives; computed on demand, possibly from
+    /// several threads at once — a law without internal variables never calls it).
+    fn commit_step(&self, state: &mut Self::State, strains: PointStrains<'_>);
 
     /// After a failed or abandoned attempt: restores the constitutive data of the last converged step (the
     /// internal variables are unchanged: only [`ConstitutiveLaw::commit_step`] changes them).
@@ -249,7 +254,7 @@ macro_rules! register_laws {
                 }
             }
 
-            fn commit_step(&self, state: &mut MaterialState, strains: &[$crate::material::SectionStrains]) {
+            fn commit_step(&self, state: &mut MaterialState, strains: $crate::material::constitutive::PointStrains<'_>) {
                 match (self, state) {
                     $((MaterialLaw::$variant(law), MaterialState::$variant(s)) => law.commit_step(s, strains),)+
                     (law, _) => $crate::material::constitutive::state_of_another_law(law.name()),

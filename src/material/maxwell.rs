@@ -17,8 +17,8 @@
 //! release captures — are the converged ones).
 
 use super::constitutive::{
-    ConstitutiveLaw, SECTION_NUMBERS, StepInput, check_state_length, push_strains, push_stress,
-    read_strains, read_stress,
+    ConstitutiveLaw, PointStrains, SECTION_NUMBERS, StepInput, check_state_length, push_strains,
+    push_stress, read_strains, read_stress,
 };
 use super::{
     BranchHistory, Integrator, Material, MaterialError, MaterialNotice, ReducedTimeQuadrature,
@@ -165,20 +165,24 @@ impl ConstitutiveLaw for MaxwellLaw {
 
     /// `ε_α ← β_α ε^{n+1} + γ_α ε^n + δ_α ε_α` and `ε^n ← ε^{n+1}` at every point (in parallel); the step's `Ē`
     /// and `H` become the converged ones.
-    #[track_caller]
-    fn commit_step(&self, state: &mut MaxwellState, strains: &[SectionStrains]) {
-        assert_eq!(strains.len(), state.strain_n.len(), "one strain per point");
+    fn commit_step(&self, state: &mut MaxwellState, strains: PointStrains<'_>) {
         let coeffs = &state.coeffs;
+        // Per point and independent: in parallel, each point's strain computed where it is used.
         match self.material.num_branches() {
-            0 => state.strain_n.copy_from_slice(strains),
+            0 => state
+                .strain_n
+                .par_iter_mut()
+                .enumerate()
+                .for_each(|(i, strain_n)| *strain_n = strains(i)),
             m => state
                 .strain_n
                 .par_iter_mut()
                 .zip(state.branches.as_mut_slice().par_chunks_mut(m))
-                .zip(strains)
-                .for_each(|((strain_n, point_branches), strain)| {
-                    update_branch_strains(coeffs, strain, strain_n, point_branches);
-                    *strain_n = *strain;
+                .enumerate()
+                .for_each(|(i, (strain_n, point_branches))| {
+                    let strain = strains(i);
+                    update_branch_strains(coeffs, &strain, strain_n, point_branches);
+                    *strain_n = strain;
                 }),
         }
         state.converged_modulus = state.modulus;
@@ -279,10 +283,7 @@ mod tests {
                     temperature: &temperature,
                 };
                 law.prepare_step(state, &step).expect("valid step");
-                let eps: Vec<SectionStrains> = (0..points)
-                    .map(|p| strains((n * points + p) as Real))
-                    .collect();
-                law.commit_step(state, &eps);
+                law.commit_step(state, &|p| strains((n * points + p) as Real));
             }
         };
         run(&law, &mut a, 0..5);

@@ -63,6 +63,24 @@ pub mod prony;
 pub mod section;
 pub mod wlf;
 
+pub use constitutive::{ConstitutiveLaw, MaterialNotice, PointStrains, StepInput};
+pub use elastic::{ElasticLaw, ElasticState};
+pub use history::{
+    BranchHistory, SectionStrains, SectionStress, history_stress, update_branch_strains,
+};
+pub use integrator::{
+    Integrator, MAX_STEP_RATE, ReducedTimeQuadrature, StepCoefficients, exponential_coefficients,
+    reduced_time_increment, step_coefficients, step_coefficients_into,
+};
+pub use law::{LAW_NUMBERS, SectionLaw};
+pub use maxwell::{MaxwellLaw, MaxwellState};
+pub use point::{simulate_strain_history, simulate_stress_history};
+pub use prony::{Prony, PronyBranch};
+pub use section::{CircularSection, Section, SectionProperties, SectionShape, ShearFactor};
+pub use wlf::Wlf;
+
+use crate::math::{Real, Short};
+
 // The registry of constitutive laws: one line per law (module docs).
 constitutive::register_laws! {
     /// Linear elastic: a modulus and a Poisson ratio, no internal variables ([`elastic`]).
@@ -86,24 +104,6 @@ impl MaterialLaw {
         MaxwellLaw::new(material, integrator).into()
     }
 }
-
-pub use constitutive::{ConstitutiveLaw, MaterialNotice, StepInput};
-pub use elastic::{ElasticLaw, ElasticState};
-pub use history::{
-    BranchHistory, SectionStrains, SectionStress, history_stress, update_branch_strains,
-};
-pub use integrator::{
-    Integrator, MAX_STEP_RATE, ReducedTimeQuadrature, StepCoefficients, exponential_coefficients,
-    reduced_time_increment, step_coefficients, step_coefficients_into,
-};
-pub use law::{LAW_NUMBERS, SectionLaw};
-pub use maxwell::{MaxwellLaw, MaxwellState};
-pub use point::{simulate_strain_history, simulate_stress_history};
-pub use prony::{Prony, PronyBranch};
-pub use section::{CircularSection, Section, SectionProperties, SectionShape, ShearFactor};
-pub use wlf::Wlf;
-
-use crate::math::{Real, Short};
 
 /// Errors raised by the material layer when data (not the programmer) is wrong. Branch indices are 1-based,
 /// as `α` in the paper's Table `PLA`.

@@ -173,7 +173,14 @@ impl TangentRecord {
     /// A tangent was assembled with these loads.
     pub(super) fn assembled(&mut self, actions: &Actions) {
         match &mut self.pending_actions {
-            Some(a) => a.clone_from(actions),
+            // Field by field: `Vec::clone_from` reuses the memory.
+            Some(a) => {
+                a.node_force.clone_from(&actions.node_force);
+                a.node_moment.clone_from(&actions.node_moment);
+                a.prescribed.clone_from(&actions.prescribed);
+                a.dist_force.clone_from(&actions.dist_force);
+                a.dist_couple.clone_from(&actions.dist_couple);
+            }
             None => self.pending_actions = Some(actions.clone()),
         }
     }

@@ -4,9 +4,7 @@
 //! roll-back, and keeps the [`SectionLaw`] of every point for the assembly (paper §3.1).
 
 use super::{Simulation, SolverTiming};
-use crate::material::{
-    ConstitutiveLaw, MaterialLaw, MaterialState, SectionLaw, SectionStrains, StepInput,
-};
+use crate::material::{ConstitutiveLaw, MaterialLaw, MaterialState, SectionLaw, StepInput};
 use crate::math::Real;
 use crate::model::Model;
 use crate::solver::SolverError;
@@ -24,8 +22,6 @@ pub(super) struct MaterialPoints {
     pub(super) points: Vec<usize>,
     /// The law's internal variables at those points.
     pub(super) state: MaterialState,
-    /// The converged strains at those points, for the commit (kept to reuse its memory).
-    strains: Vec<SectionStrains>,
 }
 
 /// Every material's points and state, and the section law of every collocation point for the step being solved
@@ -36,6 +32,8 @@ pub(super) struct PointMaterials {
     pub(super) groups: Vec<MaterialPoints>,
     /// The section law per global collocation point.
     pub(super) laws: Vec<SectionLaw>,
+    /// Per global collocation point: its group in `groups` and its index there.
+    owner: Vec<(usize, usize)>,
     /// The notices said, as `(material, kind)` ([`crate::material::MaterialNotice::kind`]): each once.
     pub(super) said: Vec<(usize, String)>,
 }
@@ -58,27 +56,35 @@ impl PointMaterials {
             groups.push(MaterialPoints {
                 material,
                 state: law.new_state(shapes),
-                strains: vec![SectionStrains::default(); points.len()],
                 points,
             });
+        }
+        let mut owner = vec![(0, 0); disc.points.len()];
+        for (k, group) in groups.iter().enumerate() {
+            for (i, &g) in group.points.iter().enumerate() {
+                owner[g] = (k, i);
+            }
         }
         let mut out = Self {
             groups,
             laws: vec![SectionLaw::default(); disc.points.len()],
+            owner,
             said: Vec::new(),
         };
         out.refresh_laws(&model.materials);
         out
     }
 
-    /// Reads every point's section law from its material's state.
+    /// Reads every point's section law from its material's state (in parallel over points).
     pub(super) fn refresh_laws(&mut self, materials: &[MaterialLaw]) {
-        for group in &self.groups {
-            let law = &materials[group.material];
-            for (i, &g) in group.points.iter().enumerate() {
-                self.laws[g] = law.section_law(&group.state, i);
-            }
-        }
+        let groups = &self.groups;
+        self.laws
+            .par_iter_mut()
+            .zip(&self.owner)
+            .for_each(|(law, &(k, i))| {
+                let group = &groups[k];
+                *law = materials[group.material].section_law(&group.state, i);
+            });
     }
 
     /// Every material back to the data of its last converged step.
@@ -125,13 +131,9 @@ impl Simulation<'_> {
         let start = Instant::now();
         let (disc, state) = (&self.disc, &self.state);
         for group in &mut self.materials.groups {
-            // Per collocation point and independent: in parallel.
-            group
-                .strains
-                .par_iter_mut()
-                .zip(&group.points)
-                .for_each(|(strain, &g)| *strain = point_strains(disc, state, g));
-            self.model.materials[group.material].commit_step(&mut group.state, &group.strains);
+            let points = &group.points;
+            let strains = |i: usize| point_strains(disc, state, points[i]);
+            self.model.materials[group.material].commit_step(&mut group.state, &strains);
         }
         // Counted with the step's preparation.
         self.timing.material.1 += start.elapsed().as_secs_f64();

@@ -201,12 +201,14 @@ impl Simulation<'_> {
             &mut sink,
         );
         let slot = if with_tangent {
-            self.tangent.assembled(actions);
             &mut self.timing.tangent
         } else {
             &mut self.timing.residual
         };
         SolverTiming::add(slot, start);
+        if with_tangent {
+            self.tangent.assembled(actions);
+        }
         let mut norm: Real = 0.0;
         for (r, s) in self.lin.residual.iter().zip(&self.lin.row_scale) {
             let x = (r / s).abs();
