@@ -15,7 +15,11 @@
 //!
 //! The simulation keeps the tangent's origin as it goes: at each successful factorisation it copies the state
 //! and the section laws into a buffer it reuses (about 0.3 kB per collocation point: 0.8 MB on the curved
-//! stent, a fraction of a millisecond against the ~10 ms of a factorisation).
+//! stent, a fraction of a millisecond against the ~10 ms of a factorisation). It also keeps, for the attempt of
+//! a step in progress, the origin of the factorisation that attempt started with (by swapping buffers when the
+//! attempt first factorises anew), so that an interrupted attempt can take the factorisation back to it
+//! (`TangentRecord::revert_attempt`): a checkpoint taken after an interruption is then as good as one taken
+//! between steps.
 //!
 //! A checkpoint names its model by a fingerprint ([`model_fingerprint`]): restoring into a simulation of
 //! another model is refused. Writing a checkpoint to a file is the `io` layer's business
