@@ -121,6 +121,7 @@ fn a_killed_or_interrupted_run_resumes_to_the_uninterrupted_result() {
     );
     let history = std::fs::read(full.join("history.csv")).expect("history");
     let rows = history.split(|&b| b == b'\n').count();
+    assert!(rows > 1000);
 
     for (case, signal) in [("killed", "KILL"), ("interrupted", "INT")] {
         let dir = root.join(case);
@@ -149,11 +150,18 @@ fn a_killed_or_interrupted_run_resumes_to_the_uninterrupted_result() {
         assert_eq!(code, Some(0), "{case}: {stderr}");
         let after = summary(&dir);
         assert_eq!(after["status"], "completed", "{case}");
-        assert_eq!(
-            std::fs::read(dir.join("history.csv")).expect("history"),
-            history,
-            "{case}: history.csv differs from the uninterrupted run's"
-        );
+        let resumed = std::fs::read(dir.join("history.csv")).expect("history");
+        if resumed != history {
+            let (a, b) = (text(&resumed), text(&history));
+            let first = a.lines().zip(b.lines()).position(|(x, y)| x != y);
+            panic!(
+                "{case}: history.csv differs from the uninterrupted run's ({} and {} lines), first at line {first:?}: {:?} vs {:?}; the resume said: {stderr}",
+                a.lines().count(),
+                b.lines().count(),
+                first.and_then(|k| a.lines().nth(k)),
+                first.and_then(|k| b.lines().nth(k)),
+            );
+        }
         assert_eq!(
             snapshot_files(&dir),
             snapshot_files(&full),

@@ -15,7 +15,11 @@
 //!
 //! The simulation keeps the tangent's origin as it goes: at each successful factorisation it copies the state
 //! and the section laws into a buffer it reuses (about 0.3 kB per collocation point: 0.8 MB on the curved
-//! stent, a fraction of a millisecond against the ~10 ms of a factorisation).
+//! stent, a fraction of a millisecond against the ~10 ms of a factorisation). It also keeps, for the attempt of
+//! a step in progress, the origin of the factorisation that attempt started with (by swapping buffers when the
+//! attempt first factorises anew), so that an interrupted attempt can take the factorisation back to it
+//! (`TangentRecord::revert_attempt`): a checkpoint taken after an interruption is then as good as one taken
+//! between steps.
 //!
 //! A checkpoint names its model by a fingerprint ([`model_fingerprint`]): restoring into a simulation of
 //! another model is refused. Writing a checkpoint to a file is the `io` layer's business
@@ -159,12 +163,26 @@ impl std::fmt::Write for Fnv1a {
 /// The simulation's record of its current factorisation's origin, kept as it goes (module docs).
 #[derive(Debug, Clone, Default)]
 pub(super) struct TangentRecord {
-    /// Whether `state`, `laws`, `actions` and `gauge_active` describe the current factorisation.
+    /// The current factorisation's origin.
+    current: Origin,
+    /// The loads of the tangent assembled last (not necessarily factorised yet).
+    pending_actions: Option<Actions>,
+    /// Factorisations so far.
+    generation: u64,
+    /// The attempt of a step in progress, if marked: the generation at its start, and whether `before` holds
+    /// the origin of the factorisation it started with (saved at its first factorisation).
+    attempt: Option<(u64, bool)>,
+    /// The origin of the factorisation an attempt started with, once the attempt factorised anew.
+    before: Origin,
+}
+
+/// Where a factorisation's tangent was assembled.
+#[derive(Debug, Clone, Default)]
+struct Origin {
+    /// Whether the other fields describe a factorisation.
     valid: bool,
     state: Option<State>,
     laws: Vec<SectionLaw>,
-    /// The loads of the tangent assembled last (not necessarily factorised yet).
-    pending_actions: Option<Actions>,
     actions: Option<Actions>,
     gauge_active: bool,
 }
@@ -187,22 +205,70 @@ impl TangentRecord {
 
     /// The tangent assembled last was factorised at this state, these laws and gauge activity.
     pub(super) fn factorised(&mut self, state: &State, laws: &[SectionLaw], gauge_active: bool) {
-        match &mut self.state {
+        if let Some((_, saved @ false)) = &mut self.attempt {
+            // The first factorisation of an attempt: keep the one it started with (buffers swapped, no copy).
+            std::mem::swap(&mut self.before, &mut self.current);
+            *saved = true;
+        }
+        let origin = &mut self.current;
+        match &mut origin.state {
             Some(s) => s.copy_from(state),
-            None => self.state = Some(state.clone()),
+            None => origin.state = Some(state.clone()),
         }
         // (No allocation once the capacity is there.)
-        self.laws.clear();
-        self.laws.extend_from_slice(laws);
-        std::mem::swap(&mut self.actions, &mut self.pending_actions);
-        self.gauge_active = gauge_active;
-        self.valid = self.actions.is_some();
+        origin.laws.clear();
+        origin.laws.extend_from_slice(laws);
+        std::mem::swap(&mut origin.actions, &mut self.pending_actions);
+        origin.gauge_active = gauge_active;
+        origin.valid = origin.actions.is_some();
+        self.generation += 1;
     }
 
     /// The factorisations were forgotten.
     pub(super) fn invalidate(&mut self) {
-        self.valid = false;
+        self.current.valid = false;
+        self.attempt = None;
     }
+
+    /// An attempt of a step starts with the current factorisation.
+    pub(super) fn begin_attempt(&mut self) {
+        self.attempt = Some((self.generation, false));
+    }
+
+    /// The attempt in progress converged.
+    pub(super) fn end_attempt(&mut self) {
+        self.attempt = None;
+    }
+
+    /// The attempt in progress was abandoned: the record goes back to the factorisation it started with.
+    /// Returns what the linear system must do: [`Revert::Keep`] its factorisation (the attempt made none),
+    /// [`Revert::Refactor`] the recorded origin's tangent (the attempt replaced it), or [`Revert::Forget`] it
+    /// (the attempt started with none).
+    pub(super) fn revert_attempt(&mut self) -> Revert {
+        match self.attempt.take() {
+            Some((generation, _)) if generation == self.generation => Revert::Keep,
+            Some((_, true)) => {
+                std::mem::swap(&mut self.before, &mut self.current);
+                if self.current.valid {
+                    Revert::Refactor
+                } else {
+                    Revert::Forget
+                }
+            }
+            _ => Revert::Forget,
+        }
+    }
+}
+
+/// What an abandoned attempt leaves to the linear system ([`TangentRecord::revert_attempt`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(super) enum Revert {
+    /// The factorisation is the one the attempt started with.
+    Keep,
+    /// The factorisation the attempt started with must be made again from its recorded origin.
+    Refactor,
+    /// There is none to go back to.
+    Forget,
 }
 
 impl Simulation<'_> {
@@ -224,7 +290,7 @@ impl Simulation<'_> {
             (Some((_, system, _)), true) => system.is_factored(),
             _ => self.system.is_factored(),
         };
-        let record = &self.tangent;
+        let record = &self.tangent.current;
         let tangent = match (&record.state, &record.actions) {
             (Some(state), Some(actions))
                 if record.valid && active_factored && record.gauge_active == self.gauge_active =>
@@ -319,17 +385,18 @@ impl Simulation<'_> {
             }
             self.build_gauge(&positions, checkpoint.time)?;
         }
+        self.state.copy_from(&checkpoint.state);
         if let Some(origin) = &checkpoint.tangent {
             // The tangent of the current factorisation, assembled and factorised again at its iterate.
-            self.state.copy_from(&origin.state);
-            let laws = std::mem::take(&mut self.materials.laws);
-            self.materials.laws = origin.laws.iter().map(SectionLaw::from_numbers).collect();
-            self.gauge_active = origin.gauge_active && self.gauge.is_some();
-            self.linearise(&origin.actions, true)?;
-            self.factor_tangent()?;
-            self.materials.laws = laws;
+            self.tangent.current = Origin {
+                valid: true,
+                state: Some(origin.state.clone()),
+                laws: origin.laws.iter().map(SectionLaw::from_numbers).collect(),
+                actions: Some(origin.actions.clone()),
+                gauge_active: origin.gauge_active,
+            };
+            self.refactor_recorded()?;
         }
-        self.state.copy_from(&checkpoint.state);
         self.gauge_active = checkpoint.gauge_active && self.gauge.is_some();
         let multipliers = match (&self.gauge, self.gauge_active) {
             (Some((g, _, _)), true) => g.len(),
@@ -344,6 +411,33 @@ impl Simulation<'_> {
         }
         self.timing = checkpoint.timing.clone();
         Ok(())
+    }
+
+    /// Assembles and factorises again the tangent of the recorded origin (its state, section laws, loads and
+    /// gauge activity): the factorisation it had, bit for bit. The simulation's own state, laws and gauge
+    /// activity are left as they were.
+    pub(super) fn refactor_recorded(&mut self) -> Result<(), SolverError> {
+        let origin = std::mem::take(&mut self.tangent.current);
+        let (Some(state), Some(actions)) = (&origin.state, &origin.actions) else {
+            return Ok(());
+        };
+        let own_state = std::mem::replace(&mut self.state, state.clone());
+        let own_laws = std::mem::replace(&mut self.materials.laws, origin.laws.clone());
+        let own_gauge = std::mem::replace(
+            &mut self.gauge_active,
+            origin.gauge_active && self.gauge.is_some(),
+        );
+        self.system.invalidate();
+        if let Some((_, system, _)) = &mut self.gauge {
+            system.invalidate();
+        }
+        let result = self
+            .linearise(actions, true)
+            .and_then(|_| self.factor_tangent());
+        self.state = own_state;
+        self.materials.laws = own_laws;
+        self.gauge_active = own_gauge;
+        result
     }
 
     /// The checkpoint's sizes against this model's.

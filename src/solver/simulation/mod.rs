@@ -32,10 +32,11 @@
 //!
 //! **Interruption.** [`Observer::interrupted`] is polled by Newton before every iteration and by
 //! [`Simulation::step_with`] before every attempt of a step (first, retried with a fresh tangent, or cut). When
-//! it answers true the step in progress is abandoned and rolled back exactly as a failed step is, `step_with`
-//! returns [`StepOutcome::Interrupted`] and `run` returns at the last converged step with
-//! [`RunSummary::stopped`] set; the step size and cuts of the abandoned step are kept, so a later `step` or
-//! `run` continues exactly.
+//! it answers true the step in progress is abandoned and rolled back as a failed step is, `step_with` returns
+//! [`StepOutcome::Interrupted`] and `run` returns at the last converged step with [`RunSummary::stopped`] set.
+//! Unlike a failure, an interruption keeps the step size and cuts of the abandoned step and takes the
+//! factorisation back to the one its attempt started with (kept, or made again from its recorded origin), so a
+//! later `step` or `run` — or a checkpoint taken now — continues bit for bit as the uninterrupted run.
 //!
 //! The concepts live in their own files: [`report`] (what a step and a run report), [`observer`] (who is told),
 //! [`timing`] (where the wall time went), `stepping` (the step loop, step-size control and roll-back), `newton`

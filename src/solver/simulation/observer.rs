@@ -23,13 +23,14 @@ pub trait Observer {
 
     /// Whether the run should stop now, within the step in progress: the seam for an interrupt (Ctrl-C) that
     /// should not wait for a long step and its cuts to finish. Polled (cheaply and often: keep it an atomic
-    /// load or a counter) by Newton before every iteration and by [`Simulation::run`] before every attempt of a
-    /// step: the first, the retry with a fresh tangent, and each cut. When it answers true, the step in progress
-    /// is abandoned and rolled back exactly as a failed step is (positions, rotations, curvatures, gauge
-    /// multipliers, captured release reactions, the step's history stresses; the factorisations of the abandoned
-    /// iterates are invalidated), [`Observer::step`] and [`Observer::step_failed`] are not called for it, and
-    /// `run` returns `Ok` with [`super::RunSummary::stopped`] at the last converged step, which is the simulation's
-    /// state. A later `run` resumes from there. The default never interrupts.
+    /// load or a counter) by Newton before every iteration and by [`Simulation::step_with`] before every attempt
+    /// of a step: the first, the retry with a fresh tangent, and each cut. When it answers true, the step in
+    /// progress is abandoned and rolled back as a failed step is (positions, rotations, curvatures, gauge
+    /// multipliers, captured release reactions, the step's history stresses), except that the factorisation goes
+    /// back to the one the attempt started with (kept, or made again) and the step size and cuts are kept;
+    /// [`Observer::step`] and [`Observer::step_failed`] are not called for it, and `run` returns `Ok` with
+    /// [`super::RunSummary::stopped`] at the last converged step, which is the simulation's state. A later `run`
+    /// or `step` continues from there exactly as the uninterrupted run. The default never interrupts.
     fn interrupted(&self) -> bool {
         false
     }

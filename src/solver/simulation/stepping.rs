@@ -1,6 +1,7 @@
 //! The step loop: step-size control (landing on breakpoints, halving on failure down to `min_step`, doubling
 //! back after a success), the reuse retry, and the roll-back of an abandoned step (module docs of [`super`]).
 
+use super::checkpoint::Revert;
 use super::newton::{NewtonFailure, round_off_notice};
 use super::observer::Observers;
 use super::{NoObserver, Observer, RunSummary, Simulation, StepReport};
@@ -132,7 +133,7 @@ impl Simulation<'_> {
                 .set_gauge(target)
                 .and_then(|()| self.prepare_step(self.time, target));
             if let Err(e) = prepared {
-                self.roll_back(start, &captured);
+                self.roll_back(start, &captured, false);
                 return Err(e);
             }
             if self.model.solver.extrapolate {
@@ -158,6 +159,7 @@ impl Simulation<'_> {
             }
             match attempt {
                 Ok(newton) => {
+                    self.tangent.end_attempt();
                     self.commit_step();
                     // A schedule's rate changes at its breakpoints: no extrapolation across them.
                     let breakpoints = &self.breakpoints;
@@ -191,15 +193,15 @@ impl Simulation<'_> {
                     return Ok(StepOutcome::Stepped(report));
                 }
                 Err(NewtonFailure::Fatal(e)) => {
-                    self.roll_back(start, &captured);
+                    self.roll_back(start, &captured, false);
                     return Err(e);
                 }
                 Err(NewtonFailure::Interrupted) => {
-                    self.roll_back(start, &captured);
+                    self.roll_back(start, &captured, true);
                     return Ok(StepOutcome::Interrupted);
                 }
                 Err(NewtonFailure::NotConverged(newton)) => {
-                    self.roll_back(start, &captured);
+                    self.roll_back(start, &captured, false);
                     observer.step_failed(target, dt, &newton);
                     if is_smallest_step(dt, min_step, target) {
                         return Err(SolverError::StepFailed {
@@ -265,30 +267,50 @@ impl Simulation<'_> {
     }
 
     /// What a step is about to change, saved before it starts (see [`Self::roll_back`]).
-    fn step_start(&self) -> StepStart {
+    fn step_start(&mut self) -> StepStart {
+        self.tangent.begin_attempt();
         StepStart {
             state: self.state.clone(),
             gauge_active: self.gauge_active,
         }
     }
 
-    /// Undoes a step that failed or was interrupted: restores the last converged state, the materials' data of
-    /// the last converged step ([`crate::material::ConstitutiveLaw::roll_back`]) and the gauge activation,
-    /// forgets the release reactions `captured` for it, and invalidates the factorisations, which belong to the
-    /// abandoned iterates. (The internal variables are only advanced by a converged step, in `commit_step`.)
-    fn roll_back(&mut self, start: StepStart, captured: &[(usize, usize)]) {
+    /// Undoes an attempt that failed or was interrupted: restores the last converged state, the materials' data
+    /// of the last converged step ([`crate::material::ConstitutiveLaw::roll_back`]) and the gauge activation,
+    /// and forgets the release reactions `captured` for it. (The internal variables are only advanced by a
+    /// converged step, in `commit_step`.)
+    ///
+    /// After a failure the factorisations are invalidated: they belong to the abandoned iterates, and the next
+    /// attempt starts with a fresh tangent. After an interruption (`interrupted`) the factorisation goes back
+    /// to the one the attempt started with — kept if the attempt made none, made again from its recorded
+    /// origin otherwise — so that continuing (a later `step`, or a restored checkpoint taken now) repeats the
+    /// uninterrupted run exactly.
+    fn roll_back(&mut self, start: StepStart, captured: &[(usize, usize)], interrupted: bool) {
         self.state = start.state;
         self.materials.roll_back(&self.model.materials);
         self.gauge_active = start.gauge_active;
-        self.system.invalidate();
-        if let Some((_, system, _)) = &mut self.gauge {
-            system.invalidate();
-        }
-        self.tangent.invalidate();
         for &(k, i) in captured {
             self.ramps[k][i] = None;
         }
         self.step_increment.clear();
+        let revert = if interrupted {
+            self.tangent.revert_attempt()
+        } else {
+            Revert::Forget
+        };
+        let kept = match revert {
+            Revert::Keep => true,
+            // (It factorised before; should it fail now, the next attempt starts with a fresh tangent.)
+            Revert::Refactor => self.refactor_recorded().is_ok(),
+            Revert::Forget => false,
+        };
+        if !kept {
+            self.system.invalidate();
+            if let Some((_, system, _)) = &mut self.gauge {
+                system.invalidate();
+            }
+            self.tangent.invalidate();
+        }
     }
 }
 
