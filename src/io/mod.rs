@@ -9,6 +9,7 @@ pub mod estimate;
 pub mod history;
 pub mod mcap;
 pub mod mcap_salvage;
+pub mod mesh_format;
 pub mod obj;
 pub mod run_charts;
 pub mod run_folder;

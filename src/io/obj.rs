@@ -14,7 +14,7 @@ use crate::io::stl::{MeshIoError, check_writable, write_atomically};
 /// OBJ snapshots ([`super::snapshots::FORMATS`]): a comment naming the design, step, time and units.
 pub struct Obj;
 
-impl super::snapshots::MeshFormat for Obj {
+impl super::mesh_format::MeshFormat for Obj {
     fn extension(&self) -> &'static str {
         "obj"
     }
@@ -23,7 +23,7 @@ impl super::snapshots::MeshFormat for Obj {
         &self,
         path: &Path,
         mesh: &TriangleMesh,
-        s: &super::snapshots::SnapshotState<'_>,
+        s: &super::mesh_format::SnapshotState<'_>,
     ) -> Result<(), MeshIoError> {
         let header = format!(
             "{}: full device at step {}, t = {} s; units {} (lengths in {})",

@@ -4,11 +4,12 @@
 //! stepping lands on those: they are the model's record times).
 //!
 //! **A new snapshot file format is a new module plus one registration line**: write `io/<format>.rs` with a
-//! type implementing [`MeshFormat`] (its extension and how it writes a mesh), declare the module in `io/mod.rs`,
+//! type implementing [`MeshFormat`] (in [`super::mesh_format`]: its extension and how it writes a mesh), declare the module in `io/mod.rs`,
 //! and add the type to [`FORMATS`]. Each snapshot then lists its file under the extension as key in
 //! summary.json, the run folder's manifest claims it, and `--resume` keeps or rewrites it with the others.
 
 use super::design::SnapshotSettings;
+use super::mesh_format::{MeshFormat, SnapshotState};
 use super::run_folder::Manifest;
 use super::stl::MeshIoError;
 use super::{obj, stl};
@@ -59,34 +60,6 @@ impl SnapshotSchedule {
                 .get(self.times.partition_point(|&t| t <= previous + self.snap))
                 .is_some_and(|&t| t <= time + self.snap)
     }
-}
-
-/// What a snapshot file says about the state it holds (for its header).
-#[derive(Debug, Clone, Copy)]
-pub struct SnapshotState<'a> {
-    /// The model.
-    pub model: &'a Model,
-    /// Step number (0: the initial state).
-    pub step: usize,
-    /// Time [time].
-    pub time: Real,
-}
-
-/// A file format of snapshot meshes.
-pub trait MeshFormat: Sync {
-    /// The file extension, also the snapshot's key in summary.json (`stl`).
-    fn extension(&self) -> &'static str;
-
-    /// Writes the device mesh of `state` to `path` (atomically: a reader sees the old file or the new one).
-    ///
-    /// # Errors
-    /// [`MeshIoError`] when the file cannot be written.
-    fn write(
-        &self,
-        path: &Path,
-        mesh: &TriangleMesh,
-        state: &SnapshotState<'_>,
-    ) -> Result<(), MeshIoError>;
 }
 
 /// The formats every snapshot is written in, in this order: the registration list of [`MeshFormat`]s.

@@ -13,7 +13,7 @@
 use std::ffi::OsString;
 use std::fs::{self, File, OpenOptions};
 use std::io::{self, BufReader, BufWriter, Write};
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::sync::atomic::{AtomicU64, Ordering};
 
 use crate::geometry::mesh::TriangleMesh;
@@ -22,29 +22,7 @@ use crate::math::Vec3;
 /// Length of the binary STL header in bytes.
 const STL_HEADER_LEN: usize = 80;
 
-/// Errors of the mesh readers and writers, each carrying the file's path.
-#[derive(Debug, thiserror::Error)]
-pub enum MeshIoError {
-    /// Writing (creating the temporary file, writing, syncing or renaming it) failed; the target is
-    /// unchanged and the temporary file has been removed.
-    #[error("cannot write mesh file {path}: {source}")]
-    Write {
-        /// The target path.
-        path: PathBuf,
-        /// The underlying error.
-        #[source]
-        source: io::Error,
-    },
-    /// Opening or reading a mesh file failed, or its content is not a valid mesh.
-    #[error("cannot read mesh file {path}: {source}")]
-    Read {
-        /// The file read.
-        path: PathBuf,
-        /// The underlying error.
-        #[source]
-        source: io::Error,
-    },
-}
+pub use super::mesh_format::MeshIoError;
 
 /// Writes `mesh` to `path` as binary STL, atomically, with the header `stentkit binary STL`.
 ///
@@ -60,7 +38,7 @@ pub fn write_stl(path: &Path, mesh: &TriangleMesh) -> Result<(), MeshIoError> {
 /// unit system.
 pub struct Stl;
 
-impl super::snapshots::MeshFormat for Stl {
+impl super::mesh_format::MeshFormat for Stl {
     fn extension(&self) -> &'static str {
         "stl"
     }
@@ -69,7 +47,7 @@ impl super::snapshots::MeshFormat for Stl {
         &self,
         path: &Path,
         mesh: &TriangleMesh,
-        s: &super::snapshots::SnapshotState<'_>,
+        s: &super::mesh_format::SnapshotState<'_>,
     ) -> Result<(), MeshIoError> {
         let header = format!(
             "{} step {} t={:.6} {}",
@@ -337,6 +315,7 @@ mod tests {
     use crate::geometry::sphere::sphere;
     use crate::geometry::tube::{TubeSettings, sweep_tube};
     use crate::math::{Mat3, Real};
+    use std::path::PathBuf;
 
     /// A fresh, empty scratch directory under the system temporary directory.
     fn scratch_dir(name: &str) -> PathBuf {
