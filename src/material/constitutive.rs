@@ -126,6 +126,12 @@ pub trait ConstitutiveLaw: Clone + fmt::Debug + PartialEq + Send + Sync {
     /// Poisson's ratio `ν` \[-\]: it gives the section shapes (`G = E / (2(1 + ν))`, DESIGN §3).
     fn poisson(&self) -> Real;
 
+    /// The WLF shift that makes the law depend on temperature, if any: a model of such a material needs a
+    /// temperature schedule, and a schedule reaching `Tg − C2` freezes its relaxation. `None` by default.
+    fn temperature_shift(&self) -> Option<&super::Wlf> {
+        None
+    }
+
     /// A modulus of the law's stiffest response \[stress\] (the instantaneous modulus), which scales the residual
     /// rows of its points into strain-like numbers (DESIGN §4).
     fn reference_modulus(&self) -> Real;
@@ -221,6 +227,12 @@ macro_rules! register_laws {
             fn poisson(&self) -> $crate::math::Real {
                 match self {
                     $(MaterialLaw::$variant(law) => law.poisson(),)+
+                }
+            }
+
+            fn temperature_shift(&self) -> Option<&$crate::material::Wlf> {
+                match self {
+                    $(MaterialLaw::$variant(law) => law.temperature_shift(),)+
                 }
             }
 

@@ -84,6 +84,10 @@ impl ConstitutiveLaw for MaxwellLaw {
     }
 
     /// The instantaneous (glassy) modulus `E0 = E∞ + Σ E_α`.
+    fn temperature_shift(&self) -> Option<&super::Wlf> {
+        self.material.wlf()
+    }
+
     fn reference_modulus(&self) -> Real {
         self.material.prony().instantaneous_modulus()
     }

@@ -494,7 +494,7 @@ impl ModelBuilder {
         let time = self.time.settings()?;
         check_solver(&self.solver)?;
         let mut sections = self.sections.clone();
-        let stent = match &self.stent {
+        let mut stent = match &self.stent {
             Some((spec, mesh)) => Some(stent_model::generate(
                 spec,
                 mesh,
@@ -504,7 +504,10 @@ impl ModelBuilder {
             )?),
             None => None,
         };
-        let generated = stent.as_ref().map_or_else(Vec::new, |s| s.patches.clone());
+        // The stent's fitted patches and nodes move into the model; its geometry stays for the programme.
+        let generated = stent
+            .as_mut()
+            .map_or_else(Vec::new, |s| std::mem::take(&mut s.patches));
         let patches = self.patches(generated, &sections, &mut warnings)?;
         let tolerance = self.joints.tolerance.unwrap_or_else(|| {
             let (mut lo, mut hi) = (
@@ -517,7 +520,9 @@ impl ModelBuilder {
             }
             DEFAULT_JOINT_TOLERANCE * (hi - lo).norm()
         });
-        let initial = stent.as_ref().map_or_else(Vec::new, |s| s.nodes.clone());
+        let initial = stent
+            .as_mut()
+            .map_or_else(Vec::new, |s| std::mem::take(&mut s.nodes));
         let mut nodes = nodes::nodes(
             &self.nodes,
             &patches,
@@ -565,7 +570,11 @@ impl ModelBuilder {
         };
         conditions::apply(&self.conditions, &patches, &mut nodes, &node_sets, &preset)?;
         let distributed_loads = self.distributed_loads(&patches)?;
-        let shifts: Vec<&Wlf> = self.materials.iter().filter_map(wlf).collect();
+        let shifts: Vec<&Wlf> = self
+            .materials
+            .iter()
+            .filter_map(ConstitutiveLaw::temperature_shift)
+            .collect();
         let temperature = match (&self.temperature, shifts.is_empty()) {
             (Some(f), _) => f.clone(),
             (None, true) => TimeFunction::constant(DEFAULT_TEMPERATURE),
@@ -803,14 +812,6 @@ impl ModelBuilder {
             });
         }
         Ok(out)
-    }
-}
-
-/// The WLF shift of a material law, if it has one (its temperature dependence).
-fn wlf(law: &MaterialLaw) -> Option<&Wlf> {
-    match law {
-        MaterialLaw::Maxwell(m) => m.material().wlf(),
-        _ => None,
     }
 }
 
