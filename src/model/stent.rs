@@ -66,9 +66,10 @@ pub struct GeneratedStent {
     pub spec: StentSpec,
     /// The analytic device.
     pub geometry: StentGeometry,
-    /// Fitted patches, in the order of `geometry.patches`.
+    /// Fitted patches, in the order of `geometry.patches` (moved into the model by the builder).
     pub patches: Vec<Patch>,
-    /// Nodes, in the order of `geometry.nodes`, with their symmetry conditions.
+    /// Nodes, in the order of `geometry.nodes`, with their symmetry conditions (moved into the model by the
+    /// builder).
     pub nodes: Vec<Node>,
 }
 
