@@ -6,7 +6,7 @@
 
 use super::dto::*;
 pub use super::issue::Issue;
-use super::issue::{Result, issue};
+use super::issue::{Result, issue, mesh_key_path};
 use super::size::{MemoryEstimate, StepCount, check_size};
 use super::stent;
 use crate::geometry::GeometryError;
@@ -217,11 +217,6 @@ fn builder_issue(e: BuildError, dto: &DesignDto) -> Issue {
 /// The design field path of a builder [`Field`]: the builder counts patches, nodes, conditions, loads and probes
 /// in the order this module adds them, which is the order of the design's lists.
 pub fn field_path(field: &Field, dto: &DesignDto) -> String {
-    // The key a degree or size came from: the patch's (or stent mesh's) own, else the design's `mesh`.
-    let mesh_key = |own: Option<usize>, own_path: String, key: &str| match own {
-        Some(_) => format!("{own_path}.{key}"),
-        None => format!("mesh.{key}"),
-    };
     match *field {
         Field::Patches => "patches".into(),
         Field::Patch { index, field } => {
@@ -231,8 +226,8 @@ pub fn field_path(field: &Field, dto: &DesignDto) -> String {
             };
             match field {
                 PatchField::Name => format!("{base}.name"),
-                PatchField::Degree => mesh_key(pd.p, base, "p"),
-                PatchField::ControlPoints => mesh_key(pd.n, base, "n"),
+                PatchField::Degree => mesh_key_path(pd.p, &base, "p"),
+                PatchField::ControlPoints => mesh_key_path(pd.n, &base, "n"),
                 PatchField::Section => format!("{base}.diameter"),
                 PatchField::Material => base,
                 PatchField::Geometry | PatchField::Angle => {

@@ -21,3 +21,12 @@ pub(super) fn issue(path: impl Into<String>, message: impl Into<String>) -> Issu
 
 /// A result whose error is an [`Issue`].
 pub(super) type Result<T> = std::result::Result<T, Issue>;
+
+/// The path of a degree or size `key` (`p`, `n`) that a block may give itself (`own` at `own_path`) or inherit
+/// from the design's `mesh`: where the value came from.
+pub(super) fn mesh_key_path(own: Option<usize>, own_path: &str, key: &str) -> String {
+    match own {
+        Some(_) => format!("{own_path}.{key}"),
+        None => format!("mesh.{key}"),
+    }
+}

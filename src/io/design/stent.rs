@@ -25,7 +25,7 @@
 //! ```
 
 use super::dto::*;
-use super::issue::{Result, issue};
+use super::issue::{Result, issue, mesh_key_path};
 use crate::geometry::stent::{
     BridgeDirection, BridgeShape, BridgeSpec, CentrelineSpec, CrownSpec, StentParameter, StentSpec,
     Symmetry, TemporaryCentreline, TemporarySpec,
@@ -75,10 +75,7 @@ pub(super) fn field_path(field: StentField, dto: &DesignDto) -> String {
         } else {
             "stent.crown_mesh"
         };
-        match own(bridge).and_then(given) {
-            Some(_) => format!("{own_path}.{key}"),
-            None => format!("mesh.{key}"),
-        }
+        mesh_key_path(own(bridge).and_then(given), own_path, key)
     };
     match field {
         StentField::Whole => "stent".into(),
