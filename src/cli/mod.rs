@@ -80,6 +80,11 @@ pub enum Command {
         /// state (a few MB for a large stent) and closes the recording's chunk.
         #[arg(long, value_name = "SECONDS", default_value_t = 60.0)]
         checkpoint_every: f64,
+        /// Error-controlled time steps at this time-error tolerance (replaces the design's `time.tolerance`; a
+        /// design's `step` becomes the first step): the estimated error of each step, normalised as Newton's
+        /// increments (translations over the patch length, rotations in radians), stays below it.
+        #[arg(long, value_name = "TOLERANCE")]
+        tol: Option<f64>,
     },
     /// Make the folder of a run that was killed (SIGKILL, power loss, crash) whole: cut history.csv back to its
     /// last complete row, finish run.mcap after its last complete chunk, remove unfinished temporaries, and mark
@@ -280,6 +285,7 @@ pub fn main() -> ExitCode {
             verbose,
             resume,
             checkpoint_every,
+            tol,
         } => run::run(
             &design,
             run::RunOptions {
@@ -289,6 +295,7 @@ pub fn main() -> ExitCode {
                 verbose,
                 resume,
                 checkpoint_every,
+                time_tolerance: tol,
             },
         ),
         Command::Schema => schema(),

@@ -35,7 +35,7 @@ use super::signals;
 use super::{BadInput, Interrupted, error_text, short_time};
 use crate::io::checkpoint::{self, OutputsCheckpoint, RunCheckpoint};
 use crate::io::design::size::human_bytes;
-use crate::io::design::{Design, load_design};
+use crate::io::design::{Design, DesignOverrides, load_design_with};
 use crate::io::history::HistoryWriter;
 use crate::io::mcap::{McapRecorder, RunInfo};
 use crate::io::mcap_salvage::{Salvage, salvage};
@@ -205,6 +205,19 @@ impl Outputs {
         s.newton_iterations = t.iterations;
         s.iterations_per_step = t.iterations as Real / t.steps.max(1) as Real;
         s.step_cuts = t.cuts;
+        if let Some(control) = &mut s.time_error_control {
+            let steps = || self.charts.samples().iter().skip(1);
+            control.accepted_steps = t.steps;
+            control.rejected_steps = t.rejected;
+            control.largest_estimate = steps()
+                .filter_map(|x| x.error_estimate)
+                .fold(0.0, Real::max);
+            control.smallest_step = steps().map(|x| x.dt).fold(Real::INFINITY, Real::min);
+            control.largest_step = steps().map(|x| x.dt).fold(0.0, Real::max);
+            if t.steps == 0 {
+                control.smallest_step = 0.0;
+            }
+        }
         s.final_time = sim.time();
         s.snapshots = self.snapshots.snapshots().iter().map(Into::into).collect();
         s.final_state = self
@@ -409,6 +422,8 @@ pub struct RunOptions {
     pub resume: Option<PathBuf>,
     /// Wall time between checkpoints \[s\] (0: after every step).
     pub checkpoint_every: Real,
+    /// Error-controlled stepping at this time-error tolerance, replacing the design's (`--tol`).
+    pub time_tolerance: Option<Real>,
 }
 
 /// Simulates the design and writes the run folder.
@@ -419,7 +434,16 @@ pub struct RunOptions {
 pub fn run(design_path: &Path, options: RunOptions) -> anyhow::Result<()> {
     let started = Instant::now();
     signals::install();
-    let design = load_design(design_path)?;
+    if let Some(tol) = options.time_tolerance
+        && !(tol > 0.0 && tol.is_finite())
+    {
+        return Err(BadInput(format!("--tol {tol}: give a tolerance > 0")).into());
+    }
+    let overrides = DesignOverrides {
+        time_tolerance: options.time_tolerance,
+        ..DesignOverrides::default()
+    };
+    let design = load_design_with(design_path, &overrides)?;
     for w in &design.warnings {
         eprintln!("warning: {w}");
     }

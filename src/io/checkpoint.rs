@@ -2,11 +2,11 @@
 //! output stood at that step ([`OutputsCheckpoint`]), from which `stentkit run --resume` continues a killed or
 //! interrupted run exactly.
 //!
-//! # Format (version 1)
+//! # Format (version 2; version 1, before error-controlled stepping, had no step-control memory)
 //!
 //! ```text
 //! magic     8 bytes   "STKCKPT\0"
-//! version   u32       1
+//! version   u32       2
 //! length    u64       bytes of the payload
 //! payload   …         the fields below, in order
 //! crc32     u32       CRC-32 (IEEE 802.3, as zlib and PNG) of everything before it
@@ -15,7 +15,7 @@
 //! All integers and floats little-endian; a float is its IEEE-754 bits (`f64::to_bits`), so every number comes
 //! back exactly; a `usize` is a `u64`; a vector or string is its length (`u64`) then its items; an option is a
 //! byte 0/1 then the value. The payload is the model fingerprint of the outputs' settings, the solver's
-//! checkpoint (time, step, state, materials, ramps, gauge, tangent origin, notices, timing) and the outputs'
+//! checkpoint (time, step, step control, state, materials, ramps, gauge, tangent origin, notices, timing) and the outputs'
 //! positions, in the order [`write()`] writes them.
 //!
 //! Why this format: a checkpoint must restore every number bit for bit (a text format would need round-trip
@@ -34,6 +34,7 @@ use crate::material::LAW_NUMBERS;
 use crate::math::{Mat3, Real, Vec3};
 use crate::solver::assembly::{Actions, ReleaseRamp};
 use crate::solver::simulation::TangentOrigin;
+use crate::solver::simulation::adaptive::StepControl;
 use crate::solver::state::State;
 use crate::solver::{Checkpoint, RunSummary, SolverTiming};
 use std::path::{Path, PathBuf};
@@ -45,7 +46,7 @@ pub const FILE_NAME: &str = "checkpoint.bin";
 const MAGIC: &[u8; 8] = b"STKCKPT\0";
 
 /// The format version this build writes and reads.
-pub const VERSION: u32 = 1;
+pub const VERSION: u32 = 2;
 
 /// Bytes before the payload: magic, version, length.
 const HEADER: usize = 8 + 4 + 8;
@@ -480,6 +481,9 @@ fn encode_solver(e: &mut Encoder, c: &Checkpoint) {
     e.usize(c.step);
     e.f64(c.step_size);
     e.usize(c.step_cuts);
+    e.option(c.control.previous_ratio.as_ref(), |e, r| e.f64(*r));
+    e.usize(c.control.rejections);
+    e.bool(c.control.above_tolerance_reported);
     encode_state(e, &c.state);
     e.list(&c.materials, |e, (material, values)| {
         e.usize(*material);
@@ -523,6 +527,11 @@ fn decode_solver(d: &mut Decoder<'_>) -> Result<Checkpoint, Problem> {
         step: d.usize()?,
         step_size: d.f64()?,
         step_cuts: d.usize()?,
+        control: StepControl {
+            previous_ratio: d.option(|d| d.f64())?,
+            rejections: d.usize()?,
+            above_tolerance_reported: d.bool()?,
+        },
         state: decode_state(d)?,
         materials: d.list(16, |d| Ok((d.usize()?, d.f64s()?)))?,
         material_notices: d.list(16, |d| Ok((d.usize()?, d.str()?)))?,
@@ -559,6 +568,7 @@ fn encode_sample(e: &mut Encoder, s: &StateSample) {
     e.usize(s.iterations);
     e.f64s(&s.residuals);
     e.usize(s.cuts);
+    e.option(s.error_estimate.as_ref(), |e, v| e.f64(*v));
     e.vec3s(&s.probes);
     e.option(s.recovery.as_ref(), |e, r| {
         e.f64(r.ratio_mean);
@@ -577,6 +587,7 @@ fn decode_sample(d: &mut Decoder<'_>) -> Result<StateSample, Problem> {
         iterations: d.usize()?,
         residuals: d.f64s()?,
         cuts: d.usize()?,
+        error_estimate: d.option(|d| d.f64())?,
         probes: d.vec3s()?,
         recovery: d.option(|d| {
             Ok(Recovery {
@@ -613,7 +624,7 @@ fn encode_outputs(e: &mut Encoder, o: &OutputsCheckpoint) {
     e.option(o.recording.last_mesh.as_ref(), |e, step| e.usize(*step));
     e.list(&o.samples, encode_sample);
     let t = &o.totals;
-    for v in [t.steps, t.iterations, t.cuts, t.factorisations] {
+    for v in [t.steps, t.iterations, t.cuts, t.rejected, t.factorisations] {
         e.usize(v);
     }
     e.f64(t.time);
@@ -652,6 +663,7 @@ fn decode_outputs(d: &mut Decoder<'_>) -> Result<OutputsCheckpoint, Problem> {
             steps: d.usize()?,
             iterations: d.usize()?,
             cuts: d.usize()?,
+            rejected: d.usize()?,
             factorisations: d.usize()?,
             time: d.f64()?,
             stopped: d.bool()?,
@@ -685,6 +697,11 @@ mod tests {
             step: 700,
             step_size: 2.5e-3 / 4.0,
             step_cuts: 0,
+            control: StepControl {
+                previous_ratio: Some(0.25),
+                rejections: 2,
+                above_tolerance_reported: true,
+            },
             state: state.clone(),
             materials: vec![(0, vec![1.0, 2.0, Real::NAN]), (2, vec![])],
             material_notices: vec![(0, "relaxation_frozen".into())],
@@ -757,6 +774,7 @@ mod tests {
                 iterations: 3,
                 residuals: vec![1e-3, 1e-11],
                 cuts: 0,
+                error_estimate: Some(2.5e-4),
                 probes: vec![Vec3::new(1.0, 2.0, 3.0)],
                 recovery: Some(Recovery {
                     ratio_mean: 0.5,
@@ -768,6 +786,7 @@ mod tests {
                 steps: 9,
                 iterations: 30,
                 cuts: 1,
+                rejected: 3,
                 factorisations: 5,
                 time: 0.9,
                 stopped: false,

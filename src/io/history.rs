@@ -1,6 +1,9 @@
 //! `history.csv`: one row per converged step (and the initial state): `time`, then for each probe `P` the
 //! displacement columns `P.ux, P.uy, P.uz` (in the design's length unit), then `temperature` [°C],
 //! `iterations` (Newton solves of the step), `residual` (final normalised residual) and `cuts` (step cuts).
+//! With error-controlled stepping (`time.tolerance`) it adds `dt` (the step taken), `error_estimate` (its
+//! time-error estimate, normalised as Newton's increments; 0 for a material without internal variables) and
+//! `rejected` (attempts rejected by error control before it).
 //! A design with a programme (stents) adds `recovery_ratio_mean` and `recovery_ratio_max`, the mean (weighted
 //! over the full device) and largest `‖η_l‖ / ‖η_temp,l‖` over the driven nodes — 1 at the temporary shape, 0 at
 //! the permanent one — and, for a radial contraction, `delta_r`: the mean radial contraction of the driven
@@ -50,6 +53,9 @@ impl HistoryWriter {
             }
         }
         header.push_str(",temperature,iterations,residual,cuts");
+        if sim.model().time.tolerance.is_some() {
+            header.push_str(",dt,error_estimate,rejected");
+        }
         if let Some(programme) = &sim.model().programme {
             header.push_str(",recovery_ratio_mean,recovery_ratio_max");
             if matches!(
@@ -150,6 +156,12 @@ impl HistoryWriter {
         line.push_str(&format!(
             ",{temperature:.6},{iterations},{residual:.3e},{cuts}"
         ));
+        if sim.model().time.tolerance.is_some() {
+            let (dt, estimate, rejected) = report.map_or((0.0, 0.0, 0), |r| {
+                (r.dt, r.error_estimate.unwrap_or(0.0), r.rejected)
+            });
+            line.push_str(&format!(",{dt:.6e},{estimate:.3e},{rejected}"));
+        }
         if let Some(r) = super::state::recovery(sim) {
             line.push_str(&format!(",{:.9e},{:.9e}", r.ratio_mean, r.ratio_max));
             if let Some(delta_r) = r.delta_r {

@@ -9,7 +9,9 @@
 //! * `recovery.svg` — the mean and largest recovery ratio against time with the normalised temperature and
 //!   the programme's ramp (designs with a programme: 1 at the temporary shape, 0 at the permanent one);
 //! * `delta_r.svg` — the mean radial contraction Δr against time (radial-contraction programmes);
-//! * `newton.svg` — Newton iterations per step against time (every run).
+//! * `newton.svg` — Newton iterations per step against time (every run);
+//! * `step_size.svg` — the step size and the time-error estimate over the tolerance against time, on log axes
+//!   (error-controlled runs, `time.tolerance`).
 
 use super::chart::{ChartError, LineChart, Series, write_svg};
 use super::run_folder::Manifest;
@@ -194,6 +196,42 @@ impl RunCharts {
             newton.series[0].points.push((0.0, 0.0));
         }
         charts.push(("newton.svg", newton));
+
+        if let Some(tolerance) = model.time.tolerance {
+            let mut steps = LineChart::new(
+                format!("{name}: error-controlled steps (tolerance {tolerance:e})"),
+                "time [s]",
+                "step size [s]; estimate / tolerance [-]",
+            );
+            steps.y_scale = super::chart::Scale::Log;
+            let dt: Vec<(Real, Real)> = self
+                .samples
+                .iter()
+                .filter(|s| s.dt > 0.0)
+                .map(|s| (s.time, s.dt))
+                .collect();
+            // (A log axis takes positive values only: estimates of zero, in holds of an elastic material, are
+            // left out.)
+            let ratio: Vec<(Real, Real)> = self
+                .samples
+                .iter()
+                .filter_map(|s| s.error_estimate.map(|e| (s.time, e / tolerance)))
+                .filter(|p| p.1 > 0.0)
+                .collect();
+            if !dt.is_empty() {
+                steps
+                    .series
+                    .push(Series::new("step size dt [s]", dt).with_color(0));
+                if !ratio.is_empty() {
+                    steps.series.push(
+                        Series::new("estimate / tolerance [-]", ratio)
+                            .dashed()
+                            .with_color(1),
+                    );
+                }
+                charts.push(("step_size.svg", steps));
+            }
+        }
         charts
     }
 

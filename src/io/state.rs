@@ -180,6 +180,8 @@ pub struct StateSample {
     pub residuals: Vec<Real>,
     /// Step cuts before the step converged.
     pub cuts: usize,
+    /// The step's time-error estimate (error-controlled stepping), normalised as Newton's increments.
+    pub error_estimate: Option<Real>,
     /// Displacement of every probe of the model, in its order [length].
     pub probes: Vec<Vec3>,
     /// Recovery measures, for a model with a programme.
@@ -200,6 +202,7 @@ impl StateSample {
             iterations: report.map_or(0, |r| r.newton.iterations),
             residuals: report.map_or_else(Vec::new, |r| r.newton.residuals.clone()),
             cuts: report.map_or(0, |r| r.cuts),
+            error_estimate: report.and_then(|r| r.error_estimate),
             probes: model
                 .probes
                 .iter()

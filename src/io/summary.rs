@@ -298,6 +298,9 @@ pub struct RunSummaryFile {
     pub iterations_per_step: Real,
     /// Step cuts.
     pub step_cuts: usize,
+    /// Error-controlled stepping, when the design asks for it (`time.tolerance`).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub time_error_control: Option<TimeErrorControl>,
     /// Time reached [s].
     pub final_time: Real,
     /// End time of the design [s].
@@ -328,6 +331,23 @@ pub struct RunSummaryFile {
     pub notices: Vec<String>,
 }
 
+/// What error-controlled stepping did (`summary.json` `time_error_control`).
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct TimeErrorControl {
+    /// The time-error tolerance asked (normalised as Newton's increments).
+    pub tolerance: Real,
+    /// Steps accepted.
+    pub accepted_steps: usize,
+    /// Attempts rejected because their estimate exceeded the tolerance.
+    pub rejected_steps: usize,
+    /// The largest estimate of an accepted step (above the tolerance only at the smallest step, with a notice).
+    pub largest_estimate: Real,
+    /// The smallest step taken [s].
+    pub smallest_step: Real,
+    /// The largest step taken [s].
+    pub largest_step: Real,
+}
+
 impl RunSummaryFile {
     /// The summary of a run of `model` that is starting: `"status": "running"`, nothing done yet.
     pub fn start(
@@ -354,6 +374,14 @@ impl RunSummaryFile {
             newton_iterations: 0,
             iterations_per_step: 0.0,
             step_cuts: 0,
+            time_error_control: model.time.tolerance.map(|tolerance| TimeErrorControl {
+                tolerance,
+                accepted_steps: 0,
+                rejected_steps: 0,
+                largest_estimate: 0.0,
+                smallest_step: 0.0,
+                largest_step: 0.0,
+            }),
             final_time: 0.0,
             end_time: model.time.end,
             time_step: model.time.step,

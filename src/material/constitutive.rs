@@ -132,6 +132,12 @@ pub trait ConstitutiveLaw: Clone + fmt::Debug + PartialEq + Send + Sync {
         None
     }
 
+    /// Why error-controlled stepping cannot be trusted with this law, if it cannot (the builder refuses a
+    /// time tolerance then); `None` by default.
+    fn time_error_unsupported(&self) -> Option<String> {
+        None
+    }
+
     /// A modulus of the law's stiffest response \[stress\] (the instantaneous modulus), which scales the residual
     /// rows of its points into strain-like numbers (DESIGN §4).
     fn reference_modulus(&self) -> Real;
@@ -160,6 +166,25 @@ pub trait ConstitutiveLaw: Clone + fmt::Debug + PartialEq + Send + Sync {
     /// The section law (stress and tangent) of point `point` for the step prepared last, or for the last
     /// converged step after a commit or roll-back. Panics if `point` is out of range.
     fn section_law(&self, state: &Self::State, point: usize) -> SectionLaw;
+
+    /// The section laws of the step prepared last as the law's *companion* update of the internal variables would
+    /// give them (the same law advanced by [`super::Integrator::companion`] over the same step, from the same
+    /// internal variables at `t_n`), one per point into `out`, for the time-error estimate of adaptive stepping:
+    /// the solver measures how far the converged configuration would move under the companion's stresses. The
+    /// state is not changed. Returns `false` (and leaves `out` empty) for a law without internal variables, which
+    /// has no time-discretisation error: the default.
+    ///
+    /// # Errors
+    /// As [`ConstitutiveLaw::prepare_step`].
+    fn companion_laws(
+        &self,
+        _state: &Self::State,
+        _step: &StepInput<'_>,
+        out: &mut Vec<SectionLaw>,
+    ) -> Result<bool, MaterialError> {
+        out.clear();
+        Ok(false)
+    }
 
     /// After the step converged: advances the internal variables to `t_{n+1}`, with `strains(i)` the converged
     /// total strains of point `i` (`Γ_N`, `K_M` and their s-derivatives; computed on demand, possibly from
@@ -236,6 +261,12 @@ macro_rules! register_laws {
                 }
             }
 
+            fn time_error_unsupported(&self) -> Option<String> {
+                match self {
+                    $(MaterialLaw::$variant(law) => law.time_error_unsupported(),)+
+                }
+            }
+
             fn reference_modulus(&self) -> $crate::math::Real {
                 match self {
                     $(MaterialLaw::$variant(law) => law.reference_modulus(),)+
@@ -262,6 +293,18 @@ macro_rules! register_laws {
             fn section_law(&self, state: &MaterialState, point: usize) -> $crate::material::SectionLaw {
                 match (self, state) {
                     $((MaterialLaw::$variant(law), MaterialState::$variant(s)) => law.section_law(s, point),)+
+                    (law, _) => $crate::material::constitutive::state_of_another_law(law.name()),
+                }
+            }
+
+            fn companion_laws(
+                &self,
+                state: &MaterialState,
+                step: &$crate::material::StepInput<'_>,
+                out: &mut Vec<$crate::material::SectionLaw>,
+            ) -> Result<bool, $crate::material::MaterialError> {
+                match (self, state) {
+                    $((MaterialLaw::$variant(law), MaterialState::$variant(s)) => law.companion_laws(s, step, out),)+
                     (law, _) => $crate::material::constitutive::state_of_another_law(law.name()),
                 }
             }

@@ -88,6 +88,18 @@ impl ConstitutiveLaw for MaxwellLaw {
         self.material.wlf()
     }
 
+    fn time_error_unsupported(&self) -> Option<String> {
+        if self.material.num_branches() == 0 {
+            return None;
+        }
+        self.integrator.companion().err().map(|why| {
+            format!(
+                "error-controlled steps need `integrator: trapezoidal` (the material's is `{}`): {why}",
+                self.integrator.name()
+            )
+        })
+    }
+
     fn reference_modulus(&self) -> Real {
         self.material.prony().instantaneous_modulus()
     }
@@ -160,6 +172,55 @@ impl ConstitutiveLaw for MaxwellLaw {
                 temperature,
                 frozen_below: wlf.frozen_below(),
             }))
+    }
+
+    /// The companion integrator's coefficients for the step (computed here, not kept), its `Ē` and every point's
+    /// history stresses from the internal variables at `t_n`: the laws `prepare_step` would give under
+    /// [`Integrator::companion`]. An elastic Maxwell material (no branch) has no time error: `false`.
+    fn companion_laws(
+        &self,
+        state: &MaxwellState,
+        step: &StepInput<'_>,
+        out: &mut Vec<SectionLaw>,
+    ) -> Result<bool, MaterialError> {
+        out.clear();
+        let material = &self.material;
+        if material.num_branches() == 0 {
+            return Ok(false);
+        }
+        let companion =
+            self.integrator
+                .companion()
+                .map_err(|why| MaterialError::NoTimeErrorEstimate {
+                    integrator: self.integrator.name(),
+                    why,
+                })?;
+        let mut coeffs = StepCoefficients::identity(material.num_branches());
+        step_coefficients_into(
+            material,
+            companion,
+            &ReducedTimeQuadrature::default(),
+            step.t_n,
+            step.t_np1,
+            step.temperature,
+            &mut coeffs,
+        )?;
+        let modulus = coeffs.effective_modulus(material.prony());
+        (0..state.shapes.len())
+            .into_par_iter()
+            .map(|i| {
+                let shape = &state.shapes[i];
+                let history = history_stress(
+                    material.prony(),
+                    shape,
+                    &coeffs,
+                    &state.strain_n[i],
+                    state.branches.point(i),
+                );
+                SectionLaw::new(shape, modulus, history)
+            })
+            .collect_into_vec(out);
+        Ok(true)
     }
 
     #[inline]

@@ -209,6 +209,15 @@ pub enum MaterialError {
         /// Numbers given.
         found: usize,
     },
+    /// Error-controlled stepping was asked of a Maxwell material whose update has no trustworthy time-error
+    /// estimate ([`Integrator::companion`]).
+    #[error("no time-error estimate for the `{integrator}` update: {why}")]
+    NoTimeErrorEstimate {
+        /// The update's design name.
+        integrator: &'static str,
+        /// Why.
+        why: &'static str,
+    },
     /// Stress control is impossible: the step's effective modulus vanished (a Maxwell fluid, `E∞ = 0`, whose
     /// branches all relax completely within one step cannot carry a prescribed stress).
     #[error("effective modulus {modulus} at t = {} leaves the stress-controlled step singular", Short(*time))]

@@ -244,7 +244,8 @@ pub struct Probe {
 pub struct TimeSettings {
     /// End time [time] (the run starts at 0).
     pub end: Real,
-    /// Nominal time step `h` [time]; steps are shortened to land on schedule breakpoints.
+    /// Nominal time step `h` [time]; steps are shortened to land on schedule breakpoints. With error-controlled
+    /// stepping (`tolerance`), the first step.
     pub step: Real,
     /// Smallest step that automatic step cutting may reach before giving up [time].
     pub min_step: Real,
@@ -253,6 +254,13 @@ pub struct TimeSettings {
     /// that held it, so the node stays in equilibrium; the reaction then falls linearly to the prescribed load
     /// after release. This turns the release snap into a continuation that step cutting can subdivide.
     pub release_ramp: Real,
+    /// Error-controlled stepping when `Some`: the tolerance of the time error estimated per step, in Newton's
+    /// normalised norm (translations over the patch length, rotations in radians; see
+    /// [`crate::solver::simulation`], *Error-controlled stepping*). Steps then grow and shrink with the estimate
+    /// between `min_step` and `max_step`, starting from `step`. `None`: fixed steps of `step`.
+    pub tolerance: Option<Real>,
+    /// The largest step error-controlled stepping takes [time] (default: the end time).
+    pub max_step: Real,
 }
 
 /// Times closer than this fraction of the nominal step are one time when time stepping lands on schedule

@@ -9,7 +9,8 @@
 //! of 0.01 s (Maxwell/WLF, 15 branches; the programme's release at 1.75 s captures reaction ramps and switches on
 //! gauge constraints with Lagrange multipliers) and the 45° bend (elastic) in steps of 0.5, whose first step is
 //! cut twice (the step size grows back over the next), also with the extrapolated start of each step (which
-//! reads the last step's increment). Exact comparisons: no tolerance.
+//! reads the last step's increment), and the stent with error-controlled steps (rejected attempts, the
+//! controller's memory). Exact comparisons: no tolerance.
 
 use crate::common::{design_text, model_from_text, replace_line};
 use std::ops::ControlFlow;
@@ -32,6 +33,19 @@ fn small_stent() -> Model {
     model_from_text(&text, "straight_stent_2_crowns.yaml")
 }
 
+/// The same stent with error-controlled steps (tolerance 1e-3 from a first step of 0.01): the step-size
+/// controller's memory, rejected attempts (which keep their factorisation) and the error estimates (which may
+/// factorise) must continue exactly too.
+fn small_stent_adaptive() -> Model {
+    let text = replace_line(&design_text("straight_stent.yaml"), "crowns:", "crowns: 2");
+    let text = replace_line(
+        &text,
+        "time:",
+        "time: {end: 2.0, step: 0.01, tolerance: 1.0e-3}",
+    );
+    model_from_text(&text, "straight_stent_2_crowns_adaptive.yaml")
+}
+
 /// The 45° bend in steps of 0.5: the first is cut twice, so the step size is below the nominal one for a step.
 fn cut_bend() -> Model {
     let text = replace_line(
@@ -48,10 +62,24 @@ fn a_restored_simulation_continues_bit_for_bit() {
     let mut extrapolated = cut_bend();
     extrapolated.solver.extrapolate = true;
     extrapolated.name = "bend45_extrapolated".into();
-    for model in [small_stent(), cut_bend(), extrapolated] {
+    for model in [
+        small_stent(),
+        small_stent_adaptive(),
+        cut_bend(),
+        extrapolated,
+    ] {
         let mut full = Simulation::new(&model).expect("simulation");
         let reports = finish(&mut full);
         assert!(full.is_finished(), "{}", model.name);
+        if model.time.tolerance.is_some() {
+            let rejected: usize = reports.iter().map(|r| r.rejected).sum();
+            println!(
+                "{}: {} steps, {rejected} rejected",
+                model.name,
+                reports.len()
+            );
+            assert!(rejected > 0, "the adaptive run rejects some steps");
+        }
         let n = reports.len();
         // At the start, early, around the release (the stent's at 1.75 s, step 175 of 200), near the end.
         let mut at_steps = vec![0, 1, n / 3, n * 7 / 8 - 1, n * 7 / 8 + 1, n - 1];

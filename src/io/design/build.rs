@@ -60,7 +60,7 @@ pub fn build(dto: &DesignDto, default_name: &str) -> Result<Built> {
     let name = design_name(dto, default_name)?;
     let (material, integrator) = material(&dto.material)?;
     let (section, shear_factor) = section(&dto.section)?;
-    let time = time_spec(&dto.time);
+    let time = time_spec(&dto.time)?;
     let settings = time.settings().map_err(|e| builder_issue(e, dto))?;
     // Before any geometry is generated: a size that would exhaust memory is refused with an estimate (with the
     // nominal steps; the steps landing on breakpoints are counted once the model exists, below).
@@ -283,6 +283,8 @@ pub fn field_path(field: &Field, dto: &DesignDto) -> String {
             TimeField::Step => "time.step",
             TimeField::MinStep => "time.min_step",
             TimeField::ReleaseRamp => "time.release_ramp",
+            TimeField::Tolerance => "time.tolerance",
+            TimeField::MaxStep => "time.max_step",
         }
         .into(),
         Field::Solver(field) => match field {
@@ -717,13 +719,30 @@ fn distributed_load(k: usize, d: &DistributedLoadDto) -> Result<DistributedLoadS
     })
 }
 
-fn time_spec(t: &TimeDto) -> TimeSpec {
-    TimeSpec {
+/// The first step of error-controlled stepping when the design gives none, as a fraction of the end time.
+pub const DEFAULT_FIRST_STEP_FRACTION: Real = 1e-3;
+
+/// The time stepping of the design: fixed steps of `step`, or error-controlled ones from `step` (default
+/// [`DEFAULT_FIRST_STEP_FRACTION`] of the end time) when a tolerance is given.
+fn time_spec(t: &TimeDto) -> Result<TimeSpec> {
+    let step = match (t.step, t.tolerance) {
+        (Some(Positive(h)), _) => h,
+        (None, Some(_)) => t.end.0 * DEFAULT_FIRST_STEP_FRACTION,
+        (None, None) => {
+            return Err(issue(
+                "time.step",
+                "missing: give `step` (fixed steps) or `tolerance` (error-controlled steps)",
+            ));
+        }
+    };
+    Ok(TimeSpec {
         end: t.end.0,
-        step: t.step.0,
+        step,
         min_step: t.min_step.map(|m| m.0),
         release_ramp: t.release_ramp.map(|r| r.0),
-    }
+        tolerance: t.tolerance.map(|r| r.0),
+        max_step: t.max_step.map(|r| r.0),
+    })
 }
 
 fn solver_settings(s: Option<&SolverDto>) -> SolverSettings {

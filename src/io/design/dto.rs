@@ -575,8 +575,15 @@ pub struct DistributedLoadDto {
 pub struct TimeDto {
     /// End time.
     pub end: Positive,
-    /// Nominal step.
-    pub step: Positive,
+    /// Nominal step (fixed steps); with `tolerance`, the first step (default: end / 1000).
+    #[serde(default)]
+    pub step: Option<Positive>,
+    /// Time-error tolerance: error-controlled steps (normalised as Newton's increments) instead of fixed ones.
+    #[serde(default)]
+    pub tolerance: Option<Positive>,
+    /// Largest step of error-controlled stepping (default: the end time).
+    #[serde(default)]
+    pub max_step: Option<Positive>,
     /// Smallest step of automatic step cutting.
     #[serde(default)]
     pub min_step: Option<Positive>,

@@ -157,6 +157,11 @@ impl std::error::Error for DesignError {}
 /// Reads and validates the design file at `path`. At most [`guard::MAX_DESIGN_BYTES`] are read: a larger
 /// file is refused without reading the rest.
 pub fn load_design(path: &Path) -> Result<Design, DesignError> {
+    load_design_with(path, &DesignOverrides::default())
+}
+
+/// [`load_design`] with `overrides` applied before the model is built (e.g. `run --tol`).
+pub fn load_design_with(path: &Path, overrides: &DesignOverrides) -> Result<Design, DesignError> {
     use std::io::Read as _;
     let read_error = |source| DesignError::Read {
         file: path.to_path_buf(),
@@ -175,7 +180,7 @@ pub fn load_design(path: &Path) -> Result<Design, DesignError> {
     }
     let text = String::from_utf8(bytes)
         .map_err(|e| read_error(std::io::Error::new(std::io::ErrorKind::InvalidData, e)))?;
-    parse_design(&text, path)
+    parse_design_with(&text, path, overrides)
 }
 
 /// The design error of a text refused by [`guard`] (no field: the text is refused before it is read as
@@ -235,6 +240,8 @@ pub struct DesignOverrides {
     pub end_time: Option<f64>,
     /// Time step (replaces `time.step`).
     pub step: Option<f64>,
+    /// Time-error tolerance (replaces `time.tolerance`: error-controlled steps).
+    pub time_tolerance: Option<f64>,
     /// Internal-variable update (replaces `material.integrator`).
     pub integrator: Option<dto::IntegratorDto>,
     /// Crowns of the generated stent (replaces `stent.crowns`); a design without a `stent` block is refused.
@@ -258,7 +265,10 @@ impl DesignOverrides {
             d.time.end = dto::Positive(t);
         }
         if let Some(h) = self.step {
-            d.time.step = dto::Positive(h);
+            d.time.step = Some(dto::Positive(h));
+        }
+        if let Some(tol) = self.time_tolerance {
+            d.time.tolerance = Some(dto::Positive(tol));
         }
         if let Some(i) = self.integrator {
             d.material.integrator = Some(i);

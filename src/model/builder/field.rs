@@ -169,6 +169,10 @@ pub enum TimeField {
     MinStep,
     /// The release ramp.
     ReleaseRamp,
+    /// The time-error tolerance of error-controlled stepping.
+    Tolerance,
+    /// The largest step of error-controlled stepping.
+    MaxStep,
 }
 
 /// A Newton setting.

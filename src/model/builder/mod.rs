@@ -243,6 +243,11 @@ pub struct TimeSpec {
     pub min_step: Option<Real>,
     /// Release ramp (default: one step).
     pub release_ramp: Option<Real>,
+    /// Time-error tolerance: error-controlled stepping from a first step `step` when given
+    /// ([`TimeSettings::tolerance`]); fixed steps otherwise.
+    pub tolerance: Option<Real>,
+    /// Largest step of error-controlled stepping (default: the end time).
+    pub max_step: Option<Real>,
 }
 
 impl TimeSpec {
@@ -253,10 +258,20 @@ impl TimeSpec {
             step,
             min_step: None,
             release_ramp: None,
+            tolerance: None,
+            max_step: None,
         }
     }
 
-    /// The settings, checked: `0 < step ≤ end`, `0 < min_step ≤ step`, `release_ramp ≥ 0`.
+    /// The same with error-controlled stepping at the time-error tolerance `tolerance`, `step` being the first
+    /// step.
+    pub fn with_tolerance(mut self, tolerance: Real) -> Self {
+        self.tolerance = Some(tolerance);
+        self
+    }
+
+    /// The settings, checked: `0 < step ≤ end`, `0 < min_step ≤ step`, `release_ramp ≥ 0`, a tolerance > 0,
+    /// `step ≤ max_step`.
     pub fn settings(&self) -> Result<TimeSettings> {
         let (end, step) = (self.end, self.step);
         let positive = |v: Real| v > 0.0 && v.is_finite();
@@ -298,11 +313,34 @@ impl TimeSpec {
                 format!("{release_ramp} must be ≥ 0 and finite"),
             ));
         }
+        if let Some(tolerance) = self.tolerance
+            && !positive(tolerance)
+        {
+            return Err(BuildError::new(
+                Field::Time(TimeField::Tolerance),
+                format!("{tolerance} must be > 0 and finite"),
+            ));
+        }
+        let max_step = self.max_step.unwrap_or(end);
+        if !positive(max_step) {
+            return Err(BuildError::new(
+                Field::Time(TimeField::MaxStep),
+                format!("{max_step} must be > 0 and finite"),
+            ));
+        }
+        if max_step < step {
+            return Err(BuildError::new(
+                Field::Time(TimeField::MaxStep),
+                format!("max_step {max_step} is below the (first) step {step}"),
+            ));
+        }
         Ok(TimeSettings {
             end,
             step,
             min_step,
             release_ramp,
+            tolerance: self.tolerance,
+            max_step,
         })
     }
 }
@@ -492,6 +530,14 @@ impl ModelBuilder {
     pub fn build(&self) -> Result<Built> {
         let mut warnings = Vec::new();
         let time = self.time.settings()?;
+        if time.tolerance.is_some()
+            && let Some(why) = self
+                .materials
+                .iter()
+                .find_map(|m| m.time_error_unsupported())
+        {
+            return Err(BuildError::new(Field::Time(TimeField::Tolerance), why));
+        }
         check_solver(&self.solver)?;
         let mut sections = self.sections.clone();
         let mut stent = match &self.stent {

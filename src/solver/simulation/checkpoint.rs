@@ -48,6 +48,8 @@ pub struct Checkpoint {
     pub step_size: Real,
     /// Cuts of the step in progress (0 at a step boundary).
     pub step_cuts: usize,
+    /// The memory of error-controlled stepping.
+    pub control: super::adaptive::StepControl,
     /// The configuration.
     pub state: State,
     /// Per material that some patch uses: its index in `Model::materials` and its saved state
@@ -310,6 +312,7 @@ impl Simulation<'_> {
             step: self.step,
             step_size: self.step_size,
             step_cuts: self.step_cuts,
+            control: self.control,
             state: self.state.clone(),
             materials,
             material_notices: self.materials.said.clone(),
@@ -370,6 +373,7 @@ impl Simulation<'_> {
         self.step = checkpoint.step;
         self.step_size = checkpoint.step_size;
         self.step_cuts = checkpoint.step_cuts;
+        self.control = checkpoint.control;
         self.notices.clone_from(&checkpoint.notices);
         self.round_off_reported = checkpoint.round_off_reported;
         self.ramps.clone_from(&checkpoint.ramps);

@@ -23,6 +23,16 @@
 //! tolerance asked); [`NewtonReport::at_round_off`] marks each such step. At tolerances from
 //! [`ROUND_OFF_TOLERANCE`] up (the default is 1e-9) this rule never applies: the stopping rule is unchanged.
 //!
+//! **Error-controlled stepping.** With `time.tolerance` (a design's `time: {tolerance: 1e-4}` or `run --tol`)
+//! every converged step gets a time-error estimate — how far the configuration would move had the internal
+//! variables been advanced by a companion update (backward Euler for the second-order rules), measured in
+//! Newton's normalised norm, so that a tolerance means the same on a stent and an arch — and a step whose
+//! estimate exceeds the tolerance is rejected and retried shorter; the next step comes from a PI controller
+//! with growth and shrink limits ([`adaptive`]). Steps still land on every schedule breakpoint (releases, load
+//! and temperature breakpoints, snapshot times), Newton failures still halve the step, and a step at
+//! `min_step` whose estimate is above the tolerance is accepted with a notice (said once). Fixed steps (no
+//! tolerance) are unchanged. [`StepReport::error_estimate`] and [`StepReport::rejected`] report each step.
+//!
 //! **Stepping as an API.** [`Simulation::step`] takes one converged step (with the retries and cuts it needs)
 //! and returns its [`StepReport`]; the caller reads the state between steps ([`Simulation::state`],
 //! [`Simulation::probe_displacement`], [`Simulation::node_end_resultants`]). [`Simulation::run`] is the loop over
@@ -39,11 +49,13 @@
 //! later `step` or `run` — or a checkpoint taken now — continues bit for bit as the uninterrupted run.
 //!
 //! The concepts live in their own files: [`report`] (what a step and a run report), [`observer`] (who is told),
+//! [`adaptive`] (the time-error estimate and the step-size controller),
 //! [`timing`] (where the wall time went), `stepping` (the step loop, step-size control and roll-back), `newton`
 //! (Newton's method on normalised norms and its diagnostics), `releases` (release ramps and gauge constraints),
 //! `constitutive` (the materials at the points: step preparation, commit, roll-back) and [`checkpoint`] (the
 //! whole state as a value, and its restore).
 
+pub mod adaptive;
 pub mod checkpoint;
 mod constitutive;
 mod newton;
@@ -119,6 +131,8 @@ pub struct Simulation<'m> {
     step_cuts: usize,
     /// What the current factorisation was computed from, for checkpoints ([`checkpoint`]).
     tangent: checkpoint::TangentRecord,
+    /// The memory of error-controlled stepping ([`adaptive`]).
+    control: adaptive::StepControl,
 }
 
 impl<'m> Simulation<'m> {
@@ -215,6 +229,7 @@ impl<'m> Simulation<'m> {
             step_size: model.time.step,
             step_cuts: 0,
             tangent: checkpoint::TangentRecord::default(),
+            control: adaptive::StepControl::default(),
         })
     }
 }

@@ -21,6 +21,12 @@ pub trait Observer {
         let _ = (time, dt, newton);
     }
 
+    /// Called when a converged step is rejected by error control (its time-error `estimate` exceeded the
+    /// tolerance) and is retried shorter (`time` is the target that was not accepted).
+    fn step_rejected(&mut self, time: Real, dt: Real, estimate: Real) {
+        let _ = (time, dt, estimate);
+    }
+
     /// Whether the run should stop now, within the step in progress: the seam for an interrupt (Ctrl-C) that
     /// should not wait for a long step and its cuts to finish. Polled (cheaply and often: keep it an atomic
     /// load or a counter) by Newton before every iteration and by [`Simulation::step_with`] before every attempt
@@ -82,6 +88,12 @@ impl Observer for Observers<'_, '_> {
     fn step_failed(&mut self, time: Real, dt: Real, newton: &NewtonReport) {
         for observer in self.list.iter_mut() {
             observer.step_failed(time, dt, newton);
+        }
+    }
+
+    fn step_rejected(&mut self, time: Real, dt: Real, estimate: Real) {
+        for observer in self.list.iter_mut() {
+            observer.step_rejected(time, dt, estimate);
         }
     }
 

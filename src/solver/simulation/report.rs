@@ -39,6 +39,11 @@ pub struct StepReport {
     pub newton: NewtonReport,
     /// Step cuts needed before this step converged.
     pub cuts: usize,
+    /// The time-error estimate of the step (error-controlled stepping, `time.tolerance`), in Newton's
+    /// normalised increment norm; `None` with fixed steps or without internal variables.
+    pub error_estimate: Option<Real>,
+    /// Attempts of this step rejected because their time-error estimate exceeded the tolerance.
+    pub rejected: usize,
 }
 
 /// Totals of a run.
@@ -50,6 +55,8 @@ pub struct RunSummary {
     pub iterations: usize,
     /// Step cuts.
     pub cuts: usize,
+    /// Steps rejected by error control.
+    pub rejected: usize,
     /// LU factorisations over all converged steps.
     pub factorisations: usize,
     /// Time reached.

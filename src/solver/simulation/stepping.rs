@@ -1,6 +1,7 @@
 //! The step loop: step-size control (landing on breakpoints, halving on failure down to `min_step`, doubling
 //! back after a success), the reuse retry, and the roll-back of an abandoned step (module docs of [`super`]).
 
+use super::adaptive::{LOCAL_FRACTION, error_ratio};
 use super::checkpoint::Revert;
 use super::newton::{NewtonFailure, round_off_notice};
 use super::observer::Observers;
@@ -52,6 +53,17 @@ struct StepStart {
     state: State,
     /// Whether the gauge constraints were active.
     gauge_active: bool,
+}
+
+/// Why an attempt of a step is abandoned ([`Simulation::roll_back`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Abandon {
+    /// Newton failed, or a fatal error: the factorisations are forgotten.
+    Failed,
+    /// It converged but error control rejected it: the factorisation is kept.
+    Rejected,
+    /// The observer asked to stop: the factorisation goes back to the one the attempt started with.
+    Interrupted,
 }
 
 /// What one call of [`Simulation::step_with`] did.
@@ -133,7 +145,7 @@ impl Simulation<'_> {
                 .set_gauge(target)
                 .and_then(|()| self.prepare_step(self.time, target));
             if let Err(e) = prepared {
-                self.roll_back(start, &captured, false);
+                self.roll_back(start, &captured, Abandon::Failed);
                 return Err(e);
             }
             if self.model.solver.extrapolate {
@@ -155,6 +167,34 @@ impl Simulation<'_> {
                 };
                 if let Ok(newton) = &mut attempt {
                     newton.factorisations += factorisations;
+                }
+            }
+            // Error control: a converged step whose time-error estimate exceeds the tolerance is rejected and
+            // retried shorter (module `adaptive`), unless it is already the smallest step.
+            let mut estimate = None;
+            if let (Ok(_), Some(tolerance)) = (&attempt, self.model.time.tolerance) {
+                estimate = match self.time_error_estimate(self.time, target) {
+                    Ok(e) => e,
+                    Err(e) => {
+                        self.roll_back(start, &captured, Abandon::Failed);
+                        return Err(e);
+                    }
+                };
+                let ratio = error_ratio(estimate, tolerance);
+                if ratio > 1.0 {
+                    if !is_smallest_step(dt, min_step, target) {
+                        self.roll_back(start, &captured, Abandon::Rejected);
+                        observer.step_rejected(target, dt, estimate.unwrap_or(0.0));
+                        self.step_size = self.control.rejected(dt, ratio).max(min_step);
+                        continue;
+                    }
+                    if !self.control.above_tolerance_reported {
+                        self.control.above_tolerance_reported = true;
+                        self.notices.push(format!(
+                            "at t = {target} the time-error estimate {:.3e} exceeds its share {LOCAL_FRACTION} of the tolerance {tolerance:e} at the smallest step {min_step:e}: this step and any other like it are accepted (said once; the trapezoidal rule ringing after a jump of strain at a high temperature does this)",
+                            estimate.unwrap_or(0.0)
+                        ));
+                    }
                 }
             }
             match attempt {
@@ -186,22 +226,36 @@ impl Simulation<'_> {
                         temperature: self.model.temperature.value(target),
                         newton,
                         cuts: std::mem::take(&mut self.step_cuts),
+                        error_estimate: estimate,
+                        rejected: std::mem::take(&mut self.control.rejections),
                     };
-                    if self.step_size < nominal {
-                        self.step_size = (STEP_FACTOR * self.step_size).min(nominal);
+                    match self.model.time.tolerance {
+                        Some(tolerance) => {
+                            let ratio = error_ratio(estimate, tolerance);
+                            let mut next = self.control.accepted(dt, ratio);
+                            // A step shortened to land on a breakpoint does not shrink the next below the plan.
+                            if dt < self.step_size && report.cuts == 0 {
+                                next = next.max(self.step_size);
+                            }
+                            self.step_size = next.clamp(min_step, self.model.time.max_step);
+                        }
+                        None if self.step_size < nominal => {
+                            self.step_size = (STEP_FACTOR * self.step_size).min(nominal);
+                        }
+                        None => {}
                     }
                     return Ok(StepOutcome::Stepped(report));
                 }
                 Err(NewtonFailure::Fatal(e)) => {
-                    self.roll_back(start, &captured, false);
+                    self.roll_back(start, &captured, Abandon::Failed);
                     return Err(e);
                 }
                 Err(NewtonFailure::Interrupted) => {
-                    self.roll_back(start, &captured, true);
+                    self.roll_back(start, &captured, Abandon::Interrupted);
                     return Ok(StepOutcome::Interrupted);
                 }
                 Err(NewtonFailure::NotConverged(newton)) => {
-                    self.roll_back(start, &captured, false);
+                    self.roll_back(start, &captured, Abandon::Failed);
                     observer.step_failed(target, dt, &newton);
                     if is_smallest_step(dt, min_step, target) {
                         return Err(SolverError::StepFailed {
@@ -249,6 +303,7 @@ impl Simulation<'_> {
                     summary.iterations += report.newton.iterations;
                     summary.factorisations += report.newton.factorisations;
                     summary.cuts += report.cuts;
+                    summary.rejected += report.rejected;
                     summary.time = report.time;
                     if observers.step(self, &report).is_break() {
                         summary.stopped = true;
@@ -281,11 +336,12 @@ impl Simulation<'_> {
     /// converged step, in `commit_step`.)
     ///
     /// After a failure the factorisations are invalidated: they belong to the abandoned iterates, and the next
-    /// attempt starts with a fresh tangent. After an interruption (`interrupted`) the factorisation goes back
-    /// to the one the attempt started with — kept if the attempt made none, made again from its recorded
-    /// origin otherwise — so that continuing (a later `step`, or a restored checkpoint taken now) repeats the
-    /// uninterrupted run exactly.
-    fn roll_back(&mut self, start: StepStart, captured: &[(usize, usize)], interrupted: bool) {
+    /// attempt starts with a fresh tangent. After a rejection by error control the attempt converged: its last
+    /// factorisation is a fair tangent for the shorter retry and is kept (the record of its origin with it).
+    /// After an interruption the factorisation goes back to the one the attempt started with — kept if the
+    /// attempt made none, made again from its recorded origin otherwise — so that continuing (a later `step`, or
+    /// a restored checkpoint taken now) repeats the uninterrupted run exactly.
+    fn roll_back(&mut self, start: StepStart, captured: &[(usize, usize)], why: Abandon) {
         self.state = start.state;
         self.materials.roll_back(&self.model.materials);
         self.gauge_active = start.gauge_active;
@@ -293,10 +349,13 @@ impl Simulation<'_> {
             self.ramps[k][i] = None;
         }
         self.step_increment.clear();
-        let revert = if interrupted {
-            self.tangent.revert_attempt()
-        } else {
-            Revert::Forget
+        let revert = match why {
+            Abandon::Interrupted => self.tangent.revert_attempt(),
+            Abandon::Rejected => {
+                self.tangent.end_attempt();
+                Revert::Keep
+            }
+            Abandon::Failed => Revert::Forget,
         };
         let kept = match revert {
             Revert::Keep => true,
