@@ -847,7 +847,7 @@ mod tests {
             Err(Problem::NotACheckpoint)
         ));
         let mut other = bytes.clone();
-        other[8] = 2;
-        assert!(matches!(decode(&other), Err(Problem::Version(2))));
+        other[8] = 3;
+        assert!(matches!(decode(&other), Err(Problem::Version(3))));
     }
 }

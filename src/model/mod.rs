@@ -259,8 +259,8 @@ pub struct TimeSettings {
     /// [`crate::solver::simulation`], *Error-controlled stepping*). Steps then grow and shrink with the estimate
     /// between `min_step` and `max_step`, starting from `step`. `None`: fixed steps of `step`.
     pub tolerance: Option<Real>,
-    /// The largest step error-controlled stepping takes [time] (default: the end time).
-    pub max_step: Real,
+    /// The largest step error-controlled stepping takes [time] (`None`: no bound but the end time).
+    pub max_step: Option<Real>,
 }
 
 /// Times closer than this fraction of the nominal step are one time when time stepping lands on schedule

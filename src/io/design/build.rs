@@ -128,6 +128,19 @@ pub fn build(dto: &DesignDto, default_name: &str) -> Result<Built> {
         builder.probe(p.name.clone(), at);
     }
     let mut output = output_settings(dto.output.as_ref(), &settings)?;
+    let snapshots_given = dto
+        .output
+        .as_ref()
+        .and_then(|o| o.snapshots.as_ref())
+        .is_some_and(|s| s.every.is_some() || s.times.is_some());
+    if settings.tolerance.is_some() && !snapshots_given {
+        // Error-controlled steps have no step count to space snapshots by: about DEFAULT_COUNT of them evenly in
+        // time instead (landing times of the run).
+        let count = super::SnapshotSettings::DEFAULT_COUNT;
+        output.snapshots.times = (1..count)
+            .map(|k| settings.end * k as Real / count as Real)
+            .collect();
+    }
     builder.record_times(
         output
             .snapshots
@@ -145,12 +158,13 @@ pub fn build(dto: &DesignDto, default_name: &str) -> Result<Built> {
     // default snapshot spacing follows them.
     let plan = model.planned_steps();
     let memory = check_size(dto, &StepCount::planned(&plan, model.time.step, dto))?;
-    if dto
-        .output
-        .as_ref()
-        .and_then(|o| o.snapshots.as_ref())
-        .and_then(|s| s.every)
-        .is_none()
+    if settings.tolerance.is_none()
+        && dto
+            .output
+            .as_ref()
+            .and_then(|o| o.snapshots.as_ref())
+            .and_then(|s| s.every)
+            .is_none()
     {
         output.snapshots.every = plan
             .total()

@@ -321,18 +321,19 @@ impl TimeSpec {
                 format!("{tolerance} must be > 0 and finite"),
             ));
         }
-        let max_step = self.max_step.unwrap_or(end);
-        if !positive(max_step) {
-            return Err(BuildError::new(
-                Field::Time(TimeField::MaxStep),
-                format!("{max_step} must be > 0 and finite"),
-            ));
-        }
-        if max_step < step {
-            return Err(BuildError::new(
-                Field::Time(TimeField::MaxStep),
-                format!("max_step {max_step} is below the (first) step {step}"),
-            ));
+        if let Some(max_step) = self.max_step {
+            if !positive(max_step) {
+                return Err(BuildError::new(
+                    Field::Time(TimeField::MaxStep),
+                    format!("{max_step} must be > 0 and finite"),
+                ));
+            }
+            if max_step < step {
+                return Err(BuildError::new(
+                    Field::Time(TimeField::MaxStep),
+                    format!("max_step {max_step} is below the (first) step {step}"),
+                ));
+            }
         }
         Ok(TimeSettings {
             end,
@@ -340,7 +341,7 @@ impl TimeSpec {
             min_step,
             release_ramp,
             tolerance: self.tolerance,
-            max_step,
+            max_step: self.max_step,
         })
     }
 }

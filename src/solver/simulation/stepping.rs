@@ -237,7 +237,8 @@ impl Simulation<'_> {
                             if dt < self.step_size && report.cuts == 0 {
                                 next = next.max(self.step_size);
                             }
-                            self.step_size = next.clamp(min_step, self.model.time.max_step);
+                            let largest = self.model.time.max_step.unwrap_or(Real::INFINITY);
+                            self.step_size = next.clamp(min_step, largest.max(min_step));
                         }
                         None if self.step_size < nominal => {
                             self.step_size = (STEP_FACTOR * self.step_size).min(nominal);
