@@ -267,13 +267,24 @@ fn sigterm_and_sighup_stop_a_run_as_ctrl_c_does() {
 #[test]
 fn a_second_signal_still_leaves_a_readable_recording_and_summary() {
     let dir = test_outputs("second_signal");
-    let child = spawn_run(&design("straight_stent.yaml"), &dir);
+    // Standard signals do not queue: two sent before the process takes the first are one. The second is sent
+    // once the run has said it took the first, so its stderr goes to a file the test can read while it runs.
+    let log = dir.with_extension("stderr");
+    let mut child = Command::new(env!("CARGO_BIN_EXE_stentkit"))
+        .args(["run", path_str(&design("straight_stent.yaml"))])
+        .args(["-o", path_str(&dir), "--quiet"])
+        .stdout(Stdio::null())
+        .stderr(std::fs::File::create(&log).expect("stderr file"))
+        .spawn()
+        .expect("stentkit starts");
+    let said = |what: &str| std::fs::read_to_string(&log).is_ok_and(|s| s.contains(what));
     wait_for("a few steps", || history_rows(&dir) >= 5);
     signal(&child, "TERM");
+    wait_for("the first signal taken", || said("SIGTERM: stopping"));
     signal(&child, "TERM");
-    let out = child.wait_with_output().expect("ends");
-    let stderr = text(&out.stderr);
-    assert_eq!(out.status.code(), Some(130), "{stderr}");
+    let status = child.wait().expect("ends");
+    let stderr = std::fs::read_to_string(&log).expect("stderr");
+    assert_eq!(status.code(), Some(130), "{stderr}");
     assert_eq!(
         stderr
             .matches("SIGTERM again: finishing run.mcap and summary.json, then exiting")
