@@ -5,7 +5,8 @@
 //! the geometry and checks everything that involves several values; [`locate`] maps the field path of such a
 //! check back to its line and column. Every error names the file, the line and column, the field, what is
 //! wrong and what is allowed. Before any of this, [`guard`] refuses text too large, too deeply nested or with
-//! aliases, which would make the parsers slow or the design enormous.
+//! aliases, which would make the parsers slow or the design enormous. [`tuned_text`] writes a design's text
+//! with the discretisation `stentkit tune` chose.
 
 pub mod build;
 pub mod dto;
@@ -15,6 +16,9 @@ pub mod locate;
 pub mod size;
 
 pub mod stent;
+mod tuned;
+
+pub use tuned::{TunedChoice, TunedTextError, tuned_text};
 
 use crate::math::Real;
 use crate::math::quote;
@@ -232,9 +236,9 @@ fn split_message(message: &str) -> (String, Option<locate::Position>) {
 /// Changes applied to a design after it is read and before the model is built (studies vary these).
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct DesignOverrides {
-    /// Degree of every patch (replaces `mesh.p` and per-patch `p`).
+    /// Degree of every patch (replaces `mesh.p`, per-patch `p` and a stent's `crown_mesh.p`/`bridge_mesh.p`).
     pub degree: Option<usize>,
-    /// Control points of every patch (replaces `mesh.n` and per-patch `n`).
+    /// Control points of every patch (replaces `mesh.n`, per-patch `n` and a stent's `crown_mesh.n`/`bridge_mesh.n`).
     pub points: Option<usize>,
     /// End time (replaces `time.end`).
     pub end_time: Option<f64>,
@@ -254,11 +258,25 @@ impl DesignOverrides {
             let mesh = d.mesh.get_or_insert(dto::MeshDto { p: None, n: None });
             if let Some(p) = self.degree {
                 mesh.p = Some(p);
-                d.patches.iter_mut().for_each(|q| q.p = None);
             }
             if let Some(n) = self.points {
                 mesh.n = Some(n);
-                d.patches.iter_mut().for_each(|q| q.n = None);
+            }
+            // The meshes patches and a stent's crowns or bridges give themselves yield to the override.
+            let own = d.patches.iter_mut().map(|q| (&mut q.p, &mut q.n)).chain(
+                d.stent
+                    .iter_mut()
+                    .flat_map(|s| [s.crown_mesh.as_mut(), s.bridge_mesh.as_mut()])
+                    .flatten()
+                    .map(|m| (&mut m.p, &mut m.n)),
+            );
+            for (p, n) in own {
+                if self.degree.is_some() {
+                    *p = None;
+                }
+                if self.points.is_some() {
+                    *n = None;
+                }
             }
         }
         if let Some(t) = self.end_time {
