@@ -9,6 +9,7 @@ pub mod repair;
 pub mod run;
 pub mod signals;
 pub mod study;
+pub mod tune;
 
 use clap::{Parser, Subcommand};
 use std::path::PathBuf;
@@ -86,6 +87,30 @@ pub enum Command {
         #[arg(long, value_name = "TOLERANCE")]
         tol: Option<f64>,
     },
+    /// Find the cheapest degree p, points per patch n and time-error tolerance whose results (every probe, Δr,
+    /// the recovery ratios) stay within --tol of a finer run over the design's whole schedule: the space error
+    /// screened on a short horizon (n against 2n), then the time tolerance (τ against τ/10), then the choice
+    /// verified against (p, 2n, τ/10). Prints what it tried; writes the tuned design with -o.
+    ///
+    /// Example: stentkit tune designs/curved_stent.yaml --tol 5e-3 -o curved_stent_tuned.yaml
+    Tune {
+        /// The design file (YAML).
+        design: PathBuf,
+        /// Tolerance on the results: displacements over the largest one, Δr over its largest, recovery ratios
+        /// absolute.
+        #[arg(long, value_name = "TOLERANCE")]
+        tol: f64,
+        /// Write the tuned design here (the design's text with `mesh` and `time` changed and a comment block
+        /// stating the estimated error and the expected saving). An existing file is not replaced.
+        #[arg(short, long)]
+        output: Option<PathBuf>,
+        /// Degrees to try.
+        #[arg(long, value_delimiter = ',', default_value = "4,5,6")]
+        degrees: Vec<usize>,
+        /// Most control points per patch tried.
+        #[arg(long, default_value_t = 200)]
+        max_points: usize,
+    },
     /// Make the folder of a run that was killed (SIGKILL, power loss, crash) whole: cut history.csv back to its
     /// last complete row, finish run.mcap after its last complete chunk, remove unfinished temporaries, and mark
     /// summary.json `killed`. A folder whose run is still going is refused.
@@ -154,6 +179,10 @@ pub enum StudyCommand {
         /// Sampling points per patch.
         #[arg(long, default_value_t = 9)]
         samples: usize,
+        /// Also run every p × n with error-controlled steps at this time-error tolerance (work–precision
+        /// curves beside the fixed steps); `none` for none.
+        #[arg(long, default_value = "1e-4", value_parser = tolerance_or_none)]
+        time_tolerance: Option<f64>,
     },
     /// Time-step sweep per integrator: displacement error at time T against a self-converged run, and wall
     /// time (CSV, error_vs_h.svg, error_vs_time.svg); prints the observed order of each integrator.
@@ -171,6 +200,10 @@ pub enum StudyCommand {
         /// Nominal time steps h.
         #[arg(long, value_delimiter = ',', default_value = "0.04,0.02,0.01,0.005")]
         steps: Vec<f64>,
+        /// Time-error tolerances of error-controlled runs (trapezoidal update) beside the fixed steps; `none`
+        /// for none.
+        #[arg(long, value_delimiter = ',', default_value = "1e-2,1e-3,1e-4,1e-5", value_parser = tolerance_or_none)]
+        tolerances: Vec<Option<f64>>,
         /// Integrators to compare.
         #[arg(
             long,
@@ -298,6 +331,13 @@ pub fn main() -> ExitCode {
                 time_tolerance: tol,
             },
         ),
+        Command::Tune {
+            design,
+            tol,
+            output,
+            degrees,
+            max_points,
+        } => tune::run(&design, tol, output.as_deref(), degrees, max_points),
         Command::Schema => schema(),
         Command::Repair { run_dir } => repair::run(&run_dir),
         Command::Study(StudyCommand::Convergence {
@@ -308,23 +348,33 @@ pub fn main() -> ExitCode {
             time,
             reference,
             samples,
-        }) => study::convergence(&design, &output, degrees, points, time, reference, samples),
+            time_tolerance,
+        }) => study::convergence(
+            &design,
+            &output,
+            degrees,
+            points,
+            reference,
+            study::Sampling { time, samples },
+            time_tolerance,
+        ),
         Command::Study(StudyCommand::Time {
             design,
             output,
             time,
             steps,
+            tolerances,
             integrators,
             reference,
             samples,
         }) => study::time(
             &design,
             &output,
-            time,
             steps,
+            tolerances.into_iter().flatten().collect(),
             &integrators,
             &reference,
-            samples,
+            study::Sampling { time, samples },
         ),
         Command::Study(StudyCommand::Stability { output, maps }) => {
             study::stability_maps(&output, &maps)
@@ -342,6 +392,17 @@ pub fn main() -> ExitCode {
             eprintln!("error: {}", error_text(&e));
             ExitCode::from(exit_code(&e))
         }
+    }
+}
+
+/// A tolerance, or `none` (no tolerance: the list is empty).
+fn tolerance_or_none(text: &str) -> Result<Option<f64>, String> {
+    match text {
+        "none" => Ok(None),
+        t => t
+            .parse()
+            .map(Some)
+            .map_err(|e| format!("`{t}` is not a number or `none`: {e}")),
     }
 }
 

@@ -12,6 +12,16 @@ use crate::study::time::{TimeReference, TimeStudy, time_charts, time_csv, time_s
 use anyhow::Context;
 use std::path::Path;
 
+/// When and where a study measures its error: at `time` (default: the design's end time), on `samples` points
+/// per patch.
+#[derive(Debug, Clone, Copy)]
+pub struct Sampling {
+    /// Time of the measurement.
+    pub time: Option<f64>,
+    /// Sampling points per patch.
+    pub samples: usize,
+}
+
 /// `stentkit study convergence`: the `p × n` sweep of `design` against the reference `P,N`, measured at `time`
 /// (default: the design's end time).
 pub fn convergence(
@@ -19,10 +29,11 @@ pub fn convergence(
     output: &Path,
     degrees: Vec<usize>,
     points: Vec<usize>,
-    time: Option<f64>,
     reference: Vec<usize>,
-    samples: usize,
+    sampling: Sampling,
+    time_tolerance: Option<f64>,
 ) -> anyhow::Result<()> {
+    let Sampling { time, samples } = sampling;
     let design = load_design(design)?;
     let model = &design.model;
     let [rp, rn] = reference[..] else {
@@ -34,6 +45,7 @@ pub fn convergence(
         time: time.unwrap_or(model.time.end),
         reference: (rp, rn),
         samples,
+        time_tolerance,
     };
     create(output)?;
     let rows = convergence_study(&design, &study, progress)?;
@@ -70,12 +82,13 @@ pub fn parse_integrator(name: &str) -> Result<Integrator, String> {
 pub fn time(
     design: &Path,
     output: &Path,
-    time: Option<f64>,
     steps: Vec<f64>,
+    tolerances: Vec<f64>,
     integrators: &[String],
     reference: &str,
-    samples: usize,
+    sampling: Sampling,
 ) -> anyhow::Result<()> {
+    let Sampling { time, samples } = sampling;
     let design = load_design(design)?;
     let model = &design.model;
     let integrators = integrators
@@ -92,6 +105,7 @@ pub fn time(
     let study = TimeStudy {
         integrators,
         steps,
+        tolerances,
         time: time.unwrap_or(model.time.end),
         reference,
         samples,

@@ -5,6 +5,10 @@
 //! parameters by default) against a reference run (by default `p = 8`, `n = 150`), as the paper does for its
 //! Fig. conv_circ: `err = ‖u_ref − u_h‖ / ‖u_ref‖` over the grid ([`super::relative_error`]). The table, with
 //! the wall time of each run, charts error against `n` and against time (work–precision).
+//!
+//! With a time-error tolerance, every `p × n` runs a second time with error-controlled steps at that tolerance
+//! and the trapezoidal update (the reference keeps the design's steps and update): the work–precision chart then shows, per degree, what adaptive
+//! steps buy at the same discretisation in space.
 
 use super::StudyError;
 use super::charts::{ErrorChartLabels, ErrorCurve, error_charts};
@@ -13,6 +17,7 @@ use super::sample::{SampledRun, sample_run};
 use super::variant::{Remesh, TimeVariant, rebuild};
 use crate::io::chart::LineChart;
 use crate::io::design::Design;
+use crate::material::Integrator;
 use crate::math::Real;
 use std::fmt::Write as _;
 
@@ -23,6 +28,8 @@ pub struct ConvergencePoint {
     pub degree: usize,
     /// Control points per patch.
     pub points: usize,
+    /// The time-error tolerance of an error-controlled run (`None`: the design's steps).
+    pub time_tolerance: Option<Real>,
     /// Unknowns of the global system.
     pub unknowns: usize,
     /// Relative displacement error against the reference.
@@ -46,6 +53,8 @@ pub struct ConvergenceStudy {
     pub reference: (usize, usize),
     /// Sampling points per patch.
     pub samples: usize,
+    /// Also run every `p × n` with error-controlled steps at this time-error tolerance.
+    pub time_tolerance: Option<Real>,
 }
 
 /// Runs the study on `design` (re-built for every `p` and `n`, [`rebuild`]) and returns its rows; `progress` is
@@ -60,41 +69,55 @@ pub fn convergence_study(
     mut progress: impl FnMut(&str),
 ) -> Result<Vec<ConvergencePoint>, StudyError> {
     let (rp, rn) = study.reference;
-    let run = |p: usize, n: usize| -> Result<SampledRun, StudyError> {
+    let run = |p: usize, n: usize, tolerance: Option<Real>| -> Result<SampledRun, StudyError> {
         let remesh = Remesh {
             degree: Some(p),
             points: Some(n),
             ..Remesh::default()
         };
+        // Error control needs the trapezoidal update (`Integrator::companion`): its runs take it.
         let until = TimeVariant {
             end: Some(study.time),
+            tolerance,
+            integrator: tolerance.map(|_| Integrator::Trapezoidal),
             ..TimeVariant::default()
         };
         let model = until.of(&rebuild(design, &remesh)?)?;
         Ok(sample_run(&model, study.samples)?)
     };
-    let reference = run(rp, rn).map_err(|e| e.in_run("reference run"))?;
+    let reference = run(rp, rn, None).map_err(|e| e.in_run("reference run"))?;
     progress(&format!(
         "reference p = {rp}, n = {rn}: {:.2} s",
         reference.wall
     ));
     let mut rows = Vec::new();
     for &p in &study.degrees {
-        for &n in study.points.iter().filter(|&&n| n > p) {
-            let run = run(p, n).map_err(|e| e.in_run(format!("run with p = {p}, n = {n}")))?;
-            let error = relative_error(&run.grid, &reference.grid);
-            progress(&format!(
-                "p = {p}, n = {n}: error {error:.3e}, {:.2} s",
-                run.wall
-            ));
-            rows.push(ConvergencePoint {
-                degree: p,
-                points: n,
-                unknowns: run.unknowns,
-                error,
-                wall: run.wall,
-                iterations: run.summary.iterations,
-            });
+        let stepping = [None].into_iter().chain(study.time_tolerance.map(Some));
+        for tolerance in stepping {
+            let what = |n: usize| match tolerance {
+                Some(tol) => format!("p = {p}, n = {n}, τ = {tol:e}"),
+                None => format!("p = {p}, n = {n}"),
+            };
+            for &n in study.points.iter().filter(|&&n| n > p) {
+                let run =
+                    run(p, n, tolerance).map_err(|e| e.in_run(format!("run with {}", what(n))))?;
+                let error = relative_error(&run.grid, &reference.grid);
+                progress(&format!(
+                    "{}: error {error:.3e}, {} steps, {:.2} s",
+                    what(n),
+                    run.summary.steps,
+                    run.wall
+                ));
+                rows.push(ConvergencePoint {
+                    degree: p,
+                    points: n,
+                    time_tolerance: tolerance,
+                    unknowns: run.unknowns,
+                    error,
+                    wall: run.wall,
+                    iterations: run.summary.iterations,
+                });
+            }
         }
     }
     Ok(rows)
@@ -112,12 +135,21 @@ pub fn convergence_csv(
         "# convergence study of {design}: displacement error at t = {} on {} points per patch against a self-converged run with p = {}, n = {}",
         study.time, study.samples, study.reference.0, study.reference.1
     );
-    let _ = writeln!(s, "p,n,unknowns,error,wall_s,newton_iterations");
+    let _ = writeln!(
+        s,
+        "p,n,time_tolerance,unknowns,error,wall_s,newton_iterations"
+    );
     for r in rows {
         let _ = writeln!(
             s,
-            "{},{},{},{:.6e},{:.4},{}",
-            r.degree, r.points, r.unknowns, r.error, r.wall, r.iterations
+            "{},{},{},{},{:.6e},{:.4},{}",
+            r.degree,
+            r.points,
+            r.time_tolerance.map_or(String::new(), |t| format!("{t:e}")),
+            r.unknowns,
+            r.error,
+            r.wall,
+            r.iterations
         );
     }
     s
@@ -134,16 +166,20 @@ pub fn convergence_charts(
         "against p = {}, n = {} at t = {}",
         study.reference.0, study.reference.1, study.time
     );
-    let curves: Vec<ErrorCurve> = study
-        .degrees
-        .iter()
-        .map(|&p| ErrorCurve {
-            label: format!("p = {p}"),
-            runs: rows
-                .iter()
-                .filter(|r| r.degree == p)
-                .map(|r| (r.points as Real, r.error, r.wall))
-                .collect(),
+    let stepping = [None].into_iter().chain(study.time_tolerance.map(Some));
+    let curves: Vec<ErrorCurve> = stepping
+        .flat_map(|tolerance| {
+            study.degrees.iter().map(move |&p| ErrorCurve {
+                label: match tolerance {
+                    Some(tol) => format!("p = {p}, τ = {tol:e}"),
+                    None => format!("p = {p}"),
+                },
+                runs: rows
+                    .iter()
+                    .filter(|r| r.degree == p && r.time_tolerance == tolerance)
+                    .map(|r| (r.points as Real, r.error, r.wall))
+                    .collect(),
+            })
         })
         .collect();
     error_charts(

@@ -14,6 +14,7 @@
 //! * [`charts`]: the pair of log–log charts error-against-parameter and error-against-wall-time.
 //! * [`convergence`]: error against `p` and `n` (the paper's Fig. conv_circ) and work–precision.
 //! * [`time`]: error against the time step per internal-variable integrator, observed orders.
+//! * [`tune`]: the cheapest `p`, `n` and time tolerance whose results stay within a tolerance of a finer run.
 //! * [`stability`]: where each integrator rings (one Maxwell branch against its exact solution) and where
 //!   Newton needs cuts or fails (load steps, heating rate, release snap).
 //!
@@ -32,6 +33,7 @@ pub mod fit;
 pub mod sample;
 pub mod stability;
 pub mod time;
+pub mod tune;
 pub mod variant;
 
 pub use fit::{fit_log_slope, relative_error};
@@ -76,6 +78,9 @@ pub enum StudyError {
         /// The end time \[time\].
         end: Real,
     },
+    /// A variant the solver cannot run as asked (error control with an update that has no estimate).
+    #[error("{0}")]
+    Refused(String),
     /// One run of a study failed: which one, and why.
     #[error("{run}")]
     Run {

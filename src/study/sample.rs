@@ -1,9 +1,13 @@
-//! One run of a model sampled for a study: the displacement on a grid of equally spaced parameters per patch,
-//! with the run's wall time and the solver's totals.
+//! One run of a model sampled for a study: the displacement on a grid of equally spaced parameters per patch
+//! at the end ([`sample_run`]), or the watched quantities — displacements at chosen locations, the recovery
+//! measures, optionally the grid — at every record time ([`watched_run`]); with the run's wall time and the
+//! solver's totals.
 
+use crate::io::state::{Recovery, recovery};
 use crate::math::{Real, Vec3};
 use crate::model::{Model, ProbeLocation};
-use crate::solver::{RunSummary, Simulation, SolverError};
+use crate::solver::{Observer, RunSummary, Simulation, SolverError, StepReport};
+use std::ops::ControlFlow;
 use std::time::Instant;
 
 /// A finished run sampled on the study grid.
@@ -28,13 +32,7 @@ pub fn sample_run(model: &Model, samples: usize) -> Result<SampledRun, SolverErr
     let mut sim = Simulation::new(model)?;
     let summary = sim.run(&mut [])?;
     let wall = started.elapsed().as_secs_f64();
-    let grid = (0..model.patches.len())
-        .flat_map(|patch| {
-            (0..samples).map(move |k| ProbeLocation::Patch {
-                patch,
-                u: k as Real / (samples.max(2) - 1) as Real,
-            })
-        })
+    let grid = grid_locations(model, samples)
         .map(|loc| sim.probe_displacement(&loc))
         .collect();
     Ok(SampledRun {
@@ -43,4 +41,113 @@ pub fn sample_run(model: &Model, samples: usize) -> Result<SampledRun, SolverErr
         summary,
         unknowns: model.num_unknowns(),
     })
+}
+
+/// `samples` equally spaced parameters on every patch, patch by patch.
+pub fn grid_locations(model: &Model, samples: usize) -> impl Iterator<Item = ProbeLocation> + '_ {
+    (0..model.patches.len()).flat_map(move |patch| {
+        (0..samples).map(move |k| ProbeLocation::Patch {
+            patch,
+            u: k as Real / (samples.max(2) - 1) as Real,
+        })
+    })
+}
+
+/// The watched quantities of a run at one time.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Watched {
+    /// The time \[time\].
+    pub time: Real,
+    /// Displacements at the watched locations, in their order \[length\].
+    pub displacements: Vec<Vec3>,
+    /// The recovery measures, for a model with a programme.
+    pub recovery: Option<Recovery>,
+    /// The displacement on the study grid (empty unless asked for) \[length\].
+    pub grid: Vec<Vec3>,
+}
+
+/// A run watched at its record times.
+#[derive(Debug, Clone, PartialEq)]
+pub struct WatchedRun {
+    /// One per record time the run reached, in order.
+    pub states: Vec<Watched>,
+    /// Wall time of the run \[s\].
+    pub wall: Real,
+    /// The solver's totals.
+    pub summary: RunSummary,
+}
+
+/// Runs `model` to its end time and records, at each of its record times (`model.record_times`, which every run
+/// lands on), the displacements at `locations`, the recovery measures and, with `grid_samples`, the grid.
+///
+/// # Errors
+/// The solver's, when the run fails.
+pub fn watched_run(
+    model: &Model,
+    locations: &[ProbeLocation],
+    grid_samples: Option<usize>,
+) -> Result<WatchedRun, SolverError> {
+    let mut times = model.record_times.clone();
+    times.sort_by(Real::total_cmp);
+    let started = Instant::now();
+    let mut sim = Simulation::new(model)?;
+    let mut watch = Watch {
+        times: &times,
+        locations,
+        grid_samples,
+        states: Vec::new(),
+    };
+    let summary = sim.run(&mut [&mut watch])?;
+    Ok(WatchedRun {
+        states: watch.states,
+        wall: started.elapsed().as_secs_f64(),
+        summary,
+    })
+}
+
+/// Records the watched quantities when a run reaches each of `times`.
+struct Watch<'a> {
+    times: &'a [Real],
+    locations: &'a [ProbeLocation],
+    grid_samples: Option<usize>,
+    states: Vec<Watched>,
+}
+
+impl Watch<'_> {
+    fn record(&mut self, sim: &Simulation<'_>) {
+        let t = sim.time();
+        // Runs land on record times; the tolerance only absorbs the rounding of the accumulated time.
+        let eps = 1e-9 * sim.model().time.end.max(1.0);
+        while let Some(&target) = self.times.get(self.states.len()) {
+            if t + eps < target {
+                break;
+            }
+            self.states.push(Watched {
+                time: target,
+                displacements: self
+                    .locations
+                    .iter()
+                    .map(|l| sim.probe_displacement(l))
+                    .collect(),
+                recovery: recovery(sim),
+                grid: self.grid_samples.map_or_else(Vec::new, |samples| {
+                    grid_locations(sim.model(), samples)
+                        .map(|l| sim.probe_displacement(&l))
+                        .collect()
+                }),
+            });
+        }
+    }
+}
+
+impl Observer for Watch<'_> {
+    fn start(&mut self, sim: &Simulation<'_>) -> ControlFlow<()> {
+        self.record(sim);
+        ControlFlow::Continue(())
+    }
+
+    fn step(&mut self, sim: &Simulation<'_>, _: &StepReport) -> ControlFlow<()> {
+        self.record(sim);
+        ControlFlow::Continue(())
+    }
 }

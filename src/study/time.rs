@@ -7,6 +7,11 @@
 //! convergence study: `‖u_ref − u_h‖ / ‖u_ref‖` over the grid. The observed order per integrator is the
 //! least-squares slope of `log err` against `log h`. Steps are nominal: the solver lands on every schedule
 //! breakpoint and may cut a step, so a run's steps are `≤ h`.
+//!
+//! Beside the fixed steps, the trapezoidal update with error-controlled steps runs at every time-error
+//! tolerance asked for (`time.tolerance`): its rows carry the tolerance and, as their `h`, the mean step
+//! `T / steps`, so they sit on the same charts — error against (mean) step and error against wall time, the
+//! work–precision comparison of fixed and adaptive steps.
 
 use super::charts::{ErrorChartLabels, ErrorCurve, error_charts};
 use super::fit::{fit_log_slope, relative_error};
@@ -37,6 +42,8 @@ pub struct TimeStudy {
     pub integrators: Vec<Integrator>,
     /// Nominal time steps `h` \[time\].
     pub steps: Vec<Real>,
+    /// Time-error tolerances of the error-controlled runs (trapezoidal update).
+    pub tolerances: Vec<Real>,
     /// Time at which errors are measured (the runs end there) \[time\].
     pub time: Real,
     /// The reference run.
@@ -50,8 +57,11 @@ pub struct TimeStudy {
 pub struct TimePoint {
     /// The integrator.
     pub integrator: Integrator,
-    /// Nominal step `h` \[time\].
+    /// Nominal step `h` \[time\]; for an error-controlled run the mean step `T / steps` (its first step when
+    /// it failed).
     pub step: Real,
+    /// The time-error tolerance of an error-controlled run (`None`: fixed steps of `step`).
+    pub tolerance: Option<Real>,
     /// Relative displacement error at the study time, or why the run failed.
     pub error: Result<Real, String>,
     /// Wall time of the run \[s\].
@@ -119,46 +129,58 @@ pub fn time_study(
         reference_run.summary.steps, reference_run.wall
     ));
     let mut rows = Vec::new();
-    for &integrator in &study.integrators {
-        for &step in &study.steps {
-            let variant = TimeVariant {
-                end: Some(study.time),
-                step: Some(step),
-                integrator: Some(integrator),
-                ..TimeVariant::default()
-            };
-            let row = match run(&variant) {
-                Ok(run) => TimePoint {
-                    integrator,
-                    step,
-                    error: Ok(relative_error(&run.grid, &reference_run.grid)),
-                    wall: run.wall,
-                    steps: run.summary.steps,
-                    iterations: run.summary.iterations,
-                    cuts: run.summary.cuts,
-                },
-                Err(e) => TimePoint {
-                    integrator,
-                    step,
-                    error: Err(error_chain(&e)),
-                    wall: 0.0,
-                    steps: 0,
-                    iterations: 0,
-                    cuts: 0,
-                },
-            };
-            progress(&match &row.error {
-                Ok(e) => format!(
-                    "{} h = {step:e}: error {e:.3e}, {} steps, {} cuts, {:.2} s",
-                    integrator.name(),
-                    row.steps,
-                    row.cuts,
-                    row.wall
-                ),
-                Err(e) => format!("{} h = {step:e}: failed: {e}", integrator.name()),
-            });
-            rows.push(row);
+    let fixed = study.integrators.iter().flat_map(|&integrator| {
+        study.steps.iter().map(move |&step| TimeVariant {
+            end: Some(study.time),
+            step: Some(step),
+            integrator: Some(integrator),
+            ..TimeVariant::default()
+        })
+    });
+    let controlled = study.tolerances.iter().map(|&tolerance| TimeVariant {
+        end: Some(study.time),
+        tolerance: Some(tolerance),
+        integrator: Some(Integrator::Trapezoidal),
+        ..TimeVariant::default()
+    });
+    for variant in fixed.chain(controlled) {
+        let integrator = variant.integrator.unwrap_or(Integrator::Trapezoidal);
+        let first = variant.step.unwrap_or(model.time.step);
+        let mut row = TimePoint {
+            integrator,
+            step: first,
+            tolerance: variant.tolerance,
+            error: Err(String::new()),
+            wall: 0.0,
+            steps: 0,
+            iterations: 0,
+            cuts: 0,
+        };
+        match run(&variant) {
+            Ok(run) => {
+                if row.tolerance.is_some() {
+                    row.step = study.time / run.summary.steps.max(1) as Real;
+                }
+                row.error = Ok(relative_error(&run.grid, &reference_run.grid));
+                row.wall = run.wall;
+                row.steps = run.summary.steps;
+                row.iterations = run.summary.iterations;
+                row.cuts = run.summary.cuts;
+            }
+            Err(e) => row.error = Err(error_chain(&e)),
         }
+        let what = match row.tolerance {
+            Some(tol) => format!("{} τ = {tol:e}", integrator.name()),
+            None => format!("{} h = {:e}", integrator.name(), row.step),
+        };
+        progress(&match &row.error {
+            Ok(e) => format!(
+                "{what}: error {e:.3e}, {} steps, {} cuts, {:.2} s",
+                row.steps, row.cuts, row.wall
+            ),
+            Err(e) => format!("{what}: failed: {e}"),
+        });
+        rows.push(row);
     }
     let orders = study
         .integrators
@@ -172,10 +194,10 @@ pub fn time_study(
     })
 }
 
-/// `(h, error)` of the successful runs of one integrator.
+/// `(h, error)` of the successful fixed-step runs of one integrator.
 fn error_points(rows: &[TimePoint], integrator: Integrator) -> Vec<(Real, Real)> {
     rows.iter()
-        .filter(|r| r.integrator == integrator)
+        .filter(|r| r.integrator == integrator && r.tolerance.is_none())
         .filter_map(|r| r.error.as_ref().ok().map(|e| (r.step, *e)))
         .collect()
 }
@@ -199,7 +221,7 @@ pub fn time_csv(result: &TimeStudyResult, study: &TimeStudy, design: &str) -> St
     }
     let _ = writeln!(
         s,
-        "integrator,h,error,wall_s,steps,newton_iterations,cuts,failure"
+        "integrator,time_tolerance,h,error,wall_s,steps,newton_iterations,cuts,failure"
     );
     for r in &result.rows {
         let (error, failure) = match &r.error {
@@ -208,8 +230,9 @@ pub fn time_csv(result: &TimeStudyResult, study: &TimeStudy, design: &str) -> St
         };
         let _ = writeln!(
             s,
-            "{},{:e},{error},{:.4},{},{},{},{failure}",
+            "{},{},{:e},{error},{:.4},{},{},{},{failure}",
             r.integrator.name(),
+            r.tolerance.map_or(String::new(), |t| format!("{t:e}")),
             r.step,
             r.wall,
             r.steps,
@@ -223,7 +246,15 @@ pub fn time_csv(result: &TimeStudyResult, study: &TimeStudy, design: &str) -> St
 /// The two charts of a time-step study: error against `h` and error against wall time, one series per
 /// integrator (labelled with its observed order), on log–log axes; the titles name the reference.
 pub fn time_charts(result: &TimeStudyResult, study: &TimeStudy, design: &str) -> [LineChart; 2] {
-    let curves: Vec<ErrorCurve> = result
+    let runs = |keep: &dyn Fn(&TimePoint) -> bool| -> Vec<(Real, Real, Real)> {
+        result
+            .rows
+            .iter()
+            .filter(|r| keep(r))
+            .filter_map(|r| r.error.as_ref().ok().map(|e| (r.step, *e, r.wall)))
+            .collect()
+    };
+    let mut curves: Vec<ErrorCurve> = result
         .orders
         .iter()
         .map(|(integrator, order)| ErrorCurve {
@@ -231,14 +262,15 @@ pub fn time_charts(result: &TimeStudyResult, study: &TimeStudy, design: &str) ->
                 Some(q) => format!("{} (order {q:.2})", integrator.name()),
                 None => integrator.name().to_string(),
             },
-            runs: result
-                .rows
-                .iter()
-                .filter(|r| r.integrator == *integrator)
-                .filter_map(|r| r.error.as_ref().ok().map(|e| (r.step, *e, r.wall)))
-                .collect(),
+            runs: runs(&|r| r.integrator == *integrator && r.tolerance.is_none()),
         })
         .collect();
+    if !study.tolerances.is_empty() {
+        curves.push(ErrorCurve {
+            label: "trapezoidal, error-controlled (h = mean step)".into(),
+            runs: runs(&|r| r.tolerance.is_some()),
+        });
+    }
     let against = format!("at t = {}, against {}", study.time, result.reference);
     error_charts(
         &curves,

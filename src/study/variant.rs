@@ -8,7 +8,7 @@
 
 use super::{StudyError, positive};
 use crate::io::design::{Design, DesignOverrides, parse_design_with};
-use crate::material::{Integrator, MaterialLaw, MaxwellLaw};
+use crate::material::{ConstitutiveLaw, Integrator, MaterialLaw, MaxwellLaw};
 use crate::math::Real;
 use crate::model::Model;
 
@@ -24,6 +24,9 @@ pub struct TimeVariant {
     pub step: Option<Real>,
     /// Release ramp `time.release_ramp` \[time\], > 0 (applied after `step`).
     pub release_ramp: Option<Real>,
+    /// Error-controlled steps at this time-error tolerance (`time.tolerance`, > 0; `step` is then the first
+    /// step). A `step` without a tolerance means fixed steps: the model's tolerance is cleared.
+    pub tolerance: Option<Real>,
     /// Internal-variable update of every Maxwell material (an elastic one has no internal variables).
     pub integrator: Option<Integrator>,
 }
@@ -33,7 +36,8 @@ impl TimeVariant {
     ///
     /// # Errors
     /// [`StudyError::InvalidSetting`] when a value is not positive and finite, [`StudyError::StepBeyondEnd`]
-    /// when the step exceeds the end time; `model` may then be partly changed.
+    /// when the step exceeds the end time, [`StudyError::Refused`] for error control with an internal-variable
+    /// update that has no estimate; `model` may then be partly changed.
     pub fn apply(&self, model: &mut Model) -> Result<(), StudyError> {
         let time = &mut model.time;
         if let Some(end) = self.end {
@@ -48,6 +52,11 @@ impl TimeVariant {
                 time.release_ramp = h;
             }
             time.step = h;
+        }
+        match (self.tolerance, self.step) {
+            (Some(tol), _) => time.tolerance = Some(positive("the time-error tolerance", tol)?),
+            (None, Some(_)) => time.tolerance = None,
+            (None, None) => {}
         }
         if let Some(ramp) = self.release_ramp {
             time.release_ramp = positive("the release ramp", ramp)?;
@@ -64,6 +73,15 @@ impl TimeVariant {
                     *maxwell = MaxwellLaw::new(maxwell.material().clone(), integrator);
                 }
             }
+        }
+        // As the design layer does: error control only where its estimate holds (`Integrator::companion`).
+        if model.time.tolerance.is_some()
+            && let Some(why) = model
+                .materials
+                .iter()
+                .find_map(ConstitutiveLaw::time_error_unsupported)
+        {
+            return Err(StudyError::Refused(why));
         }
         Ok(())
     }

@@ -16,4 +16,5 @@ mod run_folder;
 mod solver;
 mod stent;
 mod studies;
+mod tune;
 mod viscoelastic;

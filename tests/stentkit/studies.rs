@@ -16,16 +16,18 @@ fn repo(relative: &str) -> String {
         .into_owned()
 }
 
-/// `(integrator, h, error)` of the rows of a `time_steps.csv`.
-fn time_rows(csv: &str) -> Vec<(String, Real, Real)> {
+/// `(integrator, time tolerance, h, error)` of the rows of a `time_steps.csv` (`h` the mean step of an
+/// error-controlled row).
+fn time_rows(csv: &str) -> Vec<(String, Option<Real>, Real, Real)> {
     csv.lines()
         .filter(|l| !l.starts_with('#') && !l.starts_with("integrator"))
         .map(|l| {
             let f: Vec<&str> = l.split(',').collect();
             (
                 f[0].to_string(),
-                f[1].parse().expect("h"),
-                f[2].parse().expect("error (no run failed)"),
+                (!f[1].is_empty()).then(|| f[1].parse().expect("tolerance")),
+                f[2].parse().expect("h"),
+                f[3].parse().expect("error (no run failed)"),
             )
         })
         .collect()
@@ -80,8 +82,8 @@ fn study_time_shows_each_integrators_order_and_writes_csv_and_charts() {
     ] {
         let points: Vec<(Real, Real)> = rows
             .iter()
-            .filter(|r| r.0 == name)
-            .map(|r| (r.1, r.2))
+            .filter(|r| r.0 == name && r.1.is_none())
+            .map(|r| (r.2, r.3))
             .collect();
         assert_eq!(points.len(), 4, "{name}");
         let order = fit_log_slope(&points).expect("an order");
