@@ -182,7 +182,7 @@ pub enum StudyCommand {
         /// Also run every p × n with error-controlled steps at this time-error tolerance (work–precision
         /// curves beside the fixed steps); `none` for none.
         #[arg(long, default_value = "1e-4", value_parser = tolerance_or_none)]
-        time_tolerance: Option<f64>,
+        time_tolerance: MaybeTolerance,
     },
     /// Time-step sweep per integrator: displacement error at time T against a self-converged run, and wall
     /// time (CSV, error_vs_h.svg, error_vs_time.svg); prints the observed order of each integrator.
@@ -203,7 +203,7 @@ pub enum StudyCommand {
         /// Time-error tolerances of error-controlled runs (trapezoidal update) beside the fixed steps; `none`
         /// for none.
         #[arg(long, value_delimiter = ',', default_value = "1e-2,1e-3,1e-4,1e-5", value_parser = tolerance_or_none)]
-        tolerances: Vec<Option<f64>>,
+        tolerances: Vec<MaybeTolerance>,
         /// Integrators to compare.
         #[arg(
             long,
@@ -356,7 +356,7 @@ pub fn main() -> ExitCode {
             points,
             reference,
             study::Sampling { time, samples },
-            time_tolerance,
+            time_tolerance.0,
         ),
         Command::Study(StudyCommand::Time {
             design,
@@ -371,7 +371,7 @@ pub fn main() -> ExitCode {
             &design,
             &output,
             steps,
-            tolerances.into_iter().flatten().collect(),
+            tolerances.into_iter().filter_map(|t| t.0).collect(),
             &integrators,
             &reference,
             study::Sampling { time, samples },
@@ -395,13 +395,18 @@ pub fn main() -> ExitCode {
     }
 }
 
-/// A tolerance, or `none` (no tolerance: the list is empty).
-fn tolerance_or_none(text: &str) -> Result<Option<f64>, String> {
+/// A tolerance argument that may be `none` (a type of its own: clap would take an `Option` field for an
+/// optional argument).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct MaybeTolerance(pub Option<f64>);
+
+/// A tolerance, or `none`.
+fn tolerance_or_none(text: &str) -> Result<MaybeTolerance, String> {
     match text {
-        "none" => Ok(None),
+        "none" => Ok(MaybeTolerance(None)),
         t => t
             .parse()
-            .map(Some)
+            .map(|v| MaybeTolerance(Some(v)))
             .map_err(|e| format!("`{t}` is not a number or `none`: {e}")),
     }
 }
