@@ -654,6 +654,53 @@ mod tests {
         assert_eq!(rung_above(4), 5);
     }
 
+    // Source: the module docs' definition. Displacements count over the finer run's largest (a 1 mm
+    // difference when it reaches 100 mm is 1e-2), Δr over its largest |Δr| (0.03 of 15: 2e-3), recovery ratios
+    // absolutely (0.004); the largest of them is reported with its quantity and time, and a run that stopped
+    // short of a comparison time cannot pass.
+    #[test]
+    fn the_difference_normalises_each_quantity_as_documented() {
+        use crate::io::state::Recovery;
+        let watched = |time: Real, u: Real, delta_r: Real, ratio: Real| Watched {
+            time,
+            displacements: vec![Vec3::new(u, 0.0, 0.0)],
+            recovery: Some(Recovery {
+                ratio_mean: ratio,
+                ratio_max: ratio,
+                delta_r: Some(delta_r),
+            }),
+            grid: Vec::new(),
+        };
+        let names = vec!["probe tip".to_string()];
+        let finer = [
+            watched(1.0, 100.0, 15.0, 0.5),
+            watched(2.0, 50.0, 10.0, 0.2),
+        ];
+        let run = [
+            watched(1.0, 100.0, 15.03, 0.5),
+            watched(2.0, 51.0, 10.0, 0.204),
+        ];
+        let d = difference(&run, &finer, &names);
+        assert!((d.value - 1e-2).abs() < 1e-12, "{d:?}");
+        assert_eq!((d.quantity.as_str(), d.time), ("probe tip", 2.0));
+        let run = [
+            watched(1.0, 100.0, 15.03, 0.5),
+            watched(2.0, 50.0, 10.0, 0.204),
+        ];
+        let d = difference(&run, &finer, &names);
+        assert!((d.value - 4e-3).abs() < 1e-12, "{d:?}");
+        assert!(d.quantity.starts_with("recovery ratio"), "{d:?}");
+        let run = [
+            watched(1.0, 100.0, 15.03, 0.5),
+            watched(2.0, 50.0, 10.0, 0.2),
+        ];
+        let d = difference(&run, &finer, &names);
+        assert!((d.value - 2e-3).abs() < 1e-12, "{d:?}");
+        assert_eq!(d.quantity, "Δr");
+        let d = difference(&run[..1], &finer, &names);
+        assert!(d.value.is_infinite(), "{d:?}");
+    }
+
     #[test]
     fn the_time_ladder_takes_round_values_one_and_three() {
         assert_eq!(time_ladder_start(0.1), 0.1);

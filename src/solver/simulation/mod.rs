@@ -26,8 +26,9 @@
 //! **Error-controlled stepping.** With `time.tolerance` (a design's `time: {tolerance: 1e-4}` or `run --tol`)
 //! every converged step gets a time-error estimate — how far the configuration would move had the internal
 //! variables been advanced by a companion update (backward Euler for the second-order rules), measured in
-//! Newton's normalised norm, so that a tolerance means the same on a stent and an arch — and a step whose
-//! estimate exceeds the tolerance is rejected and retried shorter; the next step comes from a PI controller
+//! Newton's normalised norm, so that a tolerance means the same on a stent and an arch, or, where held nodes
+//! keep the configuration from showing it, the strain that carries the two updates' stress difference — and a
+//! step whose estimate exceeds its share of the tolerance is rejected and retried shorter; the next step comes from a PI controller
 //! with growth and shrink limits ([`adaptive`]). Steps still land on every schedule breakpoint (releases, load
 //! and temperature breakpoints, snapshot times), Newton failures still halve the step, and a step at
 //! `min_step` whose estimate is above the tolerance is accepted with a notice (said once). Fixed steps (no
