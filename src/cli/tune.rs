@@ -58,7 +58,7 @@ pub fn run(
     let (wall, steps, iterations) = tuned.cost;
     println!("\nchosen: {}", choice(&tuned));
     println!(
-        "expected wall time {wall:.2} s ({steps} steps, {iterations} Newton iterations) against {:.1} s for the \
+        "expected wall time {wall:.2} s ({steps} steps, {iterations} Newton iterations) against {:.2} s for the \
          design's own settings ({:.1}× less)",
         tuned.design_wall,
         tuned.design_wall / wall
@@ -145,7 +145,7 @@ fn write_tuned(
         header: format!(
             "Tuned by `stentkit tune {} --tol {}` (stentkit {}):\n{},\n\
              over the whole schedule (displacements over the largest one, Δr over its largest, recovery ratios\n\
-             absolute). Expected wall time {wall:.2} s against {:.1} s for the source's settings ({:.1}× less, on\n\
+             absolute). Expected wall time {wall:.2} s against {:.2} s for the source's settings ({:.1}× less, on\n\
              the machine that tuned it).",
             design_path.display(),
             Short(tolerance),

@@ -328,7 +328,7 @@ pub fn difference(run: &[Watched], finer: &[Watched], names: &[String]) -> Diffe
     let f_scale = largest(&|w| w.grid.iter().map(|u| u.norm()).fold(0.0, Real::max));
     let mut worst = Difference {
         value: 0.0,
-        quantity: "nothing watched".into(),
+        quantity: "no difference".into(),
         time: 0.0,
     };
     let mut see = |value: Real, quantity: &dyn Fn() -> String, time: Real| {
