@@ -27,11 +27,12 @@
 //! -- curved` (or `straight`, `arch`, `cantilever`) one. The tables in the README come from it.
 
 use std::path::Path;
-use stentkit::io::design::{Design, DesignOverrides, load_design, load_design_with};
+use stentkit::io::design::load_design;
 use stentkit::math::Real;
 use stentkit::model::{Model, ProbeLocation};
-use stentkit::study::sample::{Watched, WatchedRun, watched_run};
+use stentkit::study::sample::{Watched, WatchedRun, node_lengths, watched_run};
 use stentkit::study::tune::{comparison_times, difference, watched_locations};
+use stentkit::study::variant::{Remesh, TimeVariant, rebuild};
 
 /// A quantity of a case: its name, unit and value in a watched state.
 struct Quantity {
@@ -136,8 +137,8 @@ fn main() {
         locations.extend((0..paper.model.nodes.len()).map(ProbeLocation::Node));
         // Runs under 5 s are repeated three times and their shortest wall time kept (the machine's noise is
         // ±20 % on a single run of a few seconds).
-        let run = |design: &Design| -> WatchedRun {
-            let mut model = design.model.clone();
+        let run = |model: &Model| -> WatchedRun {
+            let mut model = model.clone();
             model.record_times = times.clone();
             let once = || watched_run(&model, &locations, None).expect("the run converges");
             let mut best = once();
@@ -149,12 +150,13 @@ fn main() {
             }
             best
         };
-        let with_tolerance = |tol: Real| {
-            let overrides = DesignOverrides {
-                time_tolerance: Some(tol),
-                ..DesignOverrides::default()
+        // The paper's model with error-controlled steps, without reading the file again.
+        let with_tolerance = |tolerance: Real| {
+            let variant = TimeVariant {
+                tolerance: Some(tolerance),
+                ..TimeVariant::default()
             };
-            load_design_with(&root.join(case.design), &overrides).expect("reads")
+            variant.of(&paper.model).expect("a valid tolerance")
         };
         let tuned = load_design(&root.join(case.tuned)).expect("the tuned design reads");
         let tuned_label = format!(
@@ -167,7 +169,7 @@ fn main() {
         let mut rows = vec![Row {
             label: "paper settings (fixed steps)".into(),
             tolerance: None,
-            run: run(&paper),
+            run: run(&paper.model),
         }];
         for tol in [1e-1, 3e-2, 1e-2, 1e-3, 1e-4] {
             rows.push(Row {
@@ -180,17 +182,21 @@ fn main() {
         rows.push(Row {
             label: tuned_label,
             tolerance: None,
-            run: run(&tuned),
+            run: run(&tuned.model),
         });
         let tight = case.tight.map(|(p, n, tol)| {
-            let overrides = DesignOverrides {
+            let remesh = Remesh {
                 degree: Some(p),
                 points: Some(n),
-                time_tolerance: Some(tol),
-                ..DesignOverrides::default()
+                crowns: None,
             };
-            let design = load_design_with(&root.join(case.design), &overrides).expect("reads");
-            (format!("p = {p}, n = {n}, τ = {tol:e}"), run(&design))
+            let model = rebuild(&paper, &remesh).expect("the finer mesh builds");
+            let variant = TimeVariant {
+                tolerance: Some(tol),
+                ..TimeVariant::default()
+            };
+            let model = variant.of(&model).expect("a valid tolerance");
+            (format!("p = {p}, n = {n}, τ = {tol:e}"), run(&model))
         });
         report(
             &case,
@@ -282,25 +288,4 @@ fn report(
         }
         println!("{line}");
     }
-}
-
-/// The length of the shortest patch at each node (of its control polygon: at least the arc length, and not
-/// zero for a closed patch).
-fn node_lengths(model: &Model) -> Vec<Real> {
-    model
-        .nodes
-        .iter()
-        .map(|node| {
-            node.ends
-                .iter()
-                .map(|e| {
-                    let points = model.patches[e.patch].curve.points();
-                    points
-                        .windows(2)
-                        .map(|w| (w[1] - w[0]).norm())
-                        .sum::<Real>()
-                })
-                .fold(Real::INFINITY, Real::min)
-        })
-        .collect()
 }

@@ -5,7 +5,7 @@
 use super::BadInput;
 use crate::io::design::{DesignOverrides, TunedChoice, load_design, parse_design, tuned_text};
 use crate::math::Short;
-use crate::study::tune::{Stepping, Trial, TuneSettings, Tuned, tune};
+use crate::study::tune::{Trial, TuneSettings, Tuned, tune};
 use anyhow::Context;
 use std::io::Write as _;
 use std::path::Path;
@@ -84,10 +84,6 @@ fn choice(tuned: &Tuned) -> String {
 }
 
 fn print_trial(t: &Trial) {
-    let stepping = match t.stepping {
-        Stepping::Fixed(h) => format!("h = {}", Short(h)),
-        Stepping::Tolerance(tau) => format!("τ = {}", Short(tau)),
-    };
     let (difference, at) = match (&t.difference, &t.failure) {
         (_, Some(failure)) => ("failed".to_string(), first_words(failure)),
         (Some(d), None) => (
@@ -106,7 +102,7 @@ fn print_trial(t: &Trial) {
         t.stage.to_string(),
         t.degree,
         t.points,
-        stepping,
+        t.stepping.to_string(),
         Short(t.horizon).to_string(),
         t.against,
         difference,

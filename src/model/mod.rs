@@ -15,7 +15,7 @@ pub mod stent;
 pub use programme::{DrivenNode, Programme, ProgrammeError, ProgrammeKind};
 pub use schedule::{ScheduleError, TimeFunction};
 
-use crate::material::{MaterialLaw, Section};
+use crate::material::{ConstitutiveLaw as _, MaterialLaw, Section};
 use crate::math::{Mat3, NurbsCurve, Real, Vec3};
 use std::collections::BTreeMap;
 
@@ -263,6 +263,16 @@ pub struct TimeSettings {
     pub max_step: Option<Real>,
 }
 
+impl TimeSettings {
+    /// Why these settings' error control cannot be trusted with `materials`, if they ask for it and one of the
+    /// materials has no estimate that holds ([`crate::material::ConstitutiveLaw::time_error_unsupported`]): the
+    /// builder and the studies refuse the model then.
+    pub fn error_control_refusal(&self, materials: &[MaterialLaw]) -> Option<String> {
+        self.tolerance?;
+        materials.iter().find_map(|m| m.time_error_unsupported())
+    }
+}
+
 /// Times closer than this fraction of the nominal step are one time when time stepping lands on schedule
 /// breakpoints: the landing tolerance of the solver ([`crate::solver::Simulation::run`]), of the snapshot
 /// schedule and of [`Model::planned_steps`], which keeps round-off from making sliver steps.
@@ -458,8 +468,20 @@ impl Model {
     /// Every time at which a schedule changes slope or a condition switches, and every record time, within
     /// `(0, end]`, sorted and deduplicated: time stepping lands on each.
     pub fn schedule_breakpoints(&self) -> Vec<Real> {
+        self.breakpoints(true)
+    }
+
+    /// [`Model::schedule_breakpoints`] without the record times: where the temperature, a load or a prescribed
+    /// value changes slope, and the releases with the ends of their ramps.
+    pub fn condition_breakpoints(&self) -> Vec<Real> {
+        self.breakpoints(false)
+    }
+
+    fn breakpoints(&self, with_record_times: bool) -> Vec<Real> {
         let mut times: Vec<Real> = self.temperature.breakpoints().collect();
-        times.extend(&self.record_times);
+        if with_record_times {
+            times.extend(&self.record_times);
+        }
         for node in &self.nodes {
             for c in &node.conditions.components {
                 match c {

@@ -57,6 +57,14 @@ pub struct ConvergenceStudy {
     pub time_tolerance: Option<Real>,
 }
 
+impl ConvergenceStudy {
+    /// The time steppings every `p × n` runs with: the design's steps (`None`), then error control at the
+    /// study's time tolerance, if any.
+    fn steppings(&self) -> impl Iterator<Item = Option<Real>> + use<> {
+        [None].into_iter().chain(self.time_tolerance.map(Some))
+    }
+}
+
 /// Runs the study on `design` (re-built for every `p` and `n`, [`rebuild`]) and returns its rows; `progress` is
 /// told about each finished run.
 ///
@@ -92,8 +100,7 @@ pub fn convergence_study(
     ));
     let mut rows = Vec::new();
     for &p in &study.degrees {
-        let stepping = [None].into_iter().chain(study.time_tolerance.map(Some));
-        for tolerance in stepping {
+        for tolerance in study.steppings() {
             let what = |n: usize| match tolerance {
                 Some(tol) => format!("p = {p}, n = {n}, τ = {tol:e}"),
                 None => format!("p = {p}, n = {n}"),
@@ -166,8 +173,8 @@ pub fn convergence_charts(
         "against p = {}, n = {} at t = {}",
         study.reference.0, study.reference.1, study.time
     );
-    let stepping = [None].into_iter().chain(study.time_tolerance.map(Some));
-    let curves: Vec<ErrorCurve> = stepping
+    let curves: Vec<ErrorCurve> = study
+        .steppings()
         .flat_map(|tolerance| {
             study.degrees.iter().map(move |&p| ErrorCurve {
                 label: match tolerance {

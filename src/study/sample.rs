@@ -53,6 +53,28 @@ pub fn grid_locations(model: &Model, samples: usize) -> impl Iterator<Item = Pro
     })
 }
 
+/// The length of the shortest patch at each node, along its control polygon (at least the arc length, and not
+/// zero for a closed patch): a node's translation over it is the translation part of Newton's normalised norm,
+/// in which the time-error estimate is measured.
+pub fn node_lengths(model: &Model) -> Vec<Real> {
+    model
+        .nodes
+        .iter()
+        .map(|node| {
+            node.ends
+                .iter()
+                .map(|e| {
+                    let points = model.patches[e.patch].curve.points();
+                    points
+                        .windows(2)
+                        .map(|w| (w[1] - w[0]).norm())
+                        .sum::<Real>()
+                })
+                .fold(Real::INFINITY, Real::min)
+        })
+        .collect()
+}
+
 /// The watched quantities of a run at one time.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Watched {

@@ -50,11 +50,9 @@ use super::StudyError;
 use super::sample::{Watched, WatchedRun, watched_run};
 use super::variant::{Remesh, TimeVariant, rebuild};
 use crate::io::design::Design;
-use crate::math::{Real, Vec3};
+use crate::math::{Real, Short, Vec3};
 use crate::model::{Model, ProbeLocation};
-use crate::solver::Simulation;
 use std::fmt;
-use std::time::Instant;
 
 /// Fixed steps over the screening horizon. With 20 (a step of 0.075 s on the curved stent's programming) the
 /// path of the compacted crowns depends on the step as much as on `n` and `n` against `2n` does not converge
@@ -94,8 +92,8 @@ pub enum Stepping {
 impl fmt::Display for Stepping {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match self {
-            Stepping::Fixed(h) => write!(f, "h = {h:.3e}"),
-            Stepping::Tolerance(t) => write!(f, "τ = {t:e}"),
+            Stepping::Fixed(h) => write!(f, "h = {}", Short(*h)),
+            Stepping::Tolerance(t) => write!(f, "τ = {}", Short(*t)),
         }
     }
 }
@@ -225,17 +223,16 @@ struct Runner<'d> {
 }
 
 impl Runner<'_> {
-    /// The results of `key` (run now, or remembered), or why the run failed.
-    fn results(&mut self, key: RunKey) -> Result<&WatchedRun, String> {
-        let index = match self.cache.iter().position(|(k, _)| *k == key) {
+    /// The index in the cache of `key`'s results (run now, or remembered).
+    fn cached(&mut self, key: RunKey) -> usize {
+        match self.cache.iter().position(|(k, _)| *k == key) {
             Some(i) => i,
             None => {
                 let outcome = self.run(key).map_err(|e| super::error_chain(&e));
                 self.cache.push((key, outcome));
                 self.cache.len() - 1
             }
-        };
-        self.cache[index].1.as_ref().map_err(Clone::clone)
+        }
     }
 
     fn run(&self, key: RunKey) -> Result<WatchedRun, StudyError> {
@@ -276,6 +273,7 @@ impl Runner<'_> {
         share: Real,
         against: String,
     ) -> Trial {
+        let (a, b) = (self.cached(candidate), self.cached(finer));
         let mut trial = Trial {
             stage,
             degree: candidate.degree,
@@ -288,24 +286,19 @@ impl Runner<'_> {
             accepted: false,
             failure: None,
         };
-        let a = match self.results(candidate) {
-            Ok(a) => a.clone(),
-            Err(e) => {
-                trial.failure = Some(format!("{candidate}: {e}"));
-                return trial;
-            }
-        };
-        trial.cost = Some((a.wall, a.summary.steps, a.summary.iterations));
-        let b = match self.results(finer) {
-            Ok(b) => b.clone(),
-            Err(e) => {
+        match (&self.cache[a].1, &self.cache[b].1) {
+            (Err(e), _) => trial.failure = Some(format!("{candidate}: {e}")),
+            (Ok(a), Err(e)) => {
+                trial.cost = Some((a.wall, a.summary.steps, a.summary.iterations));
                 trial.failure = Some(format!("{finer}: {e}"));
-                return trial;
             }
-        };
-        let d = difference(&a.states, &b.states, &self.names);
-        trial.accepted = d.value <= share;
-        trial.difference = Some(d);
+            (Ok(a), Ok(b)) => {
+                trial.cost = Some((a.wall, a.summary.steps, a.summary.iterations));
+                let d = difference(&a.states, &b.states, &self.names);
+                trial.accepted = d.value <= share;
+                trial.difference = Some(d);
+            }
+        }
         trial
     }
 }
@@ -381,11 +374,8 @@ pub fn difference(run: &[Watched], finer: &[Watched], names: &[String]) -> Diffe
 /// The comparison times of `model` over its whole schedule (module docs).
 pub fn comparison_times(model: &Model) -> Vec<Real> {
     let end = model.time.end;
-    let mut plain = model.clone();
-    plain.record_times.clear();
-    let mut times = plain.schedule_breakpoints();
+    let mut times = model.condition_breakpoints();
     times.extend((1..=10).map(|k| end * k as Real / 10.0));
-    times.retain(|&t| t > 0.0 && t <= end);
     times.sort_by(Real::total_cmp);
     times.dedup_by(|a, b| (*a - *b).abs() <= 1e-9 * end);
     times
@@ -394,10 +384,8 @@ pub fn comparison_times(model: &Model) -> Vec<Real> {
 /// The screening horizon: the first schedule breakpoint at or after a quarter of the run.
 fn screening_horizon(model: &Model) -> Real {
     let end = model.time.end;
-    let mut plain = model.clone();
-    plain.record_times.clear();
-    plain
-        .schedule_breakpoints()
+    model
+        .condition_breakpoints()
         .into_iter()
         .find(|&t| t >= 0.25 * end)
         .unwrap_or(end)
@@ -405,15 +393,9 @@ fn screening_horizon(model: &Model) -> Real {
 
 /// The `n` ladder of degree `p`: from `2p` (and above `p + 1`) by [`LADDER`], up to `max`.
 fn ladder(p: usize, max: usize) -> Vec<usize> {
-    let mut rungs = vec![(2 * p).max(p + 2)];
-    while let Some(&n) = rungs.last() {
-        let next = ((n as Real * LADDER).ceil() as usize).max(n + 1);
-        if next > max {
-            break;
-        }
-        rungs.push(next);
-    }
-    rungs
+    std::iter::successors(Some((2 * p).max(p + 2)), |&n| Some(rung_above(n)))
+        .take_while(|&n| n <= max)
+        .collect()
 }
 
 /// The next rung above `n` (module docs, step 3).
@@ -632,14 +614,11 @@ fn design_cost(design: &Design) -> Result<Real, StudyError> {
         (planned / 20).max(20).min(planned) as Real / planned as Real
     };
     model.time.end *= fraction;
-    let started = Instant::now();
-    let mut sim = Simulation::new(&model)?;
-    let summary = sim.run(&mut [])?;
-    let wall = started.elapsed().as_secs_f64();
+    let run = watched_run(&model, &[], None)?;
     Ok(if fraction < 1.0 {
-        wall * planned as Real / summary.steps.max(1) as Real
+        run.wall * planned as Real / run.summary.steps.max(1) as Real
     } else {
-        wall
+        run.wall
     })
 }
 

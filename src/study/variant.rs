@@ -8,7 +8,7 @@
 
 use super::{StudyError, positive};
 use crate::io::design::{Design, DesignOverrides, parse_design_with};
-use crate::material::{ConstitutiveLaw, Integrator, MaterialLaw, MaxwellLaw};
+use crate::material::{Integrator, MaterialLaw, MaxwellLaw};
 use crate::math::Real;
 use crate::model::Model;
 
@@ -74,13 +74,8 @@ impl TimeVariant {
                 }
             }
         }
-        // As the design layer does: error control only where its estimate holds (`Integrator::companion`).
-        if model.time.tolerance.is_some()
-            && let Some(why) = model
-                .materials
-                .iter()
-                .find_map(ConstitutiveLaw::time_error_unsupported)
-        {
+        // As the builder does: error control only where its estimate holds (`Integrator::companion`).
+        if let Some(why) = model.time.error_control_refusal(&model.materials) {
             return Err(StudyError::Refused(why));
         }
         Ok(())

@@ -51,11 +51,10 @@ pub fn tuned_text(text: &str, choice: &TunedChoice) -> Result<String, TunedTextE
     let time_line = format!("time: {}", flow(time, choice.time_tolerance)?);
     let mut header: String = choice.header.lines().map(|l| format!("# {l}\n")).collect();
     if !own_meshes(top) {
-        let body = replace_entry(text, "time", Some(&time_line));
-        let body = match replace_entry(&body, "mesh", Some(&mesh_line)) {
-            same if same == body => format!("{}\n{mesh_line}\n", body.trim_end()),
-            edited => edited,
-        };
+        // A design that parsed has a top-level `time` entry; one without `mesh` gets it appended.
+        let body = replace_entry(text, "time", &time_line).unwrap_or_else(|| text.to_string());
+        let body = replace_entry(&body, "mesh", &mesh_line)
+            .unwrap_or_else(|| format!("{}\n{mesh_line}\n", body.trim_end()));
         return Ok(format!("{header}#\n{body}"));
     }
     if let Some(Value::Sequence(patches)) = top.get_mut("patches") {
@@ -116,16 +115,14 @@ fn flow(time: &Mapping, tolerance: f64) -> Result<String, TunedTextError> {
 }
 
 /// `text` with the top-level entry `key` (its line and the indented or blank lines under it, but not the blank
-/// lines that end it) replaced by `line`, or removed for `None`; unchanged when there is no such entry.
-fn replace_entry(text: &str, key: &str, line: Option<&str>) -> String {
+/// lines that end it) replaced by `line`; `None` when there is no such entry.
+fn replace_entry(text: &str, key: &str, line: &str) -> Option<String> {
     let lines: Vec<&str> = text.lines().collect();
     let starts = |l: &str| {
         l.strip_prefix(key)
             .is_some_and(|rest| rest.trim_start().starts_with(':'))
     };
-    let Some(first) = lines.iter().position(|l| starts(l)) else {
-        return text.to_string();
-    };
+    let first = lines.iter().position(|l| starts(l))?;
     let mut last = first;
     for (i, l) in lines.iter().enumerate().skip(first + 1) {
         if l.starts_with([' ', '\t']) {
@@ -135,13 +132,13 @@ fn replace_entry(text: &str, key: &str, line: Option<&str>) -> String {
         }
     }
     let mut out: Vec<&str> = lines[..first].to_vec();
-    out.extend(line);
+    out.push(line);
     out.extend(&lines[last + 1..]);
     let mut joined = out.join("\n");
     if text.ends_with('\n') {
         joined.push('\n');
     }
-    joined
+    Some(joined)
 }
 
 #[cfg(test)]

@@ -531,12 +531,7 @@ impl ModelBuilder {
     pub fn build(&self) -> Result<Built> {
         let mut warnings = Vec::new();
         let time = self.time.settings()?;
-        if time.tolerance.is_some()
-            && let Some(why) = self
-                .materials
-                .iter()
-                .find_map(|m| m.time_error_unsupported())
-        {
+        if let Some(why) = time.error_control_refusal(&self.materials) {
             return Err(BuildError::new(Field::Time(TimeField::Tolerance), why));
         }
         check_solver(&self.solver)?;
