@@ -1,16 +1,16 @@
 //! `stentkit check`: validate a design and describe what a run would solve.
 
 use crate::io::design::size::{MEMORY_LIMIT_BYTES, human_bytes};
-use crate::io::design::{Design, load_design};
+use crate::io::design::{Design, DesignOverrides, SetOverride, load_design_with};
 use crate::io::estimate::estimated_disk;
 use crate::material::{ConstitutiveLaw, MaterialLaw};
 use crate::model::Component;
 use std::fmt::Write as _;
 use std::path::Path;
 
-/// Loads the design and prints its description.
-pub fn run(path: &Path) -> anyhow::Result<()> {
-    let design = load_design(path)?;
+/// Loads the design with the `--set` overrides `sets` and prints its description.
+pub fn run(path: &Path, sets: Vec<SetOverride>) -> anyhow::Result<()> {
+    let design = load_design_with(path, &DesignOverrides::sets(sets))?;
     print!("{}", describe(&design, &path.display().to_string()));
     Ok(())
 }

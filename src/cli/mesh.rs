@@ -1,13 +1,19 @@
 //! `stentkit mesh`: the reference shape of the full device as a closed tube surface.
 
-use crate::io::design::load_design;
+use crate::io::design::{DesignOverrides, SetOverride, load_design_with};
 use crate::io::{obj, stl};
 use crate::post::device::reference_device_mesh;
 use anyhow::{Context, bail};
 use std::path::Path;
 
-/// Writes the reference shape of the design to `output` (`.stl` or `.obj`).
-pub fn run(design: &Path, output: &Path, segments: usize, samples: usize) -> anyhow::Result<()> {
+/// Writes the reference shape of the design (with the `--set` overrides `sets`) to `output` (`.stl` or `.obj`).
+pub fn run(
+    design: &Path,
+    output: &Path,
+    segments: usize,
+    samples: usize,
+    sets: Vec<SetOverride>,
+) -> anyhow::Result<()> {
     let extension = output
         .extension()
         .and_then(|e| e.to_str())
@@ -15,7 +21,7 @@ pub fn run(design: &Path, output: &Path, segments: usize, samples: usize) -> any
     if !matches!(extension.as_deref(), Some("stl" | "obj")) {
         bail!("{}: the output must end in .stl or .obj", output.display());
     }
-    let design = load_design(design)?;
+    let design = load_design_with(design, &DesignOverrides::sets(sets))?;
     let model = &design.model;
     let mesh = reference_device_mesh(model, segments, samples)?;
     mesh.check_closed()

@@ -11,6 +11,7 @@ pub mod signals;
 pub mod study;
 pub mod tune;
 
+use crate::io::design::SetOverride;
 use clap::{Parser, Subcommand};
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -41,6 +42,11 @@ pub enum Command {
     Check {
         /// The design file (YAML).
         design: PathBuf,
+        /// Override a field of the design: `PATH=VALUE`, the field path as error messages write it and a YAML
+        /// value (`--set stent.crowns=8 --set material.wlf.Tg=65 --set mesh.n=30`); repeatable, applied in order
+        /// and checked as if written in the file.
+        #[arg(long = "set", value_name = "PATH=VALUE")]
+        set: Vec<SetOverride>,
     },
     /// Simulate a design and write the run folder: history.csv, summary.json, snapshots/ (STL and OBJ of the
     /// full device), run.mcap (open it in Foxglove) and charts/ (SVG).
@@ -86,6 +92,11 @@ pub enum Command {
         /// increments (translations over the patch length, rotations in radians), stays below it.
         #[arg(long, value_name = "TOLERANCE")]
         tol: Option<f64>,
+        /// Override a field of the design: `PATH=VALUE`, the field path as error messages write it and a YAML
+        /// value (`--set stent.crowns=8 --set material.wlf.Tg=65 --set mesh.n=30`); repeatable, applied in order
+        /// and checked as if written in the file.
+        #[arg(long = "set", value_name = "PATH=VALUE")]
+        set: Vec<SetOverride>,
     },
     /// Find the cheapest degree p, points per patch n and time-error tolerance whose results (every probe, Δr,
     /// the recovery ratios) stay within --tol of a finer run over the design's whole schedule: the space error
@@ -110,6 +121,11 @@ pub enum Command {
         /// Most control points per patch tried.
         #[arg(long, default_value_t = 200)]
         max_points: usize,
+        /// Override a field of the design: `PATH=VALUE`, the field path as error messages write it and a YAML
+        /// value (`--set stent.crowns=8 --set material.wlf.Tg=65 --set mesh.n=30`); repeatable, applied in order
+        /// and checked as if written in the file.
+        #[arg(long = "set", value_name = "PATH=VALUE")]
+        set: Vec<SetOverride>,
     },
     /// Make the folder of a run that was killed (SIGKILL, power loss, crash) whole: cut history.csv back to its
     /// last complete row, finish run.mcap after its last complete chunk, remove unfinished temporaries, and mark
@@ -145,6 +161,11 @@ pub enum Command {
         /// Samples along each patch per control point.
         #[arg(long, default_value_t = 4)]
         samples: usize,
+        /// Override a field of the design: `PATH=VALUE`, the field path as error messages write it and a YAML
+        /// value (`--set stent.crowns=8 --set material.wlf.Tg=65 --set mesh.n=30`); repeatable, applied in order
+        /// and checked as if written in the file.
+        #[arg(long = "set", value_name = "PATH=VALUE")]
+        set: Vec<SetOverride>,
     },
 }
 
@@ -309,7 +330,7 @@ pub fn short_time(t: crate::math::Real) -> String {
 pub fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match cli.command {
-        Command::Check { design } => check::run(&design),
+        Command::Check { design, set } => check::run(&design, set),
         Command::Run {
             design,
             output,
@@ -319,6 +340,7 @@ pub fn main() -> ExitCode {
             resume,
             checkpoint_every,
             tol,
+            set,
         } => run::run(
             &design,
             run::RunOptions {
@@ -329,6 +351,7 @@ pub fn main() -> ExitCode {
                 resume,
                 checkpoint_every,
                 time_tolerance: tol,
+                sets: set,
             },
         ),
         Command::Tune {
@@ -337,7 +360,8 @@ pub fn main() -> ExitCode {
             output,
             degrees,
             max_points,
-        } => tune::run(&design, tol, output.as_deref(), degrees, max_points),
+            set,
+        } => tune::run(&design, tol, output.as_deref(), degrees, max_points, set),
         Command::Schema => schema(),
         Command::Repair { run_dir } => repair::run(&run_dir),
         Command::Study(StudyCommand::Convergence {
@@ -384,7 +408,8 @@ pub fn main() -> ExitCode {
             output,
             segments,
             samples,
-        } => mesh::run(&design, &output, segments, samples),
+            set,
+        } => mesh::run(&design, &output, segments, samples, set),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -424,6 +424,8 @@ pub struct RunOptions {
     pub checkpoint_every: Real,
     /// Error-controlled stepping at this time-error tolerance, replacing the design's (`--tol`).
     pub time_tolerance: Option<Real>,
+    /// `--set PATH=VALUE` overrides of the design's fields.
+    pub sets: Vec<crate::io::design::SetOverride>,
 }
 
 /// Simulates the design and writes the run folder.
@@ -441,6 +443,7 @@ pub fn run(design_path: &Path, options: RunOptions) -> anyhow::Result<()> {
     }
     let overrides = DesignOverrides {
         time_tolerance: options.time_tolerance,
+        sets: options.sets.clone(),
         ..DesignOverrides::default()
     };
     let design = load_design_with(design_path, &overrides)?;
@@ -576,6 +579,10 @@ fn run_in(
         manifest: manifest.clone(),
         problem: None,
     };
+    if !design.overrides.is_empty() {
+        summary.summary.overrides.clone_from(&design.overrides);
+        summary.summary.resolved_design = Some(design.source.clone());
+    }
     summary.write(|_| {})?;
     let reserve = folder.reserve(super::disk::FINISHING_RESERVE)?;
     let setup = (|| -> anyhow::Result<_> {

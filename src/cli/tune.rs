@@ -3,7 +3,9 @@
 //! ([`crate::io::design::tuned_text`]).
 
 use super::BadInput;
-use crate::io::design::{DesignOverrides, TunedChoice, load_design, parse_design, tuned_text};
+use crate::io::design::{
+    DesignOverrides, SetOverride, TunedChoice, load_design_with, parse_design, tuned_text,
+};
 use crate::math::Short;
 use crate::study::tune::{Trial, TuneSettings, Tuned, tune};
 use anyhow::Context;
@@ -11,13 +13,14 @@ use std::io::Write as _;
 use std::path::Path;
 
 /// Tunes `design` to `tolerance`, trying `degrees` and at most `max_points` points per patch; writes the tuned
-/// design to `output` when given (never over an existing file).
+/// design to `output` when given (never over an existing file). `sets` are `--set` overrides of the design.
 pub fn run(
     design_path: &Path,
     tolerance: f64,
     output: Option<&Path>,
     degrees: Vec<usize>,
     max_points: usize,
+    sets: Vec<SetOverride>,
 ) -> anyhow::Result<()> {
     if let Some(out) = output
         && out.exists()
@@ -28,7 +31,7 @@ pub fn run(
         ))
         .into());
     }
-    let design = load_design(design_path)?;
+    let design = load_design_with(design_path, &DesignOverrides::sets(sets))?;
     let settings = TuneSettings {
         tolerance,
         degrees,

@@ -267,6 +267,12 @@ pub struct RunSummaryFile {
     pub design: String,
     /// The design file as given on the command line.
     pub design_file: String,
+    /// The `--set` overrides applied to it, as given.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub overrides: Vec<String>,
+    /// The design that ran, when overrides changed the file's: the resolved YAML.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub resolved_design: Option<String>,
     /// stentkit's version.
     pub stentkit_version: String,
     /// The command line.
@@ -360,6 +366,8 @@ impl RunSummaryFile {
         Self {
             design: model.name.clone(),
             design_file: design_file.to_string(),
+            overrides: Vec::new(),
+            resolved_design: None,
             stentkit_version: version.to_string(),
             command_line: command_line.to_string(),
             units: UnitsSummary::of(model),

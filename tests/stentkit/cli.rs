@@ -218,3 +218,55 @@ fn every_subcommand_help_has_an_example() {
         );
     }
 }
+
+/// `--set` on `run` (issue 15): summary.json lists the overrides and holds the resolved design, which reads
+/// back as the design with the overridden values; `check` prints the overridden value; a bad override exits
+/// with status 2 naming the argument.
+#[test]
+fn run_with_overrides_records_the_resolved_design() {
+    let dir = TempDir::new("set_run");
+    let out = dir.join("run");
+    let design = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/good_stent_small.yaml");
+    let run = stentkit(&[
+        "run",
+        path_str(&design),
+        "-q",
+        "-o",
+        path_str(&out),
+        "--set",
+        "time.end=0.1",
+        "--set",
+        "material.wlf.Tg=65",
+    ]);
+    assert_no_panic(&run);
+    assert!(run.status.success(), "{}", text(&run.stderr));
+    let summary: serde_json::Value = serde_json::from_str(
+        &std::fs::read_to_string(out.join("summary.json")).expect("summary.json"),
+    )
+    .expect("JSON");
+    assert_eq!(
+        summary["overrides"],
+        serde_json::json!(["time.end=0.1", "material.wlf.Tg=65"])
+    );
+    let resolved = summary["resolved_design"]
+        .as_str()
+        .expect("resolved_design");
+    let model = stentkit::io::design::parse_design(resolved, Path::new("resolved.yaml"))
+        .expect("the resolved design reads")
+        .model;
+    assert_eq!(model.time.end, 0.1);
+    assert_eq!(summary["final_time"], serde_json::json!(0.1));
+    let check = stentkit(&["check", path_str(&design), "--set", "material.wlf.Tg=61.5"]);
+    assert!(
+        text(&check.stdout).contains("Tg = 61.5 °C"),
+        "{}",
+        text(&check.stdout)
+    );
+    let bad = stentkit(&["check", path_str(&design), "--set", "stent.crowns=-2"]);
+    assert_eq!(bad.status.code(), Some(2));
+    assert!(
+        text(&bad.stderr).contains("--set stent.crowns=-2: stent.crowns: "),
+        "{}",
+        text(&bad.stderr)
+    );
+}

@@ -149,6 +149,7 @@ fn every_broken_design_gets_a_clear_located_error() {
             Err(_) => Err("panicked".to_string()),
             Ok(Ok(_)) => Err("was accepted".to_string()),
             Ok(Err(DesignError::Read { .. })) => Err("could not be read".to_string()),
+            Ok(Err(e @ DesignError::Override { .. })) => Err(format!("blamed on an override: {e}")),
             Ok(Err(e @ DesignError::Invalid { .. })) => {
                 let text = e.to_string();
                 let DesignError::Invalid {
@@ -341,7 +342,9 @@ fn generated_hostile_designs_are_refused_quickly_with_located_errors() {
         );
         let outcome = match result {
             Ok(_) => Err("was accepted".to_string()),
-            Err(e @ DesignError::Read { .. }) => Err(format!("{e}")),
+            Err(e @ (DesignError::Read { .. } | DesignError::Override { .. })) => {
+                Err(format!("{e}"))
+            }
             Err(
                 ref e @ DesignError::Invalid {
                     line,

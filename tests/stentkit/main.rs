@@ -10,6 +10,7 @@ mod designs;
 mod fuzz;
 mod mesh;
 mod outputs;
+mod overrides;
 mod reliability;
 mod resume;
 mod run_folder;

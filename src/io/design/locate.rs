@@ -22,6 +22,7 @@ const MAX_PATH_KEY_BYTES: usize = 64;
 #[derive(Debug, Default, Clone)]
 pub struct Locator {
     values: HashMap<String, Position>,
+    keys: HashMap<String, Position>,
 }
 
 enum Frame {
@@ -42,6 +43,7 @@ impl Locator {
     /// syntax error itself).
     pub fn new(text: &str) -> Self {
         let mut values = HashMap::new();
+        let mut keys = HashMap::new();
         let mut stack: Vec<Frame> = Vec::new();
         for item in Parser::new_from_str(text) {
             let Ok((event, span)) = item else {
@@ -68,7 +70,7 @@ impl Locator {
                                 Event::Scalar(v, ..) => v.to_string(),
                                 _ => "?".to_string(),
                             };
-                            values.entry(join_key(path, &k)).or_insert(pos);
+                            keys.entry(join_key(path, &k)).or_insert(pos);
                             *key = Some(if k.len() > MAX_PATH_KEY_BYTES {
                                 "…".to_string()
                             } else {
@@ -97,7 +99,12 @@ impl Locator {
                 stack.pop();
             }
         }
-        Self { values }
+        Self { values, keys }
+    }
+
+    /// The position of the key of the mapping entry `path`, if the document has that entry.
+    pub fn key(&self, path: &str) -> Option<Position> {
+        self.keys.get(path).copied()
     }
 
     /// The position of `path`'s value, if the document has that field.

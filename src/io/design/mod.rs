@@ -13,11 +13,13 @@ pub mod dto;
 pub mod guard;
 pub mod issue;
 pub mod locate;
+pub mod set;
 pub mod size;
 
 pub mod stent;
 mod tuned;
 
+pub use set::SetOverride;
 pub use tuned::{TunedChoice, TunedTextError, tuned_text};
 
 use crate::math::Real;
@@ -100,8 +102,11 @@ pub struct Design {
     /// The steps a run takes when no step is cut ([`Model::planned_steps`], computed once here: it sorts every
     /// breakpoint).
     pub steps: crate::model::StepPlan,
-    /// The YAML text as read (embedded in run recordings).
+    /// The YAML text as read (embedded in run recordings); with `--set` overrides, the resolved design
+    /// ([`set::resolved_text`]).
     pub source: String,
+    /// The `--set` overrides applied, as given (`stent.crowns=8`).
+    pub overrides: Vec<String>,
     /// Where it was read from.
     pub path: PathBuf,
 }
@@ -129,6 +134,18 @@ pub enum DesignError {
         /// What is wrong and what is allowed.
         message: String,
     },
+    /// A `--set` override was refused: its path does not fit the design, or the value it sets (or a field of a
+    /// map it created) is invalid.
+    Override {
+        /// The design file the override applies to.
+        file: PathBuf,
+        /// The `--set` argument as given.
+        argument: String,
+        /// Field path of the invalid value (the override's own, or one below it).
+        field: String,
+        /// What is wrong and what is allowed.
+        message: String,
+    },
 }
 
 impl fmt::Display for DesignError {
@@ -145,6 +162,18 @@ impl fmt::Display for DesignError {
                 message,
             } => {
                 write!(f, "{}:{line}:{column}: ", file.display())?;
+                if !field.is_empty() {
+                    write!(f, "{field}: ")?;
+                }
+                write!(f, "{message}")
+            }
+            DesignError::Override {
+                file,
+                argument,
+                field,
+                message,
+            } => {
+                write!(f, "{}: --set {argument}: ", file.display())?;
                 if !field.is_empty() {
                     write!(f, "{field}: ")?;
                 }
@@ -250,9 +279,20 @@ pub struct DesignOverrides {
     pub integrator: Option<dto::IntegratorDto>,
     /// Crowns of the generated stent (replaces `stent.crowns`); a design without a `stent` block is refused.
     pub crowns: Option<usize>,
+    /// `--set PATH=VALUE` overrides of any field, applied in order to the file's YAML before it is read
+    /// ([`set`]); the others above are applied after them.
+    pub sets: Vec<SetOverride>,
 }
 
 impl DesignOverrides {
+    /// Only the `--set` overrides `sets`.
+    pub fn sets(sets: Vec<SetOverride>) -> Self {
+        Self {
+            sets,
+            ..Self::default()
+        }
+    }
+
     fn apply(&self, d: &mut dto::DesignDto) {
         if self.degree.is_some() || self.points.is_some() {
             let mesh = d.mesh.get_or_insert(dto::MeshDto { p: None, n: None });
@@ -318,39 +358,59 @@ pub fn parse_design_with(
     let file = path.to_path_buf();
     guard::check_text(text).map_err(|r| refused(path, r))?;
     let locator = locate::Locator::new(text);
-    let deserializer = serde_yaml::Deserializer::from_str(text);
-    let mut dto: dto::DesignDto = serde_path_to_error::deserialize(deserializer).map_err(|e| {
-        let field = match e.path().to_string() {
-            p if p == "." => String::new(),
-            p => p,
+    let stem = path.file_stem().map_or_else(
+        || "design".to_string(),
+        |s| s.to_string_lossy().into_owned(),
+    );
+    let (mut dto, source, applied) = if overrides.sets.is_empty() {
+        let deserializer = serde_yaml::Deserializer::from_str(text);
+        let dto: dto::DesignDto = serde_path_to_error::deserialize(deserializer)
+            .map_err(|e| read_error(&e, &locator, &file))?;
+        (dto, text.to_string(), Vec::new())
+    } else {
+        let mut root: serde_yaml::Value = match serde_yaml::from_str(text) {
+            Ok(root) => root,
+            // Not YAML: the error is reported exactly as without overrides.
+            Err(e) => {
+                return Err(parse_design(text, path).err().unwrap_or_else(|| {
+                    DesignError::Invalid {
+                        file,
+                        line: 1,
+                        column: 1,
+                        field: String::new(),
+                        message: e.to_string(),
+                    }
+                }));
+            }
         };
-        // A value rejected by a check (a NaN, a negative size) is located exactly by its path; serde_yaml's
-        // own position is better for unknown or missing fields and syntax errors.
-        let inner = e.inner().to_string();
-        let (message, named) = split_message(&inner);
-        // Only libyaml's syntax errors name the position of the problem itself.
-        let named = named.filter(|_| inner.contains(", while "));
-        let serde_position = e.inner().location().map(|l| locate::Position {
-            line: l.line(),
-            column: l.column(),
-        });
-        let unknown_field = inner.contains("unknown field");
-        // A syntax error names its own position; a rejected value is found exactly by its path; serde_yaml's
-        // position is best for unknown and missing fields.
-        let pos = match (named, locator.get(&field), serde_position) {
-            (Some(p), _, _) => p,
-            (None, Some(p), _) if !unknown_field => p,
-            (None, _, Some(p)) => p,
-            (None, _, None) => locator.find(&field),
-        };
-        DesignError::Invalid {
-            file: file.clone(),
-            line: pos.line,
-            column: pos.column,
-            field: quote::shortened(&field, quote::MAX_FIELD_CHARS).into_owned(),
-            message: quote::shortened_message(&message).into_owned(),
+        let mut applied = Vec::new();
+        for s in &overrides.sets {
+            let a = set::apply(&mut root, s).map_err(|message| DesignError::Override {
+                file: file.clone(),
+                argument: s.argument.clone(),
+                field: s.field(),
+                message,
+            })?;
+            applied.push((a, s));
         }
-    })?;
+        // The resolved design is written elsewhere (a sweep's variant folder): it keeps the file's name.
+        if let Some(top) = root.as_mapping_mut()
+            && !top.contains_key("name")
+        {
+            top.insert("name".into(), stem.clone().into());
+        }
+        let dto: dto::DesignDto = serde_path_to_error::deserialize(root.clone())
+            .map_err(|e| owned(read_error(&e, &locator, &file), &applied))?;
+        let source =
+            set::resolved_text(&root, path, &overrides.sets).map_err(|e| DesignError::Invalid {
+                file: file.clone(),
+                line: 1,
+                column: 1,
+                field: String::new(),
+                message: format!("the resolved design cannot be written as YAML: {e}"),
+            })?;
+        (dto, source, applied)
+    };
     overrides.apply(&mut dto);
     if overrides.crowns.is_some() && dto.stent.is_none() {
         let pos = locator.find("stent");
@@ -362,19 +422,18 @@ pub fn parse_design_with(
             message: "the crown count is overridden, but the design has no `stent` block".into(),
         });
     }
-    let stem = path.file_stem().map_or_else(
-        || "design".to_string(),
-        |s| s.to_string_lossy().into_owned(),
-    );
     let built = build::build(&dto, &stem).map_err(|issue| {
         let pos = locator.find(&issue.path);
-        DesignError::Invalid {
-            file: file.clone(),
-            line: pos.line,
-            column: pos.column,
-            message: quote::shortened_message(&issue.message).into_owned(),
-            field: issue.path,
-        }
+        owned(
+            DesignError::Invalid {
+                file: file.clone(),
+                line: pos.line,
+                column: pos.column,
+                message: quote::shortened_message(&issue.message).into_owned(),
+                field: issue.path,
+            },
+            &applied,
+        )
     })?;
     Ok(Design {
         model: built.model,
@@ -382,7 +441,66 @@ pub fn parse_design_with(
         warnings: built.warnings,
         memory: built.memory,
         steps: built.steps,
-        source: text.to_string(),
+        source,
+        overrides: overrides.sets.iter().map(|s| s.argument.clone()).collect(),
         path: file,
     })
+}
+
+/// The design error of a deserialisation error `e` of the text indexed by `locator` (module docs: the
+/// position of a syntax error is the problem's own, a rejected value is found by its path, serde_yaml's
+/// position is best for unknown and missing fields).
+fn read_error(
+    e: &serde_path_to_error::Error<serde_yaml::Error>,
+    locator: &locate::Locator,
+    file: &Path,
+) -> DesignError {
+    let field = match e.path().to_string() {
+        p if p == "." => String::new(),
+        p => p,
+    };
+    let inner = e.inner().to_string();
+    let (message, named) = split_message(&inner);
+    // Only libyaml's syntax errors name the position of the problem itself.
+    let named = named.filter(|_| inner.contains(", while "));
+    let serde_position = e.inner().location().map(|l| locate::Position {
+        line: l.line(),
+        column: l.column(),
+    });
+    let unknown_field = inner.contains("unknown field");
+    let pos = match (named, locator.get(&field), serde_position) {
+        (Some(p), _, _) => p,
+        (None, Some(p), _) if !unknown_field => p,
+        (None, _, Some(p)) => p,
+        // Read from a tree (with `--set` overrides), an unknown field has no position of its own: its key's.
+        (None, _, None) => locator
+            .key(&field)
+            .filter(|_| unknown_field)
+            .unwrap_or_else(|| locator.find(&field)),
+    };
+    DesignError::Invalid {
+        file: file.to_path_buf(),
+        line: pos.line,
+        column: pos.column,
+        field: quote::shortened(&field, quote::MAX_FIELD_CHARS).into_owned(),
+        message: quote::shortened_message(&message).into_owned(),
+    }
+}
+
+/// `error` as the error of the `--set` override that set or created its field, if one did ([`set::owner`]).
+fn owned(error: DesignError, applied: &[(set::Applied, &SetOverride)]) -> DesignError {
+    match error {
+        DesignError::Invalid {
+            file,
+            field,
+            message,
+            ..
+        } if let Some(set) = set::owner(applied, &field) => DesignError::Override {
+            file,
+            argument: set.argument.clone(),
+            field,
+            message,
+        },
+        e => e,
+    }
 }
