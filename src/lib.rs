@@ -48,3 +48,4 @@ pub mod model;
 pub mod post;
 pub mod solver;
 pub mod study;
+pub mod sweep;

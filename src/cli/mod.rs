@@ -9,6 +9,7 @@ pub mod repair;
 pub mod run;
 pub mod signals;
 pub mod study;
+pub mod sweep;
 pub mod tune;
 
 use crate::io::design::SetOverride;
@@ -127,6 +128,16 @@ pub enum Command {
         #[arg(long = "set", value_name = "PATH=VALUE")]
         set: Vec<SetOverride>,
     },
+    /// Run a family of variants of a design: the cartesian product (or with --zip the pairs) of the values of
+    /// every --set, each variant a resolved design and a run folder under -o DIR, on this machine with --jobs
+    /// workers or as a Slurm job array (--slurm). A rerun continues: completed variants are skipped, interrupted
+    /// ones continue from their checkpoint, failed ones rerun with --retry-failed. Writes DIR/sweep.csv and
+    /// DIR/charts/ at the end (and `sweep collect DIR` at any time).
+    ///
+    /// Example: stentkit sweep designs/straight_stent.yaml --set material.wlf.Tg=60,65,70 --set section.diameter=0.5:0.7:0.1 -o runs/tg_sweep
+    ///
+    /// Example: stentkit sweep designs/straight_stent.yaml --set material.wlf.Tg=60:80:5 -o runs/tg --slurm --partition debug --time 00:30:00
+    Sweep(SweepCli),
     /// Make the folder of a run that was killed (SIGKILL, power loss, crash) whole: cut history.csv back to its
     /// last complete row, finish run.mcap after its last complete chunk, remove unfinished temporaries, and mark
     /// summary.json `killed`. A folder whose run is still going is refused.
@@ -166,6 +177,95 @@ pub enum Command {
         /// and checked as if written in the file.
         #[arg(long = "set", value_name = "PATH=VALUE")]
         set: Vec<SetOverride>,
+    },
+}
+
+/// `stentkit sweep`: a sweep to run, or one of its subcommands.
+#[derive(Debug, clap::Args)]
+#[command(args_conflicts_with_subcommands = true, subcommand_negates_reqs = true)]
+pub struct SweepCli {
+    /// collect, status or task.
+    #[command(subcommand)]
+    pub command: Option<SweepCommand>,
+    /// The design file (YAML).
+    #[arg(required = true)]
+    pub design: Option<PathBuf>,
+    /// A swept field: `PATH=V1,V2,…` (YAML values) or `PATH=START:STOP:STEP` (numbers, STOP included);
+    /// repeatable. A single value is the same in every variant.
+    #[arg(long = "set", value_name = "PATH=VALUES", required = true)]
+    pub set: Vec<String>,
+    /// Pair the k-th values of every --set instead of taking their cartesian product.
+    #[arg(long)]
+    pub zip: bool,
+    /// The sweep folder (new, or one this sweep wrote: it continues).
+    #[arg(short, long, required = true)]
+    pub output: Option<PathBuf>,
+    /// Variants run at once on this machine (default: cores / --threads-per-run).
+    #[arg(long)]
+    pub jobs: Option<usize>,
+    /// Threads of each run (RAYON_NUM_THREADS of each worker).
+    #[arg(long, default_value_t = 1)]
+    pub threads_per_run: usize,
+    /// Rerun the variants that failed.
+    #[arg(long)]
+    pub retry_failed: bool,
+    /// Times of the recovery-ratio columns of sweep.csv (default: halfway from the release to the end, and
+    /// the end).
+    #[arg(long, value_delimiter = ',')]
+    pub at: Option<Vec<f64>>,
+    /// Submit the variants as a Slurm job array (DIR/sweep.sbatch, one task per variant) instead of running
+    /// them here; again after a cancellation, it submits only the unfinished ones.
+    #[arg(long)]
+    pub slurm: bool,
+    /// With --slurm: the partition.
+    #[arg(long, requires = "slurm")]
+    pub partition: Option<String>,
+    /// With --slurm: the time limit of each task, HH:MM:SS.
+    #[arg(long, requires = "slurm")]
+    pub time: Option<String>,
+    /// With --slurm: CPUs (and threads) of each task.
+    #[arg(long, default_value_t = 1, requires = "slurm")]
+    pub cpus_per_task: usize,
+    /// With --slurm: tasks running at once (`--array=…%M`).
+    #[arg(long, requires = "slurm")]
+    pub max_parallel: Option<usize>,
+    /// With --slurm: write DIR/sweep.sbatch without submitting it.
+    #[arg(long, requires = "slurm")]
+    pub dry_run: bool,
+}
+
+/// The subcommands of `stentkit sweep`.
+#[derive(Debug, Subcommand)]
+pub enum SweepCommand {
+    /// Write DIR/sweep.csv (a row per variant: parameters, status, wall time, programmed displacement, snap at
+    /// release, fixity, recovery ratios, times to 50 % and 90 % recovery, final residual shape) and
+    /// DIR/charts/ (each metric against each numeric parameter), from the variants' run folders.
+    ///
+    /// Example: stentkit sweep collect runs/tg_sweep
+    Collect {
+        /// The sweep folder.
+        dir: PathBuf,
+        /// Times of the recovery-ratio columns.
+        #[arg(long, value_delimiter = ',')]
+        at: Option<Vec<f64>>,
+    },
+    /// Each variant's state: from Slurm (squeue) for the tasks it still lists, from the run folders otherwise.
+    ///
+    /// Example: stentkit sweep status runs/tg_sweep
+    Status {
+        /// The sweep folder.
+        dir: PathBuf,
+    },
+    /// Run one variant of a sweep (what each local worker and each Slurm array task runs).
+    #[command(hide = true)]
+    Task {
+        /// The sweep folder.
+        dir: PathBuf,
+        /// The variant's number (the array task id).
+        index: usize,
+        /// Rerun the variant if it failed.
+        #[arg(long)]
+        retry_failed: bool,
     },
 }
 
@@ -362,6 +462,7 @@ pub fn main() -> ExitCode {
             max_points,
             set,
         } => tune::run(&design, tol, output.as_deref(), degrees, max_points, set),
+        Command::Sweep(cli) => sweep(cli),
         Command::Schema => schema(),
         Command::Repair { run_dir } => repair::run(&run_dir),
         Command::Study(StudyCommand::Convergence {
@@ -433,6 +534,45 @@ fn tolerance_or_none(text: &str) -> Result<MaybeTolerance, String> {
             .parse()
             .map(|v| MaybeTolerance(Some(v)))
             .map_err(|e| format!("`{t}` is not a number or `none`: {e}")),
+    }
+}
+
+/// `stentkit sweep …`.
+fn sweep(cli: SweepCli) -> anyhow::Result<()> {
+    match cli.command {
+        Some(SweepCommand::Collect { dir, at }) => sweep::collect_command(&dir, at),
+        Some(SweepCommand::Status { dir }) => sweep::status(&dir),
+        Some(SweepCommand::Task {
+            dir,
+            index,
+            retry_failed,
+        }) => sweep::task(&dir, index, retry_failed),
+        None => {
+            let (Some(design), Some(output)) = (cli.design, cli.output) else {
+                return Err(BadInput("give a design, --set and -o".into()).into());
+            };
+            let slurm = cli.slurm.then_some(crate::sweep::slurm::SlurmOptions {
+                partition: cli.partition,
+                time: cli.time,
+                cpus_per_task: cli.cpus_per_task,
+                max_parallel: cli.max_parallel,
+                retry_failed: cli.retry_failed,
+            });
+            sweep::run(
+                &design,
+                sweep::SweepOptions {
+                    sets: cli.set,
+                    zip: cli.zip,
+                    output,
+                    jobs: cli.jobs,
+                    threads_per_run: cli.threads_per_run,
+                    retry_failed: cli.retry_failed,
+                    at: cli.at,
+                    slurm,
+                    dry_run: cli.dry_run,
+                },
+            )
+        }
     }
 }
 

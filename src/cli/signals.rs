@@ -22,10 +22,36 @@ static COUNT: AtomicUsize = AtomicUsize::new(0);
 static FIRST: AtomicI32 = AtomicI32::new(0);
 static INSTALL: Once = Once::new();
 
-/// Starts the thread that receives SIGINT, SIGTERM and SIGHUP for the rest of the process. Later calls do
-/// nothing. If the handlers cannot be installed the default actions stay (the process is killed) and a warning
-/// says so.
+/// What the first and second signal make the process do, said when they arrive.
+#[derive(Debug, Clone, Copy)]
+pub struct Messages {
+    /// After the first signal.
+    pub first: &'static str,
+    /// After the second.
+    pub second: &'static str,
+}
+
+/// A run's messages (module docs).
+pub const RUN: Messages = Messages {
+    first: "stopping at the next Newton iteration and finishing every file (send it again to skip the final snapshot)",
+    second: "finishing run.mcap and summary.json, then exiting (a third signal quits at once)",
+};
+
+/// A sweep's messages (`cli::sweep`).
+pub const SWEEP: Messages = Messages {
+    first: "no new variant starts; the running ones finish their files and stop (the same command continues the sweep)",
+    second: "still waiting for the running variants (a third signal quits the sweep; they finish on their own)",
+};
+
+/// Starts the thread that receives SIGINT, SIGTERM and SIGHUP for the rest of the process, with a run's
+/// messages. Later calls do nothing. If the handlers cannot be installed the default actions stay (the process
+/// is killed) and a warning says so.
 pub fn install() {
+    install_with(RUN);
+}
+
+/// [`install`] with `messages`.
+pub fn install_with(messages: Messages) {
     INSTALL.call_once(|| {
         let mut signals = match signal_hook::iterator::Signals::new([SIGINT, SIGTERM, SIGHUP]) {
             Ok(s) => s,
@@ -42,12 +68,8 @@ pub fn install() {
                     let n = COUNT.fetch_add(1, Ordering::SeqCst) + 1;
                     let name = name(signal);
                     match n {
-                        1 => eprintln!(
-                            "\n{name}: stopping at the next Newton iteration and finishing every file (send it again to skip the final snapshot)"
-                        ),
-                        2 => eprintln!(
-                            "{name} again: finishing run.mcap and summary.json, then exiting (a third signal quits at once)"
-                        ),
+                        1 => eprintln!("\n{name}: {}", messages.first),
+                        2 => eprintln!("{name} again: {}", messages.second),
                         _ => {
                             eprintln!(
                                 "{name} a third time: quitting now; `stentkit repair RUN_DIR` finishes the run folder"

@@ -7,7 +7,9 @@
 //! A design with a programme (stents) adds `recovery_ratio_mean` and `recovery_ratio_max`, the mean (weighted
 //! over the full device) and largest `‖η_l‖ / ‖η_temp,l‖` over the driven nodes — 1 at the temporary shape, 0 at
 //! the permanent one — and, for a radial contraction, `delta_r`: the mean radial contraction of the driven
-//! nodes (positive towards the axis; the paper's Δr).
+//! nodes (positive towards the axis; the paper's Δr). The last column, `max_displacement`, is the largest
+//! displacement of any node from the reference shape (length unit): the size of the programmed shape, of the
+//! snap at a release and of what is left at the end (`stentkit sweep`'s metrics).
 //! Rows are flushed as they are written, so an interrupted run leaves a valid file up to its last step; a row
 //! that cannot be written whole (a full disk) is cut off again, so the file always ends with a complete row.
 
@@ -65,6 +67,7 @@ impl HistoryWriter {
                 header.push_str(",delta_r");
             }
         }
+        header.push_str(",max_displacement");
         writeln!(out, "{header}")?;
         out.flush()?;
         Ok(Self {
@@ -168,6 +171,10 @@ impl HistoryWriter {
                 line.push_str(&format!(",{delta_r:.9e}"));
             }
         }
+        line.push_str(&format!(
+            ",{:.9e}",
+            super::state::max_node_displacement(sim)
+        ));
         let Some(out) = &mut self.out else {
             return ControlFlow::Break(());
         };

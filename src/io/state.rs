@@ -161,6 +161,13 @@ pub fn recovery(sim: &Simulation<'_>) -> Option<Recovery> {
     })
 }
 
+/// The largest displacement of any node from the reference shape [length] (0 for a model without nodes).
+pub fn max_node_displacement(sim: &Simulation<'_>) -> Real {
+    (0..sim.model().nodes.len())
+        .map(|k| sim.probe_displacement(&ProbeLocation::Node(k)).norm())
+        .fold(0.0, Real::max)
+}
+
 /// One recorded state: the initial one (step 0) or a converged step.
 #[derive(Debug, Clone, PartialEq)]
 pub struct StateSample {

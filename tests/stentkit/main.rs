@@ -17,5 +17,6 @@ mod run_folder;
 mod solver;
 mod stent;
 mod studies;
+mod sweep;
 mod tune;
 mod viscoelastic;

@@ -1,0 +1,455 @@
+//! `stentkit sweep`: run a family of variants of a design on this machine (N worker processes) or as a Slurm
+//! job array, `sweep collect` (sweep.csv and charts), `sweep status`, and `sweep task` (one variant: what each
+//! worker and each array task runs). The sweep folder and the variants' states are [`crate::sweep`]'s.
+//!
+//! Local workers are `stentkit sweep task DIR INDEX` child processes, each in its own process group with
+//! `RAYON_NUM_THREADS` set to the threads per run, their output appended to the variant's `log.txt`. On SIGINT,
+//! SIGTERM or SIGHUP no new variant starts and each running one gets one SIGTERM (it finishes its files and
+//! writes a checkpoint); the sweep waits for them, collects, and exits with status 130. A rerun continues.
+
+use super::{BadInput, Interrupted, signals};
+use crate::math::Real;
+use crate::sweep::collect::{Collected, collect};
+use crate::sweep::slurm::{self, Job, SlurmOptions};
+use crate::sweep::{Parameter, Plan, SweepDir, VariantState};
+use anyhow::Context as _;
+use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
+use std::path::{Path, PathBuf};
+use std::process::{Child, Command, Stdio};
+use std::time::{Duration, Instant};
+
+/// What `stentkit sweep DESIGN …` was asked.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SweepOptions {
+    /// The swept `--set` arguments (`PATH=V1,V2,…` or `PATH=START:STOP:STEP`).
+    pub sets: Vec<String>,
+    /// Pair the k-th values instead of the cartesian product.
+    pub zip: bool,
+    /// The sweep folder.
+    pub output: PathBuf,
+    /// Local workers (default: cores / threads per run).
+    pub jobs: Option<usize>,
+    /// Threads of each run.
+    pub threads_per_run: usize,
+    /// Rerun failed variants.
+    pub retry_failed: bool,
+    /// Times of the recovery-ratio columns (default: halfway through the recovery and the end).
+    pub at: Option<Vec<Real>>,
+    /// Submit to Slurm instead of running here.
+    pub slurm: Option<SlurmOptions>,
+    /// With `slurm`: write the batch script only.
+    pub dry_run: bool,
+}
+
+/// Plans the sweep, writes its folder and runs (or submits) the variants that need it.
+///
+/// # Errors
+/// [`BadInput`] for arguments or a folder refused, [`Interrupted`] when stopped by a signal, an error when
+/// variants failed (after the table is written) or Slurm refused the job.
+pub fn run(design: &Path, options: SweepOptions) -> anyhow::Result<()> {
+    signals::install_with(signals::SWEEP);
+    let parameters = options
+        .sets
+        .iter()
+        .map(|s| Parameter::parse(s))
+        .collect::<Result<Vec<_>, _>>()
+        .map_err(|e| BadInput(e.to_string()))?;
+    let plan = Plan::new(design, parameters, options.zip).map_err(|e| BadInput(e.to_string()))?;
+    let dir = SweepDir {
+        dir: options.output.clone(),
+    };
+    dir.prepare(&plan).map_err(|e| match e {
+        crate::sweep::SweepError::Io { .. } => anyhow::Error::from(e),
+        e => BadInput(e.to_string()).into(),
+    })?;
+    let states: Vec<VariantState> = plan.variants.iter().map(|v| dir.state(&v.id)).collect();
+    let mut todo: Vec<usize> = (0..plan.variants.len())
+        .filter(|&i| states[i].to_run(options.retry_failed))
+        .collect();
+    let refused = states
+        .iter()
+        .filter(|s| matches!(s, VariantState::Failed(_)))
+        .count();
+    eprintln!(
+        "sweep of {} → {}: {} variants, {} completed earlier, {} to run{}",
+        design.display(),
+        dir.dir.display(),
+        plan.variants.len(),
+        states
+            .iter()
+            .filter(|s| **s == VariantState::Completed)
+            .count(),
+        todo.len(),
+        if refused > 0 && !options.retry_failed {
+            format!(" ({refused} failed earlier: rerun them with --retry-failed)")
+        } else {
+            String::new()
+        }
+    );
+    if let Some(slurm_options) = &options.slurm {
+        // Variants queued or running in an earlier job of this sweep are not submitted again.
+        let jobs = slurm::read_jobs(&dir);
+        if let Some(queued) = slurm::queued(&jobs) {
+            todo.retain(|i| !queued.contains_key(i));
+        }
+        return submit(&dir, &plan, &todo, slurm_options, options.dry_run);
+    }
+    let interrupted = run_locally(&dir, &plan, &todo, &options)?;
+    let collected = collect(&dir, options.at.as_deref())?;
+    report(&collected);
+    if interrupted {
+        return Err(Interrupted(format!(
+            "{}: the sweep stopped; finished variants are kept and the same command continues it",
+            signals::first().unwrap_or("signal")
+        ))
+        .into());
+    }
+    let failed = collected
+        .rows
+        .iter()
+        .filter(|r| matches!(r.state, VariantState::Failed(_)))
+        .count();
+    anyhow::ensure!(
+        failed == 0,
+        "{failed} of {} variants failed (their rows in {} say why)",
+        collected.rows.len(),
+        collected.csv.display()
+    );
+    Ok(())
+}
+
+/// One running worker.
+struct Worker {
+    index: usize,
+    child: Child,
+    started: Instant,
+    signalled: bool,
+}
+
+/// Runs the variants `todo` with the options' workers; returns whether a signal stopped the sweep.
+fn run_locally(
+    dir: &SweepDir,
+    plan: &Plan,
+    todo: &[usize],
+    options: &SweepOptions,
+) -> anyhow::Result<bool> {
+    let threads = options.threads_per_run.max(1);
+    let cores = std::thread::available_parallelism().map_or(1, usize::from);
+    let jobs = options.jobs.unwrap_or(cores / threads).max(1);
+    if todo.is_empty() {
+        return Ok(false);
+    }
+    eprintln!("{jobs} workers, {threads} thread(s) per run");
+    let exe = std::env::current_exe().context("cannot find the stentkit executable")?;
+    let bar = ProgressBar::with_draw_target(Some(todo.len() as u64), ProgressDrawTarget::stderr());
+    bar.set_style(
+        ProgressStyle::with_template(
+            "{elapsed_precise} [{bar:30}] {pos}/{len} ETA {eta:>4}  {msg}",
+        )
+        .expect("valid progress template")
+        .progress_chars("=> "),
+    );
+    let (mut queue, mut running) = (todo.iter().copied(), Vec::<Worker>::new());
+    let (mut done, mut failed) = (0usize, 0usize);
+    loop {
+        let stopping = signals::stop_requested();
+        while !stopping && running.len() < jobs {
+            let Some(index) = queue.next() else {
+                break;
+            };
+            running.push(Worker {
+                index,
+                child: spawn_task(&exe, dir, plan, index, threads, options.retry_failed)?,
+                started: Instant::now(),
+                signalled: false,
+            });
+        }
+        if stopping {
+            for w in running.iter_mut().filter(|w| !w.signalled) {
+                terminate(&w.child);
+                w.signalled = true;
+            }
+        }
+        let mut k = 0;
+        while k < running.len() {
+            if running[k].child.try_wait()?.is_none() {
+                k += 1;
+                continue;
+            }
+            let w = running.swap_remove(k);
+            let id = &plan.variants[w.index].id;
+            let state = dir.state(id);
+            match &state {
+                VariantState::Completed => done += 1,
+                VariantState::Failed(_) => failed += 1,
+                _ => {}
+            }
+            bar.inc(1);
+            bar.suspend(|| {
+                eprintln!(
+                    "{id} [{}] {} in {:.1} s",
+                    plan.label(w.index),
+                    state.name(),
+                    w.started.elapsed().as_secs_f64()
+                );
+            });
+        }
+        bar.set_message(format!(
+            "{done} done, {failed} failed, {} running",
+            running.len()
+        ));
+        if running.is_empty() && (stopping || queue.len() == 0) {
+            break;
+        }
+        std::thread::sleep(Duration::from_millis(100));
+    }
+    bar.finish_and_clear();
+    Ok(signals::stop_requested())
+}
+
+/// Starts `stentkit sweep task DIR INDEX` in its own process group, its output appended to the variant's log.
+fn spawn_task(
+    exe: &Path,
+    dir: &SweepDir,
+    plan: &Plan,
+    index: usize,
+    threads: usize,
+    retry_failed: bool,
+) -> anyhow::Result<Child> {
+    use std::os::unix::process::CommandExt as _;
+    let log_path = dir.log(&plan.variants[index].id);
+    let log = std::fs::OpenOptions::new()
+        .create(true)
+        .append(true)
+        .open(&log_path)
+        .with_context(|| format!("cannot open {}", log_path.display()))?;
+    let mut command = Command::new(exe);
+    command
+        .arg("sweep")
+        .arg("task")
+        .arg(&dir.dir)
+        .arg(index.to_string())
+        .env("RAYON_NUM_THREADS", threads.to_string())
+        .stdin(Stdio::null())
+        .stdout(log.try_clone()?)
+        .stderr(log)
+        // A Ctrl-C at the terminal reaches only the sweep, which passes one SIGTERM on (a second signal would
+        // make a run skip its final snapshot).
+        .process_group(0);
+    if retry_failed {
+        command.arg("--retry-failed");
+    }
+    command
+        .spawn()
+        .with_context(|| format!("cannot start {}", exe.display()))
+}
+
+/// Sends SIGTERM to `child`.
+fn terminate(child: &Child) {
+    if let Ok(pid) = i32::try_from(child.id()) {
+        // SAFETY: kill(2) with a pid this process started and has not yet reaped; no memory is involved.
+        unsafe {
+            libc::kill(pid, libc::SIGTERM);
+        }
+    }
+}
+
+/// Writes the batch script of `todo` and submits it (or only writes it with `dry_run`).
+fn submit(
+    dir: &SweepDir,
+    plan: &Plan,
+    todo: &[usize],
+    options: &SlurmOptions,
+    dry_run: bool,
+) -> anyhow::Result<()> {
+    if todo.is_empty() {
+        eprintln!("nothing to submit: every variant is completed, failed or queued");
+        return Ok(());
+    }
+    let absolute = slurm::absolute(&dir.dir)?;
+    let exe = std::env::current_exe().context("cannot find the stentkit executable")?;
+    let text = slurm::sbatch_text(&absolute, &exe, plan, todo, options);
+    let script = dir.dir.join("sweep.sbatch");
+    std::fs::write(&script, text).with_context(|| format!("cannot write {}", script.display()))?;
+    if dry_run {
+        println!(
+            "wrote {} ({} tasks); submit it with: sbatch {}",
+            script.display(),
+            todo.len(),
+            script.display()
+        );
+        return Ok(());
+    }
+    let id = slurm::submit(&script).map_err(anyhow::Error::msg)?;
+    slurm::record_job(
+        dir,
+        Job {
+            id: id.clone(),
+            tasks: todo.to_vec(),
+        },
+    )?;
+    println!(
+        "submitted job {id}: array {} ({} tasks); `stentkit sweep status {}` follows it, `stentkit sweep collect {}` tabulates",
+        slurm::array_ranges(todo),
+        todo.len(),
+        dir.dir.display(),
+        dir.dir.display()
+    );
+    Ok(())
+}
+
+/// Runs variant `index` of the sweep in `dir` (what a worker or an array task does): nothing when completed;
+/// a failed one only with `retry_failed`; an unfinished one continues from its checkpoint; otherwise a fresh
+/// run (replacing the files of an earlier attempt only).
+///
+/// # Errors
+/// [`BadInput`] for an unknown index, a refused design or a failed variant without `retry_failed`; the run's
+/// own errors.
+pub fn task(dir: &Path, index: usize, retry_failed: bool) -> anyhow::Result<()> {
+    let sweep = SweepDir {
+        dir: dir.to_path_buf(),
+    };
+    let plan = sweep.read_plan().map_err(|e| BadInput(e.to_string()))?;
+    let id = plan
+        .variants
+        .get(index)
+        .map(|v| v.id.clone())
+        .ok_or_else(|| {
+            BadInput(format!(
+                "{}: no variant {index} (the sweep has {})",
+                dir.display(),
+                plan.variants.len()
+            ))
+        })?;
+    eprintln!("stentkit sweep task {index}: {id} [{}]", plan.label(index));
+    if sweep.error(&id).exists() {
+        return Err(BadInput(format!(
+            "{id}: its design was refused ({})",
+            sweep.error(&id).display()
+        ))
+        .into());
+    }
+    let state = sweep.state(&id);
+    let run_dir = sweep.run(&id);
+    let checkpoint = run_dir.join(crate::io::checkpoint::FILE_NAME).exists();
+    let (resume, force) = match &state {
+        VariantState::Completed => {
+            eprintln!("{id}: completed earlier");
+            return Ok(());
+        }
+        VariantState::Failed(why) if !retry_failed => {
+            return Err(BadInput(format!(
+                "{id} failed earlier ({why}); rerun it with --retry-failed"
+            ))
+            .into());
+        }
+        VariantState::Unfinished(_) if checkpoint => (true, false),
+        _ => (false, run_dir.exists()),
+    };
+    let _ = std::fs::remove_file(sweep.task_error(&id));
+    let options = super::run::RunOptions {
+        output: (!resume).then(|| run_dir.clone()),
+        force,
+        quiet: true,
+        verbose: false,
+        resume: resume.then(|| run_dir.clone()),
+        checkpoint_every: 60.0,
+        time_tolerance: None,
+        sets: Vec::new(),
+    };
+    let result = super::run::run(&sweep.design(&id), options);
+    if let Err(e) = &result
+        && !run_dir.join("summary.json").exists()
+    {
+        // Refused before the run folder had a summary: the state must say so.
+        let _ = std::fs::write(sweep.task_error(&id), super::error_text(e));
+    }
+    result
+}
+
+/// `stentkit sweep collect DIR`.
+///
+/// # Errors
+/// When DIR holds no sweep or the table cannot be written.
+pub fn collect_command(dir: &Path, at: Option<Vec<Real>>) -> anyhow::Result<()> {
+    let sweep = SweepDir {
+        dir: dir.to_path_buf(),
+    };
+    let collected = collect(&sweep, at.as_deref()).map_err(|e| match e {
+        crate::sweep::SweepError::Io { .. } => anyhow::Error::from(e),
+        e => BadInput(e.to_string()).into(),
+    })?;
+    report(&collected);
+    Ok(())
+}
+
+/// Prints what a collection holds.
+fn report(collected: &Collected) {
+    let count = |name: &str| {
+        collected
+            .rows
+            .iter()
+            .filter(|r| r.state.name() == name)
+            .count()
+    };
+    println!(
+        "{} variants: {} completed, {} failed, {} pending, {} unfinished → {} ({} charts)",
+        collected.rows.len(),
+        count("completed"),
+        count("failed"),
+        count("pending"),
+        collected.rows.len() - count("completed") - count("failed") - count("pending"),
+        collected.csv.display(),
+        collected.charts.len()
+    );
+}
+
+/// `stentkit sweep status DIR`: each variant's state, with the scheduler's for the tasks Slurm still lists.
+///
+/// # Errors
+/// When DIR holds no sweep.
+pub fn status(dir: &Path) -> anyhow::Result<()> {
+    let sweep = SweepDir {
+        dir: dir.to_path_buf(),
+    };
+    let plan = sweep.read_plan().map_err(|e| BadInput(e.to_string()))?;
+    let jobs = slurm::read_jobs(&sweep);
+    let queued = slurm::queued(&jobs);
+    if !jobs.is_empty() {
+        let ids: Vec<&str> = jobs.iter().map(|j| j.id.as_str()).collect();
+        match &queued {
+            Some(q) => println!(
+                "Slurm jobs {}: {} tasks queued or running",
+                ids.join(", "),
+                q.len()
+            ),
+            None => println!(
+                "Slurm jobs {}: squeue is not available here; states from the run folders",
+                ids.join(", ")
+            ),
+        }
+    }
+    let mut counts = std::collections::BTreeMap::<String, usize>::new();
+    for (i, v) in plan.variants.iter().enumerate() {
+        let state = sweep.state(&v.id);
+        let name = match queued.as_ref().and_then(|q| q.get(&i)) {
+            Some(s) => format!("slurm:{}", s.to_lowercase()),
+            None => state.name().to_string(),
+        };
+        let why = match &state {
+            VariantState::Failed(why) => format!("  {}", why.lines().next().unwrap_or("")),
+            _ => String::new(),
+        };
+        println!("{}  {name:<16} {}{why}", v.id, plan.label(i));
+        *counts.entry(name).or_default() += 1;
+    }
+    println!(
+        "{}",
+        counts
+            .iter()
+            .map(|(k, n)| format!("{n} {k}"))
+            .collect::<Vec<_>>()
+            .join(", ")
+    );
+    Ok(())
+}

@@ -1,0 +1,292 @@
+//! `sweep.csv` and the charts of a sweep folder: one row per variant (its parameters, state, wall time and
+//! [`super::metrics`]), and each metric against each numeric parameter, one line per combination of the other
+//! parameters. Collecting reads only the folder's files, so it gives the same table whether the variants ran
+//! here or on a cluster, and it can run while variants are still running (their rows say so).
+
+use super::metrics::{Metrics, Release, run_metrics};
+use super::{Plan, SweepDir, SweepError, VariantState, short_name};
+use crate::io::chart::{LineChart, Series, write_svg};
+use crate::io::design::load_design;
+use crate::math::Real;
+use std::fmt::Write as _;
+use std::path::PathBuf;
+
+/// One variant's row.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Row {
+    /// Index of the variant in the plan.
+    pub index: usize,
+    /// What its files say.
+    pub state: VariantState,
+    /// Its metrics (empty for a variant that has not run).
+    pub metrics: Metrics,
+}
+
+/// What [`collect`] wrote.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Collected {
+    /// The plan.
+    pub plan: Plan,
+    /// The rows, in the plan's order.
+    pub rows: Vec<Row>,
+    /// The times of the recovery-ratio columns.
+    pub times: Vec<Real>,
+    /// `DIR/sweep.csv`.
+    pub csv: PathBuf,
+    /// The charts written.
+    pub charts: Vec<PathBuf>,
+}
+
+/// A fixed metric column: name, unit kind, value.
+type Column = (&'static str, Unit, fn(&Metrics) -> Option<Real>);
+
+/// How a column reads its value from a row's metrics.
+type Getter = Box<dyn Fn(&Metrics) -> Option<Real>>;
+
+/// One metric column of the table and its charts.
+struct MetricColumn {
+    /// Header without the unit.
+    name: String,
+    /// ` (mm)`, ` (s)` or nothing.
+    unit: String,
+    /// Its value in a row.
+    get: Getter,
+}
+
+/// The unit of a metric column.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Unit {
+    Length,
+    Time,
+    None,
+}
+
+const BEFORE_RATIOS: [Column; 3] = [
+    ("programmed_displacement", Unit::Length, |m| {
+        m.programmed_displacement
+    }),
+    ("snap_at_release", Unit::Length, |m| m.snap),
+    ("fixity", Unit::None, |m| m.fixity),
+];
+
+const AFTER_RATIOS: [Column; 5] = [
+    ("time_to_50pc_recovery", Unit::Time, |m| m.time_to_50),
+    ("time_to_90pc_recovery", Unit::Time, |m| m.time_to_90),
+    ("final_recovery_ratio_mean", Unit::None, |m| {
+        m.final_ratio_mean
+    }),
+    ("final_recovery_ratio_max", Unit::None, |m| {
+        m.final_ratio_max
+    }),
+    ("final_displacement", Unit::Length, |m| m.final_displacement),
+];
+
+/// Reads every variant of the sweep in `dir` and writes `sweep.csv` and `charts/` (module docs). The recovery
+/// ratio is taken at `times`, or by default halfway between the release and the end and at the end (the end
+/// alone for a design without a release).
+///
+/// # Errors
+/// [`SweepError`] when the folder holds no sweep or a file cannot be written.
+pub fn collect(dir: &SweepDir, times: Option<&[Real]>) -> Result<Collected, SweepError> {
+    let plan = dir.read_plan()?;
+    let models: Vec<_> = plan
+        .variants
+        .iter()
+        .map(|v| load_design(&dir.design(&v.id)).ok().map(|d| d.model))
+        .collect();
+    // Times are in seconds in both unit systems.
+    let (length, time) = (
+        models
+            .iter()
+            .flatten()
+            .next()
+            .map_or("", |m| m.units.length()),
+        "s",
+    );
+    let times: Vec<Real> = match times {
+        Some(t) => t.to_vec(),
+        None => models.iter().flatten().next().map_or_else(Vec::new, |m| {
+            let end = m.time.end;
+            match Release::of(m) {
+                Some(r) if r.time < end => vec![r.time + 0.5 * (end - r.time), end],
+                _ => vec![end],
+            }
+        }),
+    };
+    let rows: Vec<Row> = plan
+        .variants
+        .iter()
+        .enumerate()
+        .map(|(index, v)| {
+            let state = dir.state(&v.id);
+            let metrics = models[index]
+                .as_ref()
+                .map(|m| run_metrics(m, &dir.run(&v.id), &times))
+                .unwrap_or_default();
+            Row {
+                index,
+                state,
+                metrics,
+            }
+        })
+        .collect();
+    let unit = |u: Unit| match u {
+        Unit::Length => format!(" ({length})"),
+        Unit::Time => format!(" ({time})"),
+        Unit::None => String::new(),
+    };
+    let fixed = |(name, u, get): &Column| MetricColumn {
+        name: name.to_string(),
+        unit: unit(*u),
+        get: Box::new(*get),
+    };
+    let columns: Vec<MetricColumn> = BEFORE_RATIOS
+        .iter()
+        .map(fixed)
+        .chain(times.iter().enumerate().map(|(k, t)| MetricColumn {
+            name: format!("recovery_ratio@{}", crate::math::Short(*t)),
+            unit: String::new(),
+            get: Box::new(move |m: &Metrics| m.recovery_at.get(k).copied().flatten()),
+        }))
+        .chain(AFTER_RATIOS.iter().map(fixed))
+        .collect();
+    // The table.
+    let mut csv = String::from("variant");
+    for p in &plan.parameters {
+        csv.push(',');
+        csv.push_str(&field(&p.path));
+    }
+    csv.push_str(&format!(",status,error,wall_time ({time}),steps"));
+    for c in &columns {
+        csv.push_str(&format!(",{}{}", c.name, c.unit));
+    }
+    csv.push('\n');
+    let number = |x: Option<Real>| x.map_or_else(String::new, significant);
+    for row in &rows {
+        let v = &plan.variants[row.index];
+        let m = &row.metrics;
+        csv.push_str(&v.id);
+        for value in &v.values {
+            csv.push(',');
+            csv.push_str(&field(value));
+        }
+        let error = match &row.state {
+            VariantState::Failed(why) => why.as_str(),
+            _ => "",
+        };
+        let _ = write!(
+            csv,
+            ",{},{},{},{}",
+            row.state.name(),
+            field(error),
+            number(m.wall_time_s),
+            m.steps.map_or_else(String::new, |s| s.to_string())
+        );
+        for c in &columns {
+            let _ = write!(csv, ",{}", number((c.get)(m)));
+        }
+        csv.push('\n');
+    }
+    let csv_path = dir.dir.join("sweep.csv");
+    write_replacing(&csv_path, &csv)?;
+    // The charts.
+    let charts_dir = dir.dir.join("charts");
+    let mut charts = Vec::new();
+    // A parameter with one value is the same in every variant: no chart against it, no line per its value.
+    let varied: Vec<bool> = plan.parameters.iter().map(|p| p.values.len() > 1).collect();
+    for (i, p) in plan.parameters.iter().enumerate() {
+        let xs: Option<Vec<Real>> = plan
+            .variants
+            .iter()
+            .map(|v| v.values[i].parse().ok())
+            .collect();
+        let (Some(xs), true) = (xs, varied[i]) else {
+            continue;
+        };
+        for MetricColumn { name, unit, get } in &columns {
+            // One line per combination of the other parameters' values, in the plan's order.
+            let mut groups: Vec<(String, Vec<(Real, Real)>)> = Vec::new();
+            for row in &rows {
+                let Some(y) = get(&row.metrics) else {
+                    continue;
+                };
+                let v = &plan.variants[row.index];
+                let key = plan
+                    .parameters
+                    .iter()
+                    .zip(&v.values)
+                    .enumerate()
+                    .filter(|&(j, _)| j != i && varied[j] && !plan.zip)
+                    .map(|(_, (q, value))| format!("{}={value}", short_name(&q.path)))
+                    .collect::<Vec<_>>()
+                    .join(", ");
+                match groups.iter_mut().find(|(k, _)| *k == key) {
+                    Some((_, points)) => points.push((xs[row.index], y)),
+                    None => groups.push((key, vec![(xs[row.index], y)])),
+                }
+            }
+            if groups.is_empty() {
+                continue;
+            }
+            let mut chart = LineChart::new(
+                format!("{name} against {}", p.path),
+                p.path.clone(),
+                format!("{name}{unit}"),
+            );
+            for (k, (key, mut points)) in groups.into_iter().enumerate() {
+                points.sort_by(|a, b| a.0.total_cmp(&b.0));
+                let label = if key.is_empty() { name.clone() } else { key };
+                chart
+                    .series
+                    .push(Series::new(label, points).with_markers().with_color(k));
+            }
+            std::fs::create_dir_all(&charts_dir).map_err(|source| SweepError::Io {
+                path: charts_dir.clone(),
+                source,
+            })?;
+            let file = charts_dir.join(format!(
+                "{}_vs_{}.svg",
+                name.replace('@', "_at_"),
+                short_name(&p.path)
+            ));
+            write_svg(&chart, &file).map_err(|e| SweepError::Io {
+                path: file.clone(),
+                source: std::io::Error::other(e.to_string()),
+            })?;
+            charts.push(file);
+        }
+    }
+    Ok(Collected {
+        plan,
+        rows,
+        times,
+        csv: csv_path,
+        charts,
+    })
+}
+
+/// `x` to 10 significant digits, in Rust's shortest form (`0.43047603`, not `0.43047602999999945`).
+fn significant(x: Real) -> String {
+    let rounded: Real = format!("{x:.9e}").parse().unwrap_or(x);
+    format!("{rounded}")
+}
+
+/// A CSV field: quoted when it holds a comma, a quote or a line break.
+fn field(text: &str) -> String {
+    if text.contains([',', '"', '\n', '\r']) {
+        format!("\"{}\"", text.replace('"', "\"\""))
+    } else {
+        text.to_string()
+    }
+}
+
+/// Writes `text` to `path` through a temporary file renamed over it (a reader never sees half a table).
+fn write_replacing(path: &std::path::Path, text: &str) -> Result<(), SweepError> {
+    let temporary = path.with_extension("csv.partial");
+    std::fs::write(&temporary, text)
+        .and_then(|()| std::fs::rename(&temporary, path))
+        .map_err(|source| SweepError::Io {
+            path: path.to_path_buf(),
+            source,
+        })
+}
