@@ -7,11 +7,13 @@
 //! ## Layers
 //!
 //! Dependencies point one way, left to right never imported from the right:
-//! `math → geometry → material → model → solver → post → io → study → cli`, and no two modules import each
+//! `math → geometry → material → model → solver → post → io → study → sweep → cli`, and no two modules import each
 //! other, directly or through others (`scripts/module_cycles.py`, run by CI, checks both from the source).
 //! `math`, `geometry`, `material`, `model`, `solver` and `post` are pure: no files, no printing, no serde.
 //! `study` writes no file and prints nothing either, but sits above `io`: it re-builds designs whose geometry it
-//! varies through `io::design` and draws its results as `io::chart` charts, which `cli` writes.
+//! varies through `io::design` and draws its results as `io::chart` charts, which `cli` writes. `sweep` owns a
+//! sweep folder's files and asks Slurm (`sbatch`, `squeue`) about its jobs; the processes that run variants are
+//! `cli`'s.
 //!
 //! | module | owns |
 //! |---|---|
@@ -23,6 +25,7 @@
 //! | [`post`] | the full device from a (symmetry-reduced) model or state: sampled shapes, mirror copies, tube meshes |
 //! | [`io`] | YAML design files (a translation into [`model::builder`] calls); writers of STL/OBJ, the run folder, checkpoints, charts |
 //! | [`study`] | accuracy against cost: scenarios, exact references, error measures and fits, sweeps over variants of a model |
+//! | [`sweep`] | families of variants of a design: swept parameters, the sweep folder and its variants' states, their metrics, `sweep.csv` and charts, the Slurm batch script |
 //! | [`cli`] | the `stentkit` command line |
 //!
 //! ## Conventions (stated once, here and in [`math::so3`])

@@ -81,7 +81,7 @@ pub fn run(design: &Path, options: SweepOptions) -> anyhow::Result<()> {
             .count(),
         todo.len(),
         if refused > 0 && !options.retry_failed {
-            format!(" ({refused} failed earlier: rerun them with --retry-failed)")
+            format!(" ({refused} refused or failed: --retry-failed reruns the failed runs)")
         } else {
             String::new()
         }
