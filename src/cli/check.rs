@@ -162,6 +162,9 @@ pub fn describe(design: &Design, file: &str) -> String {
         let names: Vec<_> = model.probes.iter().map(|p| p.name.as_str()).collect();
         let _ = writeln!(s, "probes              {}", names.join(", "));
     }
+    for note in &design.notes {
+        let _ = writeln!(s, "note                {note}");
+    }
     if warnings.is_empty() {
         let _ = writeln!(s, "warnings            none");
     } else {

@@ -5,7 +5,7 @@
 
 use super::analytic::{ArcLengthTable, ParametricCurve};
 use super::{GeometryError, Parameter};
-use crate::math::{KnotVector, NurbsCurve, Real, interp};
+use crate::math::{KnotVector, NurbsCurve, Real, Vec3, interp};
 
 /// Settings of a fit.
 #[derive(Debug, Clone, PartialEq)]
@@ -88,10 +88,10 @@ pub fn fit_curve(
 /// sign correction that keeps `det R = +1`; W. Kabsch, Acta Cryst. A32 (1976) 922). `None` when the weights do
 /// not sum to a positive number or the slices differ in length.
 pub fn best_fit_rigid(
-    from: &[crate::math::Vec3],
-    to: &[crate::math::Vec3],
+    from: &[Vec3],
+    to: &[Vec3],
     weights: &[Real],
-) -> Option<(crate::math::Mat3, crate::math::Vec3)> {
+) -> Option<(crate::math::Mat3, Vec3)> {
     use crate::math::{Mat3, Vec3};
     if from.len() != to.len() || from.len() != weights.len() {
         return None;
@@ -379,4 +379,83 @@ mod tests {
         assert!((tf - t).norm() < 1e-12);
         assert!(best_fit_rigid(&from, &to, &[0.0; 9]).is_none());
     }
+}
+
+/// A smooth spline through noisy data and how far it strays from it.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SmoothFit {
+    /// The cubic, `u ∈ [0, 1]` by chord length of the data.
+    pub curve: NurbsCurve,
+    /// Largest distance from a data point to the curve at its parameter [length] (an upper bound of the
+    /// distance to the curve).
+    pub max_deviation: Real,
+    /// Control points used.
+    pub control_points: usize,
+}
+
+/// The cubic with the fewest control points whose least-squares fit ([`crate::math::approx::approximate`],
+/// through the first and last point) stays within `tolerance` of every point of `points`: the count doubles
+/// from 4 until the fit is close enough, then bisection finds the smallest (the deviation falls with the count;
+/// with as many control points as points the fit interpolates).
+///
+/// # Errors
+/// [`GeometryError::InvalidParameter`] for fewer than two points, two consecutive points that coincide, or a
+/// tolerance that is not positive.
+pub fn smooth_points(points: &[Vec3], tolerance: Real) -> Result<SmoothFit, GeometryError> {
+    let invalid = |reason: String| GeometryError::InvalidParameter {
+        what: Parameter::Points,
+        reason,
+    };
+    if points.len() < 2 {
+        return Err(invalid(format!(
+            "need at least 2 points, got {}",
+            points.len()
+        )));
+    }
+    if !(tolerance > 0.0 && tolerance.is_finite()) {
+        return Err(invalid(format!(
+            "smoothing tolerance {tolerance}: give a positive length"
+        )));
+    }
+    let params = crate::math::approx::chord_parameters(points)
+        .ok_or_else(|| invalid("two consecutive points coincide".into()))?;
+    let m = points.len();
+    let degree = 3.min(m - 1);
+    let fit = |count: usize| -> Result<SmoothFit, GeometryError> {
+        let curve = crate::math::approx::approximate(points, &params, degree, count)?;
+        let max_deviation = params
+            .iter()
+            .zip(points)
+            .map(|(&u, p)| (curve.point(u) - p).norm())
+            .fold(0.0, Real::max);
+        Ok(SmoothFit {
+            curve,
+            max_deviation,
+            control_points: count,
+        })
+    };
+    let mut low = degree; // the largest count known to be too few (or below the minimum)
+    let mut count = (degree + 1).max(4).min(m);
+    let mut best = fit(count)?;
+    while best.max_deviation > tolerance && count < m {
+        low = count;
+        count = (2 * count).min(m);
+        best = fit(count)?;
+    }
+    // Bisection between `low` (too few) and `count` (enough).
+    let mut high = count;
+    while high - low > 1 {
+        let mid = (low + high) / 2;
+        if mid <= degree {
+            break;
+        }
+        let f = fit(mid)?;
+        if f.max_deviation <= tolerance {
+            high = mid;
+            best = f;
+        } else {
+            low = mid;
+        }
+    }
+    Ok(best)
 }

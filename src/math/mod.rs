@@ -5,6 +5,7 @@
 //! Everything here is pure and allocation-light; algorithms cite their source (Piegl & Tiller, *The NURBS
 //! Book*, 2nd ed., algorithm numbers A2.1 …).
 
+pub mod approx;
 pub mod basis;
 pub mod curve;
 pub mod interp;

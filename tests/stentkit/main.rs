@@ -3,6 +3,7 @@
 #[path = "../common/mod.rs"]
 mod common;
 
+mod centreline;
 mod checkpoint;
 mod cli;
 mod design_errors;

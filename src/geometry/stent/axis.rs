@@ -121,6 +121,9 @@ impl Axis {
                     centreline: Box::new(Centreline::new(curve, *reference)?),
                 })
             }
+            CentrelineSpec::Spline { curve, reference } => Ok(Axis::Curve {
+                centreline: Box::new(Centreline::new(curve.clone(), *reference)?),
+            }),
         }
     }
 

@@ -177,6 +177,13 @@ pub enum CentrelineSpec {
         /// Direction of `ϑ = 0` at the start; `None` picks one.
         reference: Option<Vec3>,
     },
+    /// A given spline (e.g. fitted to a vessel centreline read from a file), with a rotation-minimising frame.
+    Spline {
+        /// The curve, `u ∈ [0, 1]`.
+        curve: crate::math::NurbsCurve,
+        /// Direction of `ϑ = 0` at the start; `None` picks one.
+        reference: Option<Vec3>,
+    },
 }
 
 /// The symmetry of the device.

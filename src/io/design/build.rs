@@ -40,6 +40,8 @@ pub struct Built {
     pub output: super::OutputSettings,
     /// Things worth knowing that do not stop a run.
     pub warnings: Vec<String>,
+    /// How the design was read where it involved a choice (a file centreline's fit), for `check`.
+    pub notes: Vec<String>,
     /// The memory the run is estimated to need (below [`super::size::MEMORY_LIMIT_BYTES`]).
     pub memory: MemoryEstimate,
     /// The steps the run takes when no step is cut ([`Model::planned_steps`]).
@@ -77,11 +79,18 @@ pub fn build(dto: &DesignDto, default_name: &str) -> Result<Built> {
         UnitsDto::MmNMpa => Units::MmNMpa,
     });
     builder.time(time);
+    let metres_per_unit = match dto.units {
+        UnitsDto::Si => 1.0,
+        UnitsDto::MmNMpa => 1e-3,
+    };
+    let mut notes = Vec::new();
     if let Some(s) = &dto.stent {
-        builder.stent(stent::spec(s)?, stent::mesh(s, dto.mesh.as_ref())?);
+        let (spec, said) = stent::spec(s, metres_per_unit)?;
+        notes.extend(said);
+        builder.stent(spec, stent::mesh(s, dto.mesh.as_ref())?);
     }
     if let Some(p) = &dto.programme {
-        builder.programme(stent::programme(p)?);
+        builder.programme(stent::programme(p, metres_per_unit)?);
     }
     patches(dto, &mut builder, circular, shear_factor)?;
     if let Some(j) = &dto.joints {
@@ -188,6 +197,7 @@ pub fn build(dto: &DesignDto, default_name: &str) -> Result<Built> {
         model,
         output,
         warnings,
+        notes,
         memory,
         steps: plan,
     })

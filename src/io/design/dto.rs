@@ -700,8 +700,12 @@ pub struct ProbeDto {
 pub struct StentDto {
     /// Number of crowns.
     pub crowns: usize,
-    /// Crown radius `R` [length].
-    pub radius: Positive,
+    /// Crown radius `R` [length]; or give `oversize` to size the stent from a file centreline's lumen radius.
+    #[serde(default)]
+    pub radius: Option<Positive>,
+    /// With a file centreline that has the lumen radius: `R` = the segment's mean lumen radius × (1 + oversize).
+    #[serde(default)]
+    pub oversize: Option<NonNegative>,
     /// Crown amplitude `h_c` (half the crown height) [length].
     pub amplitude: Positive,
     /// Crests per crown.
@@ -775,10 +779,13 @@ pub struct BridgesDto {
     pub first: Option<usize>,
 }
 
-/// The centreline: exactly one of `straight`, `arc`, `points`.
+/// The centreline: exactly one of `straight`, `arc`, `points`, `file`.
 #[derive(Debug, Clone, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct CentrelineDto {
+    /// A vessel centreline read from a file ([`crate::io::centreline`]).
+    #[serde(default)]
+    pub file: Option<FileCentrelineDto>,
     /// A straight axis.
     #[serde(default)]
     pub straight: Option<StraightDto>,
@@ -831,6 +838,71 @@ pub struct PointsCentrelineDto {
     /// Direction of ϑ = 0 at the start.
     #[serde(default)]
     pub reference: Option<Vector>,
+}
+
+/// A vessel centreline from a file: one polyline, a segment of it, smoothed by a cubic spline.
+#[derive(Debug, Clone, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct FileCentrelineDto {
+    /// The file (`.vtp`, `.vtk`, `.pth`, `.csv`), relative to the design file's folder or absolute.
+    pub path: String,
+    /// Which polyline: its index in the file (from 0) or `longest` (default).
+    #[serde(default)]
+    pub polyline: Option<PolylineChoiceDto>,
+    /// Walk the polyline from its last point.
+    #[serde(default)]
+    pub reverse: bool,
+    /// Arc length along the polyline where the segment starts [the design's length unit] (default 0).
+    #[serde(default)]
+    pub start: Option<NonNegative>,
+    /// Length of the segment [the design's length unit] (default: to the polyline's end).
+    #[serde(default)]
+    pub length: Option<Positive>,
+    /// The file's length unit: `mm`, `cm` or `m` (default: the design's).
+    #[serde(default)]
+    pub unit: Option<FileUnitDto>,
+    /// Largest distance of the smooth centreline from the file's points [the design's length unit] (default:
+    /// a thousandth of the segment's length).
+    #[serde(default)]
+    pub smoothing: Option<Positive>,
+    /// The point array holding the lumen radius (default `MaximumInscribedSphereRadius`, VMTK's).
+    #[serde(default)]
+    pub radius_array: Option<String>,
+    /// Direction of ϑ = 0 at the start.
+    #[serde(default)]
+    pub reference: Option<Vector>,
+}
+
+/// Which polyline of a centreline file.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, JsonSchema)]
+#[serde(untagged)]
+pub enum PolylineChoiceDto {
+    /// Its index, from 0.
+    Index(usize),
+    /// `longest`.
+    Keyword(PolylineKeywordDto),
+}
+
+/// `longest`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, JsonSchema)]
+#[serde(rename_all = "snake_case")]
+pub enum PolylineKeywordDto {
+    /// The longest polyline.
+    Longest,
+}
+
+/// A centreline file's length unit.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, JsonSchema)]
+pub enum FileUnitDto {
+    /// Millimetres.
+    #[serde(rename = "mm")]
+    Mm,
+    /// Centimetres.
+    #[serde(rename = "cm")]
+    Cm,
+    /// Metres.
+    #[serde(rename = "m")]
+    M,
 }
 
 /// Symmetry keyword.

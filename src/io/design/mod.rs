@@ -18,6 +18,7 @@ pub mod size;
 
 pub mod stent;
 mod tuned;
+pub mod vessel;
 
 pub use set::SetOverride;
 pub use tuned::{TunedChoice, TunedTextError, tuned_text};
@@ -97,6 +98,8 @@ pub struct Design {
     pub output: OutputSettings,
     /// Things worth knowing that do not stop a run.
     pub warnings: Vec<String>,
+    /// How the design was read where it involved a choice (a file centreline's fit), for `check`.
+    pub notes: Vec<String>,
     /// The memory a run is estimated to need (below [`size::MEMORY_LIMIT_BYTES`]: larger designs are refused).
     pub memory: size::MemoryEstimate,
     /// The steps a run takes when no step is cut ([`Model::planned_steps`], computed once here: it sorts every
@@ -401,6 +404,7 @@ pub fn parse_design_with(
         }
         let dto: dto::DesignDto = serde_path_to_error::deserialize(root.clone())
             .map_err(|e| owned(read_error(&e, &locator, &file), &applied))?;
+        vessel::absolute_file_paths(&mut root, path.parent().unwrap_or(Path::new("")));
         let source =
             set::resolved_text(&root, path, &overrides.sets).map_err(|e| DesignError::Invalid {
                 file: file.clone(),
@@ -412,6 +416,24 @@ pub fn parse_design_with(
         (dto, source, applied)
     };
     overrides.apply(&mut dto);
+    // Centreline files are named relative to the design file.
+    let dir = path.parent().unwrap_or(Path::new(""));
+    for c in [
+        dto.stent.as_mut().map(|s| &mut s.centreline),
+        dto.programme
+            .as_mut()
+            .and_then(|p| p.temporary.as_mut())
+            .and_then(|t| t.centreline.as_mut()),
+    ]
+    .into_iter()
+    .flatten()
+    {
+        if let Some(f) = &mut c.file
+            && Path::new(&f.path).is_relative()
+        {
+            f.path = dir.join(&f.path).to_string_lossy().into_owned();
+        }
+    }
     if overrides.crowns.is_some() && dto.stent.is_none() {
         let pos = locator.find("stent");
         return Err(DesignError::Invalid {
@@ -439,6 +461,7 @@ pub fn parse_design_with(
         model: built.model,
         output: built.output,
         warnings: built.warnings,
+        notes: built.notes,
         memory: built.memory,
         steps: built.steps,
         source,

@@ -26,6 +26,7 @@
 
 use super::dto::*;
 use super::issue::{Result, issue, mesh_key_path};
+use super::vessel::{VesselCentreline, tightest_bend, vessel_centreline};
 use crate::geometry::stent::{
     BridgeDirection, BridgeShape, BridgeSpec, CentrelineSpec, CrownSpec, StentParameter, StentSpec,
     Symmetry, TemporaryCentreline, TemporarySpec,
@@ -85,37 +86,55 @@ pub(super) fn field_path(field: StentField, dto: &DesignDto) -> String {
     }
 }
 
-fn centreline(c: &CentrelineDto, path: &str) -> Result<CentrelineSpec> {
-    let given = [c.straight.is_some(), c.arc.is_some(), c.points.is_some()];
+/// A centreline of the design; a `file` one is read, cut and fitted ([`super::vessel`]) and returned with it.
+fn centreline(
+    c: &CentrelineDto,
+    path: &str,
+    metres_per_unit: Real,
+    radius_needed: bool,
+) -> Result<(CentrelineSpec, Option<VesselCentreline>)> {
+    let given = [
+        c.straight.is_some(),
+        c.arc.is_some(),
+        c.points.is_some(),
+        c.file.is_some(),
+    ];
     if given.iter().filter(|&&g| g).count() != 1 {
         return Err(issue(
             path,
-            "give exactly one of `straight`, `arc` or `points`",
+            "give exactly one of `straight`, `arc`, `points` or `file`",
         ));
     }
+    if let Some(f) = &c.file {
+        let vessel = vessel_centreline(f, &format!("{path}.file"), metres_per_unit, radius_needed)?;
+        return Ok((vessel.spec.clone(), Some(vessel)));
+    }
     let reference = |r: &Option<Vector>| r.as_ref().map(vec3);
-    Ok(if let Some(s) = &c.straight {
-        CentrelineSpec::Straight {
-            origin: s.origin.as_ref().map_or_else(Vec3::zeros, vec3),
-            direction: s.direction.as_ref().map_or_else(Vec3::x, vec3),
-            reference: reference(&s.reference),
-        }
-    } else if let Some(a) = &c.arc {
-        CentrelineSpec::Arc {
-            centre: vec3(&a.center),
-            start: vec3(&a.start),
-            axis: vec3(&a.axis),
-            angle: a.angle_deg.0.to_radians(),
-            reference: reference(&a.reference),
-        }
-    } else if let Some(p) = &c.points {
-        CentrelineSpec::Points {
-            points: p.points.iter().map(vec3).collect(),
-            reference: reference(&p.reference),
-        }
-    } else {
-        unreachable!("exactly one centreline was checked above")
-    })
+    Ok((
+        if let Some(s) = &c.straight {
+            CentrelineSpec::Straight {
+                origin: s.origin.as_ref().map_or_else(Vec3::zeros, vec3),
+                direction: s.direction.as_ref().map_or_else(Vec3::x, vec3),
+                reference: reference(&s.reference),
+            }
+        } else if let Some(a) = &c.arc {
+            CentrelineSpec::Arc {
+                centre: vec3(&a.center),
+                start: vec3(&a.start),
+                axis: vec3(&a.axis),
+                angle: a.angle_deg.0.to_radians(),
+                reference: reference(&a.reference),
+            }
+        } else if let Some(p) = &c.points {
+            CentrelineSpec::Points {
+                points: p.points.iter().map(vec3).collect(),
+                reference: reference(&p.reference),
+            }
+        } else {
+            unreachable!("exactly one centreline was checked above")
+        },
+        None,
+    ))
 }
 
 fn bridges(b: &BridgesDto) -> Result<BridgeSpec> {
@@ -167,32 +186,91 @@ fn bridges(b: &BridgesDto) -> Result<BridgeSpec> {
     })
 }
 
-/// The specification of a `stent:` block.
-pub fn spec(dto: &StentDto) -> Result<StentSpec> {
-    Ok(StentSpec {
-        crown: CrownSpec {
-            radius: dto.radius.0,
-            amplitude: dto.amplitude.0,
-            peaks: dto.peaks,
+/// The specification of a `stent:` block (lengths in units of `metres_per_unit` metres), with what `check`
+/// says about a file centreline.
+pub fn spec(dto: &StentDto, metres_per_unit: Real) -> Result<(StentSpec, Vec<String>)> {
+    let sized = dto.oversize.is_some();
+    let (axis, vessel) = centreline(&dto.centreline, "stent.centreline", metres_per_unit, sized)?;
+    let radius = match (
+        dto.radius,
+        dto.oversize,
+        vessel.as_ref().and_then(|v| v.mean_radius),
+    ) {
+        (Some(r), None, _) => r.0,
+        (None, Some(o), Some(lumen)) => lumen * (1.0 + o.0),
+        (Some(_), Some(_), _) => {
+            return Err(issue(
+                "stent.oversize",
+                "give `radius` or `oversize`, not both",
+            ));
+        }
+        (None, Some(_), None) => {
+            return Err(issue(
+                "stent.oversize",
+                "sizing from the lumen needs a `file` centreline with the lumen radius",
+            ));
+        }
+        (None, None, _) => {
+            return Err(issue(
+                "stent",
+                "give `radius` (the crown radius), or `oversize` with a `file` centreline that has the lumen radius",
+            ));
+        }
+    };
+    let mut notes = Vec::new();
+    if let Some(v) = &vessel {
+        notes.push(format!(
+            "centreline from {}: a {}-point segment {:.4} long, fitted by a cubic with {} control points within {:.3e} of its points{}",
+            dto.centreline.file.as_ref().map_or("", |f| f.path.as_str()),
+            v.points,
+            v.length,
+            v.control_points,
+            v.deviation,
+            v.mean_radius.map_or_else(String::new, |r| format!(
+                "; mean lumen radius {r:.4}, stent radius {radius:.4}"
+            ))
+        ));
+        if let Some((bend, u)) = tightest_bend(&axis)
+            && bend < radius
+        {
+            return Err(issue(
+                "stent.centreline.file",
+                format!(
+                    "the centreline bends with a radius of curvature {} (at {:.0} % of the segment), less than the stent radius {}: the crowns would fold onto themselves; smooth it more or choose another segment",
+                    crate::math::Short(bend),
+                    100.0 * u,
+                    crate::math::Short(radius)
+                ),
+            ));
+        }
+    }
+    Ok((
+        StentSpec {
+            crown: CrownSpec {
+                radius,
+                amplitude: dto.amplitude.0,
+                peaks: dto.peaks,
+            },
+            crowns: dto.crowns,
+            spacing: dto.spacing.map(|d| d.0),
+            // Reduced to (−360°, 360°): whole turns do not change the device, and angles of the size of the largest
+            // finite numbers have lost their precision.
+            rotation: dto
+                .rotation_deg
+                .map_or(std::f64::consts::PI / dto.peaks.max(1) as Real, |r| {
+                    (r.0 % 360.0).to_radians()
+                }),
+            bridges: dto.bridges.as_ref().map(bridges).transpose()?,
+            centreline: axis,
+            symmetry: match dto.symmetry {
+                None | Some(SymmetryDto::None) => Symmetry::None,
+                Some(SymmetryDto::Half) => Symmetry::Half,
+                Some(SymmetryDto::Quarter) => Symmetry::Quarter,
+            },
+            cut: !dto.full_model,
         },
-        crowns: dto.crowns,
-        spacing: dto.spacing.map(|d| d.0),
-        // Reduced to (−360°, 360°): whole turns do not change the device, and angles of the size of the largest
-        // finite numbers have lost their precision.
-        rotation: dto
-            .rotation_deg
-            .map_or(std::f64::consts::PI / dto.peaks.max(1) as Real, |r| {
-                (r.0 % 360.0).to_radians()
-            }),
-        bridges: dto.bridges.as_ref().map(bridges).transpose()?,
-        centreline: centreline(&dto.centreline, "stent.centreline")?,
-        symmetry: match dto.symmetry {
-            None | Some(SymmetryDto::None) => Symmetry::None,
-            Some(SymmetryDto::Half) => Symmetry::Half,
-            Some(SymmetryDto::Quarter) => Symmetry::Quarter,
-        },
-        cut: !dto.full_model,
-    })
+        notes,
+    ))
 }
 
 /// The crown and bridge discretisations: each role's own mesh, else the design's.
@@ -217,7 +295,7 @@ pub fn mesh(dto: &StentDto, mesh: Option<&MeshDto>) -> Result<StentMesh> {
 }
 
 /// The programme of a `programme:` block, with the checks of its form (which fields go with which kind).
-pub fn programme(dto: &ProgrammeDto) -> Result<ProgrammeSpec> {
+pub fn programme(dto: &ProgrammeDto, metres_per_unit: Real) -> Result<ProgrammeSpec> {
     let base = "programme";
     let target = match dto.kind {
         ProgrammeKindDto::RadialContraction => {
@@ -257,9 +335,9 @@ pub fn programme(dto: &ProgrammeDto) -> Result<ProgrammeSpec> {
                     ));
                 }
                 (true, None) => TemporaryCentreline::Straightened,
-                (false, Some(c)) => {
-                    TemporaryCentreline::Given(centreline(c, &format!("{tpath}.centreline"))?)
-                }
+                (false, Some(c)) => TemporaryCentreline::Given(
+                    centreline(c, &format!("{tpath}.centreline"), metres_per_unit, false)?.0,
+                ),
                 (false, None) => TemporaryCentreline::Same,
             };
             if matches!(centreline, TemporaryCentreline::Same) && t.radius.is_none() {

@@ -1,0 +1,942 @@
+//! Vessel centrelines from files: the polylines a clinician's pipeline hands over (VMTK, 3D Slicer's VMTK
+//! extension, SimVascular), with the local lumen radius where the file has it.
+//!
+//! | extension | format | radius |
+//! |---|---|---|
+//! | `.vtp` | VTK XML PolyData: `Lines` cells, any point array as the radius (VMTK: `MaximumInscribedSphereRadius`); arrays `ascii`, `binary` (base64, header `UInt32` or `UInt64`, zlib-compressed or not) or `appended` (`raw` or `base64`); several pieces | the named point array |
+//! | `.vtk` | legacy VTK POLYDATA, ASCII or binary (big-endian), `LINES` in the classic (`n size` with counts) or the VTK ≥ 9 (`OFFSETS`/`CONNECTIVITY`) layout; the radius as `SCALARS` or a `FIELD` array | the named point array |
+//! | `.pth` | SimVascular path: the `pos` of every `path_point` of every `path` | none |
+//! | `.csv` | `x,y,z[,radius]` with an optional header, `#` comments; one polyline | the fourth column |
+//!
+//! The XML formats are read with quick-xml, base64 and flate2; the binary layout follows VTK's
+//! `vtkXMLDataReader` (a header of `UInt32`/`UInt64` words — the byte count, or for compressed data the block
+//! count, block size, last block size and each block's compressed size — before the data; VTK writes a base64
+//! header and its data as separate streams, which are decoded piece by piece at each padding). vtkio (0.6.3 and
+//! 0.7.0-rc2) was tried first and refuses VMTK's files. Every file VTK's own writers make from the aorta
+//! centreline in each encoding reads here to the values VTK's reader gives (tests/data/centrelines/).
+//!
+//! A file is refused with its path and what is wrong: not the format its extension says, no polyline, a point
+//! that is not finite, a cell that names a point the file does not have, the radius array missing (when one is
+//! asked for; the arrays it does have are listed) or not positive.
+
+use crate::math::{Real, Vec3};
+use std::path::{Path, PathBuf};
+
+/// One polyline of a file, in its point order.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Polyline {
+    /// The points [the file's length unit].
+    pub points: Vec<Vec3>,
+    /// The lumen radius at each point, when the file has it.
+    pub radius: Option<Vec<Real>>,
+}
+
+impl Polyline {
+    /// Length of the polyline [the file's length unit].
+    pub fn length(&self) -> Real {
+        self.points.windows(2).map(|w| (w[1] - w[0]).norm()).sum()
+    }
+}
+
+/// Why a centreline file was refused.
+#[derive(Debug, thiserror::Error)]
+pub enum CentrelineError {
+    /// The file could not be read.
+    #[error("{}: cannot read the centreline: {source}", path.display())]
+    Read {
+        /// The file.
+        path: PathBuf,
+        /// The operating-system error.
+        source: std::io::Error,
+    },
+    /// The file's content is not a usable centreline.
+    #[error("{}: {message}", path.display())]
+    Invalid {
+        /// The file.
+        path: PathBuf,
+        /// What is wrong.
+        message: String,
+    },
+}
+
+/// Reads the polylines of the centreline file at `path` (module docs), the radius from the point array
+/// `radius_array` (`.vtp`, `.vtk`) when given.
+///
+/// # Errors
+/// [`CentrelineError`] naming the file and what is wrong.
+pub fn read_centreline(
+    path: &Path,
+    radius_array: Option<&str>,
+) -> Result<Vec<Polyline>, CentrelineError> {
+    let bytes = std::fs::read(path).map_err(|source| CentrelineError::Read {
+        path: path.to_path_buf(),
+        source,
+    })?;
+    let extension = path
+        .extension()
+        .and_then(|e| e.to_str())
+        .map(str::to_ascii_lowercase);
+    let result = match extension.as_deref() {
+        Some("vtp") => vtp::read(&bytes, radius_array),
+        Some("vtk") => legacy::read(&bytes, radius_array),
+        Some("pth") => read_pth(&bytes),
+        Some("csv") => read_csv(&bytes),
+        _ => Err("unknown centreline format: give a .vtp, .vtk, .pth or .csv file".to_string()),
+    };
+    result
+        .and_then(|polylines| validate(polylines, radius_array))
+        .map_err(|message| CentrelineError::Invalid {
+            path: path.to_path_buf(),
+            message,
+        })
+}
+
+/// Checks what every format must give: at least one polyline of two points or more, finite points, and the
+/// radius (when asked for) finite and positive.
+fn validate(polylines: Vec<Polyline>, radius_array: Option<&str>) -> Result<Vec<Polyline>, String> {
+    if polylines.iter().all(|p| p.points.len() < 2) {
+        return Err("no polyline of two or more points (a centreline needs `Lines` cells)".into());
+    }
+    for (k, line) in polylines.iter().enumerate() {
+        if let Some(i) = line
+            .points
+            .iter()
+            .position(|p| !p.iter().all(|x| x.is_finite()))
+        {
+            return Err(format!(
+                "polyline {k}: point {i} is not finite ({:?})",
+                line.points[i].as_slice()
+            ));
+        }
+        if let (Some(name), Some(radius)) = (radius_array, &line.radius)
+            && let Some(i) = radius.iter().position(|r| !(r.is_finite() && *r > 0.0))
+        {
+            return Err(format!(
+                "polyline {k}: the radius `{name}` at point {i} is {}, not a positive number",
+                radius[i]
+            ));
+        }
+    }
+    Ok(polylines)
+}
+
+/// `x,y,z[,radius]` lines; a first line that is not numbers is a header; `#` starts a comment.
+fn read_csv(bytes: &[u8]) -> Result<Vec<Polyline>, String> {
+    let text = std::str::from_utf8(bytes).map_err(|_| "not a text file (CSV)".to_string())?;
+    let (mut points, mut radius) = (Vec::new(), Vec::new());
+    let mut columns = None;
+    for (number, line) in text.lines().enumerate() {
+        let line = line.split('#').next().unwrap_or("").trim();
+        if line.is_empty() {
+            continue;
+        }
+        let fields: Result<Vec<Real>, _> =
+            line.split(',').map(|f| f.trim().parse::<Real>()).collect();
+        let Ok(fields) = fields else {
+            if points.is_empty() && columns.is_none() {
+                columns = Some(0); // a header
+                continue;
+            }
+            return Err(format!("line {}: `{line}` is not numbers", number + 1));
+        };
+        if !(3..=4).contains(&fields.len()) || columns.is_some_and(|c| c != 0 && c != fields.len())
+        {
+            return Err(format!(
+                "line {}: expected x,y,z or x,y,z,radius, found {} values",
+                number + 1,
+                fields.len()
+            ));
+        }
+        columns = Some(fields.len());
+        points.push(Vec3::new(fields[0], fields[1], fields[2]));
+        if let Some(&r) = fields.get(3) {
+            radius.push(r);
+        }
+    }
+    let radius = (columns == Some(4)).then_some(radius);
+    Ok(vec![Polyline { points, radius }])
+}
+
+/// A SimVascular path file: the `pos` of every `path_point`, one polyline per `path`.
+fn read_pth(bytes: &[u8]) -> Result<Vec<Polyline>, String> {
+    use quick_xml::events::Event;
+    let mut reader = quick_xml::Reader::from_reader(bytes);
+    let mut buf = Vec::new();
+    let (mut polylines, mut current, mut in_path_point) = (Vec::new(), Vec::new(), false);
+    let mut seen_path = false;
+    loop {
+        let event = reader
+            .read_event_into(&mut buf)
+            .map_err(|e| format!("not a SimVascular path file (XML): {e}"))?;
+        match event {
+            Event::Start(e) | Event::Empty(e) => match e.name().as_ref() {
+                b"path" => seen_path = true,
+                b"path_point" => in_path_point = true,
+                b"pos" if in_path_point => {
+                    let attrs = attributes(&e)?;
+                    let coordinate = |k: &str| {
+                        attrs
+                            .iter()
+                            .find(|(n, _)| n == k)
+                            .and_then(|(_, v)| v.trim().parse::<Real>().ok())
+                            .ok_or_else(|| format!("a path point's `pos` has no number `{k}`"))
+                    };
+                    current.push(Vec3::new(
+                        coordinate("x")?,
+                        coordinate("y")?,
+                        coordinate("z")?,
+                    ));
+                }
+                _ => {}
+            },
+            Event::End(e) => match e.name().as_ref() {
+                b"path_point" => in_path_point = false,
+                b"path" if !current.is_empty() => polylines.push(Polyline {
+                    points: std::mem::take(&mut current),
+                    radius: None,
+                }),
+                _ => {}
+            },
+            Event::Eof => break,
+            _ => {}
+        }
+        buf.clear();
+    }
+    if !seen_path {
+        return Err("not a SimVascular path file: no <path> element".into());
+    }
+    if !current.is_empty() {
+        polylines.push(Polyline {
+            points: current,
+            radius: None,
+        });
+    }
+    Ok(polylines)
+}
+
+/// An XML element's attributes as (name, value) strings.
+fn attributes(e: &quick_xml::events::BytesStart<'_>) -> Result<Vec<(String, String)>, String> {
+    e.attributes()
+        .map(|a| {
+            let a = a.map_err(|e| format!("bad XML attribute: {e}"))?;
+            let value = a
+                .unescape_value()
+                .map_err(|e| format!("bad XML attribute value: {e}"))?;
+            Ok((
+                String::from_utf8_lossy(a.key.as_ref()).into_owned(),
+                value.into_owned(),
+            ))
+        })
+        .collect()
+}
+
+/// The numeric types of VTK arrays.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Scalar {
+    I8,
+    U8,
+    I16,
+    U16,
+    I32,
+    U32,
+    I64,
+    U64,
+    F32,
+    F64,
+}
+
+impl Scalar {
+    /// From an XML `type` (`Float32`) or a legacy type name (`float`, `vtktypeint64`).
+    fn parse(name: &str) -> Option<Self> {
+        Some(match name.to_ascii_lowercase().as_str() {
+            "int8" | "char" | "signed_char" => Self::I8,
+            "uint8" | "unsigned_char" | "bit" => Self::U8,
+            "int16" | "short" => Self::I16,
+            "uint16" | "unsigned_short" => Self::U16,
+            "int32" | "int" => Self::I32,
+            "uint32" | "unsigned_int" => Self::U32,
+            "int64" | "long" | "vtktypeint64" | "vtkidtype" => Self::I64,
+            "uint64" | "unsigned_long" | "vtktypeuint64" => Self::U64,
+            "float32" | "float" => Self::F32,
+            "float64" | "double" => Self::F64,
+            _ => return None,
+        })
+    }
+
+    fn size(self) -> usize {
+        match self {
+            Self::I8 | Self::U8 => 1,
+            Self::I16 | Self::U16 => 2,
+            Self::I32 | Self::U32 | Self::F32 => 4,
+            Self::I64 | Self::U64 | Self::F64 => 8,
+        }
+    }
+
+    /// The values of `bytes` (whole elements only), little-endian unless `big`.
+    fn values(self, bytes: &[u8], big: bool) -> Vec<Real> {
+        let n = self.size();
+        bytes
+            .chunks_exact(n)
+            .map(|c| {
+                let mut b = [0u8; 8];
+                b[..n].copy_from_slice(c);
+                if big {
+                    b[..n].reverse();
+                }
+                match self {
+                    Self::I8 => Real::from(b[0] as i8),
+                    Self::U8 => Real::from(b[0]),
+                    Self::I16 => Real::from(i16::from_le_bytes([b[0], b[1]])),
+                    Self::U16 => Real::from(u16::from_le_bytes([b[0], b[1]])),
+                    Self::I32 => Real::from(i32::from_le_bytes([b[0], b[1], b[2], b[3]])),
+                    Self::U32 => Real::from(u32::from_le_bytes([b[0], b[1], b[2], b[3]])),
+                    Self::I64 => i64::from_le_bytes(b) as Real,
+                    Self::U64 => u64::from_le_bytes(b) as Real,
+                    Self::F32 => Real::from(f32::from_le_bytes([b[0], b[1], b[2], b[3]])),
+                    Self::F64 => f64::from_le_bytes(b),
+                }
+            })
+            .collect()
+    }
+}
+
+/// Polylines from cell connectivity and per-cell end offsets (XML and VTK ≥ 9 layout: `offsets[k]` is where
+/// cell `k` ends; a leading 0 is allowed).
+fn polylines_from_offsets(
+    points: &[Vec3],
+    radius: Option<&[Real]>,
+    connectivity: &[Real],
+    offsets: &[Real],
+) -> Result<Vec<Polyline>, String> {
+    let mut start = 0usize;
+    let mut lines = Vec::new();
+    for &end in offsets {
+        let end = end as usize;
+        if end == 0 && start == 0 {
+            continue;
+        }
+        if end < start || end > connectivity.len() {
+            return Err(format!(
+                "a line's offset {end} is outside its {} connectivity entries",
+                connectivity.len()
+            ));
+        }
+        lines.push(polyline(points, radius, &connectivity[start..end])?);
+        start = end;
+    }
+    Ok(lines)
+}
+
+/// One polyline through the point ids `ids`.
+fn polyline(points: &[Vec3], radius: Option<&[Real]>, ids: &[Real]) -> Result<Polyline, String> {
+    let ids: Vec<usize> = ids
+        .iter()
+        .map(|&i| {
+            (i >= 0.0 && (i as usize) < points.len())
+                .then_some(i as usize)
+                .ok_or_else(|| {
+                    format!(
+                        "a line names point {i}, but the file has {} points",
+                        points.len()
+                    )
+                })
+        })
+        .collect::<Result<_, _>>()?;
+    Ok(Polyline {
+        points: ids.iter().map(|&i| points[i]).collect(),
+        radius: radius.map(|r| ids.iter().map(|&i| r[i]).collect()),
+    })
+}
+
+/// The point triples of a flat array.
+fn triples(values: &[Real], what: &str) -> Result<Vec<Vec3>, String> {
+    if !values.len().is_multiple_of(3) {
+        return Err(format!(
+            "{what} holds {} numbers, not a multiple of 3",
+            values.len()
+        ));
+    }
+    Ok(values
+        .chunks_exact(3)
+        .map(|c| Vec3::new(c[0], c[1], c[2]))
+        .collect())
+}
+
+/// The radius array `name` among `arrays` (name, components, values) of `count` points.
+fn radius_values(
+    arrays: &[(String, usize, Vec<Real>)],
+    name: Option<&str>,
+    count: usize,
+) -> Result<Option<Vec<Real>>, String> {
+    let Some(name) = name else {
+        return Ok(None);
+    };
+    match arrays.iter().find(|(n, _, _)| n == name) {
+        Some((_, 1, values)) if values.len() == count => Ok(Some(values.clone())),
+        Some((_, c, values)) => Err(format!(
+            "the radius array `{name}` has {c} components and {} values for {count} points",
+            values.len()
+        )),
+        None => Err(format!(
+            "no point array `{name}` (the lumen radius); the file's point arrays: {}",
+            if arrays.is_empty() {
+                "none".to_string()
+            } else {
+                arrays
+                    .iter()
+                    .map(|(n, _, _)| format!("`{n}`"))
+                    .collect::<Vec<_>>()
+                    .join(", ")
+            }
+        )),
+    }
+}
+
+mod vtp {
+    //! VTK XML PolyData (module docs of [`super`]).
+
+    use super::{Polyline, Scalar, attributes, polylines_from_offsets, radius_values, triples};
+    use crate::math::Real;
+    use base64::Engine as _;
+    use quick_xml::events::Event;
+    use std::io::Read as _;
+
+    /// One `DataArray` as written.
+    struct Array {
+        /// The enclosing element: `Points`, `PointData`, `Lines`, `Verts`, …
+        section: String,
+        /// Its attributes.
+        attrs: Vec<(String, String)>,
+        /// Its text (ascii or inline base64).
+        text: String,
+    }
+
+    impl Array {
+        fn attr(&self, name: &str) -> Option<&str> {
+            self.attrs
+                .iter()
+                .find(|(n, _)| n == name)
+                .map(|(_, v)| v.as_str())
+        }
+    }
+
+    /// How the file encodes its binary data.
+    struct Layout<'a> {
+        big: bool,
+        header: Scalar,
+        compressed: bool,
+        /// The bytes after `_` in `<AppendedData>`, and whether they are base64.
+        appended: Option<(&'a [u8], bool)>,
+    }
+
+    pub(super) fn read(bytes: &[u8], radius_array: Option<&str>) -> Result<Vec<Polyline>, String> {
+        // Appended raw data is binary: the XML parser reads only what comes before it.
+        let appended_at = find(bytes, b"<AppendedData");
+        let head = &bytes[..appended_at.unwrap_or(bytes.len())];
+        let mut reader = quick_xml::Reader::from_reader(head);
+        let mut buf = Vec::new();
+        let (mut stack, mut arrays, mut pieces) = (Vec::<String>::new(), Vec::new(), Vec::new());
+        let mut root: Option<Vec<(String, String)>> = None;
+        let mut current: Option<Array> = None;
+        loop {
+            let event = match reader.read_event_into(&mut buf) {
+                Ok(e) => e,
+                // A document cut before its appended data ends early: what was read stands.
+                Err(_) if appended_at.is_some() && root.is_some() => break,
+                Err(e) => return Err(format!("not VTK XML PolyData: {e}")),
+            };
+            let empty = matches!(event, Event::Empty(_));
+            match event {
+                Event::Start(e) | Event::Empty(e) => {
+                    let name = String::from_utf8_lossy(e.name().as_ref()).into_owned();
+                    match name.as_str() {
+                        "VTKFile" => root = Some(attributes(&e)?),
+                        "Piece" => pieces.push(arrays.len()),
+                        "DataArray" => {
+                            let array = Array {
+                                section: stack.last().cloned().unwrap_or_default(),
+                                attrs: attributes(&e)?,
+                                text: String::new(),
+                            };
+                            if empty {
+                                arrays.push(array);
+                            } else {
+                                current = Some(array);
+                            }
+                        }
+                        _ => {}
+                    }
+                    if !empty && name != "DataArray" {
+                        stack.push(name);
+                    }
+                }
+                Event::Text(t) => {
+                    if let Some(a) = &mut current {
+                        a.text.push_str(&String::from_utf8_lossy(&t));
+                    }
+                }
+                Event::End(e) => {
+                    if e.name().as_ref() == b"DataArray" {
+                        arrays.extend(current.take());
+                    } else {
+                        stack.pop();
+                    }
+                }
+                Event::Eof => break,
+                _ => {}
+            }
+            buf.clear();
+        }
+        let root = root.ok_or("not VTK XML PolyData: no <VTKFile> element")?;
+        let get = |n: &str| root.iter().find(|(k, _)| k == n).map(|(_, v)| v.as_str());
+        if get("type") != Some("PolyData") {
+            return Err(format!(
+                "a VTK XML file of type `{}`, not PolyData",
+                get("type").unwrap_or("?")
+            ));
+        }
+        let compressed = match get("compressor") {
+            None | Some("") => false,
+            Some("vtkZLibDataCompressor") => true,
+            Some(other) => {
+                return Err(format!(
+                    "compressed with {other}: only zlib (vtkZLibDataCompressor) or no compression is read"
+                ));
+            }
+        };
+        let header = match get("header_type") {
+            None | Some("UInt32") => Scalar::U32,
+            Some("UInt64") => Scalar::U64,
+            Some(other) => return Err(format!("header_type {other}: expected UInt32 or UInt64")),
+        };
+        let appended = match appended_at {
+            Some(at) => Some(appended_data(&bytes[at..])?),
+            None => None,
+        };
+        let layout = Layout {
+            big: get("byte_order") == Some("BigEndian"),
+            header,
+            compressed,
+            appended,
+        };
+        let mut polylines = Vec::new();
+        pieces.push(arrays.len());
+        for w in pieces.windows(2) {
+            polylines.extend(piece(&arrays[w[0]..w[1]], &layout, radius_array)?);
+        }
+        Ok(polylines)
+    }
+
+    /// The polylines of one piece.
+    fn piece(
+        arrays: &[Array],
+        layout: &Layout<'_>,
+        radius_array: Option<&str>,
+    ) -> Result<Vec<Polyline>, String> {
+        fn in_section<'a>(
+            arrays: &'a [Array],
+            section: &'a str,
+        ) -> impl Iterator<Item = &'a Array> {
+            arrays.iter().filter(move |a| a.section == section)
+        }
+        let Some(points) = in_section(arrays, "Points").next() else {
+            return Ok(Vec::new());
+        };
+        let points = triples(&values(points, layout)?, "the Points array")?;
+        let mut point_arrays = Vec::new();
+        for a in in_section(arrays, "PointData") {
+            let components = a
+                .attr("NumberOfComponents")
+                .and_then(|c| c.parse().ok())
+                .unwrap_or(1);
+            point_arrays.push((
+                a.attr("Name").unwrap_or("").to_string(),
+                components,
+                values(a, layout)?,
+            ));
+        }
+        let radius = radius_values(&point_arrays, radius_array, points.len())?;
+        let named = |name: &str| in_section(arrays, "Lines").find(|a| a.attr("Name") == Some(name));
+        let (Some(connectivity), Some(offsets)) = (named("connectivity"), named("offsets")) else {
+            return Ok(Vec::new());
+        };
+        polylines_from_offsets(
+            &points,
+            radius.as_deref(),
+            &values(connectivity, layout)?,
+            &values(offsets, layout)?,
+        )
+    }
+
+    /// The values of an array, whatever its format.
+    fn values(a: &Array, layout: &Layout<'_>) -> Result<Vec<Real>, String> {
+        let name = a.attr("Name").unwrap_or("(unnamed)");
+        let scalar = a
+            .attr("type")
+            .and_then(Scalar::parse)
+            .ok_or_else(|| format!("array `{name}`: unknown type {:?}", a.attr("type")))?;
+        let bytes = match a.attr("format").unwrap_or("ascii") {
+            "ascii" => {
+                return a
+                    .text
+                    .split_whitespace()
+                    .map(|t| t.parse::<Real>())
+                    .collect::<Result<_, _>>()
+                    .map_err(|e| format!("array `{name}`: {e}"));
+            }
+            "binary" => block(&decode_base64(a.text.trim().as_bytes())?, layout)?,
+            "appended" => {
+                let (data, base64) = layout.appended.ok_or_else(|| {
+                    format!("array `{name}` is appended, but the file has no <AppendedData>")
+                })?;
+                let offset: usize = a
+                    .attr("offset")
+                    .and_then(|o| o.parse().ok())
+                    .ok_or_else(|| format!("array `{name}` is appended without an offset"))?;
+                let data = data.get(offset..).ok_or_else(|| {
+                    format!("array `{name}`: offset {offset} is past the appended data")
+                })?;
+                if base64 {
+                    // Up to the next array (decoding stops at the first block's end anyway).
+                    let end = data.iter().position(|&c| c == b'<').unwrap_or(data.len());
+                    block(&decode_base64(&data[..end])?, layout)?
+                } else {
+                    block(data, layout)?
+                }
+            }
+            other => return Err(format!("array `{name}`: unknown format `{other}`")),
+        };
+        Ok(scalar.values(&bytes, layout.big))
+    }
+
+    /// The data of one binary block (header and data, module docs of [`super`]).
+    fn block(bytes: &[u8], layout: &Layout<'_>) -> Result<Vec<u8>, String> {
+        let size = layout.header.size();
+        let word = |k: usize| -> Result<usize, String> {
+            bytes
+                .get(k * size..(k + 1) * size)
+                .map(|w| layout.header.values(w, layout.big)[0] as usize)
+                .ok_or_else(|| "a binary array ends inside its header".to_string())
+        };
+        if !layout.compressed {
+            let n = word(0)?;
+            return bytes
+                .get(size..size + n)
+                .map(<[u8]>::to_vec)
+                .ok_or_else(|| format!("a binary array says {n} bytes but holds fewer"));
+        }
+        let blocks = word(0)?;
+        let mut at = (3 + blocks) * size;
+        let mut out = Vec::new();
+        for k in 0..blocks {
+            let compressed = word(3 + k)?;
+            let chunk = bytes
+                .get(at..at + compressed)
+                .ok_or("a compressed array ends inside a block")?;
+            flate2::read::ZlibDecoder::new(chunk)
+                .read_to_end(&mut out)
+                .map_err(|e| format!("a compressed block does not inflate: {e}"))?;
+            at += compressed;
+        }
+        Ok(out)
+    }
+
+    /// Base64 text that may be several streams, each padded (VTK encodes a header and its data separately):
+    /// decoded piece by piece at each padding.
+    fn decode_base64(text: &[u8]) -> Result<Vec<u8>, String> {
+        let clean: Vec<u8> = text
+            .iter()
+            .copied()
+            .filter(|c| !c.is_ascii_whitespace())
+            .collect();
+        let mut out = Vec::new();
+        let mut start = 0;
+        while start < clean.len() {
+            // A piece ends after its padding, or at a multiple of 4 before a padded group.
+            let mut end = start;
+            while end < clean.len() && clean[end] != b'=' {
+                end += 1;
+            }
+            while end < clean.len() && clean[end] == b'=' {
+                end += 1;
+            }
+            base64::engine::general_purpose::STANDARD
+                .decode_vec(&clean[start..end], &mut out)
+                .map_err(|e| format!("bad base64 data: {e}"))?;
+            start = end;
+        }
+        Ok(out)
+    }
+
+    /// The appended bytes after `_`, and whether they are base64 (`encoding="base64"`).
+    fn appended_data(from: &[u8]) -> Result<(&[u8], bool), String> {
+        let tag_end = from
+            .iter()
+            .position(|&c| c == b'>')
+            .ok_or("an unfinished <AppendedData> tag")?;
+        let tag = String::from_utf8_lossy(&from[..tag_end]);
+        let base64 = !tag.contains("\"raw\"");
+        let rest = &from[tag_end + 1..];
+        let underscore = rest
+            .iter()
+            .position(|&c| c == b'_')
+            .ok_or("<AppendedData> without the `_` that starts its data")?;
+        Ok((&rest[underscore + 1..], base64))
+    }
+
+    /// The first position of `needle` in `haystack`.
+    fn find(haystack: &[u8], needle: &[u8]) -> Option<usize> {
+        haystack.windows(needle.len()).position(|w| w == needle)
+    }
+
+    #[cfg(test)]
+    mod tests {
+        use super::decode_base64;
+        use base64::Engine as _;
+
+        /// Source: RFC 4648 base64; two separately padded streams decode to their concatenation.
+        #[test]
+        fn separately_padded_streams_decode_in_turn() {
+            let e = |b: &[u8]| base64::engine::general_purpose::STANDARD.encode(b);
+            let text = format!("{}{}", e(&[1, 2, 3, 4]), e(b"hello world"));
+            assert_eq!(
+                decode_base64(text.as_bytes()).expect("decodes"),
+                [&[1u8, 2, 3, 4][..], b"hello world"].concat()
+            );
+            let single = e(&[7u8; 10]);
+            assert_eq!(
+                decode_base64(single.as_bytes()).expect("decodes"),
+                vec![7u8; 10]
+            );
+        }
+    }
+}
+
+mod legacy {
+    //! Legacy VTK POLYDATA, ASCII or binary (module docs of [`super`]).
+
+    use super::{Polyline, Scalar, polyline, polylines_from_offsets, radius_values, triples};
+    use crate::math::Real;
+
+    /// A cursor over the file: words in ASCII sections, raw big-endian values in binary ones.
+    struct Cursor<'a> {
+        bytes: &'a [u8],
+        at: usize,
+        binary: bool,
+    }
+
+    impl<'a> Cursor<'a> {
+        /// The next line (without its end), or `None` at the end.
+        fn line(&mut self) -> Option<&'a str> {
+            if self.at >= self.bytes.len() {
+                return None;
+            }
+            let rest = &self.bytes[self.at..];
+            let end = rest.iter().position(|&c| c == b'\n').unwrap_or(rest.len());
+            self.at += end + 1;
+            Some(std::str::from_utf8(&rest[..end]).unwrap_or("").trim())
+        }
+
+        /// The next non-empty line.
+        fn keyword_line(&mut self) -> Option<&'a str> {
+            loop {
+                let l = self.line()?;
+                if !l.is_empty() {
+                    return Some(l);
+                }
+            }
+        }
+
+        /// The next whitespace-separated word.
+        fn word(&mut self) -> Option<&'a str> {
+            while self.at < self.bytes.len() && self.bytes[self.at].is_ascii_whitespace() {
+                self.at += 1;
+            }
+            let start = self.at;
+            while self.at < self.bytes.len() && !self.bytes[self.at].is_ascii_whitespace() {
+                self.at += 1;
+            }
+            (self.at > start)
+                .then(|| std::str::from_utf8(&self.bytes[start..self.at]).unwrap_or(""))
+        }
+
+        /// `count` values of type `scalar`.
+        fn values(&mut self, count: usize, scalar: Scalar) -> Result<Vec<Real>, String> {
+            if self.binary {
+                let n = count * scalar.size();
+                let bytes = self
+                    .bytes
+                    .get(self.at..self.at + n)
+                    .ok_or("the binary data ends early")?;
+                self.at += n;
+                // The line break after the binary block.
+                if self.bytes.get(self.at) == Some(&b'\n') {
+                    self.at += 1;
+                }
+                return Ok(scalar.values(bytes, true));
+            }
+            (0..count)
+                .map(|_| {
+                    let w = self.word().ok_or("the data ends early")?;
+                    w.parse::<Real>()
+                        .map_err(|_| format!("`{w}` is not a number"))
+                })
+                .collect()
+        }
+    }
+
+    /// The count and type after a keyword (`POINTS 409 float`).
+    fn count(words: &[&str], k: usize, line: &str) -> Result<usize, String> {
+        words
+            .get(k)
+            .and_then(|w| w.parse().ok())
+            .ok_or_else(|| format!("`{line}`: expected a count"))
+    }
+
+    pub(super) fn read(bytes: &[u8], radius_array: Option<&str>) -> Result<Vec<Polyline>, String> {
+        let mut c = Cursor {
+            bytes,
+            at: 0,
+            binary: false,
+        };
+        if !c.line().is_some_and(|l| l.starts_with("# vtk DataFile")) {
+            return Err("not a legacy VTK file: no `# vtk DataFile` first line".into());
+        }
+        c.line(); // the title
+        c.binary = match c.keyword_line() {
+            Some(l) if l.eq_ignore_ascii_case("ASCII") => false,
+            Some(l) if l.eq_ignore_ascii_case("BINARY") => true,
+            other => return Err(format!("expected ASCII or BINARY, found {other:?}")),
+        };
+        let (mut points, mut cells, mut offsets, mut connectivity) = (None, None, None, None);
+        let mut arrays: Vec<(String, usize, Vec<Real>)> = Vec::new();
+        while let Some(line) = c.keyword_line() {
+            let words: Vec<&str> = line.split_whitespace().collect();
+            match words[0].to_ascii_uppercase().as_str() {
+                "DATASET"
+                    if words
+                        .get(1)
+                        .is_some_and(|w| !w.eq_ignore_ascii_case("POLYDATA")) =>
+                {
+                    return Err(format!("a legacy VTK {} dataset, not POLYDATA", words[1]));
+                }
+                "POINTS" => {
+                    let n = count(&words, 1, line)?;
+                    let scalar = words
+                        .get(2)
+                        .and_then(|t| Scalar::parse(t))
+                        .ok_or("POINTS: unknown type")?;
+                    points = Some(triples(&c.values(3 * n, scalar)?, "POINTS")?);
+                }
+                "LINES" => {
+                    let (a, b) = (count(&words, 1, line)?, count(&words, 2, line)?);
+                    // VTK ≥ 9: `LINES nOffsets nConnectivity`, then OFFSETS and CONNECTIVITY arrays; before,
+                    // `LINES nCells size` and size integers (a count before each cell's ids).
+                    let save = c.at;
+                    match c.keyword_line() {
+                        Some(next) if next.starts_with("OFFSETS") => {
+                            let scalar = next
+                                .split_whitespace()
+                                .nth(1)
+                                .and_then(Scalar::parse)
+                                .ok_or("OFFSETS: unknown type")?;
+                            offsets = Some(c.values(a, scalar)?);
+                            let conn = c.keyword_line().unwrap_or("");
+                            let scalar = conn
+                                .split_whitespace()
+                                .nth(1)
+                                .and_then(Scalar::parse)
+                                .ok_or("CONNECTIVITY: expected after OFFSETS")?;
+                            connectivity = Some(c.values(b, scalar)?);
+                        }
+                        _ => {
+                            c.at = save;
+                            cells = Some(c.values(b, Scalar::I32)?);
+                        }
+                    }
+                }
+                "VERTICES" | "POLYGONS" | "TRIANGLE_STRIPS" => {
+                    let (a, b) = (count(&words, 1, line)?, count(&words, 2, line)?);
+                    let save = c.at;
+                    match c.keyword_line() {
+                        Some(next) if next.starts_with("OFFSETS") => {
+                            let s = next
+                                .split_whitespace()
+                                .nth(1)
+                                .and_then(Scalar::parse)
+                                .unwrap_or(Scalar::I64);
+                            c.values(a, s)?;
+                            let conn = c.keyword_line().unwrap_or("");
+                            let s = conn
+                                .split_whitespace()
+                                .nth(1)
+                                .and_then(Scalar::parse)
+                                .unwrap_or(Scalar::I64);
+                            c.values(b, s)?;
+                        }
+                        _ => {
+                            c.at = save;
+                            c.values(b, Scalar::I32)?;
+                        }
+                    }
+                }
+                "SCALARS" => {
+                    let name = words.get(1).copied().unwrap_or("").to_string();
+                    let scalar = words
+                        .get(2)
+                        .and_then(|t| Scalar::parse(t))
+                        .ok_or("SCALARS: unknown type")?;
+                    let components: usize = words.get(3).and_then(|w| w.parse().ok()).unwrap_or(1);
+                    let save = c.at;
+                    if !c
+                        .keyword_line()
+                        .is_some_and(|l| l.starts_with("LOOKUP_TABLE"))
+                    {
+                        c.at = save;
+                    }
+                    let n = points.as_ref().map_or(0, Vec::len);
+                    arrays.push((name, components, c.values(n * components, scalar)?));
+                }
+                "FIELD" => {
+                    let k = count(&words, 2, line)?;
+                    for _ in 0..k {
+                        let head = c.keyword_line().ok_or("FIELD: an array is missing")?;
+                        let w: Vec<&str> = head.split_whitespace().collect();
+                        let (components, tuples) = (count(&w, 1, head)?, count(&w, 2, head)?);
+                        let scalar = w
+                            .get(3)
+                            .and_then(|t| Scalar::parse(t))
+                            .ok_or("FIELD: unknown type")?;
+                        arrays.push((
+                            w[0].to_string(),
+                            components,
+                            c.values(components * tuples, scalar)?,
+                        ));
+                    }
+                }
+                "METADATA" => {
+                    // Information keys up to an empty line.
+                    while c.line().is_some_and(|l| !l.is_empty()) {}
+                }
+                _ => {}
+            }
+        }
+        let points = points.ok_or("no POINTS")?;
+        let radius = radius_values(&arrays, radius_array, points.len())?;
+        if let (Some(offsets), Some(connectivity)) = (&offsets, &connectivity) {
+            return polylines_from_offsets(&points, radius.as_deref(), connectivity, offsets);
+        }
+        let mut polylines = Vec::new();
+        let cells = cells.unwrap_or_default();
+        let mut at = 0;
+        while at < cells.len() {
+            let n = cells[at] as usize;
+            let ids = cells
+                .get(at + 1..at + 1 + n)
+                .ok_or("LINES: a cell runs past its data")?;
+            polylines.push(polyline(&points, radius.as_deref(), ids)?);
+            at += 1 + n;
+        }
+        Ok(polylines)
+    }
+}

@@ -1,0 +1,221 @@
+//! A stent centreline from a vessel file (`centreline: {file: …}`): the polyline chosen, its segment, the
+//! unit conversion, the smoothing spline, the lumen radius along the segment, and the check that the centreline
+//! does not bend tighter than the stent's radius.
+//!
+//! ```yaml
+//! stent:
+//!   oversize: 0.1                       # R = mean lumen radius over the segment × 1.1 (or give `radius`)
+//!   centreline:
+//!     file:
+//!       path: data/aorta-centerline.vtp # relative to the design file
+//!       polyline: longest               # or an index from 0
+//!       start: 20                       # arc length where the segment starts [design length unit]
+//!       length: 60                      # the segment's length (default: to the end)
+//!       unit: mm                        # the file's (default: the design's)
+//!       smoothing: 0.1                  # largest distance of the spline from the points (default L/1000)
+//! ```
+//!
+//! The segment is cut from the polyline at those arc lengths (its end points and radii interpolated linearly);
+//! the spline is the cubic with the fewest control points within `smoothing` of every point of the segment
+//! ([`crate::geometry::fit::smooth_points`]); `check` prints its deviation. The stent radius from the lumen is
+//! the mean of the radius along the segment (weighted by arc length), one radius for every crown.
+
+use super::dto::{FileCentrelineDto, FileUnitDto, PolylineChoiceDto};
+use super::issue::{Result, issue};
+use crate::geometry::fit::smooth_points;
+use crate::geometry::stent::CentrelineSpec;
+use crate::io::centreline::{Polyline, read_centreline};
+use crate::math::{Real, Vec3};
+use std::path::Path;
+
+/// VMTK's point array of the lumen radius.
+pub const DEFAULT_RADIUS_ARRAY: &str = "MaximumInscribedSphereRadius";
+
+/// A file centreline as the stent uses it.
+#[derive(Debug, Clone, PartialEq)]
+pub struct VesselCentreline {
+    /// The smooth centreline.
+    pub spec: CentrelineSpec,
+    /// The segment's mean lumen radius [design length unit], when the file has the radius.
+    pub mean_radius: Option<Real>,
+    /// Largest distance of the spline from the segment's points [design length unit].
+    pub deviation: Real,
+    /// The spline's control points.
+    pub control_points: usize,
+    /// The segment's length along the polyline [design length unit].
+    pub length: Real,
+    /// Points of the segment.
+    pub points: usize,
+}
+
+/// Reads and fits the file centreline `f` (at `path` in the design); `metres_per_unit` is the design's length
+/// unit; `radius_needed` asks for the lumen radius (sizing by `oversize`).
+pub fn vessel_centreline(
+    f: &FileCentrelineDto,
+    path: &str,
+    metres_per_unit: Real,
+    radius_needed: bool,
+) -> Result<VesselCentreline> {
+    let field = |name: &str| format!("{path}.{name}");
+    let radius_array = f.radius_array.as_deref().unwrap_or(DEFAULT_RADIUS_ARRAY);
+    let asked = (radius_needed || f.radius_array.is_some()).then_some(radius_array);
+    let polylines = read_centreline(Path::new(&f.path), asked)
+        .map_err(|e| issue(field("path"), e.to_string()))?;
+    let chosen = match f.polyline {
+        Some(PolylineChoiceDto::Index(k)) => polylines.get(k).ok_or_else(|| {
+            issue(
+                field("polyline"),
+                format!(
+                    "the file has {} polylines (0 … {})",
+                    polylines.len(),
+                    polylines.len() - 1
+                ),
+            )
+        })?,
+        _ => polylines
+            .iter()
+            .max_by(|a, b| a.length().total_cmp(&b.length()))
+            .ok_or_else(|| issue(field("path"), "no polyline"))?,
+    };
+    let scale = match f.unit {
+        None => 1.0,
+        Some(FileUnitDto::Mm) => 1e-3 / metres_per_unit,
+        Some(FileUnitDto::Cm) => 1e-2 / metres_per_unit,
+        Some(FileUnitDto::M) => 1.0 / metres_per_unit,
+    };
+    let mut line = Polyline {
+        points: chosen.points.iter().map(|p| p * scale).collect(),
+        radius: chosen
+            .radius
+            .as_ref()
+            .map(|r| r.iter().map(|x| x * scale).collect()),
+    };
+    if f.reverse {
+        line.points.reverse();
+        if let Some(r) = &mut line.radius {
+            r.reverse();
+        }
+    }
+    // Consecutive duplicates (VMTK repeats a point where branches meet) carry no direction.
+    let total = line.length();
+    let start = f.start.map_or(0.0, |s| s.0);
+    let length = f.length.map_or(total - start, |l| l.0);
+    if !(start + length <= total * (1.0 + 1e-12)) || !(length > 0.0) {
+        return Err(issue(
+            field(if f.length.is_some() {
+                "length"
+            } else {
+                "start"
+            }),
+            format!(
+                "the segment from {start} to {} is longer than the polyline ({total} in the design's length unit)",
+                start + length
+            ),
+        ));
+    }
+    let segment = cut(&line, start, start + length);
+    let smoothing = f.smoothing.map_or(1e-3 * length, |s| s.0);
+    let fit = smooth_points(&segment.points, smoothing)
+        .map_err(|e| issue(field("path"), format!("the segment cannot be fitted: {e}")))?;
+    let mean_radius = segment.radius.as_ref().map(|r| {
+        let mut weighted = 0.0;
+        for (w, rr) in segment.points.windows(2).zip(r.windows(2)) {
+            weighted += 0.5 * (rr[0] + rr[1]) * (w[1] - w[0]).norm();
+        }
+        weighted / length
+    });
+    Ok(VesselCentreline {
+        spec: CentrelineSpec::Spline {
+            curve: fit.curve,
+            reference: f.reference.as_ref().map(super::dto::vec3),
+        },
+        mean_radius,
+        deviation: fit.max_deviation,
+        control_points: fit.control_points,
+        length,
+        points: segment.points.len(),
+    })
+}
+
+/// The part of `line` between arc lengths `from` and `to`, its ends interpolated, consecutive duplicate points
+/// dropped.
+fn cut(line: &Polyline, from: Real, to: Real) -> Polyline {
+    let (mut points, mut radius) = (Vec::new(), Vec::new());
+    let at = |k: usize, t: Real| -> (Vec3, Option<Real>) {
+        let p = line.points[k] + (line.points[k + 1] - line.points[k]) * t;
+        let r = line.radius.as_ref().map(|r| r[k] + (r[k + 1] - r[k]) * t);
+        (p, r)
+    };
+    let mut s = 0.0;
+    for k in 0..line.points.len() - 1 {
+        let d = (line.points[k + 1] - line.points[k]).norm();
+        if d == 0.0 {
+            continue;
+        }
+        let (a, b) = (s, s + d);
+        if b >= from && a <= to {
+            let t0 = ((from - a) / d).clamp(0.0, 1.0);
+            let t1 = ((to - a) / d).clamp(0.0, 1.0);
+            for t in [t0, t1] {
+                let (p, r) = at(k, t);
+                if points
+                    .last()
+                    .is_none_or(|q: &Vec3| (p - q).norm() > 1e-12 * (1.0 + to))
+                {
+                    points.push(p);
+                    radius.extend(r);
+                }
+            }
+        }
+        s = b;
+    }
+    Polyline {
+        points,
+        radius: line.radius.as_ref().map(|_| radius),
+    }
+}
+
+/// The smallest radius of curvature of `spec`'s spline and the normalised parameter where it is, sampled at
+/// 1000 points (`None` for other centrelines).
+pub fn tightest_bend(spec: &CentrelineSpec) -> Option<(Real, Real)> {
+    let CentrelineSpec::Spline { curve, .. } = spec else {
+        return None;
+    };
+    (0..=1000)
+        .map(|k| {
+            let u = k as Real / 1000.0;
+            let d = curve.derivatives(u, 2);
+            let speed = d[1].norm();
+            let curvature = d[1].cross(&d[2]).norm() / (speed * speed * speed);
+            (1.0 / curvature, u)
+        })
+        .min_by(|a, b| a.0.total_cmp(&b.0))
+}
+
+/// The field paths of the centreline files a design can name.
+const FILE_FIELDS: [[&str; 4]; 2] = [
+    ["stent", "centreline", "file", "path"],
+    ["temporary", "centreline", "file", "path"],
+];
+
+/// Makes every centreline file path of the design tree `root` that is relative absolute, relative to `dir`
+/// (the design file's folder), so that the design reads the same from anywhere — a sweep's resolved designs
+/// are written into other folders.
+pub fn absolute_file_paths(root: &mut serde_yaml::Value, dir: &Path) {
+    for fields in FILE_FIELDS {
+        let mut node = if fields[0] == "temporary" {
+            root.get_mut("programme")
+        } else {
+            Some(&mut *root)
+        };
+        for key in fields {
+            node = node.and_then(|n| n.get_mut(key));
+        }
+        if let Some(value) = node
+            && let Some(text) = value.as_str()
+            && Path::new(text).is_relative()
+        {
+            *value = dir.join(text).to_string_lossy().into_owned().into();
+        }
+    }
+}
