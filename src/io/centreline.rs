@@ -272,6 +272,16 @@ impl Scalar {
         }
     }
 
+    /// The value of a number written as text, held as this type (a `Float32` array's text is rounded to
+    /// single precision, as VTK's reader does).
+    fn parse_text(self, word: &str) -> Option<Real> {
+        match self {
+            Self::F32 => word.parse::<f32>().ok().map(Real::from),
+            Self::F64 => word.parse::<f64>().ok(),
+            _ => word.parse::<i64>().ok().map(|i| i as Real),
+        }
+    }
+
     /// The values of `bytes` (whole elements only), little-endian unless `big`.
     fn values(self, bytes: &[u8], big: bool) -> Vec<Real> {
         let n = self.size();
@@ -438,6 +448,8 @@ mod vtp {
         let (mut stack, mut arrays, mut pieces) = (Vec::<String>::new(), Vec::new(), Vec::new());
         let mut root: Option<Vec<(String, String)>> = None;
         let mut current: Option<Array> = None;
+        // Elements open inside the current DataArray (VTK writes <InformationKey> there): their text is not data.
+        let mut nested = 0usize;
         loop {
             let event = match reader.read_event_into(&mut buf) {
                 Ok(e) => e,
@@ -467,10 +479,13 @@ mod vtp {
                         _ => {}
                     }
                     if !empty && name != "DataArray" {
+                        if current.is_some() {
+                            nested += 1;
+                        }
                         stack.push(name);
                     }
                 }
-                Event::Text(t) => {
+                Event::Text(t) if nested == 0 => {
                     if let Some(a) = &mut current {
                         a.text.push_str(&String::from_utf8_lossy(&t));
                     }
@@ -479,6 +494,7 @@ mod vtp {
                     if e.name().as_ref() == b"DataArray" {
                         arrays.extend(current.take());
                     } else {
+                        nested = nested.saturating_sub(1);
                         stack.pop();
                     }
                 }
@@ -580,9 +596,12 @@ mod vtp {
                 return a
                     .text
                     .split_whitespace()
-                    .map(|t| t.parse::<Real>())
-                    .collect::<Result<_, _>>()
-                    .map_err(|e| format!("array `{name}`: {e}"));
+                    .map(|t| {
+                        scalar
+                            .parse_text(t)
+                            .ok_or_else(|| format!("array `{name}`: `{t}` is not a number"))
+                    })
+                    .collect();
             }
             "binary" => block(&decode_base64(a.text.trim().as_bytes())?, layout)?,
             "appended" => {
@@ -778,8 +797,9 @@ mod legacy {
             (0..count)
                 .map(|_| {
                     let w = self.word().ok_or("the data ends early")?;
-                    w.parse::<Real>()
-                        .map_err(|_| format!("`{w}` is not a number"))
+                    scalar
+                        .parse_text(w)
+                        .ok_or_else(|| format!("`{w}` is not a number"))
                 })
                 .collect()
         }
@@ -900,7 +920,12 @@ mod legacy {
                 "FIELD" => {
                     let k = count(&words, 2, line)?;
                     for _ in 0..k {
-                        let head = c.keyword_line().ok_or("FIELD: an array is missing")?;
+                        let mut head = c.keyword_line().ok_or("FIELD: an array is missing")?;
+                        // VTK ≥ 8 writes a METADATA block (information keys, up to an empty line) after an array.
+                        while head.starts_with("METADATA") {
+                            while c.line().is_some_and(|l| !l.is_empty()) {}
+                            head = c.keyword_line().ok_or("FIELD: an array is missing")?;
+                        }
                         let w: Vec<&str> = head.split_whitespace().collect();
                         let (components, tuples) = (count(&w, 1, head)?, count(&w, 2, head)?);
                         let scalar = w

@@ -111,3 +111,164 @@ fn a_csv_of_an_exact_arc_gives_the_arc_centrelines_device() {
         fitted.notes
     );
 }
+
+/// One polyline of a reference: its points and, where the file has it, the radius at them.
+type ReferenceLine = (Vec<[f64; 3]>, Option<Vec<f64>>);
+
+/// The polylines of a `*.reference.json` (written by scripts/centreline_test_files.py from VTK's readers).
+fn reference(file: &Path) -> Vec<ReferenceLine> {
+    let text =
+        std::fs::read_to_string(format!("{}.reference.json", file.display())).expect("reference");
+    let json: serde_json::Value = serde_json::from_str(&text).expect("JSON");
+    json["polylines"]
+        .as_array()
+        .expect("polylines")
+        .iter()
+        .map(|l| {
+            let points = l["points"]
+                .as_array()
+                .expect("points")
+                .iter()
+                .map(|p| {
+                    let c: Vec<f64> = p
+                        .as_array()
+                        .expect("xyz")
+                        .iter()
+                        .map(|x| x.as_f64().expect("number"))
+                        .collect();
+                    [c[0], c[1], c[2]]
+                })
+                .collect();
+            let radius = l["radius"]
+                .as_array()
+                .map(|r| r.iter().map(|x| x.as_f64().expect("number")).collect());
+            (points, radius)
+        })
+        .collect()
+}
+
+/// Source: VTK 9.7's own readers (scripts/centreline_test_files.py), on files VTK's writers made from the aorta
+/// centreline in every XML encoding (ascii; inline base64 with and without zlib; appended raw with and without
+/// zlib; appended base64; UInt64 headers; the radius array after two others), as legacy VTK (ASCII and binary,
+/// the 5.1 OFFSETS/CONNECTIVITY layout and the 4.2 one), with a third polyline, as CSV and as a SimVascular path.
+/// Tolerance 1e-12 relative: both read the same stored numbers (a Float32 array's text rounded to single
+/// precision as VTK does); the reference's JSON is parsed by serde_json, whose float parsing may be one ulp off.
+#[test]
+fn every_encoding_reads_to_what_vtk_reads() {
+    let dir = data("");
+    let mut files: Vec<PathBuf> = std::fs::read_dir(&dir)
+        .expect("centrelines")
+        .map(|e| e.expect("entry").path())
+        .filter(|p| {
+            p.extension().is_some_and(|e| e == "json")
+                && p.to_string_lossy().ends_with(".reference.json")
+        })
+        .map(|p| PathBuf::from(p.to_string_lossy().trim_end_matches(".reference.json")))
+        .collect();
+    files.sort();
+    assert!(files.len() >= 13, "{files:?}");
+    for file in &files {
+        let radius_array = (!file.extension().is_some_and(|e| e == "pth" || e == "csv"))
+            .then_some("MaximumInscribedSphereRadius");
+        let lines = read_centreline(file, radius_array).unwrap_or_else(|e| panic!("{e}"));
+        let expected = reference(file);
+        assert_eq!(lines.len(), expected.len(), "{}", file.display());
+        for (line, (points, radius)) in lines.iter().zip(&expected) {
+            let close = |a: f64, b: f64| (a - b).abs() <= 1e-12 * b.abs().max(1.0);
+            assert_eq!(line.points.len(), points.len(), "{}", file.display());
+            for (k, (p, q)) in line.points.iter().zip(points).enumerate() {
+                assert!(
+                    close(p.x, q[0]) && close(p.y, q[1]) && close(p.z, q[2]),
+                    "{}: point {k}: {p:?} against VTK's {q:?}",
+                    file.display()
+                );
+            }
+            match (&line.radius, radius) {
+                (Some(r), Some(q)) => assert!(
+                    r.len() == q.len() && r.iter().zip(q).all(|(a, b)| close(*a, *b)),
+                    "{}: radius",
+                    file.display()
+                ),
+                (None, None) => {}
+                (r, q) => panic!("{}: radius {r:?} against VTK's {q:?}", file.display()),
+            }
+        }
+    }
+}
+
+/// Bad files are refused naming the file and what is wrong.
+#[test]
+fn bad_centreline_files_are_refused_with_the_reason() {
+    for (name, radius, fragment) in [
+        ("not_vtk.vtp", None, "not VTK XML PolyData"),
+        ("no_lines.vtp", None, "no polyline"),
+        (
+            "no_radius.vtp",
+            Some("MaximumInscribedSphereRadius"),
+            "no point array `MaximumInscribedSphereRadius`",
+        ),
+        ("nan_point.vtp", None, "is not finite ([NaN,"),
+        ("missing.vtp", None, "cannot read the centreline"),
+        (
+            "aorta_line0.csv.reference.json",
+            None,
+            "unknown centreline format",
+        ),
+    ] {
+        let error = read_centreline(&data(name), radius)
+            .expect_err(name)
+            .to_string();
+        assert!(
+            error.starts_with(&data(name).display().to_string()),
+            "{error}"
+        );
+        assert!(error.contains(fragment), "{name}: {error}");
+    }
+}
+
+/// A design placing a stent on a file centreline refuses a segment longer than the polyline, a polyline index
+/// the file does not have, and a centreline bending tighter than the stent radius, each at its field; the
+/// aorta design itself reads and sizes the stent at the segment's mean lumen radius × (1 + oversize).
+#[test]
+fn designs_on_file_centrelines_are_checked() {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("designs/aorta_stent.yaml");
+    let text = std::fs::read_to_string(&path).expect("design");
+    let design = stentkit::io::design::parse_design(&text, &path).expect("the aorta design reads");
+    assert!(
+        design
+            .notes
+            .iter()
+            .any(|n| n.contains("mean lumen radius") && n.contains("stent radius")),
+        "{:?}",
+        design.notes
+    );
+    for (from, to, field, fragment) in [
+        (
+            "length: 40 ",
+            "length: 400 ",
+            "stent.centreline.file.length",
+            "longer than the polyline",
+        ),
+        (
+            "polyline: longest",
+            "polyline: 7",
+            "stent.centreline.file.polyline",
+            "the file has 2 polylines",
+        ),
+        (
+            "smoothing: 0.2 ",
+            "smoothing: 0.01 ",
+            "stent.centreline.file",
+            "radius of curvature",
+        ),
+    ] {
+        assert!(text.contains(from), "{from}");
+        let error = stentkit::io::design::parse_design(&text.replace(from, to), &path)
+            .expect_err(to)
+            .to_string();
+        assert!(
+            error.contains(field) && error.contains(fragment),
+            "{to}: {error}"
+        );
+    }
+}
