@@ -813,6 +813,38 @@ mod legacy {
             .ok_or_else(|| format!("`{line}`: expected a count"))
     }
 
+    /// The cells after a `LINES`/`VERTICES`/… line (`words`): VTK ≥ 9 writes `KEY nOffsets nConnectivity`
+    /// and then `OFFSETS type` and `CONNECTIVITY type` arrays; earlier versions `KEY nCells size` and `size`
+    /// integers, a count before each cell's point ids.
+    enum Cells {
+        Offsets(Vec<Real>, Vec<Real>),
+        Counted(Vec<Real>),
+    }
+
+    fn cell_block(c: &mut Cursor<'_>, words: &[&str], line: &str) -> Result<Cells, String> {
+        let (a, b) = (count(words, 1, line)?, count(words, 2, line)?);
+        let save = c.at;
+        let typed = |header: &str, key: &str| {
+            header
+                .strip_prefix(key)
+                .and_then(|rest| rest.split_whitespace().next())
+                .and_then(Scalar::parse)
+                .ok_or_else(|| format!("expected `{key} type`, found `{header}`"))
+        };
+        match c.keyword_line() {
+            Some(next) if next.starts_with("OFFSETS") => {
+                let offsets = c.values(a, typed(next, "OFFSETS")?)?;
+                let header = c.keyword_line().unwrap_or("");
+                let connectivity = c.values(b, typed(header, "CONNECTIVITY")?)?;
+                Ok(Cells::Offsets(offsets, connectivity))
+            }
+            _ => {
+                c.at = save;
+                Ok(Cells::Counted(c.values(b, Scalar::I32)?))
+            }
+        }
+    }
+
     pub(super) fn read(bytes: &[u8], radius_array: Option<&str>) -> Result<Vec<Polyline>, String> {
         let mut c = Cursor {
             bytes,
@@ -848,57 +880,12 @@ mod legacy {
                         .ok_or("POINTS: unknown type")?;
                     points = Some(triples(&c.values(3 * n, scalar)?, "POINTS")?);
                 }
-                "LINES" => {
-                    let (a, b) = (count(&words, 1, line)?, count(&words, 2, line)?);
-                    // VTK ≥ 9: `LINES nOffsets nConnectivity`, then OFFSETS and CONNECTIVITY arrays; before,
-                    // `LINES nCells size` and size integers (a count before each cell's ids).
-                    let save = c.at;
-                    match c.keyword_line() {
-                        Some(next) if next.starts_with("OFFSETS") => {
-                            let scalar = next
-                                .split_whitespace()
-                                .nth(1)
-                                .and_then(Scalar::parse)
-                                .ok_or("OFFSETS: unknown type")?;
-                            offsets = Some(c.values(a, scalar)?);
-                            let conn = c.keyword_line().unwrap_or("");
-                            let scalar = conn
-                                .split_whitespace()
-                                .nth(1)
-                                .and_then(Scalar::parse)
-                                .ok_or("CONNECTIVITY: expected after OFFSETS")?;
-                            connectivity = Some(c.values(b, scalar)?);
-                        }
-                        _ => {
-                            c.at = save;
-                            cells = Some(c.values(b, Scalar::I32)?);
-                        }
-                    }
-                }
+                "LINES" => match cell_block(&mut c, &words, line)? {
+                    Cells::Offsets(o, k) => (offsets, connectivity) = (Some(o), Some(k)),
+                    Cells::Counted(v) => cells = Some(v),
+                },
                 "VERTICES" | "POLYGONS" | "TRIANGLE_STRIPS" => {
-                    let (a, b) = (count(&words, 1, line)?, count(&words, 2, line)?);
-                    let save = c.at;
-                    match c.keyword_line() {
-                        Some(next) if next.starts_with("OFFSETS") => {
-                            let s = next
-                                .split_whitespace()
-                                .nth(1)
-                                .and_then(Scalar::parse)
-                                .unwrap_or(Scalar::I64);
-                            c.values(a, s)?;
-                            let conn = c.keyword_line().unwrap_or("");
-                            let s = conn
-                                .split_whitespace()
-                                .nth(1)
-                                .and_then(Scalar::parse)
-                                .unwrap_or(Scalar::I64);
-                            c.values(b, s)?;
-                        }
-                        _ => {
-                            c.at = save;
-                            c.values(b, Scalar::I32)?;
-                        }
-                    }
+                    cell_block(&mut c, &words, line)?;
                 }
                 "SCALARS" => {
                     let name = words.get(1).copied().unwrap_or("").to_string();
