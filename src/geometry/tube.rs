@@ -274,6 +274,36 @@ pub fn sweep_tube_with_caps(
     caps: EndCaps,
     settings: &TubeSettings,
 ) -> Result<TriangleMesh, TubeError> {
+    sweep_rings(centre, frames, &vec![radius; centre.len()], caps, settings)
+}
+
+/// [`sweep_tube`] with a radius per sample (a vessel's lumen), closed at both ends.
+///
+/// # Errors
+/// As [`sweep_tube`], and a radius per sample is needed.
+pub fn sweep_tube_varying(
+    centre: &[Vec3],
+    frames: &[Mat3],
+    radii: &[Real],
+    settings: &TubeSettings,
+) -> Result<TriangleMesh, TubeError> {
+    if radii.len() != centre.len() {
+        return Err(TubeError::LengthMismatch {
+            centre: centre.len(),
+            frames: radii.len(),
+        });
+    }
+    sweep_rings(centre, frames, radii, EndCaps::BOTH, settings)
+}
+
+/// The tube of ring `i` of radius `radii[i]` (module docs of [`sweep_tube_with_caps`]).
+fn sweep_rings(
+    centre: &[Vec3],
+    frames: &[Mat3],
+    radii: &[Real],
+    caps: EndCaps,
+    settings: &TubeSettings,
+) -> Result<TriangleMesh, TubeError> {
     settings.validate()?;
     let n = centre.len();
     if n < 2 {
@@ -285,7 +315,7 @@ pub fn sweep_tube_with_caps(
             frames: frames.len(),
         });
     }
-    if !(radius > 0.0 && radius.is_finite()) {
+    if let Some(&radius) = radii.iter().find(|r| !(**r > 0.0 && r.is_finite())) {
         return Err(TubeError::InvalidRadius { radius });
     }
     if let Some(index) = frames.iter().position(|f| !f.iter().all(|x| x.is_finite())) {
@@ -320,7 +350,7 @@ pub fn sweep_tube_with_caps(
     let angles: Vec<(Real, Real)> = (0..m)
         .map(|k| (2.0 * PI * k as Real / m as Real).sin_cos())
         .collect();
-    for ((c, frame), sign) in centre.iter().zip(frames).zip(&handedness) {
+    for (((c, frame), sign), &radius) in centre.iter().zip(frames).zip(&handedness).zip(radii) {
         let (d2, d3) = (frame.column(1).into_owned(), frame.column(2).into_owned());
         mesh.vertices.extend(
             angles

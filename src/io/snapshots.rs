@@ -81,6 +81,9 @@ pub struct Snapshot {
     pub volume: Real,
 }
 
+/// The file of the vessel's lumen in the snapshot folder (a stent on a centreline read from a file).
+pub const VESSEL_FILE: &str = "vessel_lumen.stl";
+
 /// Why a snapshot could not be written.
 #[derive(Debug, thiserror::Error)]
 pub enum SnapshotError {
@@ -242,6 +245,9 @@ impl SnapshotWriter {
         for (format, path) in FORMATS.iter().zip(&files) {
             format.write(&self.run_dir.join(path), &mesh, &state)?;
         }
+        if self.written.is_empty() {
+            self.write_vessel(model)?;
+        }
         self.written.push(Snapshot {
             step,
             time,
@@ -250,6 +256,38 @@ impl SnapshotWriter {
             volume: mesh.volume(),
         });
         Ok(())
+    }
+
+    /// With the first snapshot: the lumen of the vessel the stent sits on, `snapshots/vessel_lumen.stl` (a
+    /// closed tube of the file's lumen radius around the smoothed centreline, [`crate::post::vessel`]).
+    fn write_vessel(&mut self, model: &Model) -> Result<(), SnapshotError> {
+        let Some(lumen) = model
+            .vessel
+            .as_ref()
+            .and_then(|v| crate::post::vessel::lumen_mesh(v, self.segments))
+        else {
+            return Ok(());
+        };
+        let mesh = lumen.map_err(|source| SnapshotError::Mesh {
+            step: 0,
+            time: 0.0,
+            patch: "vessel lumen".into(),
+            source,
+        })?;
+        let path = Path::new(Self::FOLDER).join(VESSEL_FILE);
+        if let Some(manifest) = &self.manifest {
+            manifest.claim(&path).map_err(SnapshotError::Manifest)?;
+        }
+        let header = format!(
+            "{} vessel lumen, lengths in {}",
+            model.name,
+            model.units.length()
+        );
+        Ok(stl::write_stl_with_header(
+            &self.run_dir.join(&path),
+            &mesh,
+            &header,
+        )?)
     }
 
     fn observe(&mut self, sim: &Simulation<'_>, step: usize) -> ControlFlow<()> {

@@ -393,6 +393,17 @@ pub struct Model {
     /// Times within `(0, end]` at which the state is recorded (snapshots) [time]: time stepping lands on each,
     /// as on a schedule breakpoint.
     pub record_times: Vec<Real>,
+    /// The vessel a stent was placed on (a centreline read from a file), for the outputs to show beside it.
+    pub vessel: Option<Vessel>,
+}
+
+/// A vessel segment: its smoothed centreline and, where the file gave it, the lumen radius along it.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Vessel {
+    /// Points along the centreline [length].
+    pub points: Vec<Vec3>,
+    /// The lumen radius at each point [length].
+    pub radius: Option<Vec<Real>>,
 }
 
 impl Model {

@@ -11,3 +11,4 @@
 //! returns). Pure: no files, no printing, no serde.
 
 pub mod device;
+pub mod vessel;

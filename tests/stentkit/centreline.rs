@@ -272,3 +272,65 @@ fn designs_on_file_centrelines_are_checked() {
         );
     }
 }
+
+/// The aorta stent's run folder holds the vessel's lumen beside the device (snapshots/vessel_lumen.stl, a
+/// closed tube of the file's lumen radius; `.ci/run` checks it with trimesh), and the stent's reference shape
+/// sits around the lumen's centreline at the oversized radius. Source: the design's sizing rule, R = the
+/// segment's mean lumen radius × (1 + oversize) with oversize 0.1, and crowns generated at R from the axis.
+/// Tolerance 3 % of R: a crest or trough sits h_c = 2 mm along the axis from its station, so on an axis bending
+/// with a radius of curvature ρ ≳ 20 mm its distance to the axis differs from R by up to about h_c²/(2ρ) ≈
+/// 0.1 mm (1.6 %); the mean over the samples of the lumen differs from the segment's by their spacing.
+#[test]
+fn the_aorta_stents_run_shows_the_vessel_lumen() {
+    let dir = crate::outputs::test_outputs("aorta_stent_vessel");
+    let design = Path::new(env!("CARGO_MANIFEST_DIR")).join("designs/aorta_stent.yaml");
+    let out = crate::outputs::stentkit(&[
+        "run",
+        design.to_str().expect("UTF-8"),
+        "-q",
+        "-o",
+        dir.to_str().expect("UTF-8"),
+        "--set",
+        "time.end=0.004",
+        "--set",
+        "output={snapshots: {times: [0.004]}}",
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let stl = std::fs::read(dir.join("snapshots/vessel_lumen.stl")).expect("the lumen");
+    let triangles = u32::from_le_bytes([stl[80], stl[81], stl[82], stl[83]]) as usize;
+    assert_eq!(stl.len(), 84 + 50 * triangles);
+    let model = stentkit::io::design::load_design(&design)
+        .expect("design")
+        .model;
+    let vessel = model.vessel.as_ref().expect("a vessel");
+    let radius = vessel.radius.as_ref().expect("a lumen radius");
+    let mut weighted = 0.0;
+    let mut length = 0.0;
+    for (w, r) in vessel.points.windows(2).zip(radius.windows(2)) {
+        let d = (w[1] - w[0]).norm();
+        weighted += 0.5 * (r[0] + r[1]) * d;
+        length += d;
+    }
+    let stent_radius = 1.1 * weighted / length;
+    for node in &model.nodes {
+        let distance = vessel
+            .points
+            .windows(2)
+            .map(|w| {
+                let (a, b) = (w[0], w[1]);
+                let t =
+                    ((node.position - a).dot(&(b - a)) / (b - a).norm_squared()).clamp(0.0, 1.0);
+                (node.position - (a + (b - a) * t)).norm()
+            })
+            .fold(f64::MAX, f64::min);
+        assert!(
+            (distance - stent_radius).abs() < 0.03 * stent_radius,
+            "node {} at {distance} from the lumen's centreline, the stent radius is {stent_radius}",
+            node.name
+        );
+    }
+}

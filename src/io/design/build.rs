@@ -85,8 +85,11 @@ pub fn build(dto: &DesignDto, default_name: &str) -> Result<Built> {
     };
     let mut notes = Vec::new();
     if let Some(s) = &dto.stent {
-        let (spec, said) = stent::spec(s, metres_per_unit)?;
+        let (spec, said, vessel) = stent::spec(s, metres_per_unit)?;
         notes.extend(said);
+        if let Some(v) = vessel {
+            builder.vessel(v);
+        }
         builder.stent(spec, stent::mesh(s, dto.mesh.as_ref())?);
     }
     if let Some(p) = &dto.programme {

@@ -188,7 +188,10 @@ fn bridges(b: &BridgesDto) -> Result<BridgeSpec> {
 
 /// The specification of a `stent:` block (lengths in units of `metres_per_unit` metres), with what `check`
 /// says about a file centreline.
-pub fn spec(dto: &StentDto, metres_per_unit: Real) -> Result<(StentSpec, Vec<String>)> {
+pub fn spec(
+    dto: &StentDto,
+    metres_per_unit: Real,
+) -> Result<(StentSpec, Vec<String>, Option<crate::model::Vessel>)> {
     let sized = dto.oversize.is_some();
     let (axis, vessel) = centreline(&dto.centreline, "stent.centreline", metres_per_unit, sized)?;
     let radius = match (
@@ -270,6 +273,7 @@ pub fn spec(dto: &StentDto, metres_per_unit: Real) -> Result<(StentSpec, Vec<Str
             cut: !dto.full_model,
         },
         notes,
+        vessel.map(|v| v.vessel),
     ))
 }
 

@@ -26,6 +26,7 @@ use crate::geometry::fit::smooth_points;
 use crate::geometry::stent::CentrelineSpec;
 use crate::io::centreline::{Polyline, read_centreline};
 use crate::math::{Real, Vec3};
+use crate::model::Vessel;
 use std::path::Path;
 
 /// VMTK's point array of the lumen radius.
@@ -46,6 +47,9 @@ pub struct VesselCentreline {
     pub length: Real,
     /// Points of the segment.
     pub points: usize,
+    /// The vessel for the outputs: the spline sampled at twice the segment's points, the lumen radius
+    /// interpolated there (by normalised arc length along the segment).
+    pub vessel: Vessel,
 }
 
 /// Reads and fits the file centreline `f` (at `path` in the design); `metres_per_unit` is the design's length
@@ -124,7 +128,25 @@ pub fn vessel_centreline(
         }
         weighted / length
     });
+    let samples = 2 * segment.points.len();
+    let u: Vec<Real> = (0..samples)
+        .map(|k| k as Real / (samples - 1) as Real)
+        .collect();
+    let along = crate::math::approx::chord_parameters(&segment.points);
+    let vessel = Vessel {
+        points: u.iter().map(|&u| fit.curve.point(u)).collect(),
+        radius: segment.radius.as_ref().zip(along).map(|(r, t)| {
+            u.iter()
+                .map(|&u| {
+                    let i = t.partition_point(|&x| x < u).clamp(1, t.len() - 1);
+                    let w = ((u - t[i - 1]) / (t[i] - t[i - 1])).clamp(0.0, 1.0);
+                    r[i - 1] + w * (r[i] - r[i - 1])
+                })
+                .collect()
+        }),
+    };
     Ok(VesselCentreline {
+        vessel,
         spec: CentrelineSpec::Spline {
             curve: fit.curve,
             reference: f.reference.as_ref().map(super::dto::vec3),

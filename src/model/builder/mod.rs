@@ -384,6 +384,8 @@ pub struct ModelBuilder {
     solver: SolverSettings,
     probes: Vec<(String, ProbeAt)>,
     record_times: Vec<Real>,
+    /// The vessel a stent sits on, for the outputs.
+    vessel: Option<crate::model::Vessel>,
 }
 
 impl ModelBuilder {
@@ -414,6 +416,7 @@ impl ModelBuilder {
             solver: SolverSettings::default(),
             probes: Vec::new(),
             record_times: Vec::new(),
+            vessel: None,
         }
     }
 
@@ -439,6 +442,12 @@ impl ModelBuilder {
     /// `crown_<k>`, …), symmetry planes and the symmetry conditions of its cut nodes ([`stent_model`]).
     pub fn stent(&mut self, spec: StentSpec, mesh: StentMesh) -> &mut Self {
         self.stent = Some((spec, mesh));
+        self
+    }
+
+    /// The vessel the stent sits on, for the outputs ([`crate::model::Vessel`]).
+    pub fn vessel(&mut self, vessel: crate::model::Vessel) -> &mut Self {
+        self.vessel = Some(vessel);
         self
     }
 
@@ -653,6 +662,7 @@ impl ModelBuilder {
             programme,
             symmetry_planes,
             record_times: self.record_times.clone(),
+            vessel: self.vessel.clone(),
         };
         Ok(Built { model, warnings })
     }
