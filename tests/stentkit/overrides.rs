@@ -127,3 +127,36 @@ fn the_files_own_errors_keep_their_place_under_an_override() {
     }
     assert!(differ.is_empty(), "{}", differ.join("\n"));
 }
+
+/// A resolved design names its centreline file by an absolute path (source: the file's own relative path
+/// joined to the design's folder), so that it reads the same from a sweep's variant folder.
+#[test]
+fn a_resolved_design_reads_from_anywhere() {
+    let design = Path::new(env!("CARGO_MANIFEST_DIR")).join("designs/aorta_stent.yaml");
+    let relative = Path::new("designs/aorta_stent.yaml");
+    let path = if relative.exists() {
+        relative
+    } else {
+        design.as_path()
+    };
+    let resolved = load_design_with(path, &sets(&["stent.crowns=2"])).expect("the design reads");
+    let elsewhere = std::env::temp_dir().join(format!("stentkit-resolved-{}", std::process::id()));
+    std::fs::create_dir_all(&elsewhere).expect("scratch");
+    let copy = elsewhere.join("design.yaml");
+    std::fs::write(&copy, &resolved.source).expect("written");
+    let reread = load_design(&copy).expect("the resolved design reads from another folder");
+    std::fs::remove_dir_all(&elsewhere).ok();
+    assert_eq!(reread.model.nodes.len(), resolved.model.nodes.len());
+    assert!(
+        resolved.source.contains(&format!(
+            "path: {}",
+            design
+                .parent()
+                .expect("folder")
+                .join("data/aorta-centerline.vtp")
+                .display()
+        )),
+        "{}",
+        resolved.source
+    );
+}

@@ -237,7 +237,9 @@ pub fn absolute_file_paths(root: &mut serde_yaml::Value, dir: &Path) {
             && let Some(text) = value.as_str()
             && Path::new(text).is_relative()
         {
-            *value = dir.join(text).to_string_lossy().into_owned().into();
+            let joined = dir.join(text);
+            let absolute = std::path::absolute(&joined).unwrap_or(joined);
+            *value = absolute.to_string_lossy().into_owned().into();
         }
     }
 }
