@@ -39,7 +39,9 @@ from mcap.reader import make_reader
 STATE = "/state"
 CENTRELINES = "/centrelines"
 DEVICE = "/device"
-SCHEMAS = {STATE: "stentkit.State", CENTRELINES: "foxglove.SceneUpdate", DEVICE: "foxglove.SceneUpdate"}
+VESSEL = "/vessel"
+SCHEMAS = {STATE: "stentkit.State", CENTRELINES: "foxglove.SceneUpdate", DEVICE: "foxglove.SceneUpdate",
+           VESSEL: "foxglove.SceneUpdate"}
 ENTITY_FIELDS = ["timestamp", "frame_id", "id", "lifetime", "frame_locked", "metadata", "arrows", "cubes",
                  "spheres", "cylinders", "lines", "triangles", "texts", "models"]
 
@@ -126,13 +128,17 @@ def check_mcap(path):
                 state_times.append(data["time"])
             else:
                 lines, triangles = check_scene_update(data, topic)
-                require(lines > 0 if topic == CENTRELINES else triangles > 0, f"{topic}: empty scene")
+                if topic == VESSEL:
+                    require(lines == 1 and triangles == 1, f"{topic}: {lines} lines, {triangles} triangle lists")
+                else:
+                    require(lines > 0 if topic == CENTRELINES else triangles > 0, f"{topic}: empty scene")
 
         by_id = {topics[t].id: t for t in topics}
         for channel_id, n in stats.channel_message_counts.items():
             require(counts[by_id[channel_id]] == n, f"{by_id[channel_id]}: {counts[by_id[channel_id]]} messages, statistics say {n}")
         require(sum(counts.values()) == stats.message_count, "message count differs from statistics")
         require(counts[STATE] == counts[CENTRELINES] and counts[STATE] >= 1, f"counts {counts}")
+        require(counts.get(VESSEL, 1) == 1, f"{counts.get(VESSEL)} vessel messages, one expected")
         require(all(b > a for a, b in zip(state_times, state_times[1:])), "/state times do not increase")
         if summary_json is not None:
             killed = summary_json["status"] == "killed"

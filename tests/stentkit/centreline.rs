@@ -300,6 +300,11 @@ fn the_aorta_stents_run_shows_the_vessel_lumen() {
         "{}",
         String::from_utf8_lossy(&out.stderr)
     );
+    let recording = std::fs::read(dir.join("run.mcap")).expect("run.mcap");
+    assert!(
+        recording.windows(b"/vessel".len()).any(|w| w == b"/vessel"),
+        "run.mcap has a /vessel channel (its one message is checked by scripts/check_outputs.py)"
+    );
     let stl = std::fs::read(dir.join("snapshots/vessel_lumen.stl")).expect("the lumen");
     let triangles = u32::from_le_bytes([stl[80], stl[81], stl[82], stl[83]]) as usize;
     assert_eq!(stl.len(), 84 + 50 * triangles);

@@ -6,6 +6,7 @@
 //! | `/state` | `stentkit.State` | every step and the initial state | time, step size, temperature, loads, Newton iterations and residuals, step cuts, probe displacements, recovery measures |
 //! | `/centrelines` | `foxglove.SceneUpdate` | every step | entity `centrelines`: one `LINE_STRIP` per rod of the full device (mirrored back), coloured by temperature |
 //! | `/device` | `foxglove.SceneUpdate` | snapshot steps | entity `device`: the full device's closed tube mesh (`TriangleListPrimitive` with indices) |
+//! | `/vessel` | `foxglove.SceneUpdate` | once, at the start (a stent on a file centreline) | entity `vessel`: the vessel's centreline (`LINE_STRIP`) and its lumen (a translucent closed tube) |
 //!
 //! The design file is attached (`application/yaml`), and a metadata record `stentkit` holds the version, the
 //! command line, the design name and the units. Log times are the simulated time in nanoseconds (1 s of
@@ -51,6 +52,8 @@ pub const STATE_TOPIC: &str = "/state";
 pub const CENTRELINE_TOPIC: &str = "/centrelines";
 /// Topic of the tube meshes.
 pub const DEVICE_TOPIC: &str = "/device";
+/// Topic of the vessel a stent sits on (a centreline read from a file): one message at the start.
+pub const VESSEL_TOPIC: &str = "/vessel";
 
 /// What the recording says about the run that made it.
 #[derive(Debug, Clone, PartialEq)]
@@ -131,6 +134,8 @@ pub struct McapRecorder {
     state_channel: u16,
     centreline_channel: u16,
     device_channel: Option<u16>,
+    /// The vessel's channel, until its one message is written.
+    vessel_channel: Option<u16>,
     channels: Vec<LoadChannel>,
     keys: StateKeys,
     schedule: SnapshotSchedule,
@@ -258,6 +263,14 @@ impl McapRecorder {
         } else {
             None
         };
+        let vessel_channel = match &model.vessel {
+            Some(_) => Some(
+                writer
+                    .add_channel(scene_schema, VESSEL_TOPIC, "json", &no_metadata)
+                    .map_err(write_error)?,
+            ),
+            None => None,
+        };
         let thickness = (0..model.patches.len())
             .flat_map(|k| {
                 let d = model.sections[model.patches[k].section].diameter();
@@ -270,6 +283,7 @@ impl McapRecorder {
             state_channel,
             centreline_channel,
             device_channel,
+            vessel_channel,
             channels,
             keys,
             schedule: SnapshotSchedule::new(snapshots, model),
@@ -482,6 +496,31 @@ impl McapRecorder {
         scene_update("centrelines", log_time, &lines, "")
     }
 
+    /// The vessel: its centreline (a thin grey line) and, with a radius, its lumen (a translucent tube).
+    fn vessel_message(
+        &self,
+        vessel: &crate::model::Vessel,
+        log_time: u64,
+    ) -> Result<String, McapError> {
+        let mut line = format!(
+            r#"{{"type":0,"pose":{IDENTITY_POSE},"thickness":{},"scale_invariant":false,"color":{},"colors":[],"indices":[],"points":"#,
+            self.thickness.first().copied().unwrap_or(0.1),
+            color(0.5, 0.5, 0.5)
+        );
+        push_points(&mut line, &vessel.points, self.decimals);
+        line.push('}');
+        let mut triangles = String::new();
+        if let Some(lumen) = crate::post::vessel::lumen_mesh(vessel, self.settings.mesh_segments) {
+            let mesh = lumen.map_err(|source| McapError::Mesh {
+                step: 0,
+                patch: "vessel lumen".into(),
+                source,
+            })?;
+            triangles = self.triangle_list(&mesh, r#"{"r":0.8,"g":0.3,"b":0.3,"a":0.25}"#);
+        }
+        Ok(scene_update("vessel", log_time, &line, &triangles))
+    }
+
     fn mesh_message(
         &self,
         sim: &Simulation<'_>,
@@ -497,10 +536,14 @@ impl McapRecorder {
                     source: e.source,
                 }
             })?;
-        let mut triangles = format!(
-            r#"{{"pose":{IDENTITY_POSE},"color":{},"colors":[],"points":"#,
-            color(0.80, 0.72, 0.45)
-        );
+        let triangles = self.triangle_list(&mesh, &color(0.80, 0.72, 0.45));
+        Ok(scene_update("device", log_time, "", &triangles))
+    }
+
+    /// A `TriangleListPrimitive` of `mesh` in colour `color` (JSON).
+    fn triangle_list(&self, mesh: &crate::geometry::mesh::TriangleMesh, color: &str) -> String {
+        let mut triangles =
+            format!(r#"{{"pose":{IDENTITY_POSE},"color":{color},"colors":[],"points":"#);
         push_points(&mut triangles, &mesh.vertices, self.decimals);
         triangles.push_str(r#","indices":["#);
         for (i, index) in mesh.triangles.iter().flatten().enumerate() {
@@ -510,7 +553,7 @@ impl McapRecorder {
             let _ = write!(triangles, "{index}");
         }
         triangles.push_str("]}");
-        Ok(scene_update("device", log_time, "", &triangles))
+        triangles
     }
 
     fn record(
@@ -532,6 +575,10 @@ impl McapRecorder {
         self.write(self.state_channel, log_time, state.as_bytes())?;
         let centrelines = self.centreline_message(sim, log_time);
         self.write(self.centreline_channel, log_time, centrelines.as_bytes())?;
+        if let (Some(channel), Some(vessel)) = (self.vessel_channel.take(), &sim.model().vessel) {
+            let message = self.vessel_message(vessel, log_time)?;
+            self.write(channel, log_time, message.as_bytes())?;
+        }
         if self.device_channel.is_some() && self.schedule.is_due(step, previous, time) {
             self.record_mesh(sim, step, log_time)?;
         }
