@@ -54,11 +54,14 @@ struct Case {
 }
 
 fn ratio(w: &Watched) -> Real {
-    w.recovery.map_or(Real::NAN, |r| r.ratio_mean)
+    w.recovery.as_ref().map_or(Real::NAN, |r| r.ratio_mean)
 }
 
 fn delta_r(w: &Watched) -> Real {
-    w.recovery.and_then(|r| r.delta_r).unwrap_or(Real::NAN)
+    w.recovery
+        .as_ref()
+        .and_then(|r| r.delta_r)
+        .unwrap_or(Real::NAN)
 }
 
 /// The first watched displacement's norm (the design's first probe: the tip).

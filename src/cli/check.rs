@@ -25,7 +25,7 @@ pub fn describe(design: &Design, file: &str) -> String {
         let label = if model.materials.len() == 1 {
             "material   ".to_string()
         } else {
-            format!("material {k} ")
+            format!("material {k}  `{}`:", model.material_names[k])
         };
         let _ = writeln!(s, "{label} {}", describe_material(law, u.stress()));
     }
@@ -51,6 +51,26 @@ pub fn describe(design: &Design, file: &str) -> String {
             sec.shear_factor(poisson)
         );
     }
+    if let Some(field) = &model.temperature_field {
+        let e = field.direction;
+        let kind = match &field.profile {
+            crate::model::Profile::Stations(stations) => format!(
+                "schedules at {} stations ζ = {:?} {}",
+                stations.len(),
+                stations.iter().map(|st| st.0).collect::<Vec<_>>(),
+                u.length()
+            ),
+            crate::model::Profile::Front { width, .. } => {
+                format!("a moving front of width {width} {}", u.length())
+            }
+        };
+        let (lo, hi) = field.range();
+        let _ = writeln!(
+            s,
+            "temperature varies along ζ = ({:.4}, {:.4}, {:.4})·(X − X₀): {kind}, between {lo} and {hi} °C",
+            e.x, e.y, e.z
+        );
+    }
     let _ = writeln!(s, "patches     {}", model.patches.len());
     let width = model
         .patches
@@ -63,9 +83,14 @@ pub fn describe(design: &Design, file: &str) -> String {
             None => "exact".to_string(),
             Some(e) => format!("fit error {e:.3e} {}", u.length()),
         };
+        let material = if model.materials.len() > 1 {
+            format!(", material `{}`", model.material_names[p.material])
+        } else {
+            String::new()
+        };
         let _ = writeln!(
             s,
-            "  {:width$}  p = {}, n = {:3}, section {}, {fit}",
+            "  {:width$}  p = {}, n = {:3}, section {}{material}, {fit}",
             p.name,
             p.curve.degree(),
             p.curve.num_points(),

@@ -2,11 +2,12 @@
 //! output stood at that step ([`OutputsCheckpoint`]), from which `stentkit run --resume` continues a killed or
 //! interrupted run exactly.
 //!
-//! # Format (version 2; version 1, before error-controlled stepping, had no step-control memory)
+//! # Format (version 3; version 2 had 18 numbers per section law and no per-material recovery, version 1, before
+//! error-controlled stepping, no step-control memory)
 //!
 //! ```text
 //! magic     8 bytes   "STKCKPT\0"
-//! version   u32       2
+//! version   u32       3
 //! length    u64       bytes of the payload
 //! payload   …         the fields below, in order
 //! crc32     u32       CRC-32 (IEEE 802.3, as zlib and PNG) of everything before it
@@ -46,7 +47,7 @@ pub const FILE_NAME: &str = "checkpoint.bin";
 const MAGIC: &[u8; 8] = b"STKCKPT\0";
 
 /// The format version this build writes and reads.
-pub const VERSION: u32 = 2;
+pub const VERSION: u32 = 3;
 
 /// Bytes before the payload: magic, version, length.
 const HEADER: usize = 8 + 4 + 8;
@@ -574,6 +575,7 @@ fn encode_sample(e: &mut Encoder, s: &StateSample) {
         e.f64(r.ratio_mean);
         e.f64(r.ratio_max);
         e.option(r.delta_r.as_ref(), |e, v| e.f64(*v));
+        e.f64s(&r.by_material);
     });
 }
 
@@ -594,6 +596,7 @@ fn decode_sample(d: &mut Decoder<'_>) -> Result<StateSample, Problem> {
                 ratio_mean: d.f64()?,
                 ratio_max: d.f64()?,
                 delta_r: d.option(|d| d.f64())?,
+                by_material: d.f64s()?,
             })
         })?,
     })
@@ -780,6 +783,7 @@ mod tests {
                     ratio_mean: 0.5,
                     ratio_max: 0.75,
                     delta_r: None,
+                    by_material: vec![0.25, 0.125],
                 }),
             }],
             totals: RunSummary {
@@ -847,7 +851,7 @@ mod tests {
             Err(Problem::NotACheckpoint)
         ));
         let mut other = bytes.clone();
-        other[8] = 3;
-        assert!(matches!(decode(&other), Err(Problem::Version(3))));
+        other[8] = 2; // the format before this one
+        assert!(matches!(decode(&other), Err(Problem::Version(2))));
     }
 }

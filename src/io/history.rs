@@ -7,7 +7,11 @@
 //! A design with a programme (stents) adds `recovery_ratio_mean` and `recovery_ratio_max`, the mean (weighted
 //! over the full device) and largest `‖η_l‖ / ‖η_temp,l‖` over the driven nodes — 1 at the temporary shape, 0 at
 //! the permanent one — and, for a radial contraction, `delta_r`: the mean radial contraction of the driven
-//! nodes (positive towards the axis; the paper's Δr). The last column, `max_displacement`, is the largest
+//! nodes (positive towards the axis; the paper's Δr), and for a device of several materials
+//! `recovery_ratio_mean@<material>`, the mean ratio over the driven nodes touching a rod of that material (a node
+//! joining two materials counts in both; [`crate::model::Model::material_regions`]). With a temperature field,
+//! `temperature` is the field's reference schedule and `temperature_min`, `temperature_max` (after `cuts`) the
+//! extremes over the collocation points. The last column, `max_displacement`, is the largest
 //! displacement of any node from the reference shape (length unit): the size of the programmed shape, of the
 //! snap at a release and of what is left at the end (`stentkit sweep`'s metrics).
 //! Rows are flushed as they are written, so an interrupted run leaves a valid file up to its last step; a row
@@ -55,6 +59,9 @@ impl HistoryWriter {
             }
         }
         header.push_str(",temperature,iterations,residual,cuts");
+        if sim.model().temperature_field.is_some() {
+            header.push_str(",temperature_min,temperature_max");
+        }
         if sim.model().time.tolerance.is_some() {
             header.push_str(",dt,error_estimate,rejected");
         }
@@ -65,6 +72,10 @@ impl HistoryWriter {
                 crate::model::ProgrammeKind::RadialContraction { .. }
             ) {
                 header.push_str(",delta_r");
+            }
+            let model = sim.model();
+            for (m, _) in model.material_regions() {
+                header.push_str(&format!(",recovery_ratio_mean@{}", model.material_names[m]));
             }
         }
         header.push_str(",max_displacement");
@@ -159,6 +170,9 @@ impl HistoryWriter {
         line.push_str(&format!(
             ",{temperature:.6},{iterations},{residual:.3e},{cuts}"
         ));
+        if let Some((lo, hi)) = sim.temperature_extremes(t) {
+            line.push_str(&format!(",{lo:.6},{hi:.6}"));
+        }
         if sim.model().time.tolerance.is_some() {
             let (dt, estimate, rejected) = report.map_or((0.0, 0.0, 0), |r| {
                 (r.dt, r.error_estimate.unwrap_or(0.0), r.rejected)
@@ -169,6 +183,9 @@ impl HistoryWriter {
             line.push_str(&format!(",{:.9e},{:.9e}", r.ratio_mean, r.ratio_max));
             if let Some(delta_r) = r.delta_r {
                 line.push_str(&format!(",{delta_r:.9e}"));
+            }
+            for ratio in &r.by_material {
+                line.push_str(&format!(",{ratio:.9e}"));
             }
         }
         line.push_str(&format!(

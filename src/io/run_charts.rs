@@ -8,6 +8,8 @@
 //!   programme);
 //! * `recovery.svg` — the mean and largest recovery ratio against time with the normalised temperature and
 //!   the programme's ramp (designs with a programme: 1 at the temporary shape, 0 at the permanent one);
+//! * `recovery_by_material.svg` — the mean recovery ratio of each material region against time, with the
+//!   normalised temperature (devices of several materials: which part recovers first);
 //! * `delta_r.svg` — the mean radial contraction Δr against time (radial-contraction programmes);
 //! * `newton.svg` — Newton iterations per step against time (every run);
 //! * `step_size.svg` — the step size and the time-error estimate over the tolerance against time, on log axes
@@ -160,10 +162,47 @@ impl RunCharts {
                 );
             }
             charts.push(("recovery.svg", chart));
+            let regions = model.material_regions();
+            if !regions.is_empty() {
+                let mut chart = LineChart::new(
+                    format!(
+                        "{name}: mean recovery ratio per material (1: temporary shape, 0: permanent)"
+                    ),
+                    "time [s]",
+                    "ratio [-], normalised temperature [-]",
+                );
+                for (k, (m, _)) in regions.iter().enumerate() {
+                    let points = self
+                        .samples
+                        .iter()
+                        .filter_map(|s| {
+                            let r = s.recovery.as_ref()?;
+                            r.by_material.get(k).map(|&v| (s.time, v))
+                        })
+                        .collect();
+                    chart
+                        .series
+                        .push(Series::new(model.material_names[*m].clone(), points));
+                }
+                chart.series.push(
+                    Series::new(
+                        format!("(T − {lo} °C)/{span} °C"),
+                        series(&|s| (s.temperature - lo) / span),
+                    )
+                    .dashed()
+                    .with_color(3),
+                );
+                charts.push(("recovery_by_material.svg", chart));
+            }
             let delta_r: Vec<(Real, Real)> = self
                 .samples
                 .iter()
-                .filter_map(|s| s.recovery.and_then(|r| r.delta_r).map(|d| (s.time, d)))
+                .filter_map(|s| {
+                    s.recovery
+                        .as_ref()
+                        .and_then(|r| r.delta_r)
+                        .map(|d| (s.time, d))
+                })
                 .collect();
             if !delta_r.is_empty() {
                 let mut chart = LineChart::new(

@@ -133,7 +133,7 @@ impl LoadChannel {
 }
 
 /// Recovery measures of a programme (DESIGN §7; paper §4.3).
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, PartialEq)]
 pub struct Recovery {
     /// Mean over the full device of `‖η_l‖ / ‖η_temp,l‖` over the driven nodes: 1 at the temporary shape, 0
     /// at the permanent one.
@@ -143,6 +143,9 @@ pub struct Recovery {
     /// Mean radial contraction of the driven nodes [length], positive towards the axis (the paper's Δr),
     /// for a radial-contraction programme.
     pub delta_r: Option<Real>,
+    /// For a device of several materials, the mean ratio over the driven nodes of each material region, in the
+    /// order of [`crate::model::Model::material_regions`] (empty for one material).
+    pub by_material: Vec<Real>,
 }
 
 /// The recovery measures of the current state, for a model with a programme.
@@ -158,6 +161,12 @@ pub fn recovery(sim: &Simulation<'_>) -> Option<Recovery> {
         ratio_max: programme.target_fraction_max(&u),
         delta_r: matches!(programme.kind, ProgrammeKind::RadialContraction { .. })
             .then(|| -programme.mean_radial_displacement(&u)),
+        by_material: sim
+            .model()
+            .material_regions()
+            .iter()
+            .map(|(_, nodes)| programme.target_fraction_where(&u, |k| nodes.contains(&k)))
+            .collect(),
     })
 }
 

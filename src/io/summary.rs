@@ -240,9 +240,9 @@ impl FinalState {
                 .zip(&sample.probes)
                 .map(|(p, u)| (p.name.clone(), [u.x, u.y, u.z]))
                 .collect(),
-            recovery_ratio_mean: sample.recovery.map(|r| r.ratio_mean),
-            recovery_ratio_max: sample.recovery.map(|r| r.ratio_max),
-            delta_r: sample.recovery.and_then(|r| r.delta_r),
+            recovery_ratio_mean: sample.recovery.as_ref().map(|r| r.ratio_mean),
+            recovery_ratio_max: sample.recovery.as_ref().map(|r| r.ratio_max),
+            delta_r: sample.recovery.as_ref().and_then(|r| r.delta_r),
         }
     }
 }

@@ -50,7 +50,7 @@ use crate::math::Real;
 use std::fmt;
 
 /// The time step a law prepares: from `t_n` to `t_{n+1}` \[time\], with the temperature \[°C\] as a function of
-/// time over it (uniform over the device, DESIGN §4). Laws that integrate the temperature over the step (the
+/// time over it — uniform over the device (DESIGN §4), or per point where it varies along the rods. Laws that integrate the temperature over the step (the
 /// exponential integrator's reduced time) evaluate it inside the step; others at its ends only.
 #[derive(Clone, Copy)]
 pub struct StepInput<'a> {
@@ -58,9 +58,16 @@ pub struct StepInput<'a> {
     pub t_n: Real,
     /// End of the step \[time\].
     pub t_np1: Real,
-    /// Temperature \[°C\] as a function of time \[time\].
+    /// Temperature \[°C\] as a function of time \[time\] (where it is uniform; a reference value otherwise).
     pub temperature: &'a dyn Fn(Real) -> Real,
+    /// Where the temperature varies along the rods: at the law's point `i` (its numbering) and time `t`, the
+    /// temperature and its derivative along the reference arc length, `(T, T,s)` \[°C, K/length\]. `None` when
+    /// it is uniform (`temperature` holds at every point).
+    pub field: Option<&'a PointTemperature<'a>>,
 }
+
+/// The temperature at a law's point `i` and time `t` with its s-derivative, `(T, T,s)` (see [`StepInput::field`]).
+pub type PointTemperature<'a> = dyn Fn(usize, Real) -> (Real, Real) + Sync + 'a;
 
 impl fmt::Debug for StepInput<'_> {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
@@ -221,6 +228,10 @@ macro_rules! register_laws {
         }
 
         /// The state of a [`MaterialLaw`] at its points: the state of the law of the same name.
+        // One state per material of a model, made once and changed in place: the size of the enum (a few
+        // hundred bytes, mostly vectors' headers) is never copied in a loop, and boxing would only add a
+        // pointer chase to every access.
+        #[allow(clippy::large_enum_variant)]
         #[derive(Debug, Clone, PartialEq)]
         pub enum MaterialState {
             $($(#[$doc])* $variant(<$law as $crate::material::ConstitutiveLaw>::State),)+

@@ -123,6 +123,7 @@ mod tests {
                 t_n: step as Real,
                 t_np1: step as Real + 1.0,
                 temperature: &temperature,
+                field: None,
             };
             assert_eq!(elastic.prepare_step(&mut e_state, &input), Ok(None));
             assert_eq!(maxwell.prepare_step(&mut m_state, &input), Ok(None));

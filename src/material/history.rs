@@ -190,6 +190,74 @@ pub fn update_branch_strains(
     }
 }
 
+/// Where the temperature varies along the rod (module docs of [`super::maxwell`]): the extra history of the
+/// s-derivatives from the slopes `coeffs_ds = (β_α,s, γ_α,s, δ_α,s)` of the step coefficients,
+/// `H_N,s += S_N ⊙ Σ_α E_α (γ_α,s Γ_N^n + δ_α,s Γ_Nα^n)` and likewise for `H_M,s`, added to `history`.
+/// Panics if the branch counts differ.
+#[track_caller]
+pub fn add_history_slope(
+    prony: &Prony,
+    shape: &SectionShape,
+    coeffs_ds: &StepCoefficients,
+    strain_n: &SectionStrains,
+    branches_n: &[SectionStrains],
+    history: &mut SectionStress,
+) {
+    assert!(
+        coeffs_ds.num_branches() == prony.num_branches()
+            && branches_n.len() == coeffs_ds.num_branches(),
+        "branch counts differ"
+    );
+    let (mut force, mut moment) = (Vec3::zeros(), Vec3::zeros());
+    for ((b, (&gamma_s, &delta_s)), branch) in prony
+        .branches()
+        .iter()
+        .zip(coeffs_ds.gamma.iter().zip(&coeffs_ds.delta))
+        .zip(branches_n)
+    {
+        force += (strain_n.force * gamma_s + branch.force * delta_s) * b.modulus;
+        moment += (strain_n.moment * gamma_s + branch.moment * delta_s) * b.modulus;
+    }
+    history.force_ds += shape.force.component_mul(&force);
+    history.moment_ds += shape.moment.component_mul(&moment);
+}
+
+/// [`update_branch_strains`] where the temperature varies along the rod: the s-derivatives of the branch
+/// strains also take the exact s-derivative of (★) through the coefficients,
+/// `ε_α,s ← β_α ε,s^{n+1} + γ_α ε,s^n + δ_α ε_α,s + β_α,s ε^{n+1} + γ_α,s ε^n + δ_α,s ε_α`.
+/// Panics if the branch counts differ.
+#[track_caller]
+pub fn update_branch_strains_with_slope(
+    coeffs: &StepCoefficients,
+    coeffs_ds: &StepCoefficients,
+    strain_np1: &SectionStrains,
+    strain_n: &SectionStrains,
+    branches: &mut [SectionStrains],
+) {
+    assert_eq!(
+        coeffs_ds.num_branches(),
+        branches.len(),
+        "branch counts differ"
+    );
+    assert_eq!(
+        coeffs.num_branches(),
+        branches.len(),
+        "branch counts differ"
+    );
+    for (k, branch) in branches.iter_mut().enumerate() {
+        let (beta_s, gamma_s, delta_s) =
+            (coeffs_ds.beta[k], coeffs_ds.gamma[k], coeffs_ds.delta[k]);
+        let force = strain_np1.force * beta_s + strain_n.force * gamma_s + branch.force * delta_s;
+        let moment =
+            strain_np1.moment * beta_s + strain_n.moment * gamma_s + branch.moment * delta_s;
+        *branch = strain_np1
+            .combine(coeffs.beta[k], strain_n, coeffs.gamma[k])
+            .combine(1.0, branch, coeffs.delta[k]);
+        branch.force_ds += force;
+        branch.moment_ds += moment;
+    }
+}
+
 #[cfg(test)]
 mod tests {
     // Reference: the definition σ = E∞ ε + Σ E_α (ε − ε_α^{n+1}) (paper, the unnumbered equations before

@@ -257,13 +257,66 @@ pub fn step_coefficients_into(
     temperature: &dyn Fn(Real) -> Real,
     out: &mut StepCoefficients,
 ) -> Result<(), MaterialError> {
+    let uniform = |t: Real| (temperature(t), 0.0);
+    coefficients_into(
+        material, integrator, quadrature, t_n, t_np1, &uniform, out, None,
+    )
+}
+
+/// [`step_coefficients_into`] at a point where the temperature varies along the rod: `temperature(t)` gives
+/// `(T, T,s)` \[°C, K/length\] there, and `out_ds` receives the derivatives `(β_α,s, γ_α,s, δ_α,s)` of the
+/// coefficients along the reference arc length \[1/length\] — exact derivatives of the formulas of the module
+/// docs through `λ_α,s = λ_α · d ln(rate_factor)/dT · T,s` ([`super::Wlf::log_rate_slope`]); zero where a
+/// rate is capped ([`MAX_STEP_RATE`]) or frozen. They make the s-derivative of (★) exact (module docs of
+/// [`super::maxwell`], *Temperature that varies along the rod*).
+///
+/// Errors as [`step_coefficients_into`] (also for a non-finite `T,s`).
+#[allow(clippy::too_many_arguments)]
+pub fn step_coefficients_with_slope_into(
+    material: &Material,
+    integrator: Integrator,
+    quadrature: &ReducedTimeQuadrature,
+    t_n: Real,
+    t_np1: Real,
+    temperature: &dyn Fn(Real) -> (Real, Real),
+    out: &mut StepCoefficients,
+    out_ds: &mut StepCoefficients,
+) -> Result<(), MaterialError> {
+    coefficients_into(
+        material,
+        integrator,
+        quadrature,
+        t_n,
+        t_np1,
+        temperature,
+        out,
+        Some(out_ds),
+    )
+}
+
+/// The coefficients of (★) and, when `out_ds` is given, their s-derivatives (see the two public wrappers).
+#[allow(clippy::too_many_arguments)]
+fn coefficients_into(
+    material: &Material,
+    integrator: Integrator,
+    quadrature: &ReducedTimeQuadrature,
+    t_n: Real,
+    t_np1: Real,
+    temperature: &dyn Fn(Real) -> (Real, Real),
+    out: &mut StepCoefficients,
+    mut out_ds: Option<&mut StepCoefficients>,
+) -> Result<(), MaterialError> {
     let h = step_length(t_n, t_np1)?;
     let branches = material.prony().branches();
     out.resize(branches.len());
+    if let Some(ds) = out_ds.as_deref_mut() {
+        ds.resize(branches.len());
+        ds.delta.fill(0.0);
+    }
     match integrator {
         Integrator::Trapezoidal => {
-            let rf0 = rate_factor_at(material, temperature, t_n)?;
-            let rf1 = rate_factor_at(material, temperature, t_np1)?;
+            let (rf0, rf0_s) = rate_factor_at(material, temperature, t_n)?;
+            let (rf1, rf1_s) = rate_factor_at(material, temperature, t_np1)?;
             for (i, b) in branches.iter().enumerate() {
                 let r0 = 0.5 * step_rate(h * rf0, b.tau_g);
                 let r1 = 0.5 * step_rate(h * rf1, b.tau_g);
@@ -271,25 +324,47 @@ pub fn step_coefficients_into(
                 out.beta[i] = r1 / d;
                 out.gamma[i] = r0 / d;
                 out.delta[i] = (1.0 - r0) / d;
+                if let Some(ds) = out_ds.as_deref_mut() {
+                    let r0_s = 0.5 * step_rate_slope(h * rf0, h * rf0_s, b.tau_g);
+                    let r1_s = 0.5 * step_rate_slope(h * rf1, h * rf1_s, b.tau_g);
+                    ds.beta[i] = r1_s / (d * d);
+                    ds.gamma[i] = r0_s / d - r0 * r1_s / (d * d);
+                    ds.delta[i] = -r0_s / d - (1.0 - r0) * r1_s / (d * d);
+                }
             }
         }
         Integrator::BackwardEuler => {
-            let rf1 = rate_factor_at(material, temperature, t_np1)?;
+            let (rf1, rf1_s) = rate_factor_at(material, temperature, t_np1)?;
             for (i, b) in branches.iter().enumerate() {
                 let r = step_rate(h * rf1, b.tau_g);
                 let d = 1.0 + r;
                 out.beta[i] = r / d;
                 out.gamma[i] = 0.0;
                 out.delta[i] = 1.0 / d;
+                if let Some(ds) = out_ds.as_deref_mut() {
+                    let r_s = step_rate_slope(h * rf1, h * rf1_s, b.tau_g);
+                    ds.beta[i] = r_s / (d * d);
+                    ds.gamma[i] = 0.0;
+                    ds.delta[i] = -r_s / (d * d);
+                }
             }
         }
         Integrator::Exponential => {
-            let xi = reduced_time_increment(material, quadrature, t_n, t_np1, temperature)?;
+            let (xi, xi_s) =
+                reduced_time_increment_with_slope(material, quadrature, t_n, t_np1, temperature)?;
             for (i, b) in branches.iter().enumerate() {
-                let (beta, gamma, delta) = exponential_coefficients(step_rate(xi, b.tau_g));
+                let x = step_rate(xi, b.tau_g);
+                let (beta, gamma, delta) = exponential_coefficients(x);
                 out.beta[i] = beta;
                 out.gamma[i] = gamma;
                 out.delta[i] = delta;
+                if let Some(ds) = out_ds.as_deref_mut() {
+                    let x_s = step_rate_slope(xi, xi_s, b.tau_g);
+                    let (beta_x, gamma_x, delta_x) = exponential_coefficient_slopes(x);
+                    ds.beta[i] = beta_x * x_s;
+                    ds.gamma[i] = gamma_x * x_s;
+                    ds.delta[i] = delta_x * x_s;
+                }
             }
         }
     }
@@ -309,25 +384,41 @@ pub fn reduced_time_increment(
     t_np1: Real,
     temperature: &dyn Fn(Real) -> Real,
 ) -> Result<Real, MaterialError> {
+    let uniform = |t: Real| (temperature(t), 0.0);
+    reduced_time_increment_with_slope(material, quadrature, t_n, t_np1, &uniform).map(|(xi, _)| xi)
+}
+
+/// The reduced-time increment `ξ` and its s-derivative `ξ,s = ∫ rate_factor,s dt` \[time/length\] by the same
+/// quadrature, for a temperature history `t ↦ (T, T,s)` at a point.
+fn reduced_time_increment_with_slope(
+    material: &Material,
+    quadrature: &ReducedTimeQuadrature,
+    t_n: Real,
+    t_np1: Real,
+    temperature: &dyn Fn(Real) -> (Real, Real),
+) -> Result<(Real, Real), MaterialError> {
     let h = step_length(t_n, t_np1)?;
     if material.wlf().is_none() {
-        return Ok(h);
+        return Ok((h, 0.0));
     }
     if h == 0.0 {
-        return Ok(0.0);
+        return Ok((0.0, 0.0));
     }
     let parts = quadrature.subintervals.get();
     let part = h / parts as Real;
-    let mut xi = 0.0;
+    let (mut xi, mut xi_s) = (0.0, 0.0);
     for k in 0..parts {
         let mid = t_n + (k as Real + 0.5) * part;
-        let mut sum = 0.0;
+        let (mut sum, mut sum_s) = (0.0, 0.0);
         for &(node, weight) in &GAUSS5 {
-            sum += weight * rate_factor_at(material, temperature, mid + 0.5 * part * node)?;
+            let (rf, rf_s) = rate_factor_at(material, temperature, mid + 0.5 * part * node)?;
+            sum += weight * rf;
+            sum_s += weight * rf_s;
         }
         xi += 0.5 * part * sum;
+        xi_s += 0.5 * part * sum_s;
     }
-    Ok(xi)
+    Ok((xi, xi_s))
 }
 
 /// The exponential integrator's coefficients `(β, γ, δ) = (1 − φ, φ − e^{−Δξ}, e^{−Δξ})`, `φ = (1 − e^{−Δξ})/Δξ`,
@@ -372,6 +463,39 @@ pub fn exponential_coefficients(reduced_step: Real) -> (Real, Real, Real) {
     (beta, gamma, (-x).exp())
 }
 
+/// The derivatives `(dβ/dΔξ, dγ/dΔξ, dδ/dΔξ)` of [`exponential_coefficients`]: with `φ' = (e^{−x}(1 + x) − 1)/x²`
+/// (from its Taylor series `Σ_{j≥1} j (−x)^{j−1}(−1)/(j+1)!`, `−1/2` at 0, below `Δξ = 0.5`, where the closed form
+/// cancels), `β' = −φ'`, `γ' = φ' + e^{−x}`, `δ' = −e^{−x}`; all zero at `Δξ = ∞`.
+pub fn exponential_coefficient_slopes(reduced_step: Real) -> (Real, Real, Real) {
+    let x = reduced_step;
+    if x == Real::INFINITY {
+        return (0.0, 0.0, 0.0);
+    }
+    let e = (-x).exp();
+    let phi_x = if x < EXP_SERIES_BELOW {
+        // φ' = Σ_{j≥1} (−1)^j j x^{j−1}/(j+1)!: alternating, decreasing terms.
+        let mut power = 1.0; // x^{j−1}
+        let mut factorial = 2.0; // (j+1)!
+        let mut sum: Real = 0.0;
+        let mut j = 1.0;
+        loop {
+            let term = j * power / factorial;
+            let signed = if (j as i64) % 2 == 1 { -term } else { term };
+            sum += signed;
+            if term <= Real::EPSILON * sum.abs() {
+                break;
+            }
+            j += 1.0;
+            power *= x;
+            factorial *= j + 1.0;
+        }
+        sum
+    } else {
+        (e * (1.0 + x) - 1.0) / (x * x)
+    };
+    (-phi_x, phi_x + e, -e)
+}
+
 /// `h = t_{n+1} − t_n ≥ 0`, or the error naming the step.
 fn step_length(t_n: Real, t_np1: Real) -> Result<Real, MaterialError> {
     if t_n.is_finite() && t_np1.is_finite() && t_np1 >= t_n {
@@ -381,24 +505,42 @@ fn step_length(t_n: Real, t_np1: Real) -> Result<Real, MaterialError> {
     }
 }
 
-/// The rate factor at time `t` (the temperature is evaluated only when the material has a WLF shift).
+/// The rate factor at time `t` and its s-derivative, from `temperature(t) = (T, T,s)` (evaluated only when the
+/// material has a WLF shift): `rate_factor,s = rate_factor · d ln(rate_factor)/dT · T,s`.
 fn rate_factor_at(
     material: &Material,
-    temperature: &dyn Fn(Real) -> Real,
+    temperature: &dyn Fn(Real) -> (Real, Real),
     t: Real,
-) -> Result<Real, MaterialError> {
-    if material.wlf().is_none() {
-        return Ok(1.0);
+) -> Result<(Real, Real), MaterialError> {
+    let Some(wlf) = material.wlf() else {
+        return Ok((1.0, 0.0));
+    };
+    let (temp, temp_s) = temperature(t);
+    for (quantity, value) in [("temperature", temp), ("temperature gradient", temp_s)] {
+        if !value.is_finite() {
+            return Err(MaterialError::NonFiniteInput {
+                quantity,
+                time: t,
+                value,
+            });
+        }
     }
-    let temp = temperature(t);
-    if !temp.is_finite() {
-        return Err(MaterialError::NonFiniteInput {
-            quantity: "temperature",
-            time: t,
-            value: temp,
-        });
+    let rf = material.rate_factor(temp);
+    let rf_s = if temp_s == 0.0 {
+        0.0
+    } else {
+        rf * wlf.log_rate_slope(temp) * temp_s
+    };
+    Ok((rf, rf_s))
+}
+
+/// The s-derivative of [`step_rate`]`(x, τ_G)` for `x,s = x_s`: `x_s/τ_G`, zero where the rate is capped.
+fn step_rate_slope(x: Real, x_s: Real, tau_g: Real) -> Real {
+    if x / tau_g < MAX_STEP_RATE {
+        x_s / tau_g
+    } else {
+        0.0
     }
-    Ok(material.rate_factor(temp))
 }
 
 /// The capped dimensionless rate `min(x/τ_G, MAX_STEP_RATE)` for `x = h · rate_factor` or `ξ`.
@@ -648,6 +790,93 @@ mod tests {
             // A zero step is the identity.
             let c = step_coefficients(&material, integrator, 0.3, 0.3, &|_| 90.0).expect("h = 0");
             assert_eq!(c, StepCoefficients::identity(15));
+        }
+    }
+
+    // Source: the slopes are derivatives. Along a rod with T(s, t) = T₀(t) + s·g(t), the coefficients at s are
+    // those of the temperature history t ↦ T(s, t); their s-derivative at s = 0 is checked against central
+    // differences in s (step 1e-4 K/g: truncation ~1e-8 relative for these smooth functions of T, round-off
+    // ~1e-16/1e-4 = 1e-12), for PLA's 15 branches (rates over 15 decades, some capped, some frozen) over steps
+    // while cooling through Tg and heating, for every integrator. Tolerance 1e-6 relative to the largest slope
+    // of the step, plus 1e-10 absolute: far below a missing chain-rule factor (O(1)).
+    #[test]
+    fn coefficient_slopes_are_derivatives_along_the_rod() {
+        let material = Material::pla_van_manen_2021();
+        let base = |t: Real| 90.0 - 40.0 * t;
+        let gradient = |t: Real| 5.0 + 3.0 * t; // K/length
+        let quadrature = ReducedTimeQuadrature::default();
+        let eps = 1e-4;
+        for integrator in [
+            Integrator::Trapezoidal,
+            Integrator::BackwardEuler,
+            Integrator::Exponential,
+        ] {
+            for (t_n, t_np1) in [(0.0, 0.01), (0.4, 0.45), (0.5, 0.6), (1.0, 1.2)] {
+                let at = |s: Real| {
+                    let f = move |t: Real| (base(t) + s * gradient(t), gradient(t));
+                    let (mut c, mut ds) =
+                        (StepCoefficients::default(), StepCoefficients::default());
+                    step_coefficients_with_slope_into(
+                        &material,
+                        integrator,
+                        &quadrature,
+                        t_n,
+                        t_np1,
+                        &f,
+                        &mut c,
+                        &mut ds,
+                    )
+                    .expect("valid step");
+                    (c, ds)
+                };
+                let (c0, slope) = at(0.0);
+                let (plus, _) = at(eps);
+                let (minus, _) = at(-eps);
+                // The value path is the uniform one's.
+                let uniform = step_coefficients(&material, integrator, t_n, t_np1, &base)
+                    .expect("valid step");
+                assert_eq!(c0, uniform, "{integrator:?}: values as without a field");
+                let pairs = [
+                    (&slope.beta, &plus.beta, &minus.beta),
+                    (&slope.gamma, &plus.gamma, &minus.gamma),
+                    (&slope.delta, &plus.delta, &minus.delta),
+                ];
+                let scale = pairs
+                    .iter()
+                    .flat_map(|(s, _, _)| s.iter())
+                    .fold(0.0_f64, |m, v| m.max(v.abs()));
+                for (name, (exact, p, m)) in ["beta", "gamma", "delta"].iter().zip(pairs) {
+                    for a in 0..exact.len() {
+                        let fd = (p[a] - m[a]) / (2.0 * eps);
+                        assert!(
+                            (exact[a] - fd).abs() <= 1e-6 * scale + 1e-10,
+                            "{integrator:?} step [{t_n}, {t_np1}] branch {}: {name},s {} against {fd}",
+                            a + 1,
+                            exact[a]
+                        );
+                    }
+                }
+            }
+        }
+        // The exponential coefficients' slopes on their own, across the series/closed-form switch.
+        for x in [0.0_f64, 1e-8, 0.1, 0.4999, 0.5001, 2.0, 40.0] {
+            let h = 1e-6 * x.max(1e-3);
+            let (p, m) = (
+                exponential_coefficients(x + h),
+                exponential_coefficients((x - h).max(0.0)),
+            );
+            let width = x + h - (x - h).max(0.0);
+            let (b, g, d) = exponential_coefficient_slopes(x);
+            for (exact, fd) in [
+                (b, (p.0 - m.0) / width),
+                (g, (p.1 - m.1) / width),
+                (d, (p.2 - m.2) / width),
+            ] {
+                assert!(
+                    (exact - fd).abs() <= 1e-6,
+                    "x = {x}: slope {exact} against {fd}"
+                );
+            }
         }
     }
 }

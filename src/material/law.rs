@@ -11,6 +11,14 @@
 //!
 //! with the step's effective modulus `Ē` ([`super::StepCoefficients::effective_modulus`]), the section shapes
 //! `S` ([`SectionShape`]) and the history stresses `H` ([`super::history_stress`]), both fixed during Newton.
+//! Where the temperature varies along the rod, `Ē` does too, and the derivatives of the stresses gain the term
+//! of its slope `C̄,s = S ⊙ Ē,s` (module docs of [`super::maxwell`]):
+//!
+//! ```text
+//! N,s = C̄_N Γ_N,s + C̄_N,s Γ_N − H_N,s,     M,s = C̄_M K_M,s + C̄_M,s K_M − H_M,s,
+//! ```
+//!
+//! with `∂N,s/∂Γ_N = C̄_N,s`, `∂M,s/∂K_M = C̄_M,s` in the tangent ([`SectionLaw::stiffness_slope_matrices`]).
 //! [`SectionLaw`] holds `C̄` and `H` of one point for one step; [`SectionLaw::stress`] evaluates the law and
 //! [`SectionLaw::stiffness_matrices`] gives its (constant) derivative `∂N/∂Γ_N = C̄_N`, `∂M/∂K_M = C̄_M`.
 //! It is `Copy`, allocates nothing and inlines: the solver builds one per collocation point per iteration.
@@ -19,7 +27,7 @@ use super::{SectionShape, SectionStrains, SectionStress};
 use crate::math::{Mat3, Real, Vec3};
 
 /// Numbers of a [`SectionLaw`] ([`SectionLaw::to_numbers`]).
-pub const LAW_NUMBERS: usize = 18;
+pub const LAW_NUMBERS: usize = 24;
 
 /// The section law `N = C̄_N Γ_N − H_N`, `M = C̄_M K_M − H_M` (and the same for the s-derivatives) of one
 /// point during one time step (module docs).
@@ -29,6 +37,10 @@ pub struct SectionLaw {
     force_stiffness: Vec3,
     /// Diagonal of `C̄_M = diag(S_M ⊙ Ē)` \[force·length²\].
     moment_stiffness: Vec3,
+    /// Diagonal of `C̄_N,s` \[force/length\] (zero unless the temperature varies along the rod).
+    force_stiffness_ds: Vec3,
+    /// Diagonal of `C̄_M,s` \[force·length\].
+    moment_stiffness_ds: Vec3,
     /// History stresses `H = (H_N, H_M, H_N,s, H_M,s)` (zero for an elastic material or the first step).
     history: SectionStress,
 }
@@ -41,7 +53,25 @@ impl SectionLaw {
         Self {
             force_stiffness: shape.force_stiffness(effective_modulus),
             moment_stiffness: shape.moment_stiffness(effective_modulus),
+            force_stiffness_ds: Vec3::zeros(),
+            moment_stiffness_ds: Vec3::zeros(),
             history,
+        }
+    }
+
+    /// The law at a point where the effective modulus varies along the rod: `Ē` \[stress\] and its slope
+    /// `Ē,s` \[stress/length\] (module docs).
+    #[inline]
+    pub fn with_slope(
+        shape: &SectionShape,
+        effective_modulus: Real,
+        modulus_slope: Real,
+        history: SectionStress,
+    ) -> Self {
+        Self {
+            force_stiffness_ds: shape.force_stiffness(modulus_slope),
+            moment_stiffness_ds: shape.moment_stiffness(modulus_slope),
+            ..Self::new(shape, effective_modulus, history)
         }
     }
 
@@ -59,13 +89,17 @@ impl SectionLaw {
         SectionStress {
             force: c_n.component_mul(&strain.force) - h.force,
             moment: c_m.component_mul(&strain.moment) - h.moment,
-            force_ds: c_n.component_mul(&strain.force_ds) - h.force_ds,
-            moment_ds: c_m.component_mul(&strain.moment_ds) - h.moment_ds,
+            force_ds: c_n.component_mul(&strain.force_ds)
+                + self.force_stiffness_ds.component_mul(&strain.force)
+                - h.force_ds,
+            moment_ds: c_m.component_mul(&strain.moment_ds)
+                + self.moment_stiffness_ds.component_mul(&strain.moment)
+                - h.moment_ds,
         }
     }
 
-    /// The law as 18 plain numbers (for checkpoints): the diagonals of `C̄_N` and `C̄_M`, then `H_N`, `H_M`,
-    /// `H_N,s`, `H_M,s`. [`SectionLaw::from_numbers`] inverts it exactly.
+    /// The law as 24 plain numbers (for checkpoints): the diagonals of `C̄_N` and `C̄_M`, then `H_N`, `H_M`,
+    /// `H_N,s`, `H_M,s`, then the diagonals of `C̄_N,s` and `C̄_M,s`. [`SectionLaw::from_numbers`] inverts it exactly.
     pub fn to_numbers(&self) -> [Real; LAW_NUMBERS] {
         let h = &self.history;
         let mut out = [0.0; LAW_NUMBERS];
@@ -76,6 +110,8 @@ impl SectionLaw {
             &h.moment,
             &h.force_ds,
             &h.moment_ds,
+            &self.force_stiffness_ds,
+            &self.moment_stiffness_ds,
         ]
         .into_iter()
         .enumerate()
@@ -91,6 +127,8 @@ impl SectionLaw {
         Self {
             force_stiffness: v(0),
             moment_stiffness: v(1),
+            force_stiffness_ds: v(6),
+            moment_stiffness_ds: v(7),
             history: SectionStress {
                 force: v(2),
                 moment: v(3),
@@ -104,6 +142,19 @@ impl SectionLaw {
     #[inline]
     pub fn stiffness(&self) -> (Vec3, Vec3) {
         (self.force_stiffness, self.moment_stiffness)
+    }
+
+    /// `C̄_N,s = ∂N,s/∂Γ_N` \[force/length\] and `C̄_M,s = ∂M,s/∂K_M` \[force·length\] as (diagonal) matrices, or
+    /// `None` when the modulus does not vary along the rod (the common case: nothing to add to the tangent).
+    #[inline]
+    pub fn stiffness_slope_matrices(&self) -> Option<(Mat3, Mat3)> {
+        (self.force_stiffness_ds != Vec3::zeros() || self.moment_stiffness_ds != Vec3::zeros())
+            .then(|| {
+                (
+                    Mat3::from_diagonal(&self.force_stiffness_ds),
+                    Mat3::from_diagonal(&self.moment_stiffness_ds),
+                )
+            })
     }
 
     /// `C̄_N = ∂N/∂Γ_N` \[force\] and `C̄_M = ∂M/∂K_M` \[force·length²\] as (diagonal) matrices, for the tangent.

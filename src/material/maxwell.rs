@@ -15,6 +15,41 @@
 //! The step's `Ē` and `H` are kept with those of the last converged step, which a roll-back restores (the
 //! section laws of the converged state are then those that produced it, so its stresses — the reactions a
 //! release captures — are the converged ones).
+//!
+//! # Temperature that varies along the rod
+//!
+//! The paper takes the temperature uniform, so the rates `λ_α`, hence the coefficients `(β_α, γ_α, δ_α)` of (★)
+//! and `Ē`, are the same at every point, and the s-derivatives of the branch strains obey (★) with the same
+//! coefficients ([`super::history`]). When `T = T(s, t)` ([`StepInput::field`]) the continuous evolution
+//! `ε̇_α = λ_α(T(s, t)) (ε − ε_α)` differentiated along the reference arc length gives
+//!
+//! ```text
+//! ε̇_α,s = λ_α (ε,s − ε_α,s) + λ_α,s (ε − ε_α),        λ_α,s = λ_α · d ln(rate_factor)/dT · T,s,
+//! d ln(rate_factor)/dT = ln 10 · C1 C2 / (C2 + T − Tg)²                  (from paper Eq. at),
+//! ```
+//!
+//! a term the paper's `T,s = 0` removes. We differentiate the *discrete* update (★) instead of discretising this
+//! equation, so that the stored `ε_α,s` stay the exact s-derivative of the stored `ε_α` (the balance equations
+//! need `N,s` consistent with `N`):
+//!
+//! ```text
+//! ε_α,s^{n+1} = β_α ε,s^{n+1} + γ_α ε,s^n + δ_α ε_α,s^n + β_α,s ε^{n+1} + γ_α,s ε^n + δ_α,s ε_α^n,
+//! ```
+//!
+//! with the coefficient slopes of [`super::step_coefficients_with_slope_into`] (a consistent discretisation of
+//! the equation above: its extra terms are the slopes of the rates). Inserted into `σ = E∞ ε + Σ_α E_α (ε − ε_α)`
+//! and multiplied by the section shapes, which do not vary along a patch:
+//!
+//! ```text
+//! N,s = C̄_N Γ_N,s + C̄_N,s Γ_N − H_N,s,      C̄_N,s = S_N ⊙ Ē,s,     Ē,s = −Σ_α E_α β_α,s,
+//! H_N,s = S_N ⊙ Σ_α E_α (γ_α Γ_N,s^n + δ_α Γ_Nα,s^n + γ_α,s Γ_N^n + δ_α,s Γ_Nα^n),
+//! ```
+//!
+//! and likewise for `M,s` ([`SectionLaw::with_slope`], [`super::add_history_slope`],
+//! [`super::update_branch_strains_with_slope`]); the tangent gains `∂N,s/∂Γ_N = C̄_N,s`, `∂M,s/∂K_M = C̄_M,s`. The
+//! moduli themselves do not depend on temperature in this material (only the relaxation times do), so no
+//! `E,s` term appears. The coefficients are then computed per point and step (a few exponentials per point:
+//! negligible beside the assembly); with a uniform temperature nothing changes.
 
 use super::constitutive::{
     ConstitutiveLaw, PointStrains, SECTION_NUMBERS, StepInput, check_state_length, push_strains,
@@ -22,8 +57,9 @@ use super::constitutive::{
 };
 use super::{
     BranchHistory, Integrator, Material, MaterialError, MaterialNotice, ReducedTimeQuadrature,
-    SectionLaw, SectionShape, SectionStrains, SectionStress, StepCoefficients, history_stress,
-    step_coefficients_into, update_branch_strains,
+    SectionLaw, SectionShape, SectionStrains, SectionStress, StepCoefficients, add_history_slope,
+    history_stress, step_coefficients_into, step_coefficients_with_slope_into,
+    update_branch_strains, update_branch_strains_with_slope,
 };
 use crate::math::Real;
 use rayon::prelude::*;
@@ -74,6 +110,43 @@ pub struct MaxwellState {
     converged_modulus: Real,
     /// `H` per point of the last converged step.
     converged_history: Vec<SectionStress>,
+    /// Per point, when the temperature varies along the rod (module docs); `None` when it is uniform.
+    field: Option<Box<PointSteps>>,
+}
+
+/// The step data of every point where the temperature varies along the rod.
+#[derive(Debug, Clone, PartialEq)]
+struct PointSteps {
+    /// Coefficients of (★) per point.
+    coeffs: Vec<StepCoefficients>,
+    /// Their s-derivatives per point \[1/length\].
+    coeffs_ds: Vec<StepCoefficients>,
+    /// `(Ē, Ē,s)` per point for the step being solved \[stress, stress/length\].
+    modulus: Vec<(Real, Real)>,
+    /// `(Ē, Ē,s)` per point of the last converged step.
+    converged_modulus: Vec<(Real, Real)>,
+}
+
+impl PointSteps {
+    /// Identity coefficients and the equilibrium modulus `e_inf` everywhere.
+    fn new(points: usize, branches: usize, e_inf: Real) -> Self {
+        Self {
+            coeffs: vec![StepCoefficients::identity(branches); points],
+            coeffs_ds: vec![StepCoefficients::identity(branches); points],
+            modulus: vec![(e_inf, 0.0); points],
+            converged_modulus: vec![(e_inf, 0.0); points],
+        }
+    }
+}
+
+/// `Ē,s = −Σ_α E_α β_α,s` \[stress/length\] (module docs).
+fn modulus_slope(prony: &super::Prony, coeffs_ds: &StepCoefficients) -> Real {
+    -prony
+        .branches()
+        .iter()
+        .zip(&coeffs_ds.beta)
+        .map(|(b, beta_s)| b.modulus * beta_s)
+        .sum::<Real>()
 }
 
 impl ConstitutiveLaw for MaxwellLaw {
@@ -119,6 +192,7 @@ impl ConstitutiveLaw for MaxwellLaw {
             history: vec![SectionStress::default(); points],
             converged_modulus: e_inf,
             converged_history: vec![SectionStress::default(); points],
+            field: None,
         }
     }
 
@@ -131,40 +205,50 @@ impl ConstitutiveLaw for MaxwellLaw {
         step: &StepInput<'_>,
     ) -> Result<Option<MaterialNotice>, MaterialError> {
         let material = &self.material;
-        step_coefficients_into(
-            material,
-            self.integrator,
-            &ReducedTimeQuadrature::default(),
-            step.t_n,
-            step.t_np1,
-            step.temperature,
-            &mut state.coeffs,
-        )?;
-        state.modulus = state.coeffs.effective_modulus(material.prony());
-        if material.num_branches() > 0 {
-            // Per point and independent: in parallel.
-            let MaxwellState {
-                shapes,
-                strain_n,
-                branches,
-                coeffs,
-                history,
-                ..
-            } = state;
-            history.par_iter_mut().enumerate().for_each(|(i, h)| {
-                *h = history_stress(
-                    material.prony(),
-                    &shapes[i],
+        if let Some(field) = step.field {
+            self.prepare_field_step(state, step, field)?;
+        } else {
+            state.field = None;
+            step_coefficients_into(
+                material,
+                self.integrator,
+                &ReducedTimeQuadrature::default(),
+                step.t_n,
+                step.t_np1,
+                step.temperature,
+                &mut state.coeffs,
+            )?;
+            state.modulus = state.coeffs.effective_modulus(material.prony());
+            if material.num_branches() > 0 {
+                // Per point and independent: in parallel.
+                let MaxwellState {
+                    shapes,
+                    strain_n,
+                    branches,
                     coeffs,
-                    &strain_n[i],
-                    branches.point(i),
-                );
-            });
+                    history,
+                    ..
+                } = state;
+                history.par_iter_mut().enumerate().for_each(|(i, h)| {
+                    *h = history_stress(
+                        material.prony(),
+                        &shapes[i],
+                        coeffs,
+                        &strain_n[i],
+                        branches.point(i),
+                    );
+                });
+            }
         }
         let Some(wlf) = material.wlf() else {
             return Ok(None);
         };
-        let temperature = (step.temperature)(step.t_np1);
+        let temperature = match step.field {
+            Some(field) => (0..state.shapes.len())
+                .map(|i| field(i, step.t_np1).0)
+                .fold(Real::INFINITY, Real::min),
+            None => (step.temperature)(step.t_np1),
+        };
         Ok(wlf
             .is_frozen(temperature)
             .then(|| MaterialNotice::RelaxationFrozen {
@@ -195,6 +279,49 @@ impl ConstitutiveLaw for MaxwellLaw {
                     integrator: self.integrator.name(),
                     why,
                 })?;
+        if let Some(field) = step.field {
+            let (t_n, t_np1) = (step.t_n, step.t_np1);
+            let m = material.num_branches();
+            return (0..state.shapes.len())
+                .into_par_iter()
+                .map(|i| {
+                    let (mut coeffs, mut coeffs_ds) =
+                        (StepCoefficients::identity(m), StepCoefficients::identity(m));
+                    step_coefficients_with_slope_into(
+                        material,
+                        companion,
+                        &ReducedTimeQuadrature::default(),
+                        t_n,
+                        t_np1,
+                        &|t| field(i, t),
+                        &mut coeffs,
+                        &mut coeffs_ds,
+                    )?;
+                    let shape = &state.shapes[i];
+                    let (strain_n, branches) = (&state.strain_n[i], state.branches.point(i));
+                    let mut history =
+                        history_stress(material.prony(), shape, &coeffs, strain_n, branches);
+                    add_history_slope(
+                        material.prony(),
+                        shape,
+                        &coeffs_ds,
+                        strain_n,
+                        branches,
+                        &mut history,
+                    );
+                    Ok(SectionLaw::with_slope(
+                        shape,
+                        coeffs.effective_modulus(material.prony()),
+                        modulus_slope(material.prony(), &coeffs_ds),
+                        history,
+                    ))
+                })
+                .collect::<Result<Vec<_>, MaterialError>>()
+                .map(|laws| {
+                    *out = laws;
+                    true
+                });
+        }
         let mut coeffs = StepCoefficients::identity(material.num_branches());
         step_coefficients_into(
             material,
@@ -225,13 +352,20 @@ impl ConstitutiveLaw for MaxwellLaw {
 
     #[inline]
     fn section_law(&self, state: &MaxwellState, point: usize) -> SectionLaw {
-        SectionLaw::new(&state.shapes[point], state.modulus, state.history[point])
+        let (shape, history) = (&state.shapes[point], state.history[point]);
+        match &state.field {
+            Some(field) => {
+                let (modulus, slope) = field.modulus[point];
+                SectionLaw::with_slope(shape, modulus, slope, history)
+            }
+            None => SectionLaw::new(shape, state.modulus, history),
+        }
     }
 
     /// `ε_α ← β_α ε^{n+1} + γ_α ε^n + δ_α ε_α` and `ε^n ← ε^{n+1}` at every point (in parallel); the step's `Ē`
     /// and `H` become the converged ones.
     fn commit_step(&self, state: &mut MaxwellState, strains: PointStrains<'_>) {
-        let coeffs = &state.coeffs;
+        let (coeffs, field) = (&state.coeffs, &state.field);
         // Per point and independent: in parallel, each point's strain computed where it is used.
         match self.material.num_branches() {
             0 => state
@@ -246,21 +380,36 @@ impl ConstitutiveLaw for MaxwellLaw {
                 .enumerate()
                 .for_each(|(i, (strain_n, point_branches))| {
                     let strain = strains(i);
-                    update_branch_strains(coeffs, &strain, strain_n, point_branches);
+                    match field {
+                        Some(f) => update_branch_strains_with_slope(
+                            &f.coeffs[i],
+                            &f.coeffs_ds[i],
+                            &strain,
+                            strain_n,
+                            point_branches,
+                        ),
+                        None => update_branch_strains(coeffs, &strain, strain_n, point_branches),
+                    }
                     *strain_n = strain;
                 }),
         }
         state.converged_modulus = state.modulus;
         state.converged_history.copy_from_slice(&state.history);
+        if let Some(field) = &mut state.field {
+            field.converged_modulus.copy_from_slice(&field.modulus);
+        }
     }
 
     fn roll_back(&self, state: &mut MaxwellState) {
         state.modulus = state.converged_modulus;
         state.history.copy_from_slice(&state.converged_history);
+        if let Some(field) = &mut state.field {
+            field.modulus.copy_from_slice(&field.converged_modulus);
+        }
     }
 
     /// Per point `ε^n` (12 numbers), then per point and branch `ε_α^n` (12 each), then the converged `Ē` and per
-    /// point its `H` (12 each).
+    /// point its `H` (12 each); with a temperature varying along the rod, then per point `(Ē, Ē,s)`.
     fn save_state(&self, state: &MaxwellState, out: &mut Vec<Real>) {
         out.reserve(saved_length(
             state.strain_n.len(),
@@ -276,6 +425,12 @@ impl ConstitutiveLaw for MaxwellLaw {
         for h in &state.converged_history {
             push_stress(out, h);
         }
+        // With a temperature varying along the rod: `(Ē, Ē,s)` per point.
+        if let Some(field) = &state.field {
+            for &(modulus, slope) in &field.converged_modulus {
+                out.extend([modulus, slope]);
+            }
+        }
     }
 
     fn restore_state(
@@ -285,7 +440,11 @@ impl ConstitutiveLaw for MaxwellLaw {
     ) -> Result<(), MaterialError> {
         let points = state.strain_n.len();
         let m = self.material.num_branches();
-        check_state_length(values, saved_length(points, m))?;
+        let uniform_length = saved_length(points, m);
+        let with_field = values.len() == uniform_length + 2 * points && points > 0;
+        if !with_field {
+            check_state_length(values, uniform_length)?;
+        }
         let mut chunks = values[..SECTION_NUMBERS * points * (1 + m)].chunks_exact(SECTION_NUMBERS);
         for (s, chunk) in state.strain_n.iter_mut().zip(chunks.by_ref()) {
             *s = read_strains(chunk);
@@ -302,9 +461,89 @@ impl ConstitutiveLaw for MaxwellLaw {
         {
             *h = read_stress(chunk);
         }
+        state.field = with_field.then(|| {
+            let mut field = PointSteps::new(points, m, self.material.prony().e_inf());
+            for (pair, chunk) in field
+                .converged_modulus
+                .iter_mut()
+                .zip(values[uniform_length..].chunks_exact(2))
+            {
+                *pair = (chunk[0], chunk[1]);
+            }
+            Box::new(field)
+        });
         // At a converged step the step's data are the converged ones.
         self.roll_back(state);
         Ok(())
+    }
+}
+
+impl MaxwellLaw {
+    /// [`ConstitutiveLaw::prepare_step`] where the temperature varies along the rod: per point (in parallel) its
+    /// coefficients and their slopes, `(Ē, Ē,s)` and the history stresses with their slope terms (module docs).
+    fn prepare_field_step(
+        &self,
+        state: &mut MaxwellState,
+        step: &StepInput<'_>,
+        field: &super::PointTemperature<'_>,
+    ) -> Result<(), MaterialError> {
+        let material = &self.material;
+        let (points, m) = (state.shapes.len(), material.num_branches());
+        let (t_n, t_np1) = (step.t_n, step.t_np1);
+        let steps = state
+            .field
+            .get_or_insert_with(|| Box::new(PointSteps::new(points, m, material.prony().e_inf())));
+        let MaxwellState {
+            shapes,
+            strain_n,
+            branches,
+            history,
+            ..
+        } = state;
+        steps
+            .coeffs
+            .par_iter_mut()
+            .zip(steps.coeffs_ds.par_iter_mut())
+            .zip(steps.modulus.par_iter_mut())
+            .zip(history.par_iter_mut())
+            .enumerate()
+            .try_for_each(|(i, (((coeffs, coeffs_ds), modulus), h))| {
+                step_coefficients_with_slope_into(
+                    material,
+                    self.integrator,
+                    &ReducedTimeQuadrature::default(),
+                    t_n,
+                    t_np1,
+                    &|t| field(i, t),
+                    coeffs,
+                    coeffs_ds,
+                )?;
+                *modulus = (
+                    coeffs.effective_modulus(material.prony()),
+                    modulus_slope(material.prony(), coeffs_ds),
+                );
+                *h = if m == 0 {
+                    SectionStress::default()
+                } else {
+                    let mut h = history_stress(
+                        material.prony(),
+                        &shapes[i],
+                        coeffs,
+                        &strain_n[i],
+                        branches.point(i),
+                    );
+                    add_history_slope(
+                        material.prony(),
+                        &shapes[i],
+                        coeffs_ds,
+                        &strain_n[i],
+                        branches.point(i),
+                        &mut h,
+                    );
+                    h
+                };
+                Ok(())
+            })
     }
 }
 
@@ -346,6 +585,7 @@ mod tests {
                     t_n: 0.1 * n as Real,
                     t_np1: 0.1 * (n + 1) as Real,
                     temperature: &temperature,
+                    field: None,
                 };
                 law.prepare_step(state, &step).expect("valid step");
                 law.commit_step(state, &|p| strains((n * points + p) as Real));
@@ -382,6 +622,7 @@ mod tests {
             t_n: 0.9,
             t_np1: 1.0,
             temperature: &temperature,
+            field: None,
         };
         law.prepare_step(&mut a, &step).expect("valid step");
         assert_ne!(law.section_law(&a, 1), before);
@@ -391,5 +632,89 @@ mod tests {
             law.restore_state(&mut b, &saved[1..]),
             Err(MaterialError::StateLength { .. })
         ));
+    }
+
+    // Source: the stored s-derivatives must be the derivatives of the stored values (module docs, *Temperature
+    // that varies along the rod*). Three points at s = −δ, 0, δ of a rod with T(s, t) = T₀(t) + s·G(t) (cooling
+    // through Tg or heating through it, 12 K per unit length) and smooth strain histories ε(s, t) given with their exact
+    // s-derivatives; after several steps N,s and M,s of the law at s = 0 must equal central differences of N and
+    // M across the points. δ = 1e-4: truncation ~δ² = 1e-8 and round-off ~1e-16/δ = 1e-12 relative to the
+    // stress slopes; tolerance 1e-6 relative. Without the slope terms (the paper's uniform-temperature
+    // recursion) the same check fails by ~10 % (asserted too, so the test would see the terms go missing).
+
+    #[test]
+    fn stress_slopes_are_derivatives_where_the_temperature_varies_along_the_rod() {
+        let delta = 1e-4;
+        let positions = [-delta, 0.0, delta];
+        let strain = |s: Real, t: Real| {
+            let w = |k: Real| (1.0 + 0.5 * k * s + 0.3 * s * s) * (t * k).sin() * 1e-2;
+            let w_s = |k: Real| (0.5 * k + 0.6 * s) * (t * k).sin() * 1e-2;
+            SectionStrains {
+                force: Vec3::new(w(1.0), w(2.0), w(3.0)),
+                moment: Vec3::new(w(4.0), w(5.0), w(6.0)),
+                force_ds: Vec3::new(w_s(1.0), w_s(2.0), w_s(3.0)),
+                moment_ds: Vec3::new(w_s(4.0), w_s(5.0), w_s(6.0)),
+            }
+        };
+        let gradient = 12.0;
+        let mismatch = |integrator: Integrator, rate: Real, with_slopes: bool| {
+            let temperature = |t: Real| if rate < 0.0 { 85.0 } else { 40.0 } + rate * t;
+            let field = |i: usize, t: Real| (temperature(t) + gradient * positions[i], gradient);
+            let law = MaxwellLaw::new(Material::pla_van_manen_2021(), integrator);
+            let shape = law.section_shape(&CircularSection::try_new(0.6).expect("valid").into());
+            let mut state = law.new_state(vec![shape; 3]);
+            let h = 0.02;
+            let mut t = 0.0;
+            for _ in 0..30 {
+                let step = StepInput {
+                    t_n: t,
+                    t_np1: t + h,
+                    temperature: &temperature,
+                    field: with_slopes.then_some(&field as &crate::material::PointTemperature<'_>),
+                };
+                if with_slopes {
+                    law.prepare_step(&mut state, &step).expect("valid step");
+                } else {
+                    // The paper's recursion: each point with its own temperature, no slope terms.
+                    let at = |i: usize, t: Real| (field(i, t).0, 0.0);
+                    let step = StepInput {
+                        field: Some(&at),
+                        ..step
+                    };
+                    law.prepare_step(&mut state, &step).expect("valid step");
+                }
+                t += h;
+                law.commit_step(&mut state, &|i| strain(positions[i], t));
+            }
+            let stress: Vec<SectionStress> = (0..3)
+                .map(|i| law.section_law(&state, i).stress(&strain(positions[i], t)))
+                .collect();
+            let fd_force = (stress[2].force - stress[0].force) / (2.0 * delta);
+            let fd_moment = (stress[2].moment - stress[0].moment) / (2.0 * delta);
+            ((stress[1].force_ds - fd_force).norm() / fd_force.norm())
+                .max((stress[1].moment_ds - fd_moment).norm() / fd_moment.norm())
+        };
+        // The trapezoidal rule only while heating: cooling, its amplification |δ| ≫ 1 of the fast branches (module
+        // docs of `integrator`) makes N a difference of numbers 1e8 times larger, and the central difference
+        // loses every digit to round-off (measured: 3e-4 at δ = 1e-4, 3e-3 at 1e-5) though the slopes are right.
+        for (integrator, rate) in [
+            (Integrator::Trapezoidal, 60.0),
+            (Integrator::BackwardEuler, -60.0),
+            (Integrator::BackwardEuler, 60.0),
+            (Integrator::Exponential, -60.0),
+            (Integrator::Exponential, 60.0),
+        ] {
+            let with = mismatch(integrator, rate, true);
+            let without = mismatch(integrator, rate, false);
+            eprintln!("{integrator:?} at {rate} K/s: {with:.3e} {without:.3e}");
+            assert!(
+                with < 1e-6,
+                "{integrator:?}: N,s and M,s against central differences: {with:.3e}"
+            );
+            assert!(
+                without > 1e-2,
+                "{integrator:?}: without the slope terms: {without:.3e}"
+            );
+        }
     }
 }

@@ -63,14 +63,18 @@ pub mod prony;
 pub mod section;
 pub mod wlf;
 
-pub use constitutive::{ConstitutiveLaw, MaterialNotice, PointStrains, StepInput};
+pub use constitutive::{
+    ConstitutiveLaw, MaterialNotice, PointStrains, PointTemperature, StepInput,
+};
 pub use elastic::{ElasticLaw, ElasticState};
 pub use history::{
-    BranchHistory, SectionStrains, SectionStress, history_stress, update_branch_strains,
+    BranchHistory, SectionStrains, SectionStress, add_history_slope, history_stress,
+    update_branch_strains, update_branch_strains_with_slope,
 };
 pub use integrator::{
-    Integrator, MAX_STEP_RATE, ReducedTimeQuadrature, StepCoefficients, exponential_coefficients,
-    reduced_time_increment, step_coefficients, step_coefficients_into,
+    Integrator, MAX_STEP_RATE, ReducedTimeQuadrature, StepCoefficients,
+    exponential_coefficient_slopes, exponential_coefficients, reduced_time_increment,
+    step_coefficients, step_coefficients_into, step_coefficients_with_slope_into,
 };
 pub use law::{LAW_NUMBERS, SectionLaw};
 pub use maxwell::{MaxwellLaw, MaxwellState};
@@ -187,7 +191,7 @@ pub enum MaterialError {
     /// A prescribed history (temperature, strain or stress) returned a non-finite value.
     #[error("{quantity} at t = {} is {value}, not a finite number", Short(*time))]
     NonFiniteInput {
-        /// Which history: `"temperature"`, `"strain"` or `"stress"`.
+        /// Which history: `"temperature"`, `"temperature gradient"`, `"strain"` or `"stress"`.
         quantity: &'static str,
         /// Where it was evaluated \[time\].
         time: Real,

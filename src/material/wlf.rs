@@ -116,6 +116,17 @@ impl Wlf {
         Some(-self.c1 * (x / (self.c2 + x)))
     }
 
+    /// `d ln(rate_factor)/dT = ln 10 · C1 C2 / (C2 + T − Tg)²` \[1/K\] (the derivative of `−ln a_T`, paper
+    /// Eq. `at`): how fast the relaxation rates change with temperature, for a temperature varying along a rod.
+    /// `0` when frozen (the rate factor is the constant 0 there).
+    pub fn log_rate_slope(&self, temperature: Real) -> Real {
+        if self.is_frozen(temperature) {
+            return 0.0;
+        }
+        let denominator = self.c2 + (temperature - self.tg);
+        std::f64::consts::LN_10 * self.c1 * self.c2 / (denominator * denominator)
+    }
+
     /// The rate factor `1/a_T = 10^{−log10 a_T}` \[-\] multiplying every relaxation rate:
     /// `λ_α(T) = rate_factor(T)/τ_G,α`. `1` at `Tg`, non-decreasing in `T`, in `[0, 10^{C1})`; `0` when frozen
     /// and, by underflow, just above the freezing temperature. Never NaN or ∞ for a non-NaN temperature.

@@ -11,9 +11,11 @@ pub mod builder;
 pub mod programme;
 pub mod schedule;
 pub mod stent;
+pub mod temperature;
 
 pub use programme::{DrivenNode, Programme, ProgrammeError, ProgrammeKind};
 pub use schedule::{ScheduleError, TimeFunction};
+pub use temperature::{Profile, TemperatureField};
 
 use crate::material::{ConstitutiveLaw as _, MaterialLaw, Section};
 use crate::math::{Mat3, NurbsCurve, Real, Vec3};
@@ -363,9 +365,11 @@ pub struct Model {
     pub name: String,
     /// Unit system of every number.
     pub units: Units,
-    /// The materials (constitutive laws), referred to by [`Patch::material`]. A design file gives one, which
-    /// every patch uses.
+    /// The materials (constitutive laws), referred to by [`Patch::material`]: a design's `material` (index 0,
+    /// every patch's unless it names another) and its named `materials`.
     pub materials: Vec<MaterialLaw>,
+    /// The name of each material, in the order of `materials` (unique; `history.csv`'s per-material columns).
+    pub material_names: Vec<String>,
     /// Cross-sections, referred to by [`Patch::section`].
     pub sections: Vec<Section>,
     /// Rod patches.
@@ -374,8 +378,11 @@ pub struct Model {
     pub nodes: Vec<Node>,
     /// Distributed loads.
     pub distributed_loads: Vec<DistributedLoad>,
-    /// Temperature [°C] as a function of time, uniform over the device.
+    /// Temperature [°C] as a function of time, uniform over the device — or, with a `temperature_field`, the
+    /// schedule reports show as the device's ([`TemperatureField::reference`]).
     pub temperature: TimeFunction,
+    /// A temperature that varies in space, which the material sees instead of `temperature` (`None`: uniform).
+    pub temperature_field: Option<TemperatureField>,
     /// Time stepping.
     pub time: TimeSettings,
     /// Newton settings.
@@ -407,6 +414,31 @@ pub struct Vessel {
 }
 
 impl Model {
+    /// The material regions of a device made of several materials: for every material some patch uses, in
+    /// material order, its index and the nodes touching a patch of it (a node joining two materials belongs to
+    /// both). Empty when every patch is of one material (there are no regions to compare).
+    pub fn material_regions(&self) -> Vec<(usize, Vec<usize>)> {
+        let mut used: Vec<usize> = self.patches.iter().map(|p| p.material).collect();
+        used.sort_unstable();
+        used.dedup();
+        if used.len() < 2 {
+            return Vec::new();
+        }
+        used.into_iter()
+            .map(|m| {
+                let nodes = (0..self.nodes.len())
+                    .filter(|&k| {
+                        self.nodes[k]
+                            .ends
+                            .iter()
+                            .any(|e| self.patches[e.patch].material == m)
+                    })
+                    .collect();
+                (m, nodes)
+            })
+            .collect()
+    }
+
     /// Total number of collocation points (one per control point of every patch).
     pub fn num_collocation_points(&self) -> usize {
         self.patches.iter().map(|p| p.curve.num_points()).sum()
@@ -490,6 +522,9 @@ impl Model {
 
     fn breakpoints(&self, with_record_times: bool) -> Vec<Real> {
         let mut times: Vec<Real> = self.temperature.breakpoints().collect();
+        if let Some(field) = &self.temperature_field {
+            times.extend(field.breakpoints());
+        }
         if with_record_times {
             times.extend(&self.record_times);
         }

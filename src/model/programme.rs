@@ -150,10 +150,16 @@ impl Programme {
     /// Mean of `|η_l| / |η_temp,l|` over the full device (the paper's measure of how far the device is from
     /// its temporary shape, Fig. `bend_stent_ext`); nodes with a zero target are skipped.
     pub fn target_fraction(&self, u: &[Vec3]) -> Real {
+        self.target_fraction_where(u, |_| true)
+    }
+
+    /// [`Programme::target_fraction`] over the driven nodes whose model node `keep` accepts (a material region);
+    /// 0 when none is left.
+    pub fn target_fraction_where(&self, u: &[Vec3], keep: impl Fn(usize) -> bool) -> Real {
         let (mut sum, mut weight) = (0.0, 0.0);
         for (d, uk) in self.nodes.iter().zip(u) {
             let t = d.target.norm();
-            if t > 0.0 {
+            if t > 0.0 && keep(d.node) {
                 sum += d.weight * uk.norm() / t;
                 weight += d.weight;
             }

@@ -27,6 +27,30 @@ pub struct StentMesh {
     pub bridge: (usize, usize),
 }
 
+/// Which material each part of a generated stent is made of (indices into the model's materials): one per
+/// crown (or one for every crown) and one for the bridges. The default is material 0 everywhere.
+#[derive(Debug, Clone, PartialEq, Eq, Default)]
+pub struct StentMaterials {
+    /// The material of crown `k` (0-based) is `crowns[k]`; a single entry applies to every crown; empty: 0.
+    pub crowns: Vec<usize>,
+    /// The material of every bridge.
+    pub bridges: usize,
+}
+
+impl StentMaterials {
+    /// The material of a patch of the given role.
+    pub fn of(&self, role: &PatchRole) -> usize {
+        match role {
+            PatchRole::Crown { crown, .. } => match self.crowns.as_slice() {
+                [] => 0,
+                [one] => *one,
+                many => many[*crown],
+            },
+            PatchRole::Bridge { .. } => self.bridges,
+        }
+    }
+}
+
 /// Where the programme takes the driven nodes.
 #[derive(Debug, Clone, PartialEq)]
 pub enum ProgrammeTarget {
@@ -83,10 +107,12 @@ fn geometry_error(e: GeometryError) -> BuildError {
 }
 
 /// Generates the stent: fitted patches (section 0, or a half section for patches lying in a symmetry plane,
-/// appended to `sections`; `poisson` gives its shear factor), all of material 0, nodes with their symmetry conditions.
+/// appended to `sections`; `poisson` gives its shear factor), of the materials `materials` gives per role
+/// (already checked against the number of crowns), nodes with their symmetry conditions.
 pub fn generate(
     spec: &StentSpec,
     mesh: &StentMesh,
+    materials: &StentMaterials,
     sections: &mut Vec<Section>,
     poisson: Real,
     warnings: &mut Vec<String>,
@@ -143,7 +169,7 @@ pub fn generate(
             curve,
             normal_hint: Some(g.normal_hint),
             section,
-            material: 0,
+            material: materials.of(&g.role),
             fit_error,
         });
     }

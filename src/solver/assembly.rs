@@ -495,13 +495,21 @@ impl Assembler {
         }
         let (Kt, Gt, Nt, Mt) = (hat(&K), hat(&k.gamma), hat(&N), hat(&M));
         let cssm = hat(&(Rt * k.c_ss));
-        let f_th = -Nt * Kt + Kt * CN * Gt + CN * (cssm + Gt * Kt - Kt * Gt) + hat(&nbar);
+        let mut f_th = -Nt * Kt + Kt * CN * Gt + CN * (cssm + Gt * Kt - Kt * Gt) + hat(&nbar);
         let f_th_s = -Nt + CN * Gt;
-        let f_eta_s = (Kt * CN - CN * Kt) * Rt;
+        let mut f_eta_s = (Kt * CN - CN * Kt) * Rt;
         let f_eta_ss = CN * Rt;
         let ng = -Nt + Gt * CN;
-        let t_th = -Mt * Kt + Kt * CM * Kt + CM * hat(&K_s) + ng * Gt + hat(&mbar);
-        let t_th_s = -Mt + Kt * CM + CM * Kt;
+        let mut t_th = -Mt * Kt + Kt * CM * Kt + CM * hat(&K_s) + ng * Gt + hat(&mbar);
+        let mut t_th_s = -Mt + Kt * CM + CM * Kt;
+        if let Some((CN_s, CM_s)) = law.stiffness_slope_matrices() {
+            // A modulus varying along s: N,s gains C̄_N,s δΓ = C̄_N,s (Γ × δΘ + Rᵀ δη,s), M,s gains C̄_M,s δK =
+            // C̄_M,s (K × δΘ + δΘ,s) (module docs of `material::law`).
+            f_th += CN_s * Gt;
+            f_eta_s += CN_s * Rt;
+            t_th += CM_s * Kt;
+            t_th_s += CM_s;
+        }
         let t_th_ss = CM;
         let t_eta_s = ng * Rt;
         for (a, b) in point.basis.iter().enumerate() {

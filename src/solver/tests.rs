@@ -137,8 +137,6 @@ fn residual(
 fn tangent_matches_central_differences_of_the_residual() {
     let model = test_model();
     let disc = Discretisation::new(&model).expect("discretisation");
-    let asm = Assembler::new(&model, &disc);
-    let actions = Actions::at(&model, 1.0, &[]);
     let laws: Vec<SectionLaw> = disc
         .points
         .iter()
@@ -147,7 +145,45 @@ fn tangent_matches_central_differences_of_the_residual() {
             law.section_law(&law.new_state(vec![disc.shapes[p.shape]]), 0)
         })
         .collect();
-    let material = StepMaterial { laws: &laws };
+    check_tangent(&model, &disc, &laws);
+}
+
+// Source: as above, where the temperature varies along the rods: every point's law has a modulus slope `Ē,s`
+// (±30 % of `Ē` per unit length, varying from point to point) and history stresses with their slopes, so the
+// residual's `N,s`, `M,s` carry the `C̄,s Γ_N`, `C̄,s K_M` terms whose linearisation the tangent must hold
+// (module docs of `material::law`). Same reference and tolerance.
+#[test]
+fn tangent_matches_central_differences_with_a_modulus_varying_along_the_rod() {
+    let model = test_model();
+    let disc = Discretisation::new(&model).expect("discretisation");
+    let laws: Vec<SectionLaw> = disc
+        .points
+        .iter()
+        .enumerate()
+        .map(|(g, p)| {
+            let x = g as Real;
+            let v = |k: Real| Vec3::new((k * x).sin(), (k + x).cos(), (0.3 * k * x).sin());
+            let shape = &disc.shapes[p.shape];
+            let history = crate::material::SectionStress {
+                force: shape.force.component_mul(&v(1.0)) * 1e3,
+                moment: shape.moment.component_mul(&v(2.0)) * 1e3,
+                force_ds: shape.force.component_mul(&v(3.0)) * 1e3,
+                moment_ds: shape.moment.component_mul(&v(4.0)) * 1e3,
+            };
+            SectionLaw::with_slope(shape, 2.0e5, 6.0e4 * (0.7 * x + 0.3).sin(), history)
+        })
+        .collect();
+    assert!(laws.iter().all(|l| l.stiffness_slope_matrices().is_some()));
+    check_tangent(&model, &disc, &laws);
+}
+
+/// The tangent of `model` with the section laws `laws` against central differences of its residual (see the
+/// tests' sources).
+fn check_tangent(model: &Model, disc: &Discretisation, laws: &[SectionLaw]) {
+    let disc = disc.clone();
+    let asm = Assembler::new(model, &disc);
+    let actions = Actions::at(model, 1.0, &[]);
+    let material = StepMaterial { laws };
     let n = disc.num_unknowns();
     // A deformed state: a smooth finite increment (translations ~5 % of the size, rotations ~0.3 rad).
     let mut state = State::reference(&disc);

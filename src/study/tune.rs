@@ -317,7 +317,12 @@ pub fn difference(run: &[Watched], finer: &[Watched], names: &[String]) -> Diffe
             .map(|u| u.norm())
             .fold(0.0, Real::max)
     });
-    let r_scale = largest(&|w| w.recovery.and_then(|r| r.delta_r).map_or(0.0, Real::abs));
+    let r_scale = largest(&|w| {
+        w.recovery
+            .as_ref()
+            .and_then(|r| r.delta_r)
+            .map_or(0.0, Real::abs)
+    });
     let f_scale = largest(&|w| w.grid.iter().map(|u| u.norm()).fold(0.0, Real::max));
     let mut worst = Difference {
         value: 0.0,
@@ -339,7 +344,7 @@ pub fn difference(run: &[Watched], finer: &[Watched], names: &[String]) -> Diffe
                 see((u - v).norm() / u_scale, &|| name.clone(), b.time);
             }
         }
-        if let (Some(x), Some(y)) = (a.recovery, b.recovery) {
+        if let (Some(x), Some(y)) = (&a.recovery, &b.recovery) {
             if let (Some(x), Some(y)) = (x.delta_r, y.delta_r)
                 && r_scale > 0.0
             {
@@ -349,6 +354,13 @@ pub fn difference(run: &[Watched], finer: &[Watched], names: &[String]) -> Diffe
             see(mean, &|| "recovery ratio (mean)".into(), b.time);
             let max = (x.ratio_max - y.ratio_max).abs();
             see(max, &|| "recovery ratio (max)".into(), b.time);
+            for (k, (p, q)) in x.by_material.iter().zip(&y.by_material).enumerate() {
+                see(
+                    (p - q).abs(),
+                    &|| format!("recovery ratio of material region {}", k + 1),
+                    b.time,
+                );
+            }
         }
         if f_scale > 0.0 {
             let field = a
@@ -647,6 +659,7 @@ mod tests {
                 ratio_mean: ratio,
                 ratio_max: ratio,
                 delta_r: Some(delta_r),
+                by_material: Vec::new(),
             }),
             grid: Vec::new(),
         };

@@ -20,6 +20,7 @@ use crate::material::{
 use crate::math::quote::quoted;
 use crate::math::{Mat3, Real, Vec3};
 use crate::model::builder::*;
+use crate::model::temperature::FieldError;
 use crate::model::*;
 
 fn time_function(f: &TimeFn, path: &str) -> Result<TimeFunction> {
@@ -60,7 +61,7 @@ pub fn build(dto: &DesignDto, default_name: &str) -> Result<Built> {
         ));
     }
     let name = design_name(dto, default_name)?;
-    let (material, integrator) = material(&dto.material)?;
+    let (material, integrator) = material(&dto.material, "material")?;
     let (section, shear_factor) = section(&dto.section)?;
     let time = time_spec(&dto.time)?;
     let settings = time.settings().map_err(|e| builder_issue(e, dto))?;
@@ -68,12 +69,16 @@ pub fn build(dto: &DesignDto, default_name: &str) -> Result<Built> {
     // nominal steps; the steps landing on breakpoints are counted once the model exists, below).
     check_size(dto, &StepCount::nominal(&settings))?;
     let circular = matches!(section, Section::Circular(_));
-    // The design's one material, used by every patch (material 0).
+    // The design's `material` is material 0 (every patch's unless it names another), `materials` follow.
     let mut builder = ModelBuilder::new(
         name,
         MaterialLaw::from_material(material, integrator),
         section,
     );
+    if let Some(first) = &dto.material.name {
+        builder.name_first_material(first.clone());
+    }
+    let material_names = named_materials(dto, &mut builder)?;
     builder.units(match dto.units {
         UnitsDto::Si => Units::Si,
         UnitsDto::MmNMpa => Units::MmNMpa,
@@ -91,11 +96,14 @@ pub fn build(dto: &DesignDto, default_name: &str) -> Result<Built> {
             builder.vessel(v);
         }
         builder.stent(spec, stent::mesh(s, dto.mesh.as_ref())?);
+        if let Some(m) = &s.materials {
+            builder.stent_materials(stent::materials(m, &material_names)?);
+        }
     }
     if let Some(p) = &dto.programme {
         builder.programme(stent::programme(p, metres_per_unit)?);
     }
-    patches(dto, &mut builder, circular, shear_factor)?;
+    patches(dto, &mut builder, circular, shear_factor, &material_names)?;
     if let Some(j) = &dto.joints {
         builder.joints(JointRule {
             automatic: true,
@@ -123,6 +131,9 @@ pub fn build(dto: &DesignDto, default_name: &str) -> Result<Built> {
     }
     if let Some(f) = &dto.temperature {
         builder.temperature(time_function(f, "temperature")?);
+    }
+    if let Some(f) = &dto.temperature_field {
+        builder.temperature_field(temperature_field(f)?);
     }
     builder.solver(solver_settings(dto.solver.as_ref()));
     for (k, p) in dto.output.iter().flat_map(|o| o.probes.iter()).enumerate() {
@@ -278,6 +289,7 @@ pub fn field_path(field: &Field, dto: &DesignDto) -> String {
             }
         }
         Field::Stent(field) => stent::field_path(field, dto),
+        Field::Materials => "materials".into(),
         Field::Node { index, field } => {
             let base = format!("nodes[{index}]");
             match field {
@@ -456,7 +468,7 @@ fn output_settings(
 
 /// The design's material, validated once, by the material constructors ([`Prony::try_new`], [`Wlf::try_new`],
 /// [`Material::try_new`]); their errors are mapped to the design's fields by [`material_issue`].
-fn material(m: &MaterialDto) -> Result<(Material, Integrator)> {
+fn material(m: &MaterialDto, base: &str) -> Result<(Material, Integrator)> {
     let branches = m
         .prony
         .iter()
@@ -465,7 +477,7 @@ fn material(m: &MaterialDto) -> Result<(Material, Integrator)> {
             tau_g: *tau,
         })
         .collect();
-    let prony = Prony::try_new(m.e_inf.0, branches).map_err(material_issue)?;
+    let prony = Prony::try_new(m.e_inf.0, branches).map_err(|e| material_issue(e, base))?;
     let wlf = m
         .wlf
         .as_ref()
@@ -476,7 +488,7 @@ fn material(m: &MaterialDto) -> Result<(Material, Integrator)> {
         // ν precedes the WLF constants in a design and is reported first.
         Err(e) => Material::try_new(prony, m.nu.0, None).and(Err(e)),
     }
-    .map_err(material_issue)?;
+    .map_err(|e| material_issue(e, base))?;
     let integrator = match m.integrator {
         None | Some(IntegratorDto::Trapezoidal) => Integrator::Trapezoidal,
         Some(IntegratorDto::BackwardEuler) => Integrator::BackwardEuler,
@@ -487,22 +499,112 @@ fn material(m: &MaterialDto) -> Result<(Material, Integrator)> {
 
 /// The design field a material constructor's error is about (`material.prony[k][0]`, `material.wlf.C2`, …),
 /// with the constructor's message. Errors count Prony branches `α` from 1, the design's list from 0.
-fn material_issue(e: MaterialError) -> Issue {
+fn material_issue(e: MaterialError, base: &str) -> Issue {
     let path = match e {
-        MaterialError::BranchModulus { branch, .. } => format!("material.prony[{}][0]", branch - 1),
+        MaterialError::BranchModulus { branch, .. } => format!("{base}.prony[{}][0]", branch - 1),
         MaterialError::BranchRelaxationTime { branch, .. } => {
-            format!("material.prony[{}][1]", branch - 1)
+            format!("{base}.prony[{}][1]", branch - 1)
         }
         MaterialError::EquilibriumModulus { .. } | MaterialError::InstantaneousModulus { .. } => {
-            "material.E_inf".into()
+            format!("{base}.E_inf")
         }
-        MaterialError::PoissonRatio { .. } => "material.nu".into(),
-        MaterialError::WlfC1 { .. } => "material.wlf.C1".into(),
-        MaterialError::WlfC2 { .. } => "material.wlf.C2".into(),
-        MaterialError::GlassTransition { .. } => "material.wlf.Tg".into(),
-        _ => "material".into(),
+        MaterialError::PoissonRatio { .. } => format!("{base}.nu"),
+        MaterialError::WlfC1 { .. } => format!("{base}.wlf.C1"),
+        MaterialError::WlfC2 { .. } => format!("{base}.wlf.C2"),
+        MaterialError::GlassTransition { .. } => format!("{base}.wlf.Tg"),
+        _ => base.into(),
     };
     issue(path, e.to_string())
+}
+
+/// Adds the design's `materials` to the builder; returns every material's name in model order (`material`'s
+/// first).
+fn named_materials(dto: &DesignDto, builder: &mut ModelBuilder) -> Result<Vec<String>> {
+    let mut names = vec![
+        dto.material
+            .name
+            .clone()
+            .unwrap_or_else(|| DEFAULT_MATERIAL_NAME.to_string()),
+    ];
+    for (k, m) in dto.materials.iter().enumerate() {
+        let base = format!("materials[{k}]");
+        let Some(name) = &m.name else {
+            return Err(issue(
+                format!("{base}.name"),
+                "missing: every entry of `materials` needs a `name` for patches and stent parts to refer to",
+            ));
+        };
+        if names.contains(name) {
+            return Err(issue(
+                format!("{base}.name"),
+                format!("a material named `{name}` exists already: names must be unique"),
+            ));
+        }
+        let (material, integrator) = material(m, &base)?;
+        builder.named_material(
+            name.clone(),
+            MaterialLaw::from_material(material, integrator),
+        );
+        names.push(name.clone());
+    }
+    Ok(names)
+}
+
+/// The index of the material named `name`, or an error at `path` listing the names there are.
+pub(super) fn material_index(name: &str, names: &[String], path: &str) -> Result<usize> {
+    names.iter().position(|n| n == name).ok_or_else(|| {
+        issue(
+            path,
+            format!(
+                "no material is named `{name}`; the design has {}",
+                names
+                    .iter()
+                    .map(|n| format!("`{n}`"))
+                    .collect::<Vec<_>>()
+                    .join(", ")
+            ),
+        )
+    })
+}
+
+/// The design's temperature field.
+fn temperature_field(f: &TemperatureFieldDto) -> Result<TemperatureField> {
+    let base = "temperature_field";
+    let profile = match (&f.stations, &f.front) {
+        (Some(stations), None) => Profile::Stations(
+            stations
+                .iter()
+                .enumerate()
+                .map(|(k, st)| {
+                    let path = format!("{base}.stations[{k}].T");
+                    Ok((st.at.0, time_function(&st.temperature, &path)?))
+                })
+                .collect::<Result<Vec<_>>>()?,
+        ),
+        (None, Some(front)) => {
+            let path = |key: &str| format!("{base}.front.{key}");
+            Profile::Front {
+                position: time_function(&front.position, &path("position"))?,
+                width: front.width.0,
+                behind: time_function(&front.behind, &path("behind"))?,
+                ahead: time_function(&front.ahead, &path("ahead"))?,
+            }
+        }
+        _ => {
+            return Err(issue(base, "give exactly one of `stations` or `front`"));
+        }
+    };
+    let origin = f.origin.as_ref().map_or_else(Vec3::zeros, vec3);
+    TemperatureField::try_new(origin, vec3(&f.direction), profile).map_err(|e| {
+        let path = match e {
+            FieldError::Direction => format!("{base}.direction"),
+            FieldError::Origin => format!("{base}.origin"),
+            FieldError::TooFewStations => format!("{base}.stations"),
+            FieldError::Stations { index, .. } => format!("{base}.stations[{index}].at"),
+            FieldError::Width(_) => format!("{base}.front.width"),
+        };
+        issue(path, e.to_string())
+    })
 }
 
 /// The design's section and the shear-factor rule patches with their own diameter inherit.
@@ -568,6 +670,7 @@ fn patches(
     builder: &mut ModelBuilder,
     circular: bool,
     shear_factor: ShearFactor,
+    material_names: &[String],
 ) -> Result<()> {
     let mesh = dto.mesh.as_ref();
     for (k, pd) in dto.patches.iter().enumerate() {
@@ -664,9 +767,13 @@ fn patches(
                 builder.section(c.into())
             }
         };
+        let material = match &pd.material {
+            Some(name) => material_index(name, material_names, &format!("patches[{k}].material"))?,
+            None => 0,
+        };
         let options = PatchOptions {
             section,
-            material: 0,
+            material,
             normal_hint: pd.normal.as_ref().map(vec3),
         };
         builder.patch_with(pd.name.clone(), shape, p, n, options);

@@ -264,8 +264,12 @@ pub struct DesignDto {
     pub description: Option<String>,
     /// Unit system (required).
     pub units: UnitsDto,
-    /// The material.
+    /// The material (every patch's unless it names another of `materials`).
     pub material: MaterialDto,
+    /// More materials, each with a `name`, for patches (`patches[].material`) and stent parts
+    /// (`stent.materials`) to name.
+    #[serde(default)]
+    pub materials: Vec<MaterialDto>,
     /// The cross-section of every patch (patches may override the diameter).
     pub section: SectionDto,
     /// Default discretisation of patches.
@@ -292,9 +296,13 @@ pub struct DesignDto {
     /// Distributed loads.
     #[serde(default)]
     pub distributed_loads: Vec<DistributedLoadDto>,
-    /// Temperature [°C] as a function of time.
+    /// Temperature [°C] as a function of time (uniform over the device; with `temperature_field`, the schedule
+    /// reports show).
     #[serde(default)]
     pub temperature: Option<TimeFn>,
+    /// A temperature that varies in space along an axis: schedules at stations, or a moving front.
+    #[serde(default)]
+    pub temperature_field: Option<TemperatureFieldDto>,
     /// Time stepping.
     pub time: TimeDto,
     /// Newton settings.
@@ -309,6 +317,9 @@ pub struct DesignDto {
 #[derive(Debug, Clone, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct MaterialDto {
+    /// Name (required in `materials`; `material` is named `material` unless it says otherwise).
+    #[serde(default)]
+    pub name: Option<String>,
     /// Equilibrium modulus E∞ [stress], ≥ 0.
     #[serde(rename = "E_inf")]
     pub e_inf: NonNegative,
@@ -416,6 +427,9 @@ pub struct PatchDto {
     /// Diameter (overrides `section.diameter`).
     #[serde(default)]
     pub diameter: Option<Positive>,
+    /// The name of its material (default: `material`'s).
+    #[serde(default)]
+    pub material: Option<String>,
     /// Hint for the first section axis at the start.
     #[serde(default)]
     pub normal: Option<Vector>,
@@ -734,6 +748,73 @@ pub struct StentDto {
     /// Discretisation of the bridges (default: `mesh`).
     #[serde(default)]
     pub bridge_mesh: Option<MeshDto>,
+    /// The materials of crowns and bridges (default: `material` everywhere).
+    #[serde(default)]
+    pub materials: Option<StentMaterialsDto>,
+}
+
+/// The materials of a stent's parts, by name.
+#[derive(Debug, Clone, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct StentMaterialsDto {
+    /// One name for every crown, or a list with one per crown (first crown first).
+    #[serde(default)]
+    pub crowns: Option<OneOrMany>,
+    /// The bridges' material.
+    #[serde(default)]
+    pub bridges: Option<String>,
+}
+
+/// A name or a list of names.
+#[derive(Debug, Clone, Deserialize, JsonSchema)]
+#[serde(untagged)]
+pub enum OneOrMany {
+    /// One name.
+    One(String),
+    /// A list of names.
+    Many(Vec<String>),
+}
+
+/// A temperature field: `T(ζ, t)` with `ζ = direction·(X − origin)` of the reference position `X`.
+#[derive(Debug, Clone, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct TemperatureFieldDto {
+    /// `X₀` [length] (default the origin).
+    #[serde(default)]
+    pub origin: Option<Vector>,
+    /// The axis along which the temperature varies.
+    pub direction: Vector,
+    /// Schedules at stations along the axis (linear between them); or give `front`.
+    #[serde(default)]
+    pub stations: Option<Vec<StationDto>>,
+    /// A front moving along the axis.
+    #[serde(default)]
+    pub front: Option<FrontDto>,
+}
+
+/// A station of a temperature field.
+#[derive(Debug, Clone, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct StationDto {
+    /// Its coordinate `ζ` [length].
+    pub at: Finite,
+    /// Its temperature [°C] as a function of time.
+    #[serde(rename = "T")]
+    pub temperature: TimeFn,
+}
+
+/// A moving temperature front.
+#[derive(Debug, Clone, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct FrontDto {
+    /// Its position `ζ_f(t)` [length].
+    pub position: TimeFn,
+    /// Its width [length] (the temperature goes from 12 % to 88 % of the jump over four widths).
+    pub width: Positive,
+    /// The temperature behind it (`ζ < ζ_f`) [°C].
+    pub behind: TimeFn,
+    /// The temperature ahead of it [°C].
+    pub ahead: TimeFn,
 }
 
 /// Bridge shape keyword.

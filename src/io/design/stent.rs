@@ -33,7 +33,7 @@ use crate::geometry::stent::{
 };
 use crate::math::{Real, Vec3};
 use crate::model::builder::StentField;
-use crate::model::stent::{ProgrammeSpec, ProgrammeTarget, StentMesh};
+use crate::model::stent::{ProgrammeSpec, ProgrammeTarget, StentMaterials, StentMesh};
 
 /// The field of a stent parameter.
 fn spec_path(parameter: StentParameter) -> &'static str {
@@ -83,7 +83,35 @@ pub(super) fn field_path(field: StentField, dto: &DesignDto) -> String {
         StentField::Parameter(p) => spec_path(p).into(),
         StentField::Degree { bridge } => mesh_key(bridge, |m| m.p, "p"),
         StentField::ControlPoints { bridge } => mesh_key(bridge, |m| m.n, "n"),
+        StentField::Materials => "stent.materials.crowns".into(),
     }
+}
+
+/// The stent's materials by name (`names`: every material's, in model order).
+pub(super) fn materials(m: &StentMaterialsDto, names: &[String]) -> Result<StentMaterials> {
+    let base = "stent.materials";
+    let crowns = match &m.crowns {
+        None => Vec::new(),
+        Some(OneOrMany::One(name)) => {
+            vec![super::build::material_index(
+                name,
+                names,
+                &format!("{base}.crowns"),
+            )?]
+        }
+        Some(OneOrMany::Many(list)) => list
+            .iter()
+            .enumerate()
+            .map(|(k, name)| {
+                super::build::material_index(name, names, &format!("{base}.crowns[{k}]"))
+            })
+            .collect::<Result<_>>()?,
+    };
+    let bridges = match &m.bridges {
+        Some(name) => super::build::material_index(name, names, &format!("{base}.bridges"))?,
+        None => 0,
+    };
+    Ok(StentMaterials { crowns, bridges })
 }
 
 /// A centreline of the design; a `file` one is read, cut and fitted ([`super::vessel`]) and returned with it.

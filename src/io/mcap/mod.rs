@@ -462,7 +462,7 @@ impl McapRecorder {
             "cuts": sample.cuts,
             "probes": probes,
         });
-        if let Some(r) = sample.recovery {
+        if let Some(r) = &sample.recovery {
             let map = message.as_object_mut().expect("object literal");
             map.insert("recovery_ratio_mean".into(), number(r.ratio_mean));
             map.insert("recovery_ratio_max".into(), number(r.ratio_max));

@@ -65,6 +65,8 @@ pub enum Field {
     },
     /// The temperature schedule.
     Temperature,
+    /// The set of materials (e.g. two share a name).
+    Materials,
     /// A time setting.
     Time(TimeField),
     /// A Newton setting.
@@ -116,6 +118,8 @@ pub enum StentField {
         /// Bridges rather than crowns.
         bridge: bool,
     },
+    /// The materials of its crowns and bridges.
+    Materials,
 }
 
 /// A part of a node.

@@ -52,6 +52,48 @@ pub const DEFAULT_MIN_STEP_FRACTION: Real = 1.0 / 1024.0;
 /// separates coincident ends from distinct ones with a wide margin on both sides.
 pub const DEFAULT_JOINT_TOLERANCE: Real = 1e-8;
 
+/// Control points a temperature front's width should span along a patch for the solution to follow the change
+/// of stiffness across it. Measured on a cantilever recovered by a front (tests/data/front_bending.yaml): with
+/// 1.5 points per width Newton diverged; with 3.1, 4.7 and 6.3 the tip dipped below the axis by 15 %, 8 % and
+/// 1.4 % of its programmed displacement while the front left the beam (a curvature of the wrong sign, which the
+/// local 1-D law cannot give); with 9.5 it did not.
+const FRONT_POINTS_PER_WIDTH: Real = 6.0;
+
+/// A warning when a temperature front is narrower than [`FRONT_POINTS_PER_WIDTH`] control-point spacings of a
+/// patch it runs along (spacing measured along the front's direction on the control polygon).
+fn unresolved_front(field: &crate::model::TemperatureField, patches: &[Patch]) -> Option<String> {
+    let crate::model::Profile::Front { width, .. } = &field.profile else {
+        return None;
+    };
+    let (worst, name) = patches
+        .iter()
+        .map(|p| {
+            let points = p.curve.points();
+            let along: Real = points
+                .windows(2)
+                .map(|w| field.direction.dot(&(w[1] - w[0])).abs())
+                .sum();
+            (along / (points.len() - 1).max(1) as Real, &p.name)
+        })
+        .fold((0.0, None), |(h, n), (spacing, name)| {
+            if spacing > h {
+                (spacing, Some(name))
+            } else {
+                (h, n)
+            }
+        });
+    let name = name?;
+    (*width < FRONT_POINTS_PER_WIDTH * worst).then(|| {
+        format!(
+            "the temperature front of width {width} spans {:.1} control-point spacings ({worst:.3e}) of patch `{name}` along its direction, fewer than {FRONT_POINTS_PER_WIDTH}: the solution cannot follow the change of stiffness across it (Newton may fail, or the shape overshoot); raise n or widen the front",
+            width / worst
+        )
+    })
+}
+
+/// The name of a model's first material unless [`ModelBuilder::name_first_material`] gives another.
+pub const DEFAULT_MATERIAL_NAME: &str = "material";
+
 /// Temperature of a model without a temperature schedule whose material does not depend on it [°C].
 pub const DEFAULT_TEMPERATURE: Real = 20.0;
 
@@ -371,8 +413,10 @@ pub struct ModelBuilder {
     name: String,
     units: Units,
     materials: Vec<MaterialLaw>,
+    material_names: Vec<String>,
     sections: Vec<Section>,
     stent: Option<(StentSpec, StentMesh)>,
+    stent_materials: stent_model::StentMaterials,
     programme: Option<ProgrammeSpec>,
     patches: Vec<PatchInput>,
     nodes: Vec<(String, NodeEnds)>,
@@ -380,6 +424,7 @@ pub struct ModelBuilder {
     conditions: Vec<ConditionSpec>,
     distributed: Vec<DistributedLoadSpec>,
     temperature: Option<TimeFunction>,
+    temperature_field: Option<crate::model::TemperatureField>,
     time: TimeSpec,
     solver: SolverSettings,
     probes: Vec<(String, ProbeAt)>,
@@ -400,8 +445,10 @@ impl ModelBuilder {
             name: name.into(),
             units: Units::Si,
             materials: vec![material.into()],
+            material_names: vec![DEFAULT_MATERIAL_NAME.to_string()],
             sections: vec![section],
             stent: None,
+            stent_materials: stent_model::StentMaterials::default(),
             programme: None,
             patches: Vec::new(),
             nodes: Vec::new(),
@@ -412,6 +459,7 @@ impl ModelBuilder {
             conditions: Vec::new(),
             distributed: Vec::new(),
             temperature: None,
+            temperature_field: None,
             time: TimeSpec::new(1.0, 0.1),
             solver: SolverSettings::default(),
             probes: Vec::new(),
@@ -432,10 +480,34 @@ impl ModelBuilder {
         self.sections.len() - 1
     }
 
-    /// Adds a material; returns its index for [`PatchOptions::material`].
+    /// Adds a material named `material_<index>`; returns its index for [`PatchOptions::material`].
     pub fn material(&mut self, material: impl Into<MaterialLaw>) -> usize {
+        let name = format!("material_{}", self.materials.len());
+        self.named_material(name, material)
+    }
+
+    /// Adds a material with a name (reports' per-material columns use it; names must be unique, which
+    /// [`ModelBuilder::build`] checks); returns its index.
+    pub fn named_material(
+        &mut self,
+        name: impl Into<String>,
+        material: impl Into<MaterialLaw>,
+    ) -> usize {
         self.materials.push(material.into());
+        self.material_names.push(name.into());
         self.materials.len() - 1
+    }
+
+    /// Renames material 0 (named `material` by default).
+    pub fn name_first_material(&mut self, name: impl Into<String>) -> &mut Self {
+        self.material_names[0] = name.into();
+        self
+    }
+
+    /// The materials of a generated stent's crowns and bridges (default: material 0 everywhere).
+    pub fn stent_materials(&mut self, materials: stent_model::StentMaterials) -> &mut Self {
+        self.stent_materials = materials;
+        self
     }
 
     /// Generates a stent whose patches and nodes come first in the model, with its node sets (`all_joints`,
@@ -507,6 +579,14 @@ impl ModelBuilder {
         self
     }
 
+    /// A temperature that varies in space ([`crate::model::TemperatureField`]), instead of a uniform schedule;
+    /// reports show its [`crate::model::TemperatureField::reference`] schedule unless
+    /// [`ModelBuilder::temperature`] gives another.
+    pub fn temperature_field(&mut self, field: crate::model::TemperatureField) -> &mut Self {
+        self.temperature_field = Some(field);
+        self
+    }
+
     /// Time stepping.
     pub fn time(&mut self, time: TimeSpec) -> &mut Self {
         self.time = time;
@@ -544,11 +624,13 @@ impl ModelBuilder {
             return Err(BuildError::new(Field::Time(TimeField::Tolerance), why));
         }
         check_solver(&self.solver)?;
+        self.check_materials()?;
         let mut sections = self.sections.clone();
         let mut stent = match &self.stent {
             Some((spec, mesh)) => Some(stent_model::generate(
                 spec,
                 mesh,
+                &self.stent_materials,
                 &mut sections,
                 self.materials[0].poisson(),
                 &mut warnings,
@@ -626,10 +708,15 @@ impl ModelBuilder {
             .iter()
             .filter_map(ConstitutiveLaw::temperature_shift)
             .collect();
-        let temperature = match (&self.temperature, shifts.is_empty()) {
-            (Some(f), _) => f.clone(),
-            (None, true) => TimeFunction::constant(DEFAULT_TEMPERATURE),
-            (None, false) => {
+        let temperature = match (
+            &self.temperature,
+            &self.temperature_field,
+            shifts.is_empty(),
+        ) {
+            (Some(f), _, _) => f.clone(),
+            (None, Some(field), _) => field.reference().clone(),
+            (None, None, true) => TimeFunction::constant(DEFAULT_TEMPERATURE),
+            (None, None, false) => {
                 return Err(BuildError::new(
                     Field::Temperature,
                     "missing: a material with `wlf` needs a temperature schedule (a number or [[t, T], …] in °C)",
@@ -638,23 +725,31 @@ impl ModelBuilder {
         };
         for w in shifts {
             let freeze = w.frozen_below();
-            let (lo, _) = temperature.range();
+            let (lo, _) = match &self.temperature_field {
+                Some(field) => field.range(),
+                None => temperature.range(),
+            };
             if lo <= freeze {
                 warnings.push(format!(
                     "temperature reaches {lo} °C, at or below the WLF singularity Tg − C2 = {freeze} °C: relaxation freezes there (instantaneous moduli)"
                 ));
             }
         }
+        if let Some(field) = &self.temperature_field {
+            warnings.extend(unresolved_front(field, &patches));
+        }
         let probes = self.probes(&patches, &nodes)?;
         let model = Model {
             name: self.name.clone(),
             units: self.units,
             materials: self.materials.clone(),
+            material_names: self.material_names.clone(),
             sections,
             patches,
             nodes,
             distributed_loads,
             temperature,
+            temperature_field: self.temperature_field.clone(),
             time,
             solver: self.solver.clone(),
             probes,
@@ -665,6 +760,41 @@ impl ModelBuilder {
             vessel: self.vessel.clone(),
         };
         Ok(Built { model, warnings })
+    }
+
+    /// Material names unique; the stent's materials exist and name one per crown or one for all.
+    fn check_materials(&self) -> Result<()> {
+        for (k, name) in self.material_names.iter().enumerate() {
+            if self.material_names[..k].contains(name) {
+                return Err(BuildError::new(
+                    Field::Materials,
+                    format!("two materials are named `{name}`: names must be unique"),
+                ));
+            }
+        }
+        let (crowns, bridges) = (&self.stent_materials.crowns, self.stent_materials.bridges);
+        let field = || Field::Stent(StentField::Materials);
+        let count = self.materials.len();
+        if let Some(&m) = crowns.iter().chain([&bridges]).find(|&&m| m >= count) {
+            return Err(BuildError::new(
+                field(),
+                format!("material {m} does not exist ({count} materials)"),
+            ));
+        }
+        if let Some((spec, _)) = &self.stent
+            && crowns.len() > 1
+            && crowns.len() != spec.crowns
+        {
+            return Err(BuildError::new(
+                field(),
+                format!(
+                    "{} crown materials for {} crowns: give one for every crown, or one for all",
+                    crowns.len(),
+                    spec.crowns
+                ),
+            ));
+        }
+        Ok(())
     }
 
     /// The model's patches: `generated` (a stent's) first, then the added ones, fitted.

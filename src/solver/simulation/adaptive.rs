@@ -32,7 +32,8 @@
 //! does not shrink the next one below the step planned before it.
 
 use super::Simulation;
-use crate::material::{ConstitutiveLaw, SectionLaw, StepInput};
+use super::constitutive::with_step_input;
+use crate::material::{ConstitutiveLaw, SectionLaw};
 use crate::math::Real;
 use crate::solver::SolverError;
 use crate::solver::assembly::{Actions, Sink, StepMaterial, point_strains};
@@ -112,19 +113,20 @@ impl Simulation<'_> {
         t_np1: Real,
     ) -> Result<Option<Real>, SolverError> {
         let model = self.model;
-        let temperature = |t: Real| model.temperature.value(t);
-        let step = StepInput {
-            t_n,
-            t_np1,
-            temperature: &temperature,
-        };
         // The converged laws, with each material's companion laws over its points.
         let mut laws: Vec<SectionLaw> = self.materials.laws.clone();
         let mut companion = Vec::new();
         let mut any = false;
         for group in &self.materials.groups {
             let law = &model.materials[group.material];
-            if law.companion_laws(&group.state, &step, &mut companion)? {
+            let has = with_step_input(
+                model,
+                self.materials.places(),
+                &group.points,
+                (t_n, t_np1),
+                |step| law.companion_laws(&group.state, step, &mut companion),
+            )?;
+            if has {
                 any = true;
                 for (&g, c) in group.points.iter().zip(&companion) {
                     laws[g] = *c;

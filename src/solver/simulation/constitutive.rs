@@ -6,6 +6,7 @@
 use super::{Simulation, SolverTiming};
 use crate::material::{ConstitutiveLaw, MaterialLaw, MaterialState, SectionLaw, StepInput};
 use crate::math::Real;
+use crate::math::Vec3;
 use crate::model::Model;
 use crate::solver::SolverError;
 use crate::solver::assembly::{StepMaterial, point_strains};
@@ -36,6 +37,57 @@ pub(super) struct PointMaterials {
     owner: Vec<(usize, usize)>,
     /// The notices said, as `(material, kind)` ([`crate::material::MaterialNotice::kind`]): each once.
     pub(super) said: Vec<(usize, String)>,
+    /// Per global collocation point, its reference position and unit reference tangent, where the model has a
+    /// temperature field (empty otherwise).
+    places: Vec<(Vec3, Vec3)>,
+}
+
+/// Calls `f` with the input of the step `t_n → t_np1` for the points `points` (global indices) of one material:
+/// the model's temperature schedule and, with a temperature field, `(T, T,s)` at each of those points.
+pub(super) fn with_step_input<R>(
+    model: &Model,
+    places: &[(Vec3, Vec3)],
+    points: &[usize],
+    (t_n, t_np1): (Real, Real),
+    f: impl FnOnce(&StepInput<'_>) -> R,
+) -> R {
+    let temperature = |t: Real| model.temperature.value(t);
+    match &model.temperature_field {
+        Some(field) => {
+            let at = |i: usize, t: Real| {
+                let (position, tangent) = &places[points[i]];
+                field.at(position, tangent, t)
+            };
+            f(&StepInput {
+                t_n,
+                t_np1,
+                temperature: &temperature,
+                field: Some(&at),
+            })
+        }
+        None => f(&StepInput {
+            t_n,
+            t_np1,
+            temperature: &temperature,
+            field: None,
+        }),
+    }
+}
+
+/// The reference position and unit tangent `X,s` of every collocation point (from its basis table).
+fn reference_places(disc: &Discretisation) -> Vec<(Vec3, Vec3)> {
+    disc.points
+        .iter()
+        .map(|point| {
+            let (mut x, mut x_s) = (Vec3::zeros(), Vec3::zeros());
+            for (a, b) in point.basis.iter().enumerate() {
+                let c = disc.control0[point.first + a];
+                x += c * b[0];
+                x_s += c * b[1];
+            }
+            (x, x_s.try_normalize(0.0).unwrap_or_else(Vec3::zeros))
+        })
+        .collect()
 }
 
 impl PointMaterials {
@@ -70,6 +122,11 @@ impl PointMaterials {
             laws: vec![SectionLaw::default(); disc.points.len()],
             owner,
             said: Vec::new(),
+            places: if model.temperature_field.is_some() {
+                reference_places(disc)
+            } else {
+                Vec::new()
+            },
         };
         out.refresh_laws(&model.materials);
         out
@@ -85,6 +142,12 @@ impl PointMaterials {
                 let group = &groups[k];
                 *law = materials[group.material].section_law(&group.state, i);
             });
+    }
+
+    /// Per global collocation point, its reference position and unit tangent (empty without a temperature
+    /// field).
+    pub(super) fn places(&self) -> &[(Vec3, Vec3)] {
+        &self.places
     }
 
     /// Every material back to the data of its last converged step.
@@ -103,15 +166,15 @@ impl Simulation<'_> {
     pub(super) fn prepare_step(&mut self, t_n: Real, t_np1: Real) -> Result<(), SolverError> {
         let start = Instant::now();
         let model = self.model;
-        let temperature = |t: Real| model.temperature.value(t);
-        let step = StepInput {
-            t_n,
-            t_np1,
-            temperature: &temperature,
-        };
         let materials = &mut self.materials;
         for group in &mut materials.groups {
-            let notice = model.materials[group.material].prepare_step(&mut group.state, &step)?;
+            let notice = with_step_input(
+                model,
+                &materials.places,
+                &group.points,
+                (t_n, t_np1),
+                |step| model.materials[group.material].prepare_step(&mut group.state, step),
+            )?;
             if let Some(notice) = notice {
                 let key = (group.material, notice.kind().to_string());
                 if !materials.said.contains(&key) {
@@ -137,6 +200,19 @@ impl Simulation<'_> {
         }
         // Counted with the step's preparation.
         self.timing.material.1 += start.elapsed().as_secs_f64();
+    }
+
+    /// With a temperature field: the lowest and highest temperature over the collocation points at time `t`
+    /// \[°C\]; `None` when the temperature is uniform.
+    pub fn temperature_extremes(&self, t: Real) -> Option<(Real, Real)> {
+        let field = self.model.temperature_field.as_ref()?;
+        Some(self.materials.places.iter().fold(
+            (Real::INFINITY, Real::NEG_INFINITY),
+            |(lo, hi), (position, tangent)| {
+                let value = field.at(position, tangent, t).0;
+                (lo.min(value), hi.max(value))
+            },
+        ))
     }
 
     /// The constitutive data of the current (or last solved) step: every point's section law.
