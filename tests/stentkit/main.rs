@@ -9,6 +9,7 @@ mod cli;
 mod design_errors;
 mod designs;
 mod fuzz;
+mod materials;
 mod mesh;
 mod outputs;
 mod overrides;
