@@ -306,6 +306,17 @@ impl Centreline {
         Ok((f.position, f.rotation))
     }
 
+    /// The derivatives `(c'(s), R'(s))` at arc length `s`: `c' = t` and `R' = R K̂` with the frame's curvature
+    /// `K = (0, −t'·d3, t'·d2)` (a rotation-minimising frame does not twist about `t`).
+    pub fn derivative_at(&self, s: Real) -> Result<(Vec3, Mat3), GeometryError> {
+        let u = self.arc.parameter_at(&self.curve, s);
+        let f = self.frames.at(&self.curve, u)?;
+        Ok((
+            f.rotation.column(0).into_owned(),
+            f.rotation * f.curvature.cross_matrix(),
+        ))
+    }
+
     /// The underlying curve.
     pub fn curve(&self) -> &NurbsCurve {
         &self.curve

@@ -146,14 +146,15 @@ impl RunCharts {
                 .push(Series::new("largest ratio", recovery(&|r| r.ratio_max)));
             let (lo, hi) = model.temperature.range();
             let span = if hi > lo { hi - lo } else { 1.0 };
-            chart.series.push(
+            let temperature = || {
                 Series::new(
                     format!("(T − {lo} °C)/{span} °C"),
                     series(&|s| (s.temperature - lo) / span),
                 )
                 .dashed()
-                .with_color(3),
-            );
+                .with_color(3)
+            };
+            chart.series.push(temperature());
             if let Some(l) = self.channels.iter().position(|c| c.name == "programme") {
                 chart.series.push(
                     Series::new("programme ramp f(t)", series(&|s| s.loads[l]))
@@ -184,14 +185,7 @@ impl RunCharts {
                         .series
                         .push(Series::new(model.material_names[*m].clone(), points));
                 }
-                chart.series.push(
-                    Series::new(
-                        format!("(T − {lo} °C)/{span} °C"),
-                        series(&|s| (s.temperature - lo) / span),
-                    )
-                    .dashed()
-                    .with_color(3),
-                );
+                chart.series.push(temperature());
                 charts.push(("recovery_by_material.svg", chart));
             }
             let delta_r: Vec<(Real, Real)> = self

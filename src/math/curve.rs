@@ -125,13 +125,27 @@ impl NurbsCurve {
     /// `c^(k) = (A^(k) − Σ_{i=1..k} C(k,i) w^(i) c^(k−i)) / w` (Piegl–Tiller Eq. 4.8, A4.2).
     /// `u` outside the domain is clamped to it.
     pub fn derivatives(&self, u: Real, nders: usize) -> Vec<Vec3> {
+        thread_local! {
+            // Basis scratch reused by every call on this thread: geometry code evaluates curves one point at a
+            // time millions of times (arc-length inversions on a file centreline), where allocating the scratch
+            // per call cost more than the evaluation.
+            static SCRATCH: std::cell::RefCell<(BasisWorkspace, BasisTable)> =
+                std::cell::RefCell::new((BasisWorkspace::new(), BasisTable::default()));
+        }
         let mut out = vec![Vec3::zeros(); nders + 1];
-        self.derivatives_into(
-            u,
-            &mut BasisWorkspace::new(),
-            &mut BasisTable::default(),
-            &mut out,
-        );
+        SCRATCH.with(|scratch| match scratch.try_borrow_mut() {
+            Ok(mut scratch) => {
+                let (work, table) = &mut *scratch;
+                self.derivatives_into(u, work, table, &mut out);
+            }
+            // Re-entered on this thread (not done today): scratch of its own.
+            Err(_) => self.derivatives_into(
+                u,
+                &mut BasisWorkspace::new(),
+                &mut BasisTable::default(),
+                &mut out,
+            ),
+        });
         out
     }
 

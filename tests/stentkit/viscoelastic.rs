@@ -509,6 +509,33 @@ fn pla_prony(factor: Real) -> Prony {
     Prony::try_new(factor * 80.59e6, branches).expect("valid Prony series")
 }
 
+/// Asserts that a run's tip rotation and position stay within 1e-6 of the reference's largest rotation and tip
+/// displacement at each of its 150 landing times (printing the measured errors, labelled).
+fn assert_tip_within_1e6(
+    label: &str,
+    samples: &[(Real, Real, Real, Real)],
+    reference: &[(Real, Real, Real, Real)],
+) {
+    let (rotation, position, compared) = tip_errors(samples, reference);
+    let largest_rotation = reference.iter().fold(0.0_f64, |m, r| m.max(r.1.abs()));
+    let largest_displacement = reference
+        .iter()
+        .fold(0.0_f64, |m, r| m.max((r.2 - 1.0).hypot(r.3)));
+    println!(
+        "{label}: {} steps; rotation error {rotation:.3e} of {largest_rotation:.3} rad, tip error {position:.3e} of {largest_displacement:.3} m at {compared} times",
+        samples.len()
+    );
+    assert_eq!(compared, 150, "every landing time is compared");
+    assert!(
+        rotation <= 1e-6 * largest_rotation,
+        "{label}: rotation error {rotation:.3e}"
+    );
+    assert!(
+        position <= 1e-6 * largest_displacement,
+        "{label}: tip error {position:.3e}"
+    );
+}
+
 /// Largest differences between a run's tip history and the reference at the reference's own times (every 20
 /// ms): of the rotation \[rad\] and of the position \[m\].
 fn tip_errors(
@@ -569,24 +596,7 @@ fn two_materials_in_series_bend_as_their_one_dimensional_laws() {
         b.node("tip", NodeEnds::Named(vec!["b.end".into()]));
         b.temperature(programme_temperature(0.0));
     });
-    let (rotation, position, compared) = tip_errors(&samples, &reference);
-    let largest_rotation = reference.iter().fold(0.0_f64, |m, r| m.max(r.1.abs()));
-    let largest_displacement = reference
-        .iter()
-        .fold(0.0_f64, |m, r| m.max((r.2 - 1.0).hypot(r.3)));
-    println!(
-        "two materials: {} steps; rotation error {rotation:.3e} of {largest_rotation:.3} rad, tip error {position:.3e} of {largest_displacement:.3} m at {compared} times",
-        samples.len()
-    );
-    assert_eq!(compared, 150, "every landing time is compared");
-    assert!(
-        rotation <= 1e-6 * largest_rotation,
-        "rotation error {rotation:.3e}"
-    );
-    assert!(
-        position <= 1e-6 * largest_displacement,
-        "tip error {position:.3e}"
-    );
+    assert_tip_within_1e6("two materials", &samples, &reference);
 }
 
 // Source: a PLA cantilever under a pure end couple with a temperature that varies linearly along it,
@@ -627,22 +637,5 @@ fn a_temperature_gradient_bends_as_the_one_dimensional_law_integrated_along_the_
         .expect("valid field");
         b.temperature_field(field);
     });
-    let (rotation, position, compared) = tip_errors(&samples, &reference);
-    let largest_rotation = reference.iter().fold(0.0_f64, |m, r| m.max(r.1.abs()));
-    let largest_displacement = reference
-        .iter()
-        .fold(0.0_f64, |m, r| m.max((r.2 - 1.0).hypot(r.3)));
-    println!(
-        "gradient: {} steps; rotation error {rotation:.3e} of {largest_rotation:.3} rad, tip error {position:.3e} of {largest_displacement:.3} m at {compared} times",
-        samples.len()
-    );
-    assert_eq!(compared, 150, "every landing time is compared");
-    assert!(
-        rotation <= 1e-6 * largest_rotation,
-        "rotation error {rotation:.3e}"
-    );
-    assert!(
-        position <= 1e-6 * largest_displacement,
-        "tip error {position:.3e}"
-    );
+    assert_tip_within_1e6("gradient", &samples, &reference);
 }

@@ -163,7 +163,8 @@ impl Axis {
         }
     }
 
-    /// `(c'(s), R'(s))` where known in closed form: `R' = ω̂ R` with `ω = axis/ρ` on an arc.
+    /// `(c'(s), R'(s))`: `R' = ω̂ R` with `ω = axis/ρ` on an arc, `R' = R K̂` from the frame's curvature on a
+    /// spline centreline; `None` only where that frame cannot be evaluated.
     pub(super) fn frame_derivative(&self, s: Real) -> Option<(Vec3, Mat3)> {
         match self {
             Axis::Straight { frame, .. } => Some((frame.column(0).into_owned(), Mat3::zeros())),
@@ -174,7 +175,17 @@ impl Axis {
                     (axis / *radius).cross_matrix() * r,
                 ))
             }
-            Axis::Curve { .. } => None,
+            Axis::Curve { centreline } => {
+                let length = centreline.length();
+                let clamped = s.clamp(0.0, length);
+                let (dc, drot) = centreline.derivative_at(clamped).ok()?;
+                // Beyond its ends the centreline continues straight, with the end frame.
+                Some(if clamped == s {
+                    (dc, drot)
+                } else {
+                    (dc, Mat3::zeros())
+                })
+            }
         }
     }
 }

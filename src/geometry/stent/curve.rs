@@ -4,7 +4,7 @@
 use super::CrownSpec;
 use super::axis::Axis;
 use crate::geometry::analytic::ParametricCurve;
-use crate::math::{Real, Vec3};
+use crate::math::{Mat3, Real, Vec3};
 use std::f64::consts::TAU;
 use std::sync::Arc;
 
@@ -39,6 +39,9 @@ pub(super) enum CurveKind {
 #[derive(Debug, Clone)]
 pub struct StentCurve {
     axis: Arc<Axis>,
+    /// For a crown wire, the centreline frame `(c, R)` at its station, evaluated once (every point of the wire
+    /// uses it; on a file centreline one evaluation costs an arc-length inversion).
+    station_frame: Option<(Vec3, Mat3)>,
     radius: Real,
     amplitude: Real,
     peaks: Real,
@@ -48,8 +51,13 @@ pub struct StentCurve {
 impl StentCurve {
     /// The curve `kind` of a device with crowns `crown` placed on `axis`.
     pub(super) fn new(axis: &Arc<Axis>, crown: &CrownSpec, kind: CurveKind) -> Self {
+        let station_frame = match kind {
+            CurveKind::Crown { station, .. } => Some(axis.frame(station)),
+            CurveKind::Bridge { .. } => None,
+        };
         Self {
             axis: axis.clone(),
+            station_frame,
             radius: crown.radius,
             amplitude: crown.amplitude,
             peaks: crown.peaks as Real,
@@ -70,6 +78,11 @@ impl StentCurve {
             ) => Some((self.point(0.0), self.point(1.0))),
             _ => None,
         }
+    }
+
+    /// The centreline frame at station `s`: the crown's, kept, or the axis's.
+    fn frame(&self, s: Real) -> (Vec3, Mat3) {
+        self.station_frame.unwrap_or_else(|| self.axis.frame(s))
     }
 
     /// Local coordinates `(x, r cos ϑ, r sin ϑ)`, their derivative in the curve parameter, the station and
@@ -132,13 +145,13 @@ impl ParametricCurve for StentCurve {
 
     fn point(&self, t: Real) -> Vec3 {
         let (p, _, s, _) = self.local(t);
-        let (c, r) = self.axis.frame(s);
+        let (c, r) = self.frame(s);
         c + r * p
     }
 
     fn derivative(&self, t: Real) -> Vec3 {
         let (p, dp, s, ds) = self.local(t);
-        let (_, r) = self.axis.frame(s);
+        let (_, r) = self.frame(s);
         if ds == 0.0 {
             return r * dp;
         }
