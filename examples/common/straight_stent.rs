@@ -46,6 +46,7 @@ pub fn straight_stent(crowns: usize, (p, n): (usize, usize), step: f64) -> Model
             },
             symmetry: Symmetry::Quarter,
             cut: true,
+            crown_radii: None,
         },
         StentMesh {
             crown: (p, n),

@@ -326,7 +326,8 @@ pub fn programme(
         ));
     }
     let geometry = &stent.geometry;
-    let radius = stent.spec.crown.radius;
+    // Δr must stay below the smallest crown radius.
+    let radius = stent.spec.radius_range().0;
     let (kind, targets): (ProgrammeKind, Vec<Vec3>) = match &spec.target {
         &ProgrammeTarget::RadialContraction { delta_r } => {
             if !(delta_r > 0.0 && delta_r.is_finite()) {

@@ -470,6 +470,7 @@ fn point_list_centreline_reproduces_the_arc() {
         centreline,
         symmetry: Symmetry::Half,
         cut: true,
+        crown_radii: None,
     };
     let a = spec(arc).generate().expect("arc device");
     let b = spec(CentrelineSpec::Points {

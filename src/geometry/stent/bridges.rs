@@ -75,6 +75,7 @@ pub(super) fn bridges(
                 curve: StentCurve::new(
                     axis,
                     &spec.crown,
+                    (spec.radius_of(k), spec.radius_of(k + 1)),
                     CurveKind::Bridge {
                         from: stations[k],
                         to: stations[k + 1],

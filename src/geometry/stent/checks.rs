@@ -17,6 +17,20 @@ impl StentSpec {
                 format!("must be > 0, got {}", c.radius),
             ));
         }
+        if let Some(radii) = &self.crown_radii {
+            if radii.len() != self.crowns {
+                return Err(invalid(
+                    StentParameter::Radius,
+                    format!("{} crown radii for {} crowns", radii.len(), self.crowns),
+                ));
+            }
+            if let Some(r) = radii.iter().find(|r| !(r.is_finite() && **r > 0.0)) {
+                return Err(invalid(
+                    StentParameter::Radius,
+                    format!("every crown radius must be > 0, got {r}"),
+                ));
+            }
+        }
         if !(c.amplitude.is_finite() && c.amplitude > 0.0) {
             return Err(invalid(
                 StentParameter::Amplitude,
@@ -81,12 +95,12 @@ impl StentSpec {
                         ),
                     ));
                 }
-                if direction == BridgeDirection::Radial && amplitude >= c.radius {
+                let smallest = self.radius_range().0;
+                if direction == BridgeDirection::Radial && amplitude >= smallest {
                     return Err(invalid(
                         StentParameter::BridgesAmplitude,
                         format!(
-                            "a radial bridge amplitude {amplitude} must be below the crown radius {}",
-                            c.radius
+                            "a radial bridge amplitude {amplitude} must be below the crown radius {smallest}"
                         ),
                     ));
                 }
@@ -97,14 +111,14 @@ impl StentSpec {
 
     /// The crowns fit inside the bend of an arc centreline: `R` below the bend radius.
     pub(super) fn check_bend_radius(&self, axis: &Axis) -> Result<(), GeometryError> {
+        let largest = self.radius_range().1;
         if let Axis::Arc { radius, .. } = axis
-            && self.crown.radius >= *radius
+            && largest >= *radius
         {
             return Err(invalid(
                 StentParameter::Radius,
                 format!(
-                    "the crown radius {} must be smaller than the centreline's bend radius {radius}",
-                    self.crown.radius
+                    "the crown radius {largest} must be smaller than the centreline's bend radius {radius}"
                 ),
             ));
         }

@@ -94,12 +94,13 @@ pub(super) fn crown_nodes(
     layout: &Layout,
     sector: &Sector,
 ) -> (Vec<GeneratedNode>, NodeIndex) {
-    let (h, big_r) = (spec.crown.amplitude, spec.crown.radius);
+    let h = spec.crown.amplitude;
     let mut nodes = Vec::new();
     let mut node_index = vec![vec![None; layout.nodes_per_crown()]; stations.len()];
     for (k, &s) in stations.iter().enumerate() {
         let (c, r) = axis.frame(s);
         let t = r.column(0).into_owned();
+        let big_r = spec.radius_of(k);
         for j in layout.by_angle(k) {
             let a = layout.angle(k, j);
             if !sector.retained(a) {
@@ -163,6 +164,7 @@ pub(super) fn crown_wires(
                 curve: StentCurve::new(
                     axis,
                     &spec.crown,
+                    (spec.radius_of(k), spec.radius_of(k)),
                     CurveKind::Crown {
                         station: s,
                         phase: layout.phase(k),

@@ -42,15 +42,22 @@ pub struct StentCurve {
     /// For a crown wire, the centreline frame `(c, R)` at its station, evaluated once (every point of the wire
     /// uses it; on a file centreline one evaluation costs an arc-length inversion).
     station_frame: Option<(Vec3, Mat3)>,
-    radius: Real,
+    /// The radius at `u = 0` and at `u = 1` (equal on a crown; a bridge's goes linearly between its crowns').
+    radius: (Real, Real),
     amplitude: Real,
     peaks: Real,
     kind: CurveKind,
 }
 
 impl StentCurve {
-    /// The curve `kind` of a device with crowns `crown` placed on `axis`.
-    pub(super) fn new(axis: &Arc<Axis>, crown: &CrownSpec, kind: CurveKind) -> Self {
+    /// The curve `kind` of a device with crowns `crown` placed on `axis`, of radius `radius.0` at its start and
+    /// `radius.1` at its end.
+    pub(super) fn new(
+        axis: &Arc<Axis>,
+        crown: &CrownSpec,
+        radius: (Real, Real),
+        kind: CurveKind,
+    ) -> Self {
         let station_frame = match kind {
             CurveKind::Crown { station, .. } => Some(axis.frame(station)),
             CurveKind::Bridge { .. } => None,
@@ -58,7 +65,7 @@ impl StentCurve {
         Self {
             axis: axis.clone(),
             station_frame,
-            radius: crown.radius,
+            radius,
             amplitude: crown.amplitude,
             peaks: crown.peaks as Real,
             kind,
@@ -88,7 +95,8 @@ impl StentCurve {
     /// Local coordinates `(x, r cos ϑ, r sin ϑ)`, their derivative in the curve parameter, the station and
     /// its derivative.
     fn local(&self, t: Real) -> (Vec3, Vec3, Real, Real) {
-        let (h, m, big_r) = (self.amplitude, self.peaks, self.radius);
+        let (h, m) = (self.amplitude, self.peaks);
+        let big_r = self.radius.0;
         match self.kind {
             CurveKind::Crown {
                 station,
@@ -118,15 +126,19 @@ impl StentCurve {
                     let k = TAU * waves;
                     (amplitude * (k * t).sin(), amplitude * k * (k * t).cos())
                 };
+                // The cylinder's radius, linear from the crest's crown to the trough's.
+                let (r0, r1) = self.radius;
+                let (rc, drc) = (r0 + (r1 - r0) * t, r1 - r0);
                 let (r, dr, a, da) = match offset {
-                    Offset::None => (big_r, 0.0, angle, 0.0),
+                    Offset::None => (rc, drc, angle, 0.0),
                     Offset::Circumferential { amplitude, waves } => {
                         let (d, dd) = wave(amplitude, waves);
-                        (big_r, 0.0, angle + d / big_r, dd / big_r)
+                        // ϑ = ϑ₀ + δ/r: the arc length δ along the circumference.
+                        (rc, drc, angle + d / rc, dd / rc - d * drc / (rc * rc))
                     }
                     Offset::Radial { amplitude, waves } => {
                         let (d, dd) = wave(amplitude, waves);
-                        (big_r + d, dd, angle, 0.0)
+                        (rc + d, drc + dd, angle, 0.0)
                     }
                 };
                 let (sa, ca) = a.sin_cos();

@@ -228,6 +228,34 @@ pub struct StentSpec {
     pub symmetry: Symmetry,
     /// Keep only the symmetry sector (`true`) or the whole device (`false`, e.g. to check the reduced model).
     pub cut: bool,
+    /// The radius of each crown, first crown first, where they differ (a stent sized to a tapering vessel);
+    /// `None`: every crown has `crown.radius`. A bridge's radius goes linearly from its crest's crown to its
+    /// trough's.
+    pub crown_radii: Option<Vec<Real>>,
+}
+
+impl StentSpec {
+    /// The radius of crown `k` (0-based) \[length\].
+    pub fn radius_of(&self, k: usize) -> Real {
+        self.crown_radii
+            .as_ref()
+            .and_then(|r| r.get(k).copied())
+            .unwrap_or(self.crown.radius)
+    }
+
+    /// The largest and smallest crown radius \[length\].
+    pub fn radius_range(&self) -> (Real, Real) {
+        (0..self.crowns.max(1))
+            .map(|k| self.radius_of(k))
+            .fold((Real::INFINITY, Real::NEG_INFINITY), |(lo, hi), r| {
+                (lo.min(r), hi.max(r))
+            })
+    }
+
+    /// The arc-length stations of the crowns on the centreline \[length\] (module docs, *Stations*).
+    pub fn crown_stations(&self) -> Result<Vec<Real>, GeometryError> {
+        self.stations(&axis::Axis::new(&self.centreline)?)
+    }
 }
 
 /// How the temporary (programmed) shape differs from the permanent one: same crowns, nodes and stations.
@@ -235,7 +263,7 @@ pub struct StentSpec {
 pub struct TemporarySpec {
     /// The temporary centreline.
     pub centreline: TemporaryCentreline,
-    /// Crown radius in the temporary shape \[length\]; `None` keeps `R`.
+    /// Crown radius in the temporary shape \[length\]; `None` keeps each crown's.
     pub radius: Option<Real>,
 }
 
@@ -538,6 +566,7 @@ mod tests {
             },
             symmetry,
             cut,
+            crown_radii: None,
         }
     }
 

@@ -17,8 +17,9 @@ impl StentSpec {
         geometry: &StentGeometry,
         temporary: &TemporarySpec,
     ) -> Result<Vec<Vec3>, GeometryError> {
-        let radius = temporary.radius.unwrap_or(self.crown.radius);
-        if !(radius.is_finite() && radius > 0.0) {
+        if let Some(radius) = temporary.radius
+            && !(radius.is_finite() && radius > 0.0)
+        {
             return Err(invalid(
                 StentParameter::TemporaryRadius,
                 format!("must be > 0, got {radius}"),
@@ -65,6 +66,7 @@ impl StentSpec {
                 let (c, r) = axis.frame(node.station);
                 let x = if node.kind == NodeKind::Crest { h } else { -h };
                 let (sa, ca) = node.angle.sin_cos();
+                let radius = temporary.radius.unwrap_or(self.radius_of(node.crown));
                 c + r * Vec3::new(x, radius * ca, radius * sa)
             })
             .collect())

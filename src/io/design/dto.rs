@@ -720,6 +720,10 @@ pub struct StentDto {
     /// With a file centreline that has the lumen radius: `R` = the segment's mean lumen radius × (1 + oversize).
     #[serde(default)]
     pub oversize: Option<NonNegative>,
+    /// With `oversize`: size each crown from the lumen radius at its own station (× (1 + oversize)) instead of
+    /// the segment's mean; bridges taper between their crowns.
+    #[serde(default)]
+    pub taper: bool,
     /// Crown amplitude `h_c` (half the crown height) [length].
     pub amplitude: Positive,
     /// Crests per crown.

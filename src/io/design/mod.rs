@@ -13,6 +13,7 @@ pub mod dto;
 pub mod guard;
 pub mod issue;
 pub mod locate;
+pub mod materials;
 pub mod set;
 pub mod size;
 

@@ -93,7 +93,7 @@ pub(super) fn materials(m: &StentMaterialsDto, names: &[String]) -> Result<Stent
     let crowns = match &m.crowns {
         None => Vec::new(),
         Some(OneOrMany::One(name)) => {
-            vec![super::build::material_index(
+            vec![super::materials::material_index(
                 name,
                 names,
                 &format!("{base}.crowns"),
@@ -103,12 +103,12 @@ pub(super) fn materials(m: &StentMaterialsDto, names: &[String]) -> Result<Stent
             .iter()
             .enumerate()
             .map(|(k, name)| {
-                super::build::material_index(name, names, &format!("{base}.crowns[{k}]"))
+                super::materials::material_index(name, names, &format!("{base}.crowns[{k}]"))
             })
             .collect::<Result<_>>()?,
     };
     let bridges = match &m.bridges {
-        Some(name) => super::build::material_index(name, names, &format!("{base}.bridges"))?,
+        Some(name) => super::materials::material_index(name, names, &format!("{base}.bridges"))?,
         None => 0,
     };
     Ok(StentMaterials { crowns, bridges })
@@ -275,34 +275,93 @@ pub fn spec(
             ));
         }
     }
-    Ok((
-        StentSpec {
-            crown: CrownSpec {
-                radius,
-                amplitude: dto.amplitude.0,
-                peaks: dto.peaks,
-            },
-            crowns: dto.crowns,
-            spacing: dto.spacing.map(|d| d.0),
-            // Reduced to (−360°, 360°): whole turns do not change the device, and angles of the size of the largest
-            // finite numbers have lost their precision.
-            rotation: dto
-                .rotation_deg
-                .map_or(std::f64::consts::PI / dto.peaks.max(1) as Real, |r| {
-                    (r.0 % 360.0).to_radians()
-                }),
-            bridges: dto.bridges.as_ref().map(bridges).transpose()?,
-            centreline: axis,
-            symmetry: match dto.symmetry {
-                None | Some(SymmetryDto::None) => Symmetry::None,
-                Some(SymmetryDto::Half) => Symmetry::Half,
-                Some(SymmetryDto::Quarter) => Symmetry::Quarter,
-            },
-            cut: !dto.full_model,
+    let mut spec = StentSpec {
+        crown: CrownSpec {
+            radius,
+            amplitude: dto.amplitude.0,
+            peaks: dto.peaks,
         },
-        notes,
-        vessel.map(|v| v.vessel),
-    ))
+        crowns: dto.crowns,
+        spacing: dto.spacing.map(|d| d.0),
+        // Reduced to (−360°, 360°): whole turns do not change the device, and angles of the size of the largest
+        // finite numbers have lost their precision.
+        rotation: dto
+            .rotation_deg
+            .map_or(std::f64::consts::PI / dto.peaks.max(1) as Real, |r| {
+                (r.0 % 360.0).to_radians()
+            }),
+        bridges: dto.bridges.as_ref().map(bridges).transpose()?,
+        centreline: axis,
+        symmetry: match dto.symmetry {
+            None | Some(SymmetryDto::None) => Symmetry::None,
+            Some(SymmetryDto::Half) => Symmetry::Half,
+            Some(SymmetryDto::Quarter) => Symmetry::Quarter,
+        },
+        cut: !dto.full_model,
+        crown_radii: None,
+    };
+    if dto.taper {
+        let (Some(o), Some(v)) = (dto.oversize, &vessel) else {
+            return Err(issue(
+                "stent.taper",
+                "tapering sizes each crown from the lumen radius at its station: it needs `oversize` and a `file` centreline with the lumen radius",
+            ));
+        };
+        let stations = spec
+            .crown_stations()
+            .map_err(|e| issue("stent", e.to_string()))?;
+        let radii: Vec<Real> = stations
+            .iter()
+            .map(|&s| lumen_radius_at(&v.vessel, s).map(|r| r * (1.0 + o.0)))
+            .collect::<Option<_>>()
+            .ok_or_else(|| issue("stent.taper", "the centreline file has no lumen radius"))?;
+        let (lo, hi) = radii
+            .iter()
+            .fold((Real::INFINITY, Real::NEG_INFINITY), |(lo, hi), &r| {
+                (lo.min(r), hi.max(r))
+            });
+        notes.push(format!(
+            "crowns sized from the local lumen radius × {:.4}: from {lo:.4} to {hi:.4} (crown 1 {:.4}, crown {} {:.4})",
+            1.0 + o.0,
+            radii[0],
+            radii.len(),
+            radii[radii.len() - 1]
+        ));
+        if let Some((bend, _)) = tightest_bend(&spec.centreline)
+            && bend < hi
+        {
+            return Err(issue(
+                "stent.taper",
+                format!(
+                    "the centreline bends with a radius of curvature {} , less than the largest crown radius {}",
+                    crate::math::Short(bend),
+                    crate::math::Short(hi)
+                ),
+            ));
+        }
+        spec.crown_radii = Some(radii);
+    }
+    Ok((spec, notes, vessel.map(|v| v.vessel)))
+}
+
+/// The lumen radius of the vessel at arc length `s` along its sampled centreline (linear between samples,
+/// clamped to the ends); `None` without a radius.
+fn lumen_radius_at(vessel: &crate::model::Vessel, s: Real) -> Option<Real> {
+    let radius = vessel.radius.as_ref()?;
+    let mut arc = 0.0;
+    for (k, w) in vessel.points.windows(2).enumerate() {
+        let step = (w[1] - w[0]).norm();
+        if s <= arc + step || k + 2 == vessel.points.len() {
+            let f = if step > 0.0 {
+                ((s - arc) / step).clamp(0.0, 1.0)
+            } else {
+                0.0
+            };
+            return Some(radius[k] + f * (radius[k + 1] - radius[k]));
+        }
+        arc += step;
+    }
+    radius.first().copied()
 }
 
 /// The crown and bridge discretisations: each role's own mesh, else the design's.

@@ -5,6 +5,7 @@
 //! ```yaml
 //! stent:
 //!   oversize: 0.1                       # R = mean lumen radius over the segment × 1.1 (or give `radius`)
+//!   taper: true                         # optional: each crown from the lumen radius at its own station
 //!   centreline:
 //!     file:
 //!       path: data/aorta-centerline.vtp # relative to the design file
