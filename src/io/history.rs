@@ -74,7 +74,7 @@ impl HistoryWriter {
                 header.push_str(",delta_r");
             }
             let model = sim.model();
-            for (m, _) in model.material_regions() {
+            for m in model.material_regions() {
                 header.push_str(&format!(",recovery_ratio_mean@{}", model.material_names[m]));
             }
         }

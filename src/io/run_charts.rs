@@ -172,7 +172,7 @@ impl RunCharts {
                     "time [s]",
                     "ratio [-], normalised temperature [-]",
                 );
-                for (k, (m, _)) in regions.iter().enumerate() {
+                for (k, m) in regions.iter().enumerate() {
                     let points = self
                         .samples
                         .iter()

@@ -150,7 +150,8 @@ pub struct Recovery {
 
 /// The recovery measures of the current state, for a model with a programme.
 pub fn recovery(sim: &Simulation<'_>) -> Option<Recovery> {
-    let programme = sim.model().programme.as_ref()?;
+    let model = sim.model();
+    let programme = model.programme.as_ref()?;
     let u: Vec<Vec3> = programme
         .nodes
         .iter()
@@ -161,11 +162,10 @@ pub fn recovery(sim: &Simulation<'_>) -> Option<Recovery> {
         ratio_max: programme.target_fraction_max(&u),
         delta_r: matches!(programme.kind, ProgrammeKind::RadialContraction { .. })
             .then(|| -programme.mean_radial_displacement(&u)),
-        by_material: sim
-            .model()
+        by_material: model
             .material_regions()
-            .iter()
-            .map(|(_, nodes)| programme.target_fraction_where(&u, |k| nodes.contains(&k)))
+            .into_iter()
+            .map(|m| programme.target_fraction_where(&u, |k| model.node_touches_material(k, m)))
             .collect(),
     })
 }

@@ -258,13 +258,13 @@ pub fn step_coefficients_into(
     out: &mut StepCoefficients,
 ) -> Result<(), MaterialError> {
     let uniform = |t: Real| (temperature(t), 0.0);
-    coefficients_into(
+    step_coefficients_with_slope_into(
         material, integrator, quadrature, t_n, t_np1, &uniform, out, None,
     )
 }
 
 /// [`step_coefficients_into`] at a point where the temperature varies along the rod: `temperature(t)` gives
-/// `(T, T,s)` \[°C, K/length\] there, and `out_ds` receives the derivatives `(β_α,s, γ_α,s, δ_α,s)` of the
+/// `(T, T,s)` \[°C, K/length\] there, and `out_ds`, when given, receives the derivatives `(β_α,s, γ_α,s, δ_α,s)` of the
 /// coefficients along the reference arc length \[1/length\] — exact derivatives of the formulas of the module
 /// docs through `λ_α,s = λ_α · d ln(rate_factor)/dT · T,s` ([`super::Wlf::log_rate_slope`]); zero where a
 /// rate is capped ([`MAX_STEP_RATE`]) or frozen. They make the s-derivative of (★) exact (module docs of
@@ -280,30 +280,6 @@ pub fn step_coefficients_with_slope_into(
     t_np1: Real,
     temperature: &dyn Fn(Real) -> (Real, Real),
     out: &mut StepCoefficients,
-    out_ds: &mut StepCoefficients,
-) -> Result<(), MaterialError> {
-    coefficients_into(
-        material,
-        integrator,
-        quadrature,
-        t_n,
-        t_np1,
-        temperature,
-        out,
-        Some(out_ds),
-    )
-}
-
-/// The coefficients of (★) and, when `out_ds` is given, their s-derivatives (see the two public wrappers).
-#[allow(clippy::too_many_arguments)]
-fn coefficients_into(
-    material: &Material,
-    integrator: Integrator,
-    quadrature: &ReducedTimeQuadrature,
-    t_n: Real,
-    t_np1: Real,
-    temperature: &dyn Fn(Real) -> (Real, Real),
-    out: &mut StepCoefficients,
     mut out_ds: Option<&mut StepCoefficients>,
 ) -> Result<(), MaterialError> {
     let h = step_length(t_n, t_np1)?;
@@ -311,7 +287,6 @@ fn coefficients_into(
     out.resize(branches.len());
     if let Some(ds) = out_ds.as_deref_mut() {
         ds.resize(branches.len());
-        ds.delta.fill(0.0);
     }
     match integrator {
         Integrator::Trapezoidal => {
@@ -824,7 +799,7 @@ mod tests {
                         t_np1,
                         &f,
                         &mut c,
-                        &mut ds,
+                        Some(&mut ds),
                     )
                     .expect("valid step");
                     (c, ds)

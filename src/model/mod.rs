@@ -414,29 +414,25 @@ pub struct Vessel {
 }
 
 impl Model {
-    /// The material regions of a device made of several materials: for every material some patch uses, in
-    /// material order, its index and the nodes touching a patch of it (a node joining two materials belongs to
-    /// both). Empty when every patch is of one material (there are no regions to compare).
-    pub fn material_regions(&self) -> Vec<(usize, Vec<usize>)> {
+    /// The material regions of a device made of several materials: every material some patch uses, in material
+    /// order; a region's nodes are those touching a patch of it ([`Model::node_touches_material`]: a node
+    /// joining two materials belongs to both). Empty when every patch is of one material (no regions to compare).
+    pub fn material_regions(&self) -> Vec<usize> {
         let mut used: Vec<usize> = self.patches.iter().map(|p| p.material).collect();
         used.sort_unstable();
         used.dedup();
         if used.len() < 2 {
-            return Vec::new();
+            used.clear();
         }
-        used.into_iter()
-            .map(|m| {
-                let nodes = (0..self.nodes.len())
-                    .filter(|&k| {
-                        self.nodes[k]
-                            .ends
-                            .iter()
-                            .any(|e| self.patches[e.patch].material == m)
-                    })
-                    .collect();
-                (m, nodes)
-            })
-            .collect()
+        used
+    }
+
+    /// Whether node `node` joins an end of a patch of material `material`.
+    pub fn node_touches_material(&self, node: usize, material: usize) -> bool {
+        self.nodes[node]
+            .ends
+            .iter()
+            .any(|e| self.patches[e.patch].material == material)
     }
 
     /// Total number of collocation points (one per control point of every patch).

@@ -180,13 +180,12 @@ fn tangent_matches_central_differences_with_a_modulus_varying_along_the_rod() {
 /// The tangent of `model` with the section laws `laws` against central differences of its residual (see the
 /// tests' sources).
 fn check_tangent(model: &Model, disc: &Discretisation, laws: &[SectionLaw]) {
-    let disc = disc.clone();
-    let asm = Assembler::new(model, &disc);
+    let asm = Assembler::new(model, disc);
     let actions = Actions::at(model, 1.0, &[]);
     let material = StepMaterial { laws };
     let n = disc.num_unknowns();
     // A deformed state: a smooth finite increment (translations ~5 % of the size, rotations ~0.3 rad).
-    let mut state = State::reference(&disc);
+    let mut state = State::reference(disc);
     let delta: Vec<Real> = (0..n)
         .map(|i| {
             let x = i as Real;
@@ -197,8 +196,8 @@ fn check_tangent(model: &Model, disc: &Discretisation, laws: &[SectionLaw]) {
             }
         })
         .collect();
-    state.apply_increment(&disc, &delta);
-    let k = dense_tangent(&disc, &asm, &state, material, &actions);
+    state.apply_increment(disc, &delta);
+    let k = dense_tangent(disc, &asm, &state, material, &actions);
     let eps = 1e-6;
     let mut worst: Real = 0.0;
     let mut report = Vec::new();
@@ -207,11 +206,11 @@ fn check_tangent(model: &Model, disc: &Discretisation, laws: &[SectionLaw]) {
         let mut minus = state.clone();
         let mut e = vec![0.0; n];
         e[j] = eps;
-        plus.apply_increment(&disc, &e);
+        plus.apply_increment(disc, &e);
         e[j] = -eps;
-        minus.apply_increment(&disc, &e);
-        let rp = residual(&disc, &asm, &plus, material, &actions);
-        let rm = residual(&disc, &asm, &minus, material, &actions);
+        minus.apply_increment(disc, &e);
+        let rp = residual(disc, &asm, &plus, material, &actions);
+        let rm = residual(disc, &asm, &minus, material, &actions);
         for i in 0..n {
             let fd = (rp[i] - rm[i]) / (2.0 * eps);
             let row_scale = k[i].iter().fold(0.0_f64, |m, v| m.max(v.abs())).max(1e-300);

@@ -479,34 +479,20 @@ fn pla(tg: Real) -> MaterialLaw {
     MaterialLaw::from_material(material, Integrator::Trapezoidal)
 }
 
-/// The PLA Prony series (paper Table PLA in Pa, van Manen et al. 2021: [E_α, τ_G,α]) with every modulus times
-/// `factor`.
+/// The PLA Prony series (paper Table PLA, van Manen et al. 2021, the library's [`Prony::pla_van_manen_2021`])
+/// in Pa with every modulus times `factor`.
 fn pla_prony(factor: Real) -> Prony {
-    const TABLE: [(Real, Real); 15] = [
-        (20.12e6, 1.0e-10),
-        (50.31e6, 1.0e-9),
-        (81.37e6, 1.0e-8),
-        (97.02e6, 1.0e-7),
-        (173.70e6, 1.0e-6),
-        (225.60e6, 1.0e-5),
-        (292.64e6, 1.0e-4),
-        (474.56e6, 1.0e-3),
-        (449.43e6, 1.0e-2),
-        (237.98e6, 1.0e-1),
-        (114.16e6, 1.0e+0),
-        (51.82e6, 1.0e+1),
-        (29.98e6, 1.0e+2),
-        (14.40e6, 1.0e+3),
-        (0.72e6, 1.0e+5),
-    ];
-    let branches = TABLE
+    let pla = Prony::pla_van_manen_2021(); // MPa
+    let scale = factor * 1e6; // to Pa
+    let branches = pla
+        .branches()
         .iter()
-        .map(|&(modulus, tau_g)| PronyBranch {
-            modulus: factor * modulus,
-            tau_g,
+        .map(|b| PronyBranch {
+            modulus: scale * b.modulus,
+            tau_g: b.tau_g,
         })
         .collect();
-    Prony::try_new(factor * 80.59e6, branches).expect("valid Prony series")
+    Prony::try_new(scale * pla.e_inf(), branches).expect("valid Prony series")
 }
 
 /// Asserts that a run's tip rotation and position stay within 1e-6 of the reference's largest rotation and tip

@@ -261,19 +261,6 @@ pub fn spec(
                 "; mean lumen radius {r:.4}, stent radius {radius:.4}"
             ))
         ));
-        if let Some((bend, u)) = tightest_bend(&axis)
-            && bend < radius
-        {
-            return Err(issue(
-                "stent.centreline.file",
-                format!(
-                    "the centreline bends with a radius of curvature {} (at {:.0} % of the segment), less than the stent radius {}: the crowns would fold onto themselves; smooth it more or choose another segment",
-                    crate::math::Short(bend),
-                    100.0 * u,
-                    crate::math::Short(radius)
-                ),
-            ));
-        }
     }
     let mut spec = StentSpec {
         crown: CrownSpec {
@@ -327,19 +314,21 @@ pub fn spec(
             radii.len(),
             radii[radii.len() - 1]
         ));
-        if let Some((bend, _)) = tightest_bend(&spec.centreline)
-            && bend < hi
-        {
-            return Err(issue(
-                "stent.taper",
-                format!(
-                    "the centreline bends with a radius of curvature {} , less than the largest crown radius {}",
-                    crate::math::Short(bend),
-                    crate::math::Short(hi)
-                ),
-            ));
-        }
         spec.crown_radii = Some(radii);
+    }
+    let largest = spec.radius_range().1;
+    if let Some((bend, u)) = tightest_bend(&spec.centreline)
+        && bend < largest
+    {
+        return Err(issue(
+            "stent.centreline.file",
+            format!(
+                "the centreline bends with a radius of curvature {} (at {:.0} % of the segment), less than the stent radius {}: the crowns would fold onto themselves; smooth it more or choose another segment",
+                crate::math::Short(bend),
+                100.0 * u,
+                crate::math::Short(largest)
+            ),
+        ));
     }
     Ok((spec, notes, vessel.map(|v| v.vessel)))
 }

@@ -9,7 +9,7 @@ use crate::math::Real;
 use crate::math::Vec3;
 use crate::model::Model;
 use crate::solver::SolverError;
-use crate::solver::assembly::{StepMaterial, point_strains};
+use crate::solver::assembly::{StepMaterial, point_position, point_strains};
 use crate::solver::discretisation::Discretisation;
 use rayon::prelude::*;
 use std::time::Instant;
@@ -74,18 +74,14 @@ pub(super) fn with_step_input<R>(
     }
 }
 
-/// The reference position and unit tangent `X,s` of every collocation point (from its basis table).
+/// The reference position and unit tangent `X,s` (the first column of `R0`) of every collocation point.
 fn reference_places(disc: &Discretisation) -> Vec<(Vec3, Vec3)> {
-    disc.points
-        .iter()
-        .map(|point| {
-            let (mut x, mut x_s) = (Vec3::zeros(), Vec3::zeros());
-            for (a, b) in point.basis.iter().enumerate() {
-                let c = disc.control0[point.first + a];
-                x += c * b[0];
-                x_s += c * b[1];
-            }
-            (x, x_s.try_normalize(0.0).unwrap_or_else(Vec3::zeros))
+    (0..disc.points.len())
+        .map(|g| {
+            (
+                point_position(disc, &disc.control0, g),
+                disc.points[g].rotation0.column(0).into_owned(),
+            )
         })
         .collect()
 }
