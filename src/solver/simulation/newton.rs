@@ -24,6 +24,10 @@ pub const ROUND_OFF_TOLERANCE: Real = 1e-9;
 /// increment is largest.
 const SINGULAR_INCREMENT: Real = 1e8;
 
+/// With error-controlled steps, Newton's tolerance as a fraction of the error allowed per step (see
+/// [`Simulation::newton_tolerance`]).
+pub const NEWTON_SHARE: Real = 1e-2;
+
 /// An iteration counts as stagnant when its residual is above this fraction of the previous one.
 const STAGNATION_RATIO: Real = 0.5;
 
@@ -75,7 +79,7 @@ impl Simulation<'_> {
         let actions = Actions::at(self.model, t, &self.ramps);
         let settings = &self.model.solver;
         let (tol, max_iterations, ratio) = (
-            settings.tolerance,
+            self.newton_tolerance(),
             settings.max_iterations,
             settings.refactor_ratio,
         );
@@ -95,8 +99,10 @@ impl Simulation<'_> {
                 return Err(NewtonFailure::NotConverged(report));
             }
             let converged = if report.iterations == 0 {
-                // Nothing changed since the last converged state (e.g. a hold step).
-                r <= tol
+                // Nothing changed since the last converged state (e.g. a hold step): the residual alone says so,
+                // at the solver's own tolerance (a looser one for error-controlled steps bounds the error of an
+                // iterate through its increments, which a first iterate has none of).
+                r <= settings.tolerance
             } else {
                 // At the residual's round-off floor an ill-conditioned tangent (a free device after a release)
                 // leaves increments of noise that never fall below the tolerance: accept when the residual is
@@ -165,6 +171,16 @@ impl Simulation<'_> {
             }
             previous = if fresh_tangent { Real::INFINITY } else { r };
         }
+    }
+
+    /// The tolerance Newton stops at: `solver.tolerance`, and with error-controlled steps at least
+    /// [`NEWTON_SHARE`] of the share of the time tolerance each step is held to
+    /// ([`super::adaptive::LOCAL_FRACTION`]).
+    pub(super) fn newton_tolerance(&self) -> Real {
+        let tolerance = self.model.solver.tolerance;
+        self.model.time.tolerance.map_or(tolerance, |tau| {
+            tolerance.max(NEWTON_SHARE * super::adaptive::LOCAL_FRACTION * tau)
+        })
     }
 
     /// Predicts the state at `t` by extrapolating the last step's increment linearly in time (scaled by `dt`
