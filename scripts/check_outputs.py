@@ -22,6 +22,14 @@ Every DIR is searched recursively. Checked:
   before its history (the recording's chunks are closed every 2 s): it must hold at most, not exactly, one
   ``/state`` per step.
 
+* every run folder with ``run.pvd`` (the fields for ParaView), with VTK's own ``vtkXMLPolyDataReader`` (the
+  ``vtk`` package): the collection lists every snapshot of the summary with its time, strictly increasing;
+  every ``.vtp`` reads, holds one polyline per patch and the point arrays stentkit documents with the right
+  number of components and tuples and their units (VTK's ``UNITS_LABEL`` information key, in the run's unit
+  system), its ``TimeValue`` is the snapshot's time; and its values agree with ``history.csv`` at that time: the
+  largest displacement over the polylines' end points (the nodes) with ``max_displacement``, the largest
+  surface strain with ``surface_strain_peak``, the displacement at each probe's point with the probe's columns.
+
 Exits with status 1 if anything fails, or if no MCAP file was found at all; prints one line per file and a
 closing ``N passed, N failed`` line.
 """
@@ -213,6 +221,86 @@ def check_run_folder(folder):
     return f"{summary['design']}: {summary['status']}, {summary['steps']} steps, {len(steps)} snapshots"
 
 
+def field_arrays(units):
+    """The point arrays of a field file: name -> (components, unit), for a run in ``units`` (summary.json's)."""
+    length, moment, force = units["length"], units["moment"], units["force"]
+    return {
+        "displacement": (3, length), "rotation": (3, "rad"), "strain": (3, "1"), "curvature": (3, f"1/{length}"),
+        "force": (3, force), "moment": (3, moment), "force_spatial": (3, force), "moment_spatial": (3, moment),
+        "viscous_strain": (3, "1"), "viscous_curvature": (3, f"1/{length}"), "temperature": (1, "°C"),
+        "log10_shift_factor": (1, "1"), "surface_strain": (1, "1"), "arc_length": (1, length),
+    }
+
+
+def check_fields(folder):
+    import xml.etree.ElementTree as ElementTree
+
+    import vtk
+    from vtk.util.numpy_support import vtk_to_numpy
+
+    summary = run_summary(folder)
+    expected = field_arrays(summary["units"])
+    entries = [(float(d.get("timestep")), d.get("file"))
+               for d in ElementTree.parse(folder / "run.pvd").getroot().iter("DataSet")]
+    times = [t for t, _ in entries]
+    require(all(a < b for a, b in zip(times, times[1:])), "run.pvd times are not strictly increasing")
+    snapshots = {s["vtp"]: s["time"] for s in summary["snapshots"] if "vtp" in s}
+    require(len(entries) == len(snapshots), f"run.pvd lists {len(entries)} files, the summary {len(snapshots)}")
+    with open(folder / "history.csv", newline="") as f:
+        rows = list(csv.reader(f))
+    header, rows = rows[0], rows[1:]
+    column = {name: k for k, name in enumerate(header)}
+    probes = [name[:-3] for name in header if name.endswith(".ux")]
+    for time, file in entries:
+        require(file in snapshots and snapshots[file] == time, f"{file}: time {time} is not the summary's")
+        reader = vtk.vtkXMLPolyDataReader()
+        reader.SetFileName(str(folder / file))
+        reader.Update()
+        data = reader.GetOutput()
+        n = data.GetNumberOfPoints()
+        require(n > 0 and data.GetNumberOfLines() == summary["patches"], f"{file}: {n} points, "
+                f"{data.GetNumberOfLines()} lines for {summary['patches']} patches")
+        points = data.GetPointData()
+        arrays = {}
+        for name, (components, unit) in expected.items():
+            array = points.GetArray(name)
+            require(array is not None, f"{file}: no array {name}")
+            require(array.GetNumberOfComponents() == components and array.GetNumberOfTuples() == n,
+                    f"{file}: {name} has {array.GetNumberOfComponents()} x {array.GetNumberOfTuples()}")
+            info = array.GetInformation()
+            key = vtk.vtkDataArray.UNITS_LABEL()
+            require(info.Has(key) and info.Get(key) == unit, f"{file}: {name} unit {info.Get(key)!r}, not {unit!r}")
+            arrays[name] = vtk_to_numpy(array).reshape(n, components)
+        field = data.GetFieldData()
+        require(abs(vtk_to_numpy(field.GetArray("TimeValue"))[0] - time) <= 1e-12 * max(1.0, abs(time)),
+                f"{file}: TimeValue is not {time}")
+        row = min(rows, key=lambda r: abs(float(r[0]) - time))
+        require(abs(float(row[0]) - time) <= 1e-9 * max(1.0, abs(time)), f"{file}: no history row at t = {time}")
+        value = lambda name: float(row[column[name]])
+        # The nodes are the polylines' end points.
+        lines = vtk_to_numpy(data.GetLines().GetOffsetsArray())
+        ends = sorted({int(i) for k in lines[1:] for i in (k - 1,)} | {int(k) for k in lines[:-1]})
+        node_max = float(np.linalg.norm(arrays["displacement"][ends], axis=1).max())
+        scale = max(1.0, node_max)
+        require(abs(node_max - value("max_displacement")) <= 1e-8 * scale,
+                f"{file}: largest node displacement {node_max} vs history {value('max_displacement')}")
+        strain = arrays["surface_strain"][:, 0]
+        peak = float(strain.max())
+        require(abs(peak - value("surface_strain_peak")) <= 1e-8 * max(1e-3, abs(peak)),
+                f"{file}: peak surface strain {peak} vs history {value('surface_strain_peak')}")
+        probe_points = field.GetArray("probe_point")
+        if probes:
+            require(probe_points is not None, f"{file}: no probe_point for {len(probes)} probes")
+            for name, point in zip(probes, vtk_to_numpy(probe_points)):
+                if point < 0:
+                    continue
+                u = arrays["displacement"][int(point)]
+                h = [value(f"{name}.u{c}") for c in "xyz"]
+                require(np.abs(u - h).max() <= 1e-9 * max(1.0, float(np.abs(h).max())),
+                        f"{file}: probe {name} displacement {u} vs history {h}")
+    return f"{summary['design']}: {len(entries)} field files, {n} points each"
+
+
 def main(argv):
     if len(argv) < 2:
         print(__doc__)
@@ -225,8 +313,10 @@ def main(argv):
     folders = sorted({p.parent for r in roots for p in r.rglob("summary.json")})
     mcaps = sorted(p for r in roots for p in r.rglob("*.mcap"))
     stls = sorted(p for r in roots for p in r.rglob("*.stl"))
+    fields = sorted(p.parent for r in roots for p in r.rglob("run.pvd"))
     passed = failed = 0
-    for kind, paths, check in (("run", folders, check_run_folder), ("mcap", mcaps, check_mcap), ("stl", stls, check_stl)):
+    for kind, paths, check in (("run", folders, check_run_folder), ("mcap", mcaps, check_mcap), ("stl", stls, check_stl),
+                               ("vtk", fields, check_fields)):
         for path in paths:
             try:
                 detail = check(path)

@@ -43,7 +43,8 @@ use crate::io::run_charts::RunCharts;
 use crate::io::run_folder::{self, Manifest, RunFolder, RunFolderError};
 use crate::io::snapshots::SnapshotWriter;
 use crate::io::summary::{
-    FailureReport, FinalState, OutputState, RunStatus, RunSummaryFile, peak_memory_mib,
+    FailureReport, FinalState, OutputState, PeakSurfaceStrainSummary, RunStatus, RunSummaryFile,
+    peak_memory_mib,
 };
 use crate::math::{Real, Short};
 use crate::solver::simulation::model_fingerprint;
@@ -151,6 +152,8 @@ struct Outputs {
     beat: Instant,
     /// What the run did so far.
     totals: crate::solver::RunSummary,
+    /// Materials' strain limits exceeded, as said.
+    strain_warnings: Vec<String>,
 }
 
 impl Outputs {
@@ -178,6 +181,12 @@ impl Outputs {
         }
         if call(&mut self.progress).is_break() || signals::stop_requested() {
             flow = ControlFlow::Break(());
+        }
+        for warning in self.history.take_warnings() {
+            self.progress
+                .bar
+                .suspend(|| eprintln!("warning: {warning}"));
+            self.strain_warnings.push(warning);
         }
         flow
     }
@@ -226,6 +235,18 @@ impl Outputs {
             .last()
             .map(|x| FinalState::of(sim.model(), x));
         s.notices = sim.notices().to_vec();
+        s.peak_surface_strain =
+            self.history
+                .peak_surface_strain()
+                .map(
+                    |(time, value, patch, arc_length)| PeakSurfaceStrainSummary {
+                        value: *value,
+                        time: *time,
+                        patch: patch.clone(),
+                        arc_length: *arc_length,
+                    },
+                );
+        s.strain_limit_warnings.clone_from(&self.strain_warnings);
         s.timing.solver = sim.timing().entries().into_iter().collect();
         s.timing.recording = Self::RECORDING
             .iter()
@@ -782,7 +803,7 @@ fn create_outputs(
     let manifest = folder.manifest();
     manifest.claim(Path::new("history.csv"))?;
     let history_path = dir.join("history.csv");
-    let history = HistoryWriter::create(&history_path, sim)
+    let history = HistoryWriter::create(&history_path, sim, &design.output.strain_limits)
         .with_context(|| format!("cannot write {}", history_path.display()))?;
     let snapshots = SnapshotWriter::create(dir, &design.output.snapshots, model)?
         .with_manifest(manifest.clone());
@@ -802,6 +823,7 @@ fn create_outputs(
         spent: [Duration::ZERO; 4],
         beat: Instant::now(),
         totals: crate::solver::RunSummary::default(),
+        strain_warnings: Vec::new(),
     })
 }
 
@@ -821,7 +843,7 @@ fn resume_outputs(
     let dir = folder.dir();
     let manifest = folder.manifest();
     let history_path = dir.join("history.csv");
-    let history = HistoryWriter::resume(&history_path, saved.history)
+    let history = HistoryWriter::resume(&history_path, saved.history, &design.output.strain_limits)
         .with_context(|| format!("cannot continue {}", history_path.display()))?;
     // Snapshots the checkpoint does not list are from after it (or the final one of an interrupted run).
     let kept: std::collections::BTreeSet<&Path> = saved
@@ -853,6 +875,7 @@ fn resume_outputs(
         spent: saved.spent.map(|s| Duration::from_secs_f64(s.max(0.0))),
         beat: Instant::now(),
         totals: saved.totals.clone(),
+        strain_warnings: Vec::new(),
     })
 }
 

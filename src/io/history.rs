@@ -11,9 +11,13 @@
 //! `recovery_ratio_mean@<material>`, the mean ratio over the driven nodes touching a rod of that material (a node
 //! joining two materials counts in both; [`crate::model::Model::material_regions`]). With a temperature field,
 //! `temperature` is the field's reference schedule and `temperature_min`, `temperature_max` (after `cuts`) the
-//! extremes over the collocation points. The last column, `max_displacement`, is the largest
+//! extremes over the collocation points. Then `max_displacement`, the largest
 //! displacement of any node from the reference shape (length unit): the size of the programmed shape, of the
-//! snap at a release and of what is left at the end (`stentkit sweep`'s metrics).
+//! snap at a release and of what is left at the end (`stentkit sweep`'s metrics). The last three columns say
+//! where the surface strain of the wire peaks ([`crate::solver::simulation::fields`]): `surface_strain_peak`
+//! (the largest fibre stretch `λ − 1` over the collocation points),
+//! `surface_strain_patch` (the patch's name) and `surface_strain_s` (the reference arc length from the patch's
+//! start, length unit).
 //! Rows are flushed as they are written, so an interrupted run leaves a valid file up to its last step; a row
 //! that cannot be written whole (a full disk) is cut off again, so the file always ends with a complete row.
 
@@ -22,6 +26,50 @@ use std::fs::File;
 use std::io::{BufWriter, Write};
 use std::ops::ControlFlow;
 use std::path::{Path, PathBuf};
+
+/// The columns of `history.csv` that hold text (a patch's name) rather than numbers.
+pub const TEXT_COLUMNS: &[&str] = &["surface_strain_patch"];
+
+/// The materials with a strain limit, as `(material index, limit)`.
+fn limited_materials(strain_limits: &[Option<f64>]) -> Vec<(usize, f64)> {
+    strain_limits
+        .iter()
+        .enumerate()
+        .filter_map(|(m, l)| l.map(|l| (m, l)))
+        .collect()
+}
+
+/// The row of `history.csv` (its text) where the device's surface strain peaks over the run: `(time, strain,
+/// patch, arc length)`; `None` without such a column or rows. Read back from the file, so that a resumed run's
+/// summary covers the steps before its checkpoint too.
+pub fn run_peak_surface_strain(text: &str) -> Option<(f64, f64, String, f64)> {
+    let mut lines = text.lines();
+    let header: Vec<&str> = lines.next()?.split(',').collect();
+    let column = |name: &str| header.iter().position(|h| *h == name);
+    let (value, patch, s) = (
+        column("surface_strain_peak")?,
+        column("surface_strain_patch")?,
+        column("surface_strain_s")?,
+    );
+    lines
+        .filter_map(|l| {
+            let fields: Vec<&str> = l.split(',').collect();
+            let number = |k: usize| fields.get(k)?.parse::<f64>().ok();
+            Some((
+                number(0)?,
+                number(value)?,
+                fields.get(patch)?.to_string(),
+                number(s)?,
+            ))
+        })
+        .fold(
+            None,
+            |best: Option<(f64, f64, String, f64)>, row| match &best {
+                Some(b) if b.1 >= row.1 => best,
+                _ => Some(row),
+            },
+        )
+}
 
 /// How far `history.csv` was written: what a checkpoint records and a resumed run continues from.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -36,6 +84,14 @@ pub struct HistoryPosition {
 
 /// Writes `history.csv` as the simulation reports steps.
 pub struct HistoryWriter {
+    /// The materials with a strain limit: `(material index, limit)`, each with a column of its own.
+    limits: Vec<(usize, f64)>,
+    /// Per entry of `limits`, whether its exceedance has been said.
+    exceeded: Vec<bool>,
+    /// Warnings not yet taken by the caller ([`HistoryWriter::take_warnings`]).
+    warnings: Vec<String>,
+    /// The row where the surface strain peaked so far ([`run_peak_surface_strain`]'s tuple).
+    peak: Option<(f64, f64, String, f64)>,
     path: PathBuf,
     /// `None` once a write failed.
     out: Option<BufWriter<File>>,
@@ -49,8 +105,14 @@ pub struct HistoryWriter {
 }
 
 impl HistoryWriter {
-    /// Creates (truncates) the file and writes the header for the model's probes.
-    pub fn create(path: &Path, sim: &Simulation<'_>) -> std::io::Result<Self> {
+    /// Creates (truncates) the file and writes the header for the model's probes; `strain_limits` (per material,
+    /// [`crate::io::design::OutputSettings::strain_limits`]) adds a peak column per material with a limit.
+    pub fn create(
+        path: &Path,
+        sim: &Simulation<'_>,
+        strain_limits: &[Option<f64>],
+    ) -> std::io::Result<Self> {
+        let limits = limited_materials(strain_limits);
         let mut out = BufWriter::new(File::create(path)?);
         let mut header = String::from("time");
         for p in &sim.model().probes {
@@ -78,10 +140,22 @@ impl HistoryWriter {
                 header.push_str(&format!(",recovery_ratio_mean@{}", model.material_names[m]));
             }
         }
-        header.push_str(",max_displacement");
+        header.push_str(
+            ",max_displacement,surface_strain_peak,surface_strain_patch,surface_strain_s",
+        );
+        for &(m, _) in &limits {
+            header.push_str(&format!(
+                ",surface_strain_peak@{}",
+                sim.model().material_names[m]
+            ));
+        }
         writeln!(out, "{header}")?;
         out.flush()?;
         Ok(Self {
+            exceeded: vec![false; limits.len()],
+            limits,
+            warnings: Vec::new(),
+            peak: None,
             path: path.to_path_buf(),
             complete: header.len() as u64 + 1,
             out: Some(out),
@@ -96,7 +170,12 @@ impl HistoryWriter {
     ///
     /// # Errors
     /// The I/O error, or [`std::io::ErrorKind::InvalidData`] when the file is shorter than the checkpoint says.
-    pub fn resume(path: &Path, position: HistoryPosition) -> std::io::Result<Self> {
+    pub fn resume(
+        path: &Path,
+        position: HistoryPosition,
+        strain_limits: &[Option<f64>],
+    ) -> std::io::Result<Self> {
+        let limits = limited_materials(strain_limits);
         let file = std::fs::OpenOptions::new().write(true).open(path)?;
         let length = file.metadata()?.len();
         if length < position.bytes {
@@ -110,9 +189,14 @@ impl HistoryWriter {
             ));
         }
         file.set_len(position.bytes)?;
+        let peak = run_peak_surface_strain(&std::fs::read_to_string(path)?);
         let mut file = file;
         std::io::Seek::seek(&mut file, std::io::SeekFrom::End(0))?;
         Ok(Self {
+            exceeded: vec![false; limits.len()],
+            limits,
+            warnings: Vec::new(),
+            peak,
             path: path.to_path_buf(),
             complete: position.bytes,
             out: Some(BufWriter::new(file)),
@@ -144,6 +228,16 @@ impl HistoryWriter {
     /// The file written.
     pub fn path(&self) -> &Path {
         &self.path
+    }
+
+    /// Where the surface strain peaked over the rows written: `(time, strain, patch, arc length)`.
+    pub fn peak_surface_strain(&self) -> Option<&(f64, f64, String, f64)> {
+        self.peak.as_ref()
+    }
+
+    /// The warnings found since the last call (a material's strain limit exceeded: each said once).
+    pub fn take_warnings(&mut self) -> Vec<String> {
+        std::mem::take(&mut self.warnings)
     }
 
     /// The first write error, if any.
@@ -192,6 +286,39 @@ impl HistoryWriter {
             ",{:.9e}",
             super::state::max_node_displacement(sim)
         ));
+        match sim.peak_surface_strain() {
+            Some(peak) => {
+                let patch = &sim.model().patches[peak.patch].name;
+                line.push_str(&format!(
+                    ",{:.9e},{patch},{:.9e}",
+                    peak.value, peak.arc_length
+                ));
+                if self.peak.as_ref().is_none_or(|p| peak.value > p.1) {
+                    self.peak = Some((t, peak.value, patch.clone(), peak.arc_length));
+                }
+            }
+            None => line.push_str(",,,"),
+        }
+        for (k, &(m, limit)) in self.limits.iter().enumerate() {
+            let Some(peak) = sim.peak_surface_strain_of(Some(m)) else {
+                line.push(',');
+                continue;
+            };
+            line.push_str(&format!(",{:.9e}", peak.value));
+            if peak.value > limit && !self.exceeded[k] {
+                self.exceeded[k] = true;
+                let model = sim.model();
+                self.warnings.push(format!(
+                    "at t = {t:.4} s the surface strain of material `{}` reaches {:.3} % (patch `{}`, s = {:.4} {}), above its strain_limit {:.3} % (said once)",
+                    model.material_names[m],
+                    100.0 * peak.value,
+                    model.patches[peak.patch].name,
+                    peak.arc_length,
+                    model.units.length(),
+                    100.0 * limit
+                ));
+            }
+        }
         let Some(out) = &mut self.out else {
             return ControlFlow::Break(());
         };

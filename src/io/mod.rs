@@ -18,3 +18,4 @@ pub mod snapshots;
 pub mod state;
 pub mod stl;
 pub mod summary;
+pub mod vtk;

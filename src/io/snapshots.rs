@@ -12,7 +12,7 @@ use super::design::SnapshotSettings;
 use super::mesh_format::{MeshFormat, SnapshotState};
 use super::run_folder::Manifest;
 use super::stl::MeshIoError;
-use super::{obj, stl};
+use super::{obj, stl, vtk};
 use crate::geometry::device_tubes::DeviceMeshError;
 use crate::geometry::mesh::TriangleMesh;
 use crate::math::Real;
@@ -73,13 +73,16 @@ pub struct Snapshot {
     /// Time [time].
     pub time: Real,
     /// Its files relative to the run folder, one per format of [`FORMATS`] in that order, each with its
-    /// format's extension.
+    /// format's extension, then the fields for ParaView (`.vtp`) when the design writes them.
     pub files: Vec<PathBuf>,
     /// Triangles of the mesh.
     pub triangles: usize,
     /// Enclosed volume [length³].
     pub volume: Real,
 }
+
+/// The ParaView collection of a run's field files, in the run folder ([`vtk::collection`]).
+pub const COLLECTION_FILE: &str = "run.pvd";
 
 /// The file of the vessel's lumen in the snapshot folder (a stent on a centreline read from a file).
 pub const VESSEL_FILE: &str = "vessel_lumen.stl";
@@ -113,6 +116,15 @@ pub enum SnapshotError {
     /// A file could not be written.
     #[error(transparent)]
     Write(#[from] MeshIoError),
+    /// A field file for ParaView (or their collection) could not be written.
+    #[error("cannot write {path}: {source}")]
+    Fields {
+        /// The file.
+        path: PathBuf,
+        /// The operating-system error.
+        #[source]
+        source: std::io::Error,
+    },
     /// The run folder's manifest could not list the snapshot's files.
     #[error("cannot list a snapshot in the run folder's manifest: {0}")]
     Manifest(std::io::Error),
@@ -145,6 +157,10 @@ pub struct SnapshotWriter {
     error: Option<SnapshotError>,
     /// The run folder's manifest, which lists each file before it is written.
     manifest: Option<Manifest>,
+    /// Whether each snapshot also writes the fields for ParaView ([`vtk`]) and `run.pvd` lists them.
+    vtk: bool,
+    /// Whether `run.pvd` is listed in the manifest yet.
+    collection_claimed: bool,
 }
 
 impl SnapshotWriter {
@@ -174,6 +190,8 @@ impl SnapshotWriter {
             written: Vec::new(),
             error: None,
             manifest: None,
+            vtk: settings.vtk,
+            collection_claimed: false,
         })
     }
 
@@ -245,6 +263,26 @@ impl SnapshotWriter {
         for (format, path) in FORMATS.iter().zip(&files) {
             format.write(&self.run_dir.join(path), &mesh, &state)?;
         }
+        let mut files = files;
+        if self.vtk {
+            let path = Path::new(Self::FOLDER).join(format!("{name}.vtp"));
+            if let Some(manifest) = &self.manifest {
+                manifest.claim(&path).map_err(SnapshotError::Manifest)?;
+            }
+            let target = self.run_dir.join(&path);
+            vtk::write_polydata(
+                &target,
+                model,
+                &sim.point_fields(),
+                &sim.probe_points(),
+                time,
+            )
+            .map_err(|source| SnapshotError::Fields {
+                path: target,
+                source,
+            })?;
+            files.push(path);
+        }
         if self.written.is_empty() {
             self.write_vessel(model)?;
         }
@@ -255,7 +293,36 @@ impl SnapshotWriter {
             triangles: mesh.triangles.len(),
             volume: mesh.volume(),
         });
+        if self.vtk {
+            self.write_collection()?;
+        }
         Ok(())
+    }
+
+    /// Rewrites `run.pvd`, the ParaView collection of the field files written so far with their times.
+    fn write_collection(&mut self) -> Result<(), SnapshotError> {
+        let entries: Vec<(Real, String)> = self
+            .written
+            .iter()
+            .flat_map(|s| {
+                s.files
+                    .iter()
+                    .filter(|f| f.extension().is_some_and(|e| e == "vtp"))
+                    .map(|f| (s.time, f.to_string_lossy().into_owned()))
+            })
+            .collect();
+        let path = Path::new(COLLECTION_FILE);
+        if !self.collection_claimed {
+            if let Some(manifest) = &self.manifest {
+                manifest.claim(path).map_err(SnapshotError::Manifest)?;
+            }
+            self.collection_claimed = true;
+        }
+        let target = self.run_dir.join(path);
+        vtk::write_collection(&target, &entries).map_err(|source| SnapshotError::Fields {
+            path: target,
+            source,
+        })
     }
 
     /// With the first snapshot: the lumen of the vessel the stent sits on, `snapshots/vessel_lumen.stl` (a

@@ -180,9 +180,10 @@ pub struct SnapshotEntry {
     pub step: usize,
     /// Time [s].
     pub time: Real,
-    /// Its files relative to the run folder by format ([`crate::io::snapshots::FORMATS`]): `"stl"`, `"obj"`.
+    /// Its files relative to the run folder by extension: `"stl"`, `"obj"` ([`crate::io::snapshots::FORMATS`])
+    /// and `"vtp"` (the fields for ParaView, [`crate::io::vtk`]).
     #[serde(flatten)]
-    pub files: std::collections::BTreeMap<&'static str, String>,
+    pub files: std::collections::BTreeMap<String, String>,
     /// Triangles.
     pub triangles: usize,
     /// Enclosed volume [length³].
@@ -194,10 +195,15 @@ impl From<&Snapshot> for SnapshotEntry {
         Self {
             step: s.step,
             time: s.time,
-            files: crate::io::snapshots::FORMATS
+            files: s
+                .files
                 .iter()
-                .zip(&s.files)
-                .map(|(f, path)| (f.extension(), path.display().to_string()))
+                .map(|path| {
+                    let extension = path
+                        .extension()
+                        .map_or_else(String::new, |e| e.to_string_lossy().into_owned());
+                    (extension, path.display().to_string())
+                })
                 .collect(),
             triangles: s.triangles,
             volume: s.volume,
@@ -335,6 +341,25 @@ pub struct RunSummaryFile {
     pub warnings: Vec<String>,
     /// Notices of the solver (e.g. relaxation frozen below Tg − C2).
     pub notices: Vec<String>,
+    /// Where the wire's surface strain peaked over the run (`history.csv`'s `surface_strain_peak`).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub peak_surface_strain: Option<PeakSurfaceStrainSummary>,
+    /// Materials whose `strain_limit` the surface strain exceeded, as `run` said (each once).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub strain_limit_warnings: Vec<String>,
+}
+
+/// Where the surface strain peaked over a run (`summary.json` `peak_surface_strain`).
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct PeakSurfaceStrainSummary {
+    /// The strain (positive: stretched) \[-\].
+    pub value: Real,
+    /// When \[s\].
+    pub time: Real,
+    /// The patch's name.
+    pub patch: String,
+    /// Reference arc length from the patch's start \[length\].
+    pub arc_length: Real,
 }
 
 /// What error-controlled stepping did (`summary.json` `time_error_control`).
@@ -408,6 +433,8 @@ impl RunSummaryFile {
             final_state: None,
             warnings,
             notices: Vec::new(),
+            peak_surface_strain: None,
+            strain_limit_warnings: Vec::new(),
         }
     }
 

@@ -46,7 +46,7 @@
 use super::{MaterialError, Section, SectionLaw, SectionShape, SectionStrains, SectionStress};
 #[cfg(doc)]
 use super::{MaterialLaw, MaterialState};
-use crate::math::Real;
+use crate::math::{Real, Vec3};
 use std::fmt;
 
 /// The time step a law prepares: from `t_n` to `t_{n+1}` \[time\], with the temperature \[°C\] as a function of
@@ -202,6 +202,15 @@ pub trait ConstitutiveLaw: Clone + fmt::Debug + PartialEq + Send + Sync {
     /// internal variables are unchanged: only [`ConstitutiveLaw::commit_step`] changes them).
     fn roll_back(&self, state: &mut Self::State);
 
+    /// For output: the viscous strains of point `i` at the last converged step, as one strain pair
+    /// `(Γ_v, K_v)` (material frame, measured from the reference like `Γ_N`, `K_M`); `None` for a law without
+    /// internal variables. A law with several branches gives their mean weighted by the branch moduli,
+    /// `Σ_α E_α ε_α / Σ_α E_α`: zero at rest and equal to the total strain once every branch has relaxed.
+    fn viscous_strains(&self, state: &Self::State, i: usize) -> Option<(Vec3, Vec3)> {
+        let _ = (state, i);
+        None
+    }
+
     /// Appends the state at a converged step to `out` as plain numbers: everything
     /// [`ConstitutiveLaw::restore_state`] needs to continue exactly.
     fn save_state(&self, state: &Self::State, out: &mut Vec<Real>);
@@ -323,6 +332,17 @@ macro_rules! register_laws {
             fn commit_step(&self, state: &mut MaterialState, strains: $crate::material::constitutive::PointStrains<'_>) {
                 match (self, state) {
                     $((MaterialLaw::$variant(law), MaterialState::$variant(s)) => law.commit_step(s, strains),)+
+                    (law, _) => $crate::material::constitutive::state_of_another_law(law.name()),
+                }
+            }
+
+            fn viscous_strains(
+                &self,
+                state: &MaterialState,
+                i: usize,
+            ) -> Option<($crate::math::Vec3, $crate::math::Vec3)> {
+                match (self, state) {
+                    $((MaterialLaw::$variant(law), MaterialState::$variant(s)) => law.viscous_strains(s, i),)+
                     (law, _) => $crate::material::constitutive::state_of_another_law(law.name()),
                 }
             }

@@ -61,7 +61,7 @@ use super::{
     history_stress, step_coefficients_into, step_coefficients_with_slope_into,
     update_branch_strains, update_branch_strains_with_slope,
 };
-use crate::math::Real;
+use crate::math::{Real, Vec3};
 use rayon::prelude::*;
 
 /// The generalized Maxwell/WLF material with its time integrator (module docs).
@@ -384,6 +384,21 @@ impl ConstitutiveLaw for MaxwellLaw {
         if let Some(field) = &mut state.field {
             field.converged_modulus.copy_from_slice(&field.modulus);
         }
+    }
+
+    fn viscous_strains(&self, state: &MaxwellState, i: usize) -> Option<(Vec3, Vec3)> {
+        let branches = self.material.prony().branches();
+        let total: Real = branches.iter().map(|b| b.modulus).sum();
+        if branches.is_empty() || total <= 0.0 {
+            return None;
+        }
+        let (force, moment) = branches
+            .iter()
+            .zip(state.branches.point(i))
+            .fold((Vec3::zeros(), Vec3::zeros()), |(f, m), (b, e)| {
+                (f + e.force * b.modulus, m + e.moment * b.modulus)
+            });
+        Some((force / total, moment / total))
     }
 
     fn roll_back(&self, state: &mut MaxwellState) {

@@ -18,8 +18,8 @@ pub mod sparse;
 pub mod state;
 
 pub use simulation::{
-    Checkpoint, CheckpointError, NewtonReport, Observer, Observers, RunSummary, Simulation,
-    SolverTiming, StepOutcome, StepReport,
+    Checkpoint, CheckpointError, NewtonReport, Observer, Observers, PeakSurfaceStrain, PointFields,
+    RunSummary, Simulation, SolverTiming, StepOutcome, StepReport,
 };
 
 use crate::geometry::GeometryError;

@@ -64,10 +64,22 @@ impl History {
             .next()
             .map(|h| h.split(',').map(str::to_string).collect())
             .unwrap_or_default();
+        // Text columns (a patch's name) are read as NaN: only numbers are looked up.
+        let text: Vec<bool> = names
+            .iter()
+            .map(|n| crate::io::history::TEXT_COLUMNS.contains(&n.as_str()))
+            .collect();
         let rows = lines
             .map(|l| {
                 l.split(',')
-                    .map(|x| x.parse::<Real>())
+                    .zip(text.iter().chain(std::iter::repeat(&false)))
+                    .map(|(x, &is_text)| {
+                        if is_text {
+                            Ok(Real::NAN)
+                        } else {
+                            x.parse::<Real>()
+                        }
+                    })
                     .collect::<Result<Vec<_>, _>>()
             })
             .take_while(|r| r.as_ref().is_ok_and(|r| r.len() == names.len()))

@@ -8,6 +8,7 @@ mod checkpoint;
 mod cli;
 mod design_errors;
 mod designs;
+mod fields;
 mod fuzz;
 mod materials;
 mod mesh;

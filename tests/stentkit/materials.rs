@@ -21,7 +21,9 @@ fn history(dir: &Path) -> Vec<HashMap<String, f64>> {
             header
                 .iter()
                 .cloned()
-                .zip(l.split(',').map(|v| v.parse().expect("number")))
+                .zip(l.split(','))
+                // Numbers only: a column naming a patch is left out.
+                .filter_map(|(name, v)| v.parse().ok().map(|v| (name, v)))
                 .collect()
         })
         .collect()

@@ -148,7 +148,7 @@ pub fn build(dto: &DesignDto, default_name: &str) -> Result<Built> {
         };
         builder.probe(p.name.clone(), at);
     }
-    let mut output = output_settings(dto.output.as_ref(), &settings)?;
+    let mut output = output_settings(dto, &settings)?;
     let snapshots_given = dto
         .output
         .as_ref()
@@ -387,11 +387,9 @@ fn check_name(name: &str) -> std::result::Result<(), String> {
     }
 }
 
-/// The `output:` block's snapshot and recording settings, with their defaults.
-fn output_settings(
-    output: Option<&OutputDto>,
-    time: &TimeSettings,
-) -> Result<super::OutputSettings> {
+/// The `output:` block's snapshot, recording and field-file settings with their defaults, and the materials' strain limits.
+fn output_settings(dto: &DesignDto, time: &TimeSettings) -> Result<super::OutputSettings> {
+    let output = dto.output.as_ref();
     use super::{OutputSettings, RecordingSettings, SnapshotSettings};
     let at_least = |value: Option<usize>, default: usize, min: usize, path: &str| match value {
         None => Ok(default),
@@ -435,6 +433,7 @@ fn output_settings(
             2,
             "output.snapshots.rings",
         )?,
+        vtk: output.and_then(|o| o.vtk).unwrap_or(true),
     };
     let recording = output.and_then(|o| o.recording.as_ref());
     let recording_settings = RecordingSettings {
@@ -461,6 +460,10 @@ fn output_settings(
     Ok(OutputSettings {
         snapshots: snapshot_settings,
         recording: recording_settings,
+        strain_limits: std::iter::once(&dto.material)
+            .chain(&dto.materials)
+            .map(|m| m.strain_limit.map(|l| l.0))
+            .collect(),
     })
 }
 

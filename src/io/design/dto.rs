@@ -334,6 +334,10 @@ pub struct MaterialDto {
     /// Internal-variable update: `trapezoidal` (default), `backward-euler`, `exponential`.
     #[serde(default)]
     pub integrator: Option<IntegratorDto>,
+    /// The surface strain the printed material survives [-] (a fraction: its elongation at break, e.g. 0.06
+    /// for 6 %): `run` warns when the peak surface strain of a rod of this material exceeds it.
+    #[serde(default)]
+    pub strain_limit: Option<Positive>,
 }
 
 /// WLF constants.
@@ -650,6 +654,10 @@ pub struct OutputDto {
     /// What `run.mcap` holds besides the state per step.
     #[serde(default)]
     pub recording: Option<RecordingDto>,
+    /// Fields along the rods for ParaView with every snapshot (`snapshots/step_NNNNN.vtp`, listed in `run.pvd`
+    /// with their times); default true.
+    #[serde(default)]
+    pub vtk: Option<bool>,
 }
 
 /// Snapshots: the initial and final shapes always, plus every `every` steps and at the given times.

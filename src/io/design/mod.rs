@@ -43,6 +43,9 @@ pub struct SnapshotSettings {
     /// Rings (sections) along each patch, about: every k-th of the samples taken at a whole number of samples
     /// per control point, the ends always included ([`crate::post::device::current_device_shapes`]).
     pub rings: usize,
+    /// With every snapshot, the fields along the rods for ParaView (`output.vtk`, default true;
+    /// [`crate::io::vtk`]).
+    pub vtk: bool,
 }
 
 impl SnapshotSettings {
@@ -88,6 +91,9 @@ pub struct OutputSettings {
     pub snapshots: SnapshotSettings,
     /// The MCAP recording.
     pub recording: RecordingSettings,
+    /// Per material of the model (`material` first, then `materials`), the surface strain it survives
+    /// (`strain_limit`), which `run` warns above.
+    pub strain_limits: Vec<Option<Real>>,
 }
 
 /// A design read from a file.

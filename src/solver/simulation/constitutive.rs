@@ -146,6 +146,18 @@ impl PointMaterials {
         &self.places
     }
 
+    /// The viscous strains of global point `g` at the last converged step
+    /// ([`ConstitutiveLaw::viscous_strains`]); `None` for a law without internal variables.
+    pub(super) fn viscous_strains(
+        &self,
+        materials: &[MaterialLaw],
+        g: usize,
+    ) -> Option<(Vec3, Vec3)> {
+        let (k, i) = self.owner[g];
+        let group = &self.groups[k];
+        materials[group.material].viscous_strains(&group.state, i)
+    }
+
     /// Every material back to the data of its last converged step.
     pub(super) fn roll_back(&mut self, materials: &[MaterialLaw]) {
         for group in &mut self.groups {

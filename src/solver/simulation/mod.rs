@@ -59,6 +59,7 @@
 pub mod adaptive;
 pub mod checkpoint;
 mod constitutive;
+pub mod fields;
 mod newton;
 pub mod observer;
 mod releases;
@@ -67,6 +68,7 @@ mod stepping;
 pub mod timing;
 
 pub use checkpoint::{Checkpoint, CheckpointError, TangentOrigin, model_fingerprint};
+pub use fields::{PeakSurfaceStrain, PointFields, peak_surface_strain};
 pub use newton::ROUND_OFF_TOLERANCE;
 pub use observer::{NoObserver, Observer, Observers};
 pub use report::{NewtonReport, RunSummary, StepReport};
@@ -134,6 +136,8 @@ pub struct Simulation<'m> {
     tangent: checkpoint::TangentRecord,
     /// The memory of error-controlled stepping ([`adaptive`]).
     control: adaptive::StepControl,
+    /// Reference arc length of every collocation point from its patch's start, for the fields ([`fields`]).
+    arc_length: Vec<Real>,
 }
 
 impl<'m> Simulation<'m> {
@@ -205,6 +209,7 @@ impl<'m> Simulation<'m> {
             })
             .collect();
         let n = disc.num_unknowns();
+        let arc_length = fields::arc_lengths(model, &disc);
         Ok(Self {
             model,
             disc,
@@ -231,6 +236,7 @@ impl<'m> Simulation<'m> {
             step_cuts: 0,
             tangent: checkpoint::TangentRecord::default(),
             control: adaptive::StepControl::default(),
+            arc_length,
         })
     }
 }
