@@ -155,12 +155,13 @@ pub fn describe(design: &Design, file: &str) -> String {
     let mb = |bytes: u64| bytes as f64 / 1e6;
     let _ = writeln!(
         s,
-        "disk                about {:.1} MB: {} snapshots {:.1} MB (STL {:.1} MB + OBJ {:.1} MB), run.mcap {:.1} MB, history.csv {:.1} MB, charts {:.1} MB, summary.json {:.1} MB",
+        "disk                about {:.1} MB: {} snapshots {:.1} MB (STL {:.1} MB + OBJ {:.1} MB + fields {:.1} MB), run.mcap {:.1} MB, history.csv {:.1} MB, charts {:.1} MB, summary.json {:.1} MB",
         mb(disk.total()),
         disk.snapshots,
-        mb(disk.snapshot_stl + disk.snapshot_obj),
+        mb(disk.snapshots_bytes()),
         mb(disk.snapshot_stl),
         mb(disk.snapshot_obj),
+        mb(disk.snapshot_vtp),
         mb(disk.recording),
         mb(disk.history),
         mb(disk.charts),

@@ -46,7 +46,7 @@ pub fn check_space(design: &Design, folder: &FitFolder) -> anyhow::Result<()> {
         design.path.display(),
         human_bytes(needed as Real),
         estimate.snapshots,
-        human_bytes((estimate.snapshot_stl + estimate.snapshot_obj) as Real),
+        human_bytes(estimate.snapshots_bytes() as Real),
         human_bytes(estimate.recording as Real),
         human_bytes(estimate.history as Real),
         human_bytes((estimate.charts + estimate.summary) as Real),
@@ -58,7 +58,7 @@ pub fn check_space(design: &Design, folder: &FitFolder) -> anyhow::Result<()> {
 
 /// The field that sizes the largest part of `estimate`, and what to do with it.
 fn largest_part(estimate: &DiskEstimate) -> (&'static str, &'static str) {
-    let snapshots = estimate.snapshot_stl + estimate.snapshot_obj;
+    let snapshots = estimate.snapshots_bytes();
     if snapshots >= estimate.recording && snapshots >= estimate.history {
         (
             "output.snapshots.every",

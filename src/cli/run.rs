@@ -1122,7 +1122,12 @@ fn finish(
         ),
     }
 
-    let charts = match outputs.charts.write(sim.model(), dir, Some(manifest)) {
+    let figures = outputs.snapshots.write_configuration_figures(sim.model());
+    let charts = match outputs
+        .charts
+        .write(sim.model(), dir, Some(manifest))
+        .and_then(|charts| figures.map(|figures| [charts, figures].concat()))
+    {
         Ok(files) => {
             state("charts/", true, format!("{} complete", files.len()));
             files

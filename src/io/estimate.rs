@@ -1,6 +1,6 @@
 //! What a run of a design will write to disk, estimated before it starts, part by part (DESIGN §7's run
-//! folder): the snapshots (binary STL and OBJ of the full device), `run.mcap`, `history.csv`, the charts and
-//! `summary.json`.
+//! folder): the snapshots (binary STL and OBJ of the full device, the field files for ParaView), `run.mcap`,
+//! `history.csv`, the charts (the configuration figures among them) and `summary.json`.
 //!
 //! Everything but the recording's compression is counted from what the writers write: the snapshot steps of
 //! [`crate::io::snapshots::SnapshotSchedule`] over [`Model::planned_steps`], the ring and point counts of
@@ -13,7 +13,7 @@
 //!
 //! | design | estimated | written | ratio |
 //! |---|---|---|---|
-//! | straight stent (1301 steps, 21 snapshots) | 307.3 MB (mcap 22.8 MB) | 293.6 MB (mcap 16.1 MB) | 1.05 (mcap 1.42) |
+//! | straight stent (1301 steps, 21 snapshots) | 314.2 MB (mcap 22.8 MB) | 300.6 MB (mcap 16.1 MB) | 1.05 (mcap 1.42) |
 //! | curved stent (4000 steps) | mcap 48.8 MB | mcap 34.1 MB (README) | mcap 1.43 |
 //! | 45° bend, h = 1e-3 (1000 steps) | 3.46 MB (mcap 0.49 MB) | 3.29 MB (mcap 0.45 MB) | 1.05 (mcap 1.09) |
 //! | 45° bend, h = 1e-5 (10⁵ steps) | 65.2 MB (mcap 41.9 MB) | 37.8 MB (mcap 19.3 MB) | 1.73 (mcap 2.17) |
@@ -26,6 +26,7 @@
 //! moving case, so it overestimates slow runs' recordings (up to about twice) and has not underestimated a
 //! measured one.
 
+use super::configurations::{CENTRELINE_SAMPLES, MAX_ROWS};
 use super::design::Design;
 use super::mcap::coordinate_decimals;
 use super::state::load_channels;
@@ -42,6 +43,8 @@ pub struct DiskEstimate {
     pub snapshot_stl: u64,
     /// The OBJ files of all snapshots [bytes].
     pub snapshot_obj: u64,
+    /// The field files of all snapshots and `run.pvd` [bytes] ([`crate::io::vtk`]).
+    pub snapshot_vtp: u64,
     /// `run.mcap` [bytes].
     pub recording: u64,
     /// `history.csv` [bytes].
@@ -53,14 +56,14 @@ pub struct DiskEstimate {
 }
 
 impl DiskEstimate {
+    /// The snapshots' files: STL, OBJ and the field files [bytes].
+    pub fn snapshots_bytes(&self) -> u64 {
+        self.snapshot_stl + self.snapshot_obj + self.snapshot_vtp
+    }
+
     /// Everything [bytes].
     pub fn total(&self) -> u64 {
-        self.snapshot_stl
-            + self.snapshot_obj
-            + self.recording
-            + self.history
-            + self.charts
-            + self.summary
+        self.snapshots_bytes() + self.recording + self.history + self.charts + self.summary
     }
 }
 
@@ -107,6 +110,15 @@ const CHART_FIXED_BYTES: Real = 30_000.0;
 /// Bytes per plotted point of a chart series: 8.2 measured (the bend's temperature chart at 10⁵ steps).
 const CHART_POINT_BYTES: Real = 10.0;
 
+/// Bytes of a field file besides its arrays: the XML of 18 arrays with their units (4.1 kB measured).
+const VTP_FIXED_BYTES: Real = 6_000.0;
+
+/// Bytes of a `run.pvd` line (about 100 measured).
+const PVD_LINE_BYTES: Real = 120.0;
+
+/// Bytes per point of a polyline in an SVG figure (`x,y ` with plotters' coordinates: 8–9 measured).
+const SVG_POINT_BYTES: Real = 10.0;
+
 /// Bytes of `summary.json` besides its list of snapshots: about 4 kB (the straight stent's), 8 kB charged
 /// for a failure report and warnings.
 const SUMMARY_FIXED_BYTES: Real = 8_000.0;
@@ -135,6 +147,11 @@ pub fn estimated_disk(design: &Design) -> DiskEstimate {
 
     // The recording: a state and the centrelines at every state, a mesh at every snapshot.
     let point_counts = device_sample_counts(model, recording.centreline_points);
+    let device_points: Real = device_sample_counts(model, CENTRELINE_SAMPLES)
+        .iter()
+        .enumerate()
+        .map(|(k, &n)| (patch_copies(model, k).len() * n) as Real)
+        .sum();
     let (mut unique, mut mirrored, mut lines) = (0.0, 0.0, 0.0);
     for (k, &points) in point_counts.iter().enumerate() {
         let copies = patch_copies(model, k).len() as Real;
@@ -159,15 +176,29 @@ pub fn estimated_disk(design: &Design) -> DiskEstimate {
         + RECORDING_FIXED_BYTES
         + design.source.len() as Real;
 
-    let history = (states + 1.0) * history_row_bytes(model);
+    // The field files: per collocation point three coordinates, 34 field values and a connectivity entry,
+    // 8 bytes each in base64 (4/3), plus the XML; run.pvd a line per snapshot.
+    let vtp = if snapshot.vtk {
+        let points: usize = model.patches.iter().map(|p| p.curve.num_points()).sum();
+        count * (VTP_FIXED_BYTES + points as Real * 38.0 * 8.0 * 4.0 / 3.0 + PVD_LINE_BYTES)
+    } else {
+        0.0
+    };
+
+    let history = (states + 1.0) * history_row_bytes(model, &design.output.strain_limits);
     let (charts, series) = chart_counts(model);
-    let chart_bytes = charts * CHART_FIXED_BYTES + states * series * CHART_POINT_BYTES;
+    // The configuration figures: up to MAX_ROWS rows and one figure per row, each panel the initial and the
+    // current centrelines of the full device in two views.
+    let figure_rows = (count - 1.0).clamp(0.0, MAX_ROWS as Real);
+    let figures = 2.0 * figure_rows * 2.0 * 2.0 * device_points * SVG_POINT_BYTES;
+    let chart_bytes = charts * CHART_FIXED_BYTES + states * series * CHART_POINT_BYTES + figures;
     let summary = SUMMARY_FIXED_BYTES + count * SUMMARY_SNAPSHOT_BYTES;
 
     DiskEstimate {
         snapshots,
         snapshot_stl: stl as u64,
         snapshot_obj: obj as u64,
+        snapshot_vtp: vtp as u64,
         recording: mcap as u64,
         history: history as u64,
         charts: chart_bytes as u64,
@@ -238,8 +269,17 @@ fn state_message_bytes(model: &Model) -> Real {
 
 /// Bytes of a `history.csv` row (io::history's formats at their longest): time (17), three displacements per
 /// probe (20 each), temperature (11), iterations (3), residual (10), cuts (3), the recovery ratios (18 each)
-/// and Δr (17) of a programme, the line end. 83 measured for the straight stent, 97 here.
-fn history_row_bytes(model: &Model) -> Real {
+/// and Δr (17) of a programme, the largest node displacement (16), the peak surface strain (16), its patch
+/// (the longest name) and arc length (16), one peak per material with a strain limit (16), the line end.
+fn history_row_bytes(model: &Model, strain_limits: &[Option<Real>]) -> Real {
+    let name = model
+        .patches
+        .iter()
+        .map(|p| p.name.len())
+        .max()
+        .unwrap_or(0) as Real;
+    let limits = strain_limits.iter().flatten().count() as Real;
+    let peaks = 16.0 + 17.0 + name + 1.0 + 17.0 + 17.0 * limits;
     let recovery = match &model.programme {
         Some(p) => {
             36.0 + if matches!(
@@ -253,7 +293,7 @@ fn history_row_bytes(model: &Model) -> Real {
         }
         None => 0.0,
     };
-    17.0 + 60.0 * model.probes.len() as Real + 11.0 + 3.0 + 11.0 + 3.0 + recovery + 1.0
+    17.0 + 60.0 * model.probes.len() as Real + 11.0 + 3.0 + 11.0 + 3.0 + recovery + peaks + 1.0
 }
 
 /// The charts a run draws and the number of series in them (io::run_charts): temperature (1), probe

@@ -5,6 +5,7 @@
 pub mod centreline;
 pub mod chart;
 pub mod checkpoint;
+pub mod configurations;
 pub mod design;
 pub mod estimate;
 pub mod history;

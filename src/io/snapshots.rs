@@ -8,6 +8,8 @@
 //! and add the type to [`FORMATS`]. Each snapshot then lists its file under the extension as key in
 //! summary.json, the run folder's manifest claims it, and `--resume` keeps or rewrites it with the others.
 
+use super::chart::ChartError;
+use super::configurations::{self, CENTRELINE_SAMPLES, Configuration};
 use super::design::SnapshotSettings;
 use super::mesh_format::{MeshFormat, SnapshotState};
 use super::run_folder::Manifest;
@@ -17,7 +19,10 @@ use crate::geometry::device_tubes::DeviceMeshError;
 use crate::geometry::mesh::TriangleMesh;
 use crate::math::Real;
 use crate::model::Model;
-use crate::post::device::{current_device_shapes, device_tube_mesh};
+use crate::post::device::{
+    current_device_shapes, decimated, device_centrelines, device_tube_mesh, reference_patch_shapes,
+    samples_per_point,
+};
 use crate::solver::{Observer, Simulation, StepReport};
 use std::ops::ControlFlow;
 use std::path::{Path, PathBuf};
@@ -161,6 +166,10 @@ pub struct SnapshotWriter {
     vtk: bool,
     /// Whether `run.pvd` is listed in the manifest yet.
     collection_claimed: bool,
+    /// The centrelines at every snapshot written by this process.
+    configurations: Vec<Configuration>,
+    /// The views of the configuration figures (`None`: the defaults).
+    views: Option<Vec<configurations::View>>,
 }
 
 impl SnapshotWriter {
@@ -192,6 +201,8 @@ impl SnapshotWriter {
             manifest: None,
             vtk: settings.vtk,
             collection_claimed: false,
+            configurations: Vec::new(),
+            views: settings.views.clone(),
         })
     }
 
@@ -296,7 +307,64 @@ impl SnapshotWriter {
         if self.vtk {
             self.write_collection()?;
         }
+        self.configurations.push(Configuration {
+            time,
+            temperature: model.temperature.value(time),
+            lines: device_centrelines(model, &current_device_shapes(sim, CENTRELINE_SAMPLES)),
+        });
         Ok(())
+    }
+
+    /// Draws the configuration figures ([`crate::io::configurations`]) of the snapshots written by this process
+    /// into `charts/`, each file listed in the manifest first; returns their paths relative to the run folder.
+    ///
+    /// # Errors
+    /// [`ChartError`] when the initial shape cannot be sampled, a figure drawn or a file written.
+    pub fn write_configuration_figures(&self, model: &Model) -> Result<Vec<PathBuf>, ChartError> {
+        let title = |message: String| ChartError::Drawing {
+            title: format!("{}: configurations", model.name),
+            message,
+        };
+        let shapes = reference_patch_shapes(model, samples_per_point(model, CENTRELINE_SAMPLES))
+            .map_err(|(k, e)| title(format!("patch `{}`: {e}", model.patches[k].name)))?;
+        let shapes: Vec<_> = shapes
+            .iter()
+            .map(|s| decimated(s, CENTRELINE_SAMPLES))
+            .collect();
+        let initial = Configuration {
+            time: 0.0,
+            temperature: model.temperature.value(0.0),
+            lines: device_centrelines(model, &shapes),
+        };
+        let rows = configurations::chosen(
+            &self.configurations,
+            &self.schedule.times,
+            self.schedule.snap,
+        );
+        if rows.is_empty() {
+            return Ok(Vec::new());
+        }
+        let views = self
+            .views
+            .clone()
+            .unwrap_or_else(|| configurations::default_views(&initial.lines));
+        let folder = self.run_dir.join(super::run_charts::RunCharts::FOLDER);
+        std::fs::create_dir_all(&folder).map_err(|source| ChartError::Io {
+            path: folder.clone(),
+            source,
+        })?;
+        configurations::write(
+            &folder,
+            Path::new(super::run_charts::RunCharts::FOLDER),
+            (&model.name, model.units.length()),
+            &initial,
+            &rows,
+            &views,
+            |path| match &self.manifest {
+                Some(manifest) => manifest.claim(path),
+                None => Ok(()),
+            },
+        )
     }
 
     /// Rewrites `run.pvd`, the ParaView collection of the field files written so far with their times.

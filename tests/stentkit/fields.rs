@@ -100,6 +100,24 @@ fn the_rolled_up_rod_strains_its_surface_by_r_kappa() {
     assert!(
         (peak["value"].as_f64().expect("value") - r * std::f64::consts::TAU / 10.0).abs() <= 1e-7
     );
+    // The configuration figures: the chosen times (up to six of the 21 snapshots, the last at t = 1), the
+    // initial shape in grey, each listed among the charts.
+    let figure = std::fs::read_to_string(dir.join("charts/configurations.svg")).expect("figure");
+    assert!(
+        figure.contains("t = 1.0000 s") && figure.contains("x1-x2"),
+        "captions"
+    );
+    let charts: Vec<&str> = summary["files"]["charts"]
+        .as_array()
+        .expect("charts")
+        .iter()
+        .filter_map(|c| c.as_str())
+        .collect();
+    assert!(charts.contains(&"charts/configurations.svg"), "{charts:?}");
+    assert!(
+        charts.contains(&"charts/configuration_t1.0000.svg"),
+        "{charts:?}"
+    );
     // Every snapshot has its field file, listed with its time in run.pvd.
     let collection = std::fs::read_to_string(dir.join("run.pvd")).expect("run.pvd");
     for snapshot in summary["snapshots"].as_array().expect("snapshots") {

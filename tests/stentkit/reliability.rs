@@ -726,9 +726,9 @@ fn the_disk_estimate_bounds_a_run_folder_from_above() {
         .expect("snapshots")
         .count();
     assert_eq!(
-        2 * estimate.snapshots,
+        3 * estimate.snapshots,
         snapshots,
-        "an STL and an OBJ per snapshot"
+        "an STL, an OBJ and a field file per snapshot"
     );
 }
 
@@ -766,7 +766,11 @@ fn two_rings_per_patch_draw_a_rolled_up_beam() {
     let snapshots = std::fs::read_dir(dir.join("run/snapshots"))
         .expect("snapshots")
         .count();
-    assert_eq!(snapshots, 2 * 21, "an STL and an OBJ at steps 0 to 20");
+    assert_eq!(
+        snapshots,
+        3 * 21,
+        "an STL, an OBJ and a field file at steps 0 to 20"
+    );
 }
 
 #[test]

@@ -434,6 +434,28 @@ fn output_settings(dto: &DesignDto, time: &TimeSettings) -> Result<super::Output
             "output.snapshots.rings",
         )?,
         vtk: output.and_then(|o| o.vtk).unwrap_or(true),
+        views: match output
+            .and_then(|o| o.configurations.as_ref())
+            .and_then(|c| c.views.as_ref())
+        {
+            None => None,
+            Some(views) => Some(
+                views
+                    .iter()
+                    .enumerate()
+                    .map(|(k, v)| {
+                        crate::io::configurations::View::parse(v).ok_or_else(|| {
+                            issue(
+                                format!("output.configurations.views[{k}]"),
+                                format!(
+                                    "`{v}` is not a view; allowed: axonometric, x1-x2, x1-x3, x2-x3"
+                                ),
+                            )
+                        })
+                    })
+                    .collect::<Result<Vec<_>>>()?,
+            ),
+        },
     };
     let recording = output.and_then(|o| o.recording.as_ref());
     let recording_settings = RecordingSettings {

@@ -658,6 +658,19 @@ pub struct OutputDto {
     /// with their times); default true.
     #[serde(default)]
     pub vtk: Option<bool>,
+    /// The configuration figures (`charts/configurations.svg`).
+    #[serde(default)]
+    pub configurations: Option<ConfigurationsDto>,
+}
+
+/// The configuration figures: which views.
+#[derive(Debug, Clone, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct ConfigurationsDto {
+    /// Panels per time: `axonometric`, `x1-x2`, `x1-x3`, `x2-x3` (default: axonometric and the plane of the
+    /// initial shape's two largest extents).
+    #[serde(default)]
+    pub views: Option<Vec<String>>,
 }
 
 /// Snapshots: the initial and final shapes always, plus every `every` steps and at the given times.

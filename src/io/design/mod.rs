@@ -46,6 +46,9 @@ pub struct SnapshotSettings {
     /// With every snapshot, the fields along the rods for ParaView (`output.vtk`, default true;
     /// [`crate::io::vtk`]).
     pub vtk: bool,
+    /// The views of the configuration figures (`output.configurations.views`); `None`: the defaults
+    /// ([`crate::io::configurations::default_views`]).
+    pub views: Option<Vec<crate::io::configurations::View>>,
 }
 
 impl SnapshotSettings {
