@@ -97,31 +97,13 @@ fn binary_block(bytes: &[u8]) -> String {
     base64::engine::general_purpose::STANDARD.encode(raw)
 }
 
+/// [`binary_block`] of `values`, each as its little-endian bytes (`to_le`: `f64::to_le_bytes`, …).
+fn le_block<T: Copy, const N: usize>(values: &[T], to_le: fn(T) -> [u8; N]) -> String {
+    binary_block(&values.iter().flat_map(|&v| to_le(v)).collect::<Vec<u8>>())
+}
+
 fn f64_block(values: &[Real]) -> String {
-    binary_block(
-        &values
-            .iter()
-            .flat_map(|v| v.to_le_bytes())
-            .collect::<Vec<u8>>(),
-    )
-}
-
-fn i64_block(values: &[i64]) -> String {
-    binary_block(
-        &values
-            .iter()
-            .flat_map(|v| v.to_le_bytes())
-            .collect::<Vec<u8>>(),
-    )
-}
-
-fn i32_block(values: &[i32]) -> String {
-    binary_block(
-        &values
-            .iter()
-            .flat_map(|v| v.to_le_bytes())
-            .collect::<Vec<u8>>(),
-    )
+    le_block(values, f64::to_le_bytes)
 }
 
 /// Escapes the five XML special characters of an attribute or text value.
@@ -186,7 +168,7 @@ pub fn polydata(
             x,
             "      <DataArray type=\"Int64\" Name=\"probe_point\" NumberOfTuples=\"{}\" format=\"binary\">\n        {}\n      </DataArray>",
             probes.len(),
-            i64_block(&probes)
+            le_block(&probes, i64::to_le_bytes)
         );
     }
     let _ = writeln!(x, "    </FieldData>");
@@ -225,7 +207,7 @@ pub fn polydata(
         let _ = writeln!(
             x,
             "        <DataArray type=\"Int32\" Name=\"{name}\" format=\"binary\">\n          {}\n        </DataArray>",
-            i32_block(values)
+            le_block(values, i32::to_le_bytes)
         );
     }
     let _ = writeln!(x, "      </CellData>");
@@ -238,8 +220,8 @@ pub fn polydata(
     let _ = writeln!(
         x,
         "      <Lines>\n        <DataArray type=\"Int64\" Name=\"connectivity\" format=\"binary\">\n          {}\n        </DataArray>\n        <DataArray type=\"Int64\" Name=\"offsets\" format=\"binary\">\n          {}\n        </DataArray>\n      </Lines>",
-        i64_block(&connectivity),
-        i64_block(&offsets)
+        le_block(&connectivity, i64::to_le_bytes),
+        le_block(&offsets, i64::to_le_bytes)
     );
     let _ = writeln!(x, "    </Piece>");
     let _ = writeln!(x, "  </PolyData>");

@@ -228,7 +228,7 @@ impl Simulation<'_> {
                 let radius = 0.5 * model.sections[model.patches[point.patch].section].diameter();
                 PointFields {
                     patch: point.patch,
-                    arc_length: self.arc_length[g],
+                    arc_length: self.arc_lengths()[g],
                     position,
                     displacement: position - point_position(disc, &disc.control0, g),
                     rotation: log(&Rot3::from_matrix_unchecked(
@@ -317,14 +317,22 @@ impl Simulation<'_> {
         Some(PeakSurfaceStrain {
             value,
             patch: disc.points[g].patch,
-            arc_length: self.arc_length[g],
+            arc_length: self.arc_lengths()[g],
         })
+    }
+}
+
+impl Simulation<'_> {
+    /// The reference arc length of every collocation point from its patch's start ([`arc_lengths`], once).
+    fn arc_lengths(&self) -> &[Real] {
+        self.arc_length
+            .get_or_init(|| arc_lengths(self.model, &self.disc))
     }
 }
 
 /// The reference arc length of every collocation point from its patch's start (Gauss–Legendre between
 /// successive points, [`ARC_LENGTH_PARTS`] parts each), computed once per simulation.
-pub(super) fn arc_lengths(
+fn arc_lengths(
     model: &crate::model::Model,
     disc: &crate::solver::discretisation::Discretisation,
 ) -> Vec<Real> {

@@ -136,8 +136,9 @@ pub struct Simulation<'m> {
     tangent: checkpoint::TangentRecord,
     /// The memory of error-controlled stepping ([`adaptive`]).
     control: adaptive::StepControl,
-    /// Reference arc length of every collocation point from its patch's start, for the fields ([`fields`]).
-    arc_length: Vec<Real>,
+    /// Reference arc length of every collocation point from its patch's start, for the fields ([`fields`]):
+    /// computed at the first use (a run without field outputs never needs it).
+    arc_length: std::sync::OnceLock<Vec<Real>>,
 }
 
 impl<'m> Simulation<'m> {
@@ -209,7 +210,6 @@ impl<'m> Simulation<'m> {
             })
             .collect();
         let n = disc.num_unknowns();
-        let arc_length = fields::arc_lengths(model, &disc);
         Ok(Self {
             model,
             disc,
@@ -236,7 +236,7 @@ impl<'m> Simulation<'m> {
             step_cuts: 0,
             tangent: checkpoint::TangentRecord::default(),
             control: adaptive::StepControl::default(),
-            arc_length,
+            arc_length: std::sync::OnceLock::new(),
         })
     }
 }
