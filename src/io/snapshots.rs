@@ -1,7 +1,10 @@
 //! Snapshots of a run: the full device as closed tubes swept along the deformed centrelines with the solver's
 //! section frames, written in every registered [`MeshFormat`] — binary STL and OBJ (`snapshots/step_NNNNN.stl`,
 //! `.obj`) — at the initial state, at the final one, every `every` steps and at the requested times (time
-//! stepping lands on those: they are the model's record times).
+//! stepping lands on those: they are the model's record times). With each snapshot, unless the design turns
+//! them off, the fields along the rods for ParaView (`snapshots/step_NNNNN.vtp`, [`super::vtk`], listed with
+//! their times in `run.pvd`); and the full device's centrelines are kept for the configuration figures drawn at
+//! the end ([`super::configurations`]).
 //!
 //! **A new snapshot file format is a new module plus one registration line**: write `io/<format>.rs` with a
 //! type implementing [`MeshFormat`] (in [`super::mesh_format`]: its extension and how it writes a mesh), declare the module in `io/mod.rs`,
