@@ -92,9 +92,8 @@ pub struct PeakSurfaceStrain {
 
 /// Peak surface strain of a section of radius `r` (module docs): the largest `λ − 1` around the circle (the
 /// most stretched fibre; negative only where every fibre is shortened), with `gamma`, `kappa` the current and
-/// `gamma0`, `kappa0` the reference strains. Sampled every 30° ([`SURFACE_SAMPLES`]) and refined by successive
-/// parabolic interpolation:
-/// `λ` is a ratio of square roots of trigonometric polynomials of degree 2, smooth in the angle, so a handful of
+/// `gamma0`, `kappa0` the reference strains. Sampled every 30° and refined by successive parabolic
+/// interpolation: `λ` is a ratio of square roots of trigonometric polynomials of degree 2, smooth in the angle, so a handful of
 /// vertices reach the peak (tests: closed forms and a dense sampling).
 pub fn peak_surface_strain(gamma: Vec3, kappa: Vec3, gamma0: Vec3, kappa0: Vec3, r: Real) -> Real {
     SectionStretch::new(gamma, kappa, gamma0, kappa0, r).peak()
