@@ -43,8 +43,7 @@ use crate::io::run_charts::RunCharts;
 use crate::io::run_folder::{self, Manifest, RunFolder, RunFolderError};
 use crate::io::snapshots::SnapshotWriter;
 use crate::io::summary::{
-    FailureReport, FinalState, OutputState, PeakSurfaceStrainSummary, RunStatus, RunSummaryFile,
-    peak_memory_mib,
+    FailureReport, FinalState, OutputState, RunStatus, RunSummaryFile, peak_memory_mib,
 };
 use crate::math::{Real, Short};
 use crate::solver::simulation::model_fingerprint;
@@ -235,17 +234,7 @@ impl Outputs {
             .last()
             .map(|x| FinalState::of(sim.model(), x));
         s.notices = sim.notices().to_vec();
-        s.peak_surface_strain =
-            self.history
-                .peak_surface_strain()
-                .map(
-                    |(time, value, patch, arc_length)| PeakSurfaceStrainSummary {
-                        value: *value,
-                        time: *time,
-                        patch: patch.clone(),
-                        arc_length: *arc_length,
-                    },
-                );
+        s.peak_surface_strain = self.history.peak_surface_strain().cloned();
         s.strain_limit_warnings.clone_from(&self.strain_warnings);
         s.timing.solver = sim.timing().entries().into_iter().collect();
         s.timing.recording = Self::RECORDING

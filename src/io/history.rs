@@ -39,10 +39,23 @@ fn limited_materials(strain_limits: &[Option<f64>]) -> Vec<(usize, f64)> {
         .collect()
 }
 
-/// The row of `history.csv` (its text) where the device's surface strain peaks over the run: `(time, strain,
-/// patch, arc length)`; `None` without such a column or rows. Read back from the file, so that a resumed run's
-/// summary covers the steps before its checkpoint too.
-pub fn run_peak_surface_strain(text: &str) -> Option<(f64, f64, String, f64)> {
+/// Where the surface strain peaked over a run (`summary.json` `peak_surface_strain`).
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+pub struct SurfaceStrainPeak {
+    /// The strain (positive: stretched) \[-\].
+    pub value: f64,
+    /// When \[s\].
+    pub time: f64,
+    /// The patch's name.
+    pub patch: String,
+    /// Reference arc length from the patch's start \[length\].
+    pub arc_length: f64,
+}
+
+/// The row of `history.csv` (its text) where the device's surface strain peaks over the run; `None` without
+/// such a column or rows. Read back from the file, so that a resumed run's summary covers the steps before its
+/// checkpoint too.
+pub fn run_peak_surface_strain(text: &str) -> Option<SurfaceStrainPeak> {
     let mut lines = text.lines();
     let header: Vec<&str> = lines.next()?.split(',').collect();
     let column = |name: &str| header.iter().position(|h| *h == name);
@@ -55,20 +68,17 @@ pub fn run_peak_surface_strain(text: &str) -> Option<(f64, f64, String, f64)> {
         .filter_map(|l| {
             let fields: Vec<&str> = l.split(',').collect();
             let number = |k: usize| fields.get(k)?.parse::<f64>().ok();
-            Some((
-                number(0)?,
-                number(value)?,
-                fields.get(patch)?.to_string(),
-                number(s)?,
-            ))
+            Some(SurfaceStrainPeak {
+                value: number(value)?,
+                time: number(0)?,
+                patch: fields.get(patch)?.to_string(),
+                arc_length: number(s)?,
+            })
         })
-        .fold(
-            None,
-            |best: Option<(f64, f64, String, f64)>, row| match &best {
-                Some(b) if b.1 >= row.1 => best,
-                _ => Some(row),
-            },
-        )
+        .fold(None, |best: Option<SurfaceStrainPeak>, row| match best {
+            Some(b) if b.value >= row.value => Some(b),
+            _ => Some(row),
+        })
 }
 
 /// How far `history.csv` was written: what a checkpoint records and a resumed run continues from.
@@ -90,8 +100,8 @@ pub struct HistoryWriter {
     exceeded: Vec<bool>,
     /// Warnings not yet taken by the caller ([`HistoryWriter::take_warnings`]).
     warnings: Vec<String>,
-    /// The row where the surface strain peaked so far ([`run_peak_surface_strain`]'s tuple).
-    peak: Option<(f64, f64, String, f64)>,
+    /// The row where the surface strain peaked so far.
+    peak: Option<SurfaceStrainPeak>,
     path: PathBuf,
     /// `None` once a write failed.
     out: Option<BufWriter<File>>,
@@ -230,8 +240,8 @@ impl HistoryWriter {
         &self.path
     }
 
-    /// Where the surface strain peaked over the rows written: `(time, strain, patch, arc length)`.
-    pub fn peak_surface_strain(&self) -> Option<&(f64, f64, String, f64)> {
+    /// Where the surface strain peaked over the rows written.
+    pub fn peak_surface_strain(&self) -> Option<&SurfaceStrainPeak> {
         self.peak.as_ref()
     }
 
@@ -293,8 +303,13 @@ impl HistoryWriter {
                     ",{:.9e},{patch},{:.9e}",
                     peak.value, peak.arc_length
                 ));
-                if self.peak.as_ref().is_none_or(|p| peak.value > p.1) {
-                    self.peak = Some((t, peak.value, patch.clone(), peak.arc_length));
+                if self.peak.as_ref().is_none_or(|p| peak.value > p.value) {
+                    self.peak = Some(SurfaceStrainPeak {
+                        value: peak.value,
+                        time: t,
+                        patch: patch.clone(),
+                        arc_length: peak.arc_length,
+                    });
                 }
             }
             None => line.push_str(",,,"),

@@ -343,23 +343,10 @@ pub struct RunSummaryFile {
     pub notices: Vec<String>,
     /// Where the wire's surface strain peaked over the run (`history.csv`'s `surface_strain_peak`).
     #[serde(skip_serializing_if = "Option::is_none")]
-    pub peak_surface_strain: Option<PeakSurfaceStrainSummary>,
+    pub peak_surface_strain: Option<super::history::SurfaceStrainPeak>,
     /// Materials whose `strain_limit` the surface strain exceeded, as `run` said (each once).
     #[serde(skip_serializing_if = "Vec::is_empty")]
     pub strain_limit_warnings: Vec<String>,
-}
-
-/// Where the surface strain peaked over a run (`summary.json` `peak_surface_strain`).
-#[derive(Debug, Clone, PartialEq, Serialize)]
-pub struct PeakSurfaceStrainSummary {
-    /// The strain (positive: stretched) \[-\].
-    pub value: Real,
-    /// When \[s\].
-    pub time: Real,
-    /// The patch's name.
-    pub patch: String,
-    /// Reference arc length from the patch's start \[length\].
-    pub arc_length: Real,
 }
 
 /// What error-controlled stepping did (`summary.json` `time_error_control`).

@@ -766,16 +766,34 @@ const LENGTH_PARTS_PER_SPAN: usize = 8;
 /// only for residual scales).
 fn curve_length(curve: &crate::math::NurbsCurve) -> Real {
     let breaks = curve.knots().breakpoints();
-    let parts = LENGTH_PARTS_PER_SPAN as Real;
-    let mut total = 0.0;
-    for w in breaks.windows(2) {
-        for k in 0..LENGTH_PARTS_PER_SPAN {
-            let a = w[0] + (w[1] - w[0]) * k as Real / parts;
-            let b = w[0] + (w[1] - w[0]) * (k + 1) as Real / parts;
-            total += crate::geometry::analytic::gauss_legendre_5(a, b, |u| {
-                curve.derivatives(u, 1)[1].norm()
-            });
-        }
-    }
-    total
+    breaks
+        .windows(2)
+        .flat_map(|w| arc_length_parts(curve, w[0], w[1], LENGTH_PARTS_PER_SPAN))
+        .sum()
+}
+
+/// Arc length of `curve` from parameter `a` to `b`: 5-point Gauss–Legendre of the speed `|c'(u)|` on `parts`
+/// equal parts (exact to round-off where the speed is smooth and the parts short).
+pub(crate) fn arc_length_between(
+    curve: &crate::math::NurbsCurve,
+    a: Real,
+    b: Real,
+    parts: usize,
+) -> Real {
+    arc_length_parts(curve, a, b, parts).sum()
+}
+
+/// The arc lengths of `curve` over `parts` equal parts of `[a, b]`, in order ([`arc_length_between`]).
+fn arc_length_parts(
+    curve: &crate::math::NurbsCurve,
+    a: Real,
+    b: Real,
+    parts: usize,
+) -> impl Iterator<Item = Real> + '_ {
+    let n = parts as Real;
+    (0..parts).map(move |k| {
+        let lo = a + (b - a) * k as Real / n;
+        let hi = a + (b - a) * (k + 1) as Real / n;
+        crate::geometry::analytic::gauss_legendre_5(lo, hi, |u| curve.derivatives(u, 1)[1].norm())
+    })
 }

@@ -3,7 +3,7 @@
 //! or, when the design says so, does not write. CI reads the field files with VTK's own reader
 //! (`scripts/check_outputs.py`).
 
-use crate::outputs::{stentkit, test_outputs};
+use crate::outputs::{run_ok, test_outputs};
 use std::path::Path;
 
 fn design(name: &str) -> std::path::PathBuf {
@@ -38,19 +38,10 @@ fn columns(dir: &Path, names: &[&str]) -> Vec<Vec<String>> {
 #[test]
 fn the_rolled_up_rod_strains_its_surface_by_r_kappa() {
     let dir = test_outputs("fields_rollup");
-    let out = stentkit(&[
-        "run",
-        design("rollup.yaml").to_str().expect("utf-8"),
-        "-o",
-        dir.to_str().expect("utf-8"),
-        "--quiet",
-        "--set",
-        "material.strain_limit=0.3",
-    ]);
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
+    let out = run_ok(
+        &design("rollup.yaml"),
+        &dir,
+        &["--quiet", "--set", "material.strain_limit=0.3"],
     );
     let r = 0.5 * (4.0 / std::f64::consts::PI).sqrt();
     let rows = columns(
@@ -131,19 +122,10 @@ fn the_rolled_up_rod_strains_its_surface_by_r_kappa() {
 #[test]
 fn a_design_can_turn_the_field_files_off() {
     let dir = test_outputs("fields_off");
-    let out = stentkit(&[
-        "run",
-        design("bend45.yaml").to_str().expect("utf-8"),
-        "-o",
-        dir.to_str().expect("utf-8"),
-        "--quiet",
-        "--set",
-        "output.vtk=false",
-    ]);
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
+    run_ok(
+        &design("bend45.yaml"),
+        &dir,
+        &["--quiet", "--set", "output.vtk=false"],
     );
     assert!(!dir.join("run.pvd").exists());
     let vtp = std::fs::read_dir(dir.join("snapshots"))

@@ -54,7 +54,7 @@ pub(crate) fn design(name: &str) -> PathBuf {
 }
 
 /// Runs `stentkit run DESIGN -o DIR` (plus `extra`) and asserts success.
-fn run_ok(design: &Path, dir: &Path, extra: &[&str]) -> Output {
+pub(crate) fn run_ok(design: &Path, dir: &Path, extra: &[&str]) -> Output {
     let mut args = vec!["run", path_str(design), "-o", path_str(dir)];
     args.extend_from_slice(extra);
     let out = stentkit(&args);

@@ -17,12 +17,11 @@
 //! 0.13 on the paper's stents) the reference length `|Γ0 + K0 × Y|` matters at that order and is kept.
 
 use super::Simulation;
-use crate::geometry::analytic::gauss_legendre_5;
 use crate::material::ConstitutiveLaw;
 use crate::math::so3::log;
 use crate::math::{Real, Rot3, Vec3};
 use crate::model::ProbeLocation;
-use crate::solver::assembly::{point_position, point_strains};
+use crate::solver::assembly::{arc_length_between, point_position, point_strains};
 use rayon::prelude::*;
 
 /// Angles sampled around the section before the peak is refined (every 30°).
@@ -209,7 +208,7 @@ impl Simulation<'_> {
             .map(|g| {
                 let point = &disc.points[g];
                 let position = point_position(disc, &state.control, g);
-                let strain = point_strains(disc, state, g);
+                let (strain, stretch) = self.stretch_at(g);
                 let stress = self.materials.laws[g].stress(&strain);
                 let rotation = state.rotation[g];
                 let temperature = match &model.temperature_field {
@@ -224,7 +223,6 @@ impl Simulation<'_> {
                     .viscous_strains(&model.materials, g)
                     .unwrap_or_default();
                 let wlf = model.materials[model.patches[point.patch].material].temperature_shift();
-                let radius = 0.5 * model.sections[model.patches[point.patch].section].diameter();
                 PointFields {
                     patch: point.patch,
                     arc_length: self.arc_lengths()[g],
@@ -245,13 +243,7 @@ impl Simulation<'_> {
                     log10_shift: wlf
                         .and_then(|w| w.log10_shift(temperature))
                         .unwrap_or(Real::NAN),
-                    surface_strain: peak_surface_strain(
-                        point.gamma0 + strain.force,
-                        state.kappa[g],
-                        point.gamma0,
-                        point.kappa0,
-                        radius,
-                    ),
+                    surface_strain: stretch.peak(),
                 }
             })
             .collect()
@@ -279,21 +271,12 @@ impl Simulation<'_> {
     /// [`Simulation::peak_surface_strain`] over the rods of one material (an index into
     /// [`crate::model::Model::materials`]), or of all with `None`; `None` when there are no such points.
     pub fn peak_surface_strain_of(&self, material: Option<usize>) -> Option<PeakSurfaceStrain> {
-        let (model, disc, state) = (self.model, &self.disc, &self.state);
+        let (model, disc) = (self.model, &self.disc);
         let mut candidates: Vec<(usize, SectionStretch, Real)> = (0..disc.points.len())
             .into_par_iter()
             .filter(|&g| material.is_none_or(|m| model.patches[disc.points[g].patch].material == m))
             .map(|g| {
-                let point = &disc.points[g];
-                let strain = point_strains(disc, state, g);
-                let radius = 0.5 * model.sections[model.patches[point.patch].section].diameter();
-                let stretch = SectionStretch::new(
-                    point.gamma0 + strain.force,
-                    state.kappa[g],
-                    point.gamma0,
-                    point.kappa0,
-                    radius,
-                );
+                let stretch = self.stretch_at(g).1;
                 (g, stretch, stretch.bound())
             })
             .collect();
@@ -322,6 +305,23 @@ impl Simulation<'_> {
 }
 
 impl Simulation<'_> {
+    /// The strains of collocation point `g` and its section's fibre stretches around the circle of its
+    /// section's radius (half the wire's diameter, or of the drawing diameter of a section given by properties).
+    fn stretch_at(&self, g: usize) -> (crate::material::SectionStrains, SectionStretch) {
+        let (model, disc, state) = (self.model, &self.disc, &self.state);
+        let point = &disc.points[g];
+        let strain = point_strains(disc, state, g);
+        let radius = 0.5 * model.sections[model.patches[point.patch].section].diameter();
+        let stretch = SectionStretch::new(
+            point.gamma0 + strain.force,
+            state.kappa[g],
+            point.gamma0,
+            point.kappa0,
+            radius,
+        );
+        (strain, stretch)
+    }
+
     /// The reference arc length of every collocation point from its patch's start ([`arc_lengths`], once).
     fn arc_lengths(&self) -> &[Real] {
         self.arc_length
@@ -337,19 +337,9 @@ fn arc_lengths(
 ) -> Vec<Real> {
     let mut out = vec![0.0; disc.points.len()];
     for (range, patch) in disc.patches.iter().zip(&model.patches) {
-        let speed = |u: Real| patch.curve.derivatives(u, 1)[1].norm();
-        for j in 1..range.n {
-            let g = range.offset + j;
+        for g in range.offset + 1..range.offset + range.n {
             let (a, b) = (disc.points[g - 1].u, disc.points[g].u);
-            let parts = ARC_LENGTH_PARTS as Real;
-            let length: Real = (0..ARC_LENGTH_PARTS)
-                .map(|k| {
-                    let lo = a + (b - a) * k as Real / parts;
-                    let hi = a + (b - a) * (k + 1) as Real / parts;
-                    gauss_legendre_5(lo, hi, speed)
-                })
-                .sum();
-            out[g] = out[g - 1] + length;
+            out[g] = out[g - 1] + arc_length_between(&patch.curve, a, b, ARC_LENGTH_PARTS);
         }
     }
     out
