@@ -5,6 +5,7 @@
 pub mod check;
 pub mod disk;
 pub mod mesh;
+pub mod render;
 pub mod repair;
 pub mod run;
 pub mod signals;
@@ -157,6 +158,26 @@ pub enum Command {
     ///
     /// Example: stentkit schema > stentkit.schema.json
     Schema,
+    /// Draw a finished run's snapshots as a shaded picture (PNG): the initial shape, then the device at each
+    /// chosen time over it in light grey (software rasteriser, no GPU).
+    ///
+    /// Example: stentkit render runs/straight_stent --times 1.75 3.25 -o straight.png
+    Render {
+        /// The run folder.
+        run_dir: PathBuf,
+        /// Output file (`.png`).
+        #[arg(short, long)]
+        output: PathBuf,
+        /// Times to draw, each the nearest snapshot's (default: those of the configuration figures).
+        #[arg(long, num_args = 1..)]
+        times: Vec<f64>,
+        /// View: `axonometric`, `x1-x2`, `x1-x3` or `x2-x3`.
+        #[arg(long, default_value = "axonometric")]
+        view: String,
+        /// Width of each panel in pixels.
+        #[arg(long, default_value_t = crate::io::render::PANEL_WIDTH)]
+        width: u32,
+    },
     /// Write the reference (permanent) shape as a closed tube surface: binary STL or OBJ by extension.
     ///
     /// Example: stentkit mesh designs/circular_arch.yaml -o arch.stl
@@ -504,6 +525,13 @@ pub fn main() -> ExitCode {
         Command::Study(StudyCommand::Stability { output, maps }) => {
             study::stability_maps(&output, &maps)
         }
+        Command::Render {
+            run_dir,
+            output,
+            times,
+            view,
+            width,
+        } => render::run(&run_dir, &output, &times, &view, width),
         Command::Mesh {
             design,
             output,

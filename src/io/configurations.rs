@@ -71,8 +71,9 @@ impl View {
         }
     }
 
-    /// The point's place on the panel (horizontal, vertical).
-    fn project(self, x: &Vec3) -> (Real, Real) {
+    /// The panel's horizontal and vertical directions and the direction toward the viewer (right-handed,
+    /// unit vectors).
+    pub fn axes(self) -> [Vec3; 3] {
         match self {
             View::Axonometric => {
                 let (azimuth, elevation) = (-55f64.to_radians(), 25f64.to_radians());
@@ -82,11 +83,19 @@ impl View {
                     elevation.cos() * azimuth.sin(),
                     elevation.sin(),
                 );
-                let up = toward.cross(&right);
-                (x.dot(&right), x.dot(&up))
+                [right, toward.cross(&right), toward]
             }
-            View::Plane(a, b) => (x[a], x[b]),
+            View::Plane(a, b) => {
+                let (right, up) = (Vec3::ith(a, 1.0), Vec3::ith(b, 1.0));
+                [right, up, right.cross(&up)]
+            }
         }
+    }
+
+    /// The point's place on the panel (horizontal, vertical).
+    pub fn project(self, x: &Vec3) -> (Real, Real) {
+        let [right, up, _] = self.axes();
+        (x.dot(&right), x.dot(&up))
     }
 }
 
@@ -122,11 +131,20 @@ pub fn chosen<'a>(
     requested: &[Real],
     snap: Real,
 ) -> Vec<&'a Configuration> {
-    let later = states.get(1..).unwrap_or_default();
+    let times: Vec<Real> = states.iter().map(|s| s.time).collect();
+    chosen_indices(&times, requested, snap)
+        .into_iter()
+        .map(|k| &states[k])
+        .collect()
+}
+
+/// The indices into `times` (the states' times, the first the initial state) of the states [`chosen`] shows.
+pub fn chosen_indices(times: &[Real], requested: &[Real], snap: Real) -> Vec<usize> {
+    let later = 1..times.len().max(1);
     if !requested.is_empty() {
-        let picked: Vec<&Configuration> = later
-            .iter()
-            .filter(|s| requested.iter().any(|t| (s.time - t).abs() <= snap))
+        let picked: Vec<usize> = later
+            .clone()
+            .filter(|&k| requested.iter().any(|t| (times[k] - t).abs() <= snap))
             .collect();
         if !picked.is_empty() {
             return picked;
@@ -134,11 +152,9 @@ pub fn chosen<'a>(
     }
     let n = later.len();
     if n <= MAX_ROWS {
-        return later.iter().collect();
+        return later.collect();
     }
-    (1..=MAX_ROWS)
-        .map(|k| &later[(k * n).div_ceil(MAX_ROWS) - 1])
-        .collect()
+    (1..=MAX_ROWS).map(|k| (k * n).div_ceil(MAX_ROWS)).collect()
 }
 
 /// Light grey of the initial shape.

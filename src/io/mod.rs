@@ -13,6 +13,7 @@ pub mod mcap;
 pub mod mcap_salvage;
 pub mod mesh_format;
 pub mod obj;
+pub mod render;
 pub mod run_charts;
 pub mod run_folder;
 pub mod snapshots;

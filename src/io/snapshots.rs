@@ -17,7 +17,7 @@ use super::design::SnapshotSettings;
 use super::mesh_format::{MeshFormat, SnapshotState};
 use super::run_folder::Manifest;
 use super::stl::MeshIoError;
-use super::{obj, stl, vtk};
+use super::{obj, render, stl, vtk};
 use crate::geometry::device_tubes::DeviceMeshError;
 use crate::geometry::mesh::TriangleMesh;
 use crate::math::Real;
@@ -173,6 +173,8 @@ pub struct SnapshotWriter {
     configurations: Vec<Configuration>,
     /// The views of the configuration figures (`None`: the defaults).
     views: Option<Vec<configurations::View>>,
+    /// Whether the configuration figures' states are also rendered (`charts/configurations.png`).
+    render: bool,
 }
 
 impl SnapshotWriter {
@@ -206,6 +208,7 @@ impl SnapshotWriter {
             collection_claimed: false,
             configurations: Vec::new(),
             views: settings.views.clone(),
+            render: settings.render,
         })
     }
 
@@ -339,35 +342,63 @@ impl SnapshotWriter {
             temperature: model.temperature.value(0.0),
             lines: device_centrelines(model, &shapes),
         };
-        let rows = configurations::chosen(
-            &self.configurations,
-            &self.schedule.times,
-            self.schedule.snap,
-        );
-        if rows.is_empty() {
+        let times: Vec<Real> = self.configurations.iter().map(|c| c.time).collect();
+        let picked =
+            configurations::chosen_indices(&times, &self.schedule.times, self.schedule.snap);
+        if picked.is_empty() {
             return Ok(Vec::new());
         }
+        let rows: Vec<&Configuration> = picked.iter().map(|&k| &self.configurations[k]).collect();
         let views = self
             .views
             .clone()
             .unwrap_or_else(|| configurations::default_views(&initial.lines));
-        let folder = self.run_dir.join(super::run_charts::RunCharts::FOLDER);
+        let charts = Path::new(super::run_charts::RunCharts::FOLDER);
+        let folder = self.run_dir.join(charts);
         std::fs::create_dir_all(&folder).map_err(|source| ChartError::Io {
             path: folder.clone(),
             source,
         })?;
-        configurations::write(
+        let claim = |path: &Path| match &self.manifest {
+            Some(manifest) => manifest.claim(path),
+            None => Ok(()),
+        };
+        let mut files = configurations::write(
             &folder,
-            Path::new(super::run_charts::RunCharts::FOLDER),
+            charts,
             (&model.name, model.units.length()),
             &initial,
             &rows,
             &views,
-            |path| match &self.manifest {
-                Some(manifest) => manifest.claim(path),
-                None => Ok(()),
-            },
-        )
+            claim,
+        )?;
+        if self.render {
+            // The snapshots of this process are the last of those written (a resumed run lists earlier ones).
+            let first = self.written.len() - self.configurations.len();
+            let stl = |k: usize| {
+                let files = &self.written[first + k].files;
+                let stl = files
+                    .iter()
+                    .find(|f| f.extension().is_some_and(|e| e == "stl"));
+                self.run_dir.join(stl.unwrap_or(&files[0]))
+            };
+            let states: Vec<PathBuf> = picked.iter().map(|&k| stl(k)).collect();
+            let lumen = self.run_dir.join(Self::FOLDER).join(VESSEL_FILE);
+            let path = charts.join("configurations.png");
+            claim(&path).map_err(|e| title(e.to_string()))?;
+            let pixmap = render::render_snapshots(
+                &stl(0),
+                &states,
+                lumen.exists().then_some(lumen.as_path()),
+                views[0],
+                render::PANEL_WIDTH,
+            )
+            .map_err(|e| title(e.to_string()))?;
+            render::write_png(&self.run_dir.join(&path), &pixmap)
+                .map_err(|e| title(e.to_string()))?;
+            files.push(path);
+        }
+        Ok(files)
     }
 
     /// Rewrites `run.pvd`, the ParaView collection of the field files written so far with their times.

@@ -109,6 +109,37 @@ fn the_rolled_up_rod_strains_its_surface_by_r_kappa() {
         charts.contains(&"charts/configuration_t1.0000.svg"),
         "{charts:?}"
     );
+    // The shaded picture of the same states (the initial shape, then six), listed among the charts; `stentkit
+    // render` draws the times asked for, each the nearest snapshot's.
+    assert!(charts.contains(&"charts/configurations.png"), "{charts:?}");
+    let picture = tiny_skia::Pixmap::load_png(dir.join("charts/configurations.png")).expect("PNG");
+    assert!(drawn_pixels(&picture) > 0);
+    let out = dir.join("render_test.png");
+    let rendered = crate::outputs::stentkit(&[
+        "render",
+        dir.to_str().expect("path"),
+        "-o",
+        out.to_str().expect("path"),
+        "--times",
+        "0.52",
+        "1",
+        "--view",
+        "x1-x2",
+        "--width",
+        "200",
+    ]);
+    assert!(rendered.status.success(), "{rendered:?}");
+    let printed = crate::outputs::text(&rendered.stdout);
+    assert!(printed.contains("t = 0, 0.5, 1 s"), "{printed}");
+    let rendered = tiny_skia::Pixmap::load_png(&out).expect("PNG");
+    // Three panels 200 pixels wide with gaps of 6: the rolled-up rod's panels (height/width 0.62) come nearest
+    // 16:9 in a 2 + 1 grid.
+    assert_eq!(
+        (rendered.width(), rendered.height()),
+        (2 * 206 + 6, 2 * (123 + 6) + 6),
+        "{printed}"
+    );
+    assert!(drawn_pixels(&rendered) > 0);
     // Every snapshot has its field file, listed with its time in run.pvd.
     let collection = std::fs::read_to_string(dir.join("run.pvd")).expect("run.pvd");
     for snapshot in summary["snapshots"].as_array().expect("snapshots") {
@@ -116,6 +147,15 @@ fn the_rolled_up_rod_strains_its_surface_by_r_kappa() {
         assert!(dir.join(file).is_file(), "{file}");
         assert!(collection.contains(&format!("file=\"{file}\"")), "{file}");
     }
+}
+
+/// Pixels that are not the white background.
+fn drawn_pixels(pixmap: &tiny_skia::Pixmap) -> usize {
+    pixmap
+        .pixels()
+        .iter()
+        .filter(|p| (p.red(), p.green(), p.blue()) != (255, 255, 255))
+        .count()
 }
 
 /// `output.vtk: false` writes no field file and no collection.
@@ -136,4 +176,27 @@ fn a_design_can_turn_the_field_files_off() {
         })
         .count();
     assert_eq!(vtp, 0);
+}
+
+/// `stentkit render` refuses an unknown view, an output that is not PNG and a folder without a summary, with
+/// exit status 2 (bad input) and a message naming what is wrong.
+#[test]
+fn render_refuses_bad_input() {
+    let dir = test_outputs("render_refusals");
+    std::fs::create_dir_all(&dir).expect("folder");
+    let folder = dir.to_str().expect("path");
+    let out_png = dir.join("out.png");
+    let out_png = out_png.to_str().expect("path");
+    for (args, message) in [
+        (vec!["-o", out_png, "--view", "x1-x1"], "--view `x1-x1`"),
+        (vec!["-o", "picture.jpg"], "must end in .png"),
+        (vec!["-o", out_png], "not a run folder"),
+    ] {
+        let mut all = vec!["render", folder];
+        all.extend(args);
+        let out = crate::outputs::stentkit(&all);
+        let stderr = crate::outputs::text(&out.stderr);
+        assert_eq!(out.status.code(), Some(2), "{stderr}");
+        assert!(stderr.contains(message), "{stderr}");
+    }
 }

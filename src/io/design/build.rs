@@ -434,6 +434,10 @@ fn output_settings(dto: &DesignDto, time: &TimeSettings) -> Result<super::Output
             "output.snapshots.rings",
         )?,
         vtk: output.and_then(|o| o.vtk).unwrap_or(true),
+        render: output
+            .and_then(|o| o.configurations.as_ref())
+            .and_then(|c| c.render)
+            .unwrap_or(true),
         views: match output
             .and_then(|o| o.configurations.as_ref())
             .and_then(|c| c.views.as_ref())

@@ -671,6 +671,10 @@ pub struct ConfigurationsDto {
     /// initial shape's two largest extents).
     #[serde(default)]
     pub views: Option<Vec<String>>,
+    /// Also a shaded picture of the tube meshes at the same times, in the first view
+    /// (`charts/configurations.png`); default true.
+    #[serde(default)]
+    pub render: Option<bool>,
 }
 
 /// Snapshots: the initial and final shapes always, plus every `every` steps and at the given times.

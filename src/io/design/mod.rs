@@ -49,6 +49,9 @@ pub struct SnapshotSettings {
     /// The views of the configuration figures (`output.configurations.views`); `None`: the defaults
     /// ([`crate::io::configurations::default_views`]).
     pub views: Option<Vec<crate::io::configurations::View>>,
+    /// A shaded picture of the configuration figures' states (`output.configurations.render`, default true;
+    /// [`crate::io::render`]).
+    pub render: bool,
 }
 
 impl SnapshotSettings {
