@@ -22,6 +22,8 @@ Every DIR is searched recursively. Checked:
   before its history (the recording's chunks are closed every 2 s): it must hold at most, not exactly, one
   ``/state`` per step.
 
+* every shaded picture a run lists among its charts (``charts/configurations.png``), with VTK's ``vtkPNGReader``:
+  it reads, and something is drawn;
 * every run folder with ``run.pvd`` (the fields for ParaView), with VTK's own ``vtkXMLPolyDataReader`` (the
   ``vtk`` package): the collection lists every snapshot of the summary with its time, strictly increasing;
   every ``.vtp`` reads, holds one polyline per patch and the point arrays stentkit documents with the right
@@ -191,6 +193,28 @@ def check_stl(path):
     return f"{len(mesh.faces)} triangles, volume {volume:.6g}"
 
 
+def check_png(path):
+    """The shaded picture: VTK's own PNG reader reads it, RGB(A) 8-bit, with drawn (non-white) pixels."""
+    import vtk
+    from vtk.util.numpy_support import vtk_to_numpy
+    data = path.read_bytes()
+    # VTK's reader crashes on a cut-off file: check the signature and the closing IEND chunk first.
+    require(data[:8] == b"\x89PNG\r\n\x1a\n" and data[-12:-4] == b"\x00\x00\x00\x00IEND",
+            f"{path.name}: not a whole PNG file")
+    reader = vtk.vtkPNGReader()
+    require(reader.CanReadFile(str(path)), f"{path.name}: not a PNG VTK can read")
+    reader.SetFileName(str(path))
+    reader.Update()
+    image = reader.GetOutput()
+    width, height, _ = image.GetDimensions()
+    require(width > 0 and height > 0, f"{path.name}: empty picture")
+    pixels = vtk_to_numpy(image.GetPointData().GetScalars())
+    require(pixels.shape == (width * height, pixels.shape[1]) and pixels.shape[1] in (3, 4), f"{path.name}: {pixels.shape}")
+    drawn = int((pixels[:, :3] < 250).any(axis=1).sum())
+    require(drawn > 0, f"{path.name}: nothing drawn")
+    return drawn
+
+
 def check_run_folder(folder):
     summary = run_summary(folder)
     for key in ("design", "units", "stentkit_version", "command_line", "wall_time_s", "steps",
@@ -215,6 +239,9 @@ def check_run_folder(folder):
             require((folder / s[key]).is_file(), f"missing {s[key]}")
         SNAPSHOT_VOLUMES[(folder / s["stl"]).resolve()] = s["volume"]
     for chart in summary["files"]["charts"]:
+        if chart.endswith(".png"):
+            check_png(folder / chart)
+            continue
         head = (folder / chart).read_text()[:200]
         require("<svg" in head, f"{chart} is not SVG")
     require(summary["files"]["charts"] or summary["status"] == "killed", "no charts")

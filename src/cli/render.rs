@@ -23,8 +23,8 @@ pub fn run(dir: &Path, output: &Path, times: &[f64], view: &str, width: u32) -> 
     if output.extension().and_then(|e| e.to_str()) != Some("png") {
         return Err(BadInput(format!("{}: the output must end in .png", output.display())).into());
     }
-    if !(16..=4096).contains(&width) {
-        return Err(BadInput(format!("--width {width}: expected 16 to 4096 pixels")).into());
+    if !(16..=2048).contains(&width) {
+        return Err(BadInput(format!("--width {width}: expected 16 to 2048 pixels")).into());
     }
     let summary_path = dir.join("summary.json");
     let text = std::fs::read_to_string(&summary_path).map_err(|e| {

@@ -27,9 +27,9 @@
 //! measured one.
 
 use super::configurations::{CENTRELINE_SAMPLES, MAX_ROWS};
-use super::render::PANEL_WIDTH;
 use super::design::Design;
 use super::mcap::coordinate_decimals;
+use super::render::PANEL_WIDTH;
 use super::state::load_channels;
 use crate::math::Real;
 use crate::model::Model;

@@ -372,23 +372,25 @@ impl SnapshotWriter {
             &views,
             claim,
         )?;
-        if self.render {
-            // The snapshots of this process are the last of those written (a resumed run lists earlier ones).
-            let first = self.written.len() - self.configurations.len();
-            let stl = |k: usize| {
-                let files = &self.written[first + k].files;
-                let stl = files
-                    .iter()
-                    .find(|f| f.extension().is_some_and(|e| e == "stl"));
-                self.run_dir.join(stl.unwrap_or(&files[0]))
-            };
-            let states: Vec<PathBuf> = picked.iter().map(|&k| stl(k)).collect();
+        // The snapshots of this process are the last of those written (a resumed run lists earlier ones).
+        let first = self.written.len() - self.configurations.len();
+        let stl = |k: usize| {
+            let files = &self.written[first + k].files;
+            let stl = files
+                .iter()
+                .find(|f| f.extension().is_some_and(|e| e == "stl"));
+            stl.map(|f| self.run_dir.join(f))
+        };
+        let meshes: Option<Vec<PathBuf>> = std::iter::once(0).chain(picked).map(stl).collect();
+        if self.render
+            && let Some((initial, states)) = meshes.as_deref().and_then(|m| m.split_first())
+        {
             let lumen = self.run_dir.join(Self::FOLDER).join(VESSEL_FILE);
             let path = charts.join("configurations.png");
             claim(&path).map_err(|e| title(e.to_string()))?;
             let pixmap = render::render_snapshots(
-                &stl(0),
-                &states,
+                initial,
+                states,
                 lumen.exists().then_some(lumen.as_path()),
                 views[0],
                 render::PANEL_WIDTH,

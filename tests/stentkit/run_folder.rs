@@ -445,8 +445,8 @@ fn in_mount_namespace(dir: &Path, script: &str) -> (String, String) {
     (status.trim().to_string(), stderr)
 }
 
-/// A disk that fills up during a run (another process takes the last free bytes of an 8 MB tmpfs while the
-/// circular arch runs): the run stops with status 1; every output is finished or removed — the history ends
+/// A disk that fills up during a run (another process takes the last free bytes of a 12 MB tmpfs while the
+/// circular arch runs, which the disk estimate expects to write 8.5 MB): the run stops with status 1; every output is finished or removed — the history ends
 /// with a complete row, the recording is a valid MCAP file (or gone), no partial snapshot, chart or temporary
 /// is left — and the error and summary say which files are complete.
 #[test]
@@ -455,10 +455,10 @@ fn a_full_disk_leaves_every_output_finished_or_removed() {
     let copy = dir.join("copy");
     let script = format!(
         r#"
-        mount -t tmpfs -o size=8m tmpfs {tmp}
+        mount -t tmpfs -o size=12m tmpfs {tmp}
         {bin} run {design} -o {tmp}/arch --quiet > {dir}/stdout 2> {dir}/stderr &
         pid=$!
-        while [ "$(wc -l < {tmp}/arch/history.csv 2>/dev/null || echo 0)" -lt 200 ]; do sleep 0.01; done
+        while kill -0 $pid 2>/dev/null && [ "$(wc -l < {tmp}/arch/history.csv 2>/dev/null || echo 0)" -lt 200 ]; do sleep 0.01; done
         dd if=/dev/zero of={tmp}/filler bs=64k 2>/dev/null || true
         set +e; wait $pid; echo $? > {dir}/status; set -e
         rm {tmp}/filler
