@@ -491,3 +491,39 @@ fn a_design_name_is_one_folder_name() {
         assert_eq!(design.model.name, name);
     }
 }
+
+/// Source: the shape-memory cycle itself (paper §1): a temporary shape is fixed by cooling below Tg before the
+/// load is removed. The straight stent held at 90 °C through its release (1.75 s), above the PLA's Tg = 70 °C,
+/// is accepted with a warning naming the release, the temperature and Tg; the paper's schedule (45 °C at the
+/// release) has none.
+#[test]
+fn a_release_above_the_glass_transition_is_a_warning() {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("designs/straight_stent.yaml");
+    let text = std::fs::read_to_string(&path).expect("design");
+    let hot = stentkit::io::design::parse_design_with(
+        &text,
+        &path,
+        &stentkit::io::design::DesignOverrides::sets(vec![
+            "temperature=[[0, 90], [3.25, 90]]".parse().expect("set"),
+        ]),
+    )
+    .expect("accepted with a warning");
+    let warning = hot
+        .warnings
+        .iter()
+        .find(|w| w.contains("above the glass transition"))
+        .unwrap_or_else(|| panic!("no warning in {:?}", hot.warnings));
+    assert!(
+        warning.contains("t = 1.75 at 90 °C") && warning.contains("Tg = 70 °C"),
+        "{warning}"
+    );
+    let paper = stentkit::io::design::parse_design(&text, &path).expect("design");
+    assert!(
+        paper
+            .warnings
+            .iter()
+            .all(|w| !w.contains("glass transition")),
+        "{:?}",
+        paper.warnings
+    );
+}

@@ -205,6 +205,7 @@ pub fn build(dto: &DesignDto, default_name: &str) -> Result<Built> {
             if names.len() == 1 { "it is" } else { "they are" }
         ));
     }
+    warnings.extend(hot_release_warnings(&model));
     Ok(Built {
         model,
         output,
@@ -828,4 +829,32 @@ fn solver_settings(s: Option<&SolverDto>) -> SolverSettings {
         }
     }
     out
+}
+
+/// A programme that releases its nodes above a material's glass transition fixes no temporary shape: the
+/// rubbery device springs back at the release (and Newton meets the snap with step cuts, issue 18). One warning
+/// per such material, from the temperature schedule at the release (a temperature field's reference schedule).
+fn hot_release_warnings(model: &crate::model::Model) -> Vec<String> {
+    let Some(release) = model
+        .programme
+        .as_ref()
+        .and_then(|p| p.release)
+        .filter(|&r| r < model.time.end)
+    else {
+        return Vec::new();
+    };
+    let temperature = model.temperature.value(release);
+    model
+        .materials
+        .iter()
+        .zip(&model.material_names)
+        .filter_map(|(law, name)| {
+            let tg = crate::material::ConstitutiveLaw::temperature_shift(law)?.tg();
+            (temperature > tg).then(|| {
+                format!(
+                    "the programme releases its nodes at t = {release} at {temperature} °C, above the glass transition of material `{name}` (Tg = {tg} °C): the device is rubbery there and springs back, so no temporary shape is fixed; cool it below Tg before the release"
+                )
+            })
+        })
+        .collect()
 }
