@@ -23,6 +23,7 @@ use stentkit::geometry::fit::best_fit_rigid;
 use stentkit::io::design::{DesignOverrides, SetOverride, parse_design_with};
 use stentkit::math::{Real, Vec3};
 use stentkit::model::{Model, ProbeLocation};
+use stentkit::post::device::reflect;
 use stentkit::solver::{Simulation, SolverError};
 
 /// The times of the paper's captions [s].
@@ -200,12 +201,12 @@ fn run(model: &Model) -> Result<Vec<Readings>, Box<dyn Error>> {
 /// The ratio's readings in the current state of `sim`.
 fn read(model: &Model, sim: &Simulation<'_>) -> Result<Readings, Box<dyn Error>> {
     let programme = model.programme.as_ref().ok_or("no programme")?;
-    // The full device's driven nodes: each modelled node and, off the symmetry plane, its mirror image.
-    let [(point, normal)] = model.symmetry_planes[..] else {
+    // The full device's driven nodes: each modelled node and, off the symmetry plane, its mirror image (a
+    // displacement mirrors as the difference of the mirrored end points).
+    if model.symmetry_planes.len() != 1 {
         return Err("this example reads half models".into());
-    };
-    let mirror = |x: Vec3| x - 2.0 * (x - point).dot(&normal) * normal;
-    let mirror_vector = |v: Vec3| v - 2.0 * v.dot(&normal) * normal;
+    }
+    let mirror = |x: Vec3| reflect(model, &[0], x);
     let (mut p0, mut u, mut target) = (Vec::new(), Vec::new(), Vec::new());
     let mut plain = Vec::new();
     for d in &programme.nodes {
@@ -215,9 +216,10 @@ fn read(model: &Model, sim: &Simulation<'_>) -> Result<Readings, Box<dyn Error>>
         u.push(uk);
         target.push(d.target);
         if d.weight > 1.0 {
-            p0.push(mirror(d.position));
-            u.push(mirror_vector(uk));
-            target.push(mirror_vector(d.target));
+            let image = mirror(d.position);
+            p0.push(image);
+            u.push(mirror(d.position + uk) - image);
+            target.push(mirror(d.position + d.target) - image);
         }
     }
     let ratios: Vec<Real> = u

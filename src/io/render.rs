@@ -186,7 +186,7 @@ struct Frame {
 /// face is nearer.
 fn draw_panel(layers: &[Layer<'_>], frame: &Frame) -> Option<Pixmap> {
     let [right, up, toward] = frame.view.axes();
-    let light = (0.35 * right + 0.6 * up + 0.75 * toward).normalize();
+    let light = light(frame.view);
     let mut canvas = Canvas::new(frame.size);
     let half = (
         0.5 * Real::from(frame.size.0),
@@ -203,46 +203,66 @@ fn draw_panel(layers: &[Layer<'_>], frame: &Frame) -> Option<Pixmap> {
     let colour = |layer: &Layer<'_>, shade: f32| layer.colour.map(|c| (c * shade).clamp(0.0, 1.0));
     let opaque = |layer: &&Layer<'_>| layer.opacity >= 1.0;
     for (l, layer) in layers.iter().enumerate().filter(|(_, l)| opaque(l)) {
-        for (_, _, t, shade) in front_faces(l, layer, toward, light) {
-            let corners = layer.mesh.corners(t).map(|x| place(&x));
-            canvas.fill(corners, colour(layer, shade), None);
+        for face in front_faces(l, layer, toward, light, &place) {
+            canvas.fill(face.corners, colour(layer, face.shade), None);
         }
     }
     let mut translucent: Vec<_> = layers
         .iter()
         .enumerate()
         .filter(|(_, l)| !opaque(l))
-        .flat_map(|(l, layer)| front_faces(l, layer, toward, light))
+        .flat_map(|(l, layer)| front_faces(l, layer, toward, light, &place))
         .collect();
-    translucent.sort_unstable_by(|a, b| a.0.total_cmp(&b.0));
-    for (_, l, t, shade) in translucent {
-        let layer = &layers[l];
-        let corners = layer.mesh.corners(t).map(|x| place(&x));
-        canvas.fill(corners, colour(layer, shade), Some(layer.opacity.max(0.0)));
+    translucent.sort_unstable_by(|a, b| a.depth.total_cmp(&b.depth));
+    for face in translucent {
+        let layer = &layers[face.layer];
+        canvas.fill(
+            face.corners,
+            colour(layer, face.shade),
+            Some(layer.opacity.max(0.0)),
+        );
     }
     canvas.downsampled(SUPERSAMPLING)
 }
 
-/// The faces of `layer` (index `l`) turned toward the viewer, each as (depth of its centroid × 3, `l`, the
-/// triangle, its shade under `light`).
+/// The direction of the fixed light from the upper left front of `view` (unit vector).
+fn light(view: View) -> Vec3 {
+    let [right, up, toward] = view.axes();
+    (0.35 * right + 0.6 * up + 0.75 * toward).normalize()
+}
+
+/// A face turned toward the viewer, ready to draw.
+struct Face {
+    /// Depth of its centroid toward the viewer, times 3 (the sort key of translucent faces).
+    depth: Real,
+    /// Index of its layer.
+    layer: usize,
+    /// Its corners placed on the canvas, `[x, y, depth]`.
+    corners: [[f32; 3]; 3],
+    /// Its shade under the light.
+    shade: f32,
+}
+
+/// The faces of `layer` (index `l`) turned toward the viewer, placed on the canvas by `place` and shaded under
+/// `light`.
 fn front_faces(
     l: usize,
     layer: &Layer<'_>,
     toward: Vec3,
     light: Vec3,
-) -> Vec<(Real, usize, usize, f32)> {
+    place: &impl Fn(&Vec3) -> [f32; 3],
+) -> Vec<Face> {
     (0..layer.mesh.triangles.len())
         .filter_map(|t| {
             let normal = layer.mesh.triangle_normal(t);
             (normal.dot(&toward) > 0.0).then(|| {
-                let depth = layer
-                    .mesh
-                    .corners(t)
-                    .iter()
-                    .map(|c| c.dot(&toward))
-                    .sum::<Real>();
-                let shade = AMBIENT + (1.0 - AMBIENT) * normal.dot(&light).abs();
-                (depth, l, t, shade as f32)
+                let corners = layer.mesh.corners(t);
+                Face {
+                    depth: corners.iter().map(|c| c.dot(&toward)).sum::<Real>(),
+                    layer: l,
+                    corners: corners.map(|x| place(&x)),
+                    shade: (AMBIENT + (1.0 - AMBIENT) * normal.dot(&light).abs()) as f32,
+                }
             })
         })
         .collect()
@@ -539,9 +559,8 @@ mod tests {
             }
             mesh
         };
-        let [right, up, toward] = View::Plane(0, 1).axes();
-        let light = (0.35 * right + 0.6 * up + 0.75 * toward).normalize();
-        let shade = AMBIENT + (1.0 - AMBIENT) * light.dot(&toward);
+        let toward = View::Plane(0, 1).axes()[2];
+        let shade = AMBIENT + (1.0 - AMBIENT) * light(View::Plane(0, 1)).dot(&toward);
         for (flip, expected) in [(false, 255.0 * shade), (true, 255.0)] {
             let mesh = square(flip);
             let layer = Layer {
