@@ -372,18 +372,11 @@ impl SnapshotWriter {
             &views,
             claim,
         )?;
-        // The snapshots of this process are the last of those written (a resumed run lists earlier ones).
-        let first = self.written.len() - self.configurations.len();
-        let stl = |k: usize| {
-            let files = &self.written[first + k].files;
-            let stl = files
-                .iter()
-                .find(|f| f.extension().is_some_and(|e| e == "stl"));
-            stl.map(|f| self.run_dir.join(f))
-        };
-        let meshes: Option<Vec<PathBuf>> = std::iter::once(0).chain(picked).map(stl).collect();
         if self.render
-            && let Some((initial, states)) = meshes.as_deref().and_then(|m| m.split_first())
+            && let Some((initial, states)) = self
+                .stl_files(&picked)
+                .as_deref()
+                .and_then(<[_]>::split_first)
         {
             let lumen = self.run_dir.join(Self::FOLDER).join(VESSEL_FILE);
             let path = charts.join("configurations.png");
@@ -401,6 +394,24 @@ impl SnapshotWriter {
             files.push(path);
         }
         Ok(files)
+    }
+
+    /// The STL files of the initial snapshot (step 0, also after `--resume`) and of the configurations
+    /// `picked` (indices into those of this process); `None` when a snapshot has no STL.
+    fn stl_files(&self, picked: &[usize]) -> Option<Vec<PathBuf>> {
+        // The snapshots of this process are the last of those written (a resumed run lists earlier ones).
+        let first = self.written.len() - self.configurations.len();
+        let stl = |k: usize| {
+            let files = &self.written.get(k)?.files;
+            let stl = files
+                .iter()
+                .find(|f| f.extension().is_some_and(|e| e == "stl"))?;
+            Some(self.run_dir.join(stl))
+        };
+        std::iter::once(0)
+            .chain(picked.iter().map(|&k| first + k))
+            .map(stl)
+            .collect()
     }
 
     /// Rewrites `run.pvd`, the ParaView collection of the field files written so far with their times.
