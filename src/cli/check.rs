@@ -131,15 +131,29 @@ pub fn describe(design: &Design, file: &str) -> String {
     let _ = writeln!(s, "collocation points  {}", model.num_collocation_points());
     let _ = writeln!(s, "unknowns            {}", model.num_unknowns());
     let plan = design.steps;
-    let _ = writeln!(
-        s,
-        "time steps          {} ({} of h = {} s + {} shortened to land on breakpoints; end {} s)",
-        plan.total(),
-        plan.full,
-        model.time.step,
-        plan.shortened,
-        model.time.end
-    );
+    match model.solver.path {
+        crate::model::PathControl::Time => {
+            let _ = writeln!(
+                s,
+                "time steps          {} ({} of h = {} s + {} shortened to land on breakpoints; end {} s)",
+                plan.total(),
+                plan.full,
+                model.time.step,
+                plan.shortened,
+                model.time.end
+            );
+        }
+        crate::model::PathControl::ArcLength(a) => {
+            let _ = writeln!(
+                s,
+                "arc-length path     at most {} increments to load factor {} (the loads at t = {} s; first increment {} of them)",
+                a.max_increments,
+                a.end_load_factor,
+                model.time.end,
+                model.time.step / model.time.end
+            );
+        }
+    }
     let memory = &design.memory;
     let _ = write!(
         s,

@@ -602,14 +602,23 @@ fn run_in(
                 .with_context(|| format!("cannot restore {}", checkpoint::FILE_NAME))?;
         }
         if !options.quiet {
+            let plan = match model.solver.path {
+                crate::model::PathControl::Time => format!(
+                    "{} steps of {} s to {} s",
+                    design.steps.total(),
+                    model.time.step,
+                    model.time.end
+                ),
+                crate::model::PathControl::ArcLength(a) => format!(
+                    "arc-length path to load factor {} (at most {} increments)",
+                    a.end_load_factor, a.max_increments
+                ),
+            };
             eprintln!(
-                "stentkit run: {} — {} patches, {} unknowns, {} steps of {} s to {} s → {}",
+                "stentkit run: {} — {} patches, {} unknowns, {plan} → {}",
                 model.name,
                 model.patches.len(),
                 model.num_unknowns(),
-                design.steps.total(),
-                model.time.step,
-                model.time.end,
                 dir.display()
             );
         }
@@ -758,11 +767,17 @@ fn run_in(
         ));
     }
     let totals = &outputs.totals;
+    let reached = match sim.load_factor() {
+        Some(lambda) => format!(
+            "load factor {lambda} (path parameter {})",
+            Short(totals.time)
+        ),
+        None => format!("t = {} s", Short(totals.time)),
+    };
     println!(
-        "{}: {} steps to t = {} s, {} Newton iterations ({:.2} per step), {} factorisations, {} step cuts, {} snapshots, run.mcap {}, wall time {:.2} s, peak memory {} → {}",
+        "{}: {} steps to {reached}, {} Newton iterations ({:.2} per step), {} factorisations, {} step cuts, {} snapshots, run.mcap {}, wall time {:.2} s, peak memory {} → {}",
         model.name,
         totals.steps,
-        Short(totals.time),
         totals.iterations,
         totals.iterations as f64 / totals.steps.max(1) as f64,
         totals.factorisations,

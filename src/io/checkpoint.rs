@@ -2,12 +2,12 @@
 //! output stood at that step ([`OutputsCheckpoint`]), from which `stentkit run --resume` continues a killed or
 //! interrupted run exactly.
 //!
-//! # Format (version 3; version 2 had 18 numbers per section law and no per-material recovery, version 1, before
-//! error-controlled stepping, no step-control memory)
+//! # Format (version 4; version 3 had no arc-length state, version 2 had 18 numbers per section law and no
+//! per-material recovery, version 1, before error-controlled stepping, no step-control memory)
 //!
 //! ```text
 //! magic     8 bytes   "STKCKPT\0"
-//! version   u32       3
+//! version   u32       4
 //! length    u64       bytes of the payload
 //! payload   …         the fields below, in order
 //! crc32     u32       CRC-32 (IEEE 802.3, as zlib and PNG) of everything before it
@@ -16,7 +16,8 @@
 //! All integers and floats little-endian; a float is its IEEE-754 bits (`f64::to_bits`), so every number comes
 //! back exactly; a `usize` is a `u64`; a vector or string is its length (`u64`) then its items; an option is a
 //! byte 0/1 then the value. The payload is the model fingerprint of the outputs' settings, the solver's
-//! checkpoint (time, step, step control, state, materials, ramps, gauge, tangent origin, notices, timing) and the outputs'
+//! checkpoint (time, step, step control, state, materials, ramps, gauge, tangent origin, notices, timing, arc-length
+//! state) and the outputs'
 //! positions, in the order [`write()`] writes them.
 //!
 //! Why this format: a checkpoint must restore every number bit for bit (a text format would need round-trip
@@ -34,8 +35,8 @@ use super::state::{Recovery, StateSample};
 use crate::material::LAW_NUMBERS;
 use crate::math::{Mat3, Real, Vec3};
 use crate::solver::assembly::{Actions, ReleaseRamp};
-use crate::solver::simulation::TangentOrigin;
 use crate::solver::simulation::adaptive::StepControl;
+use crate::solver::simulation::{ArcState, TangentOrigin};
 use crate::solver::state::State;
 use crate::solver::{Checkpoint, RunSummary, SolverTiming};
 use std::path::{Path, PathBuf};
@@ -47,7 +48,7 @@ pub const FILE_NAME: &str = "checkpoint.bin";
 const MAGIC: &[u8; 8] = b"STKCKPT\0";
 
 /// The format version this build writes and reads.
-pub const VERSION: u32 = 3;
+pub const VERSION: u32 = 4;
 
 /// Bytes before the payload: magic, version, length.
 const HEADER: usize = 8 + 4 + 8;
@@ -519,6 +520,16 @@ fn encode_solver(e: &mut Encoder, c: &Checkpoint) {
         e.bool(t.gauge_active);
     });
     encode_timing(e, &c.timing);
+    e.option(c.arc.as_ref(), |e, a| {
+        e.f64(a.load_factor);
+        e.f64(a.arc);
+        e.f64(a.first_arc);
+        e.option(a.previous.as_ref(), |e, (dx, dl)| {
+            e.f64s(dx);
+            e.f64(*dl);
+        });
+        e.bool(a.reached_end);
+    });
 }
 
 fn decode_solver(d: &mut Decoder<'_>) -> Result<Checkpoint, Problem> {
@@ -557,6 +568,15 @@ fn decode_solver(d: &mut Decoder<'_>) -> Result<Checkpoint, Problem> {
             })
         })?,
         timing: decode_timing(d)?,
+        arc: d.option(|d| {
+            Ok(ArcState {
+                load_factor: d.f64()?,
+                arc: d.f64()?,
+                first_arc: d.f64()?,
+                previous: d.option(|d| Ok((d.f64s()?, d.f64()?)))?,
+                reached_end: d.bool()?,
+            })
+        })?,
     })
 }
 
@@ -744,6 +764,13 @@ mod tests {
                 residual: (3, 0.5),
                 ..SolverTiming::default()
             },
+            arc: Some(ArcState {
+                load_factor: -0.25,
+                arc: 0.125,
+                first_arc: 0.0625,
+                previous: Some((vec![1.5; 12], -0.5)),
+                reached_end: false,
+            }),
         };
         let outputs = OutputsCheckpoint {
             settings: 42,

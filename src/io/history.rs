@@ -1,4 +1,6 @@
-//! `history.csv`: one row per converged step (and the initial state): `time`, then for each probe `P` the
+//! `history.csv`: one row per converged step (and the initial state): `time` (with arc-length continuation the
+//! path parameter, the sum of the arc lengths, followed by `load_factor`, the load factor λ reached), then for
+//! each probe `P` the
 //! displacement columns `P.ux, P.uy, P.uz` (in the design's length unit), then `temperature` [°C],
 //! `iterations` (Newton solves of the step), `residual` (final normalised residual) and `cuts` (step cuts).
 //! With error-controlled stepping (`time.tolerance`) it adds `dt` (the step taken), `error_estimate` (its
@@ -29,6 +31,14 @@ use std::path::{Path, PathBuf};
 
 /// The columns of `history.csv` that hold text (a patch's name) rather than numbers.
 pub const TEXT_COLUMNS: &[&str] = &["surface_strain_patch"];
+
+/// Whether the run follows its path by arc length (`history.csv` then has a `load_factor` column).
+fn arc_length(sim: &Simulation<'_>) -> bool {
+    matches!(
+        sim.model().solver.path,
+        crate::model::PathControl::ArcLength(_)
+    )
+}
 
 /// The materials with a strain limit, as `(material index, limit)`.
 fn limited_materials(strain_limits: &[Option<f64>]) -> Vec<(usize, f64)> {
@@ -125,6 +135,9 @@ impl HistoryWriter {
         let limits = limited_materials(strain_limits);
         let mut out = BufWriter::new(File::create(path)?);
         let mut header = String::from("time");
+        if arc_length(sim) {
+            header.push_str(",load_factor");
+        }
         for p in &sim.model().probes {
             for c in ["ux", "uy", "uz"] {
                 header.push_str(&format!(",{}.{c}", p.name));
@@ -258,6 +271,9 @@ impl HistoryWriter {
     fn row(&mut self, sim: &Simulation<'_>, report: Option<&StepReport>) -> ControlFlow<()> {
         let t = sim.time();
         let mut line = format!("{t:.10e}");
+        if arc_length(sim) {
+            line.push_str(&format!(",{:.12e}", sim.load_factor().unwrap_or(0.0)));
+        }
         for p in &sim.model().probes {
             let u = sim.probe_displacement(&p.location);
             line.push_str(&format!(",{:.12e},{:.12e},{:.12e}", u.x, u.y, u.z));

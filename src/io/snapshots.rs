@@ -50,7 +50,12 @@ impl SnapshotSchedule {
         Self {
             times: settings.times.clone(),
             every: settings.every,
-            end: model.time.end,
+            // An arc-length path's `time` is its path parameter, which passes `time.end` anywhere: its last state
+            // is written by the writers' `finish`.
+            end: match model.solver.path {
+                crate::model::PathControl::Time => model.time.end,
+                crate::model::PathControl::ArcLength(_) => Real::INFINITY,
+            },
             snap: crate::model::LANDING_TOLERANCE * model.time.step,
         }
     }

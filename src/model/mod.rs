@@ -312,6 +312,61 @@ pub enum LinearMethod {
     SparseLu,
 }
 
+/// What drives the solution along its path: time (the schedules), or the load factor under an arc-length
+/// constraint ([`crate::solver::simulation`] module docs, *Arc-length continuation*).
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub enum PathControl {
+    /// Time steps through the schedules (the default; every material).
+    #[default]
+    Time,
+    /// Riks/Crisfield arc-length continuation of the loads at `time.end` scaled by a load factor (elastic
+    /// materials, no programme).
+    ArcLength(ArcLengthSettings),
+}
+
+/// The arc-length constraint's form (Crisfield, *Non-linear Finite Element Analysis of Solids and Structures*,
+/// vol. 1, §9.3).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum ArcConstraint {
+    /// `‖Δx‖² = Δs²`: the load factor takes no part in the arc length (Crisfield's recommendation).
+    #[default]
+    Cylindrical,
+    /// `‖Δx‖² + Δλ² = Δs²`: the load factor counts as one more (normalised) unknown.
+    Spherical,
+}
+
+/// Settings of arc-length continuation. The reference load is every load and prescribed value of the design at
+/// `time.end`; the load factor λ scales it (λ = 1: the design's end state). The first increment takes
+/// `time.step / time.end` of the reference load; later arc lengths adapt to Newton's iterations.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ArcLengthSettings {
+    /// The path ends where the load factor reaches this value (landing on it exactly).
+    pub end_load_factor: Real,
+    /// At most this many increments; the run ends there with a notice if the end load factor was not reached.
+    pub max_increments: usize,
+    /// Newton iterations an increment aims at: the next arc length is scaled by `√(target / iterations)`
+    /// (within ½ … 2).
+    pub target_iterations: usize,
+    /// The arc length never grows beyond this multiple of the first one.
+    pub max_growth: Real,
+    /// The constraint's form.
+    pub constraint: ArcConstraint,
+}
+
+impl Default for ArcLengthSettings {
+    /// End at λ = 1, at most 1000 increments, 4 iterations aimed at (Crisfield's and cardillo's `iter_goal`),
+    /// arc lengths up to 10 times the first, the cylindrical constraint.
+    fn default() -> Self {
+        Self {
+            end_load_factor: 1.0,
+            max_increments: 1000,
+            target_iterations: 4,
+            max_growth: 10.0,
+            constraint: ArcConstraint::Cylindrical,
+        }
+    }
+}
+
 /// Newton settings.
 #[derive(Debug, Clone, PartialEq)]
 pub struct SolverSettings {
@@ -339,6 +394,8 @@ pub struct SolverSettings {
     pub extrapolate: bool,
     /// The linear solver.
     pub linear: LinearMethod,
+    /// What drives the path: time, or the load factor under an arc-length constraint.
+    pub path: PathControl,
 }
 
 impl Default for SolverSettings {
@@ -354,6 +411,7 @@ impl Default for SolverSettings {
             max_iterations: 25,
             extrapolate: false,
             linear: LinearMethod::Block,
+            path: PathControl::Time,
         }
     }
 }

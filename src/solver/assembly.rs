@@ -164,6 +164,23 @@ impl Actions {
             dist_couple,
         }
     }
+
+    /// Every load and prescribed value multiplied by `factor` (arc-length continuation's load factor: the
+    /// residual is affine in it).
+    pub fn scaled(&self, factor: Real) -> Self {
+        let scale = |v: &[Vec3]| v.iter().map(|x| x * factor).collect();
+        Self {
+            node_force: scale(&self.node_force),
+            node_moment: scale(&self.node_moment),
+            prescribed: self
+                .prescribed
+                .iter()
+                .map(|c| c.map(|v| v.map(|v| v * factor)))
+                .collect(),
+            dist_force: scale(&self.dist_force),
+            dist_couple: scale(&self.dist_couple),
+        }
+    }
 }
 
 /// The constitutive data of one time step: the section law of every collocation point (from its patch's

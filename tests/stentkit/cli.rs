@@ -89,7 +89,22 @@ fn check_describes_every_design() {
         assert_eq!(count("nodes"), model.nodes.len());
         assert_eq!(count("collocation points"), model.num_collocation_points());
         assert_eq!(count("unknowns"), model.num_unknowns());
-        assert_eq!(count("time steps"), model.planned_steps().total());
+        match model.solver.path {
+            stentkit::model::PathControl::Time => {
+                assert_eq!(count("time steps"), model.planned_steps().total());
+            }
+            stentkit::model::PathControl::ArcLength(a) => {
+                let line = stdout
+                    .lines()
+                    .find_map(|l| l.strip_prefix("arc-length path"))
+                    .map(str::trim)
+                    .unwrap_or_else(|| panic!("no `arc-length path` line in\n{stdout}"));
+                assert!(
+                    line.starts_with(&format!("at most {} increments", a.max_increments)),
+                    "{line}"
+                );
+            }
+        }
         let fit = value_after(&stdout, "geometry fit error");
         match model
             .patches

@@ -3,6 +3,7 @@
 #[path = "../common/mod.rs"]
 mod common;
 
+mod arc_length;
 mod centreline;
 mod checkpoint;
 mod cli;

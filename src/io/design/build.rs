@@ -176,8 +176,27 @@ pub fn build(dto: &DesignDto, default_name: &str) -> Result<Built> {
         mut warnings,
     } = builder.build().map_err(|e| builder_issue(e, dto))?;
     // The steps the run takes, landing on every breakpoint: refused if their memory is too much, and the
-    // default snapshot spacing follows them.
-    let plan = model.planned_steps();
+    // default snapshot spacing follows them. An arc-length path takes at most its increments allowed.
+    let plan = match model.solver.path {
+        PathControl::ArcLength(a) => {
+            if dto
+                .output
+                .as_ref()
+                .and_then(|o| o.snapshots.as_ref())
+                .is_some_and(|s| s.times.is_some())
+            {
+                return Err(issue(
+                    "output.snapshots.times",
+                    "an arc-length path has no times to land on (its `time` is the path parameter, known only as it is followed): use `output.snapshots.every`",
+                ));
+            }
+            StepPlan {
+                full: a.max_increments,
+                shortened: 0,
+            }
+        }
+        PathControl::Time => model.planned_steps(),
+    };
     let memory = check_size(dto, &StepCount::planned(&plan, model.time.step, dto))?;
     if settings.tolerance.is_none()
         && dto
@@ -328,6 +347,8 @@ pub fn field_path(field: &Field, dto: &DesignDto) -> String {
         Field::Solver(field) => match field {
             SolverField::Tolerance => "solver.tolerance",
             SolverField::MaxIterations => "solver.max_iterations",
+            SolverField::Path => "solver.path",
+            SolverField::ArcLength => "solver.arc_length",
         }
         .into(),
         Field::Probe { index, field } => {
@@ -826,6 +847,22 @@ fn solver_settings(s: Option<&SolverDto>) -> SolverSettings {
                 LinearDto::Block => LinearMethod::Block,
                 LinearDto::SparseLu => LinearMethod::SparseLu,
             };
+        }
+        if let Some(PathDto::ArcLength) = s.path {
+            let mut a = ArcLengthSettings::default();
+            if let Some(d) = &s.arc_length {
+                a.end_load_factor = d.end.unwrap_or(a.end_load_factor);
+                a.max_increments = d.max_increments.unwrap_or(a.max_increments);
+                a.target_iterations = d.iterations.unwrap_or(a.target_iterations);
+                a.max_growth = d.max_growth.unwrap_or(a.max_growth);
+                if let Some(c) = d.constraint {
+                    a.constraint = match c {
+                        ArcConstraintDto::Cylindrical => ArcConstraint::Cylindrical,
+                        ArcConstraintDto::Spherical => ArcConstraint::Spherical,
+                    };
+                }
+            }
+            out.path = PathControl::ArcLength(a);
         }
     }
     out

@@ -629,6 +629,54 @@ pub struct SolverDto {
     /// Linear solver: `block` (banded per patch + Schur complement on the patch ends, default) or `sparse-lu`.
     #[serde(default)]
     pub linear: Option<LinearDto>,
+    /// What drives the path: `time` (the schedules, default) or `arc-length` (Riks/Crisfield continuation of
+    /// the loads at `time.end` scaled by a load factor; elastic materials, no programme).
+    #[serde(default)]
+    pub path: Option<PathDto>,
+    /// Arc-length settings (with `path: arc-length`).
+    #[serde(default)]
+    pub arc_length: Option<ArcLengthDto>,
+}
+
+/// What drives the path.
+#[derive(Debug, Clone, Copy, Deserialize, JsonSchema)]
+#[serde(rename_all = "kebab-case")]
+pub enum PathDto {
+    /// Time steps through the schedules.
+    Time,
+    /// Arc-length continuation in the load factor.
+    ArcLength,
+}
+
+/// The arc-length constraint.
+#[derive(Debug, Clone, Copy, Deserialize, JsonSchema)]
+#[serde(rename_all = "kebab-case")]
+pub enum ArcConstraintDto {
+    /// The load factor takes no part in the arc length (default).
+    Cylindrical,
+    /// The load factor counts as one more unknown.
+    Spherical,
+}
+
+/// Arc-length continuation settings.
+#[derive(Debug, Clone, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct ArcLengthDto {
+    /// The load factor the path ends at (default 1: the loads at `time.end`).
+    #[serde(default)]
+    pub end: Option<f64>,
+    /// Increments allowed (default 1000).
+    #[serde(default)]
+    pub max_increments: Option<usize>,
+    /// Newton iterations an increment aims at (default 4).
+    #[serde(default)]
+    pub iterations: Option<usize>,
+    /// Largest arc length as a multiple of the first (default 10).
+    #[serde(default)]
+    pub max_growth: Option<f64>,
+    /// `cylindrical` (default) or `spherical`.
+    #[serde(default)]
+    pub constraint: Option<ArcConstraintDto>,
 }
 
 /// Linear solver names.

@@ -186,6 +186,10 @@ pub enum SolverField {
     Tolerance,
     /// The iterations allowed per step.
     MaxIterations,
+    /// What drives the path (time or arc length).
+    Path,
+    /// The arc-length settings.
+    ArcLength,
 }
 
 /// A part of a probe.

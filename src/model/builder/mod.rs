@@ -738,6 +738,13 @@ impl ModelBuilder {
         if let Some(field) = &self.temperature_field {
             warnings.extend(unresolved_front(field, &patches));
         }
+        check_path(
+            &self.solver,
+            &self.materials,
+            &self.material_names,
+            programme.is_some() || time.tolerance.is_some(),
+            &nodes,
+        )?;
         let probes = self.probes(&patches, &nodes)?;
         let model = Model {
             name: self.name.clone(),
@@ -1009,6 +1016,62 @@ fn check_solver(s: &SolverSettings) -> Result<()> {
             Field::Solver(SolverField::MaxIterations),
             "must be ≥ 1",
         ));
+    }
+    Ok(())
+}
+
+/// Arc-length continuation follows a load-driven path of a rate-independent model: every material elastic (a
+/// viscoelastic response depends on time, which the load factor replaces), no programme, no error-controlled
+/// time steps and no releases (they are about times). Its settings: an end load factor that is finite and not 0, at least one increment, a
+/// target of at least one iteration and a growth of at least 1.
+fn check_path(
+    s: &SolverSettings,
+    materials: &[MaterialLaw],
+    names: &[String],
+    timed: bool,
+    nodes: &[crate::model::Node],
+) -> Result<()> {
+    let PathControl::ArcLength(a) = s.path else {
+        return Ok(());
+    };
+    let path = |why: String| Err(BuildError::new(Field::Solver(SolverField::Path), why));
+    if let Some(m) = materials
+        .iter()
+        .position(|m| !matches!(m, MaterialLaw::Elastic(_)))
+    {
+        return path(format!(
+            "arc-length continuation needs rate-independent materials, and material `{}` is viscoelastic: its response depends on time, which the load factor replaces (use `path: time`; a release snap of a viscoelastic device is met by step cuts)",
+            names.get(m).map_or("?", String::as_str)
+        ));
+    }
+    if timed {
+        return path("arc-length continuation follows loads, and a programme (heating, release, recovery) or `time.tolerance` (the time-error control) is about times: use `path: time`".into());
+    }
+    if let Some(node) = nodes.iter().find(|n| {
+        n.conditions.components.iter().any(|c| {
+            matches!(
+                c,
+                crate::model::Component::Prescribed {
+                    release: Some(_),
+                    ..
+                }
+            )
+        })
+    }) {
+        return path(format!(
+            "arc-length continuation has no time at which node `{}` could be released: use `path: time`",
+            node.name
+        ));
+    }
+    let settings = |why: &str| Err(BuildError::new(Field::Solver(SolverField::ArcLength), why));
+    if !(a.end_load_factor.is_finite() && a.end_load_factor != 0.0) {
+        return settings("`end` (the load factor the path ends at) must be finite and not 0");
+    }
+    if a.max_increments == 0 || a.target_iterations == 0 {
+        return settings("`max_increments` and `iterations` must be ≥ 1");
+    }
+    if !(a.max_growth >= 1.0 && a.max_growth.is_finite()) {
+        return settings("`max_growth` must be ≥ 1 and finite");
     }
     Ok(())
 }

@@ -73,6 +73,8 @@ pub struct Checkpoint {
     pub tangent: Option<TangentOrigin>,
     /// Where the solver's time went so far.
     pub timing: SolverTiming,
+    /// Where an arc-length run is on its path (`None` for time-driven runs and before the first increment).
+    pub arc: Option<super::ArcState>,
 }
 
 /// The iterate at which the current factorisation's tangent was assembled (module docs).
@@ -324,6 +326,7 @@ impl Simulation<'_> {
             last_increment: self.last_increment.clone(),
             tangent,
             timing: self.timing.clone(),
+            arc: self.arc.clone(),
         }
     }
 
@@ -378,6 +381,7 @@ impl Simulation<'_> {
         self.round_off_reported = checkpoint.round_off_reported;
         self.ramps.clone_from(&checkpoint.ramps);
         self.last_increment.clone_from(&checkpoint.last_increment);
+        self.arc.clone_from(&checkpoint.arc);
         self.step_increment.clear();
         self.system.invalidate();
         self.tangent.invalidate();

@@ -34,6 +34,12 @@
 //! `min_step` whose estimate is above the tolerance is accepted with a notice (said once). Fixed steps (no
 //! tolerance) are unchanged. [`StepReport::error_estimate`] and [`StepReport::rejected`] report each step.
 //!
+//! **Arc-length continuation.** With `solver.path` arc length ([`crate::model::PathControl::ArcLength`]) a step
+//! is an increment along the equilibrium path of the loads at `time.end` scaled by a load factor, held by an
+//! arc-length constraint (Riks/Crisfield; `arclength`): it passes limit points in load and in displacement,
+//! where time steps stop. [`StepReport::load_factor`] carries the load factor, [`Simulation::load_factor`] the
+//! current one, and the step's `time` is the path parameter.
+//!
 //! **Stepping as an API.** [`Simulation::step`] takes one converged step (with the retries and cuts it needs)
 //! and returns its [`StepReport`]; the caller reads the state between steps ([`Simulation::state`],
 //! [`Simulation::probe_displacement`], [`Simulation::node_end_resultants`]). [`Simulation::run`] is the loop over
@@ -50,13 +56,14 @@
 //! later `step` or `run` — or a checkpoint taken now — continues bit for bit as the uninterrupted run.
 //!
 //! The concepts live in their own files: [`report`] (what a step and a run report), [`observer`] (who is told),
-//! [`adaptive`] (the time-error estimate and the step-size controller),
+//! [`adaptive`] (the time-error estimate and the step-size controller), `arclength` (arc-length continuation),
 //! [`timing`] (where the wall time went), `stepping` (the step loop, step-size control and roll-back), `newton`
 //! (Newton's method on normalised norms and its diagnostics), `releases` (release ramps and gauge constraints),
 //! `constitutive` (the materials at the points: step preparation, commit, roll-back) and [`checkpoint`] (the
 //! whole state as a value, and its restore).
 
 pub mod adaptive;
+mod arclength;
 pub mod checkpoint;
 mod constitutive;
 pub mod fields;
@@ -67,6 +74,7 @@ pub mod report;
 mod stepping;
 pub mod timing;
 
+pub use arclength::ArcState;
 pub use checkpoint::{Checkpoint, CheckpointError, TangentOrigin, model_fingerprint};
 pub use fields::{PeakSurfaceStrain, PointFields, peak_surface_strain};
 pub use newton::ROUND_OFF_TOLERANCE;
@@ -139,6 +147,8 @@ pub struct Simulation<'m> {
     /// Reference arc length of every collocation point from its patch's start, for the fields ([`fields`]):
     /// computed at the first use (a run without field outputs never needs it).
     arc_length: std::sync::OnceLock<Vec<Real>>,
+    /// Where an arc-length run is on its path (`None` for time-driven runs, and before the first increment).
+    arc: Option<arclength::ArcState>,
 }
 
 impl<'m> Simulation<'m> {
@@ -237,6 +247,7 @@ impl<'m> Simulation<'m> {
             tangent: checkpoint::TangentRecord::default(),
             control: adaptive::StepControl::default(),
             arc_length: std::sync::OnceLock::new(),
+            arc: None,
         })
     }
 }

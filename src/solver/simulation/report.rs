@@ -44,6 +44,8 @@ pub struct StepReport {
     pub error_estimate: Option<Real>,
     /// Attempts of this step rejected because their time-error estimate exceeded the tolerance.
     pub rejected: usize,
+    /// The load factor reached (arc-length continuation); `None` for time steps.
+    pub load_factor: Option<Real>,
 }
 
 /// Totals of a run.

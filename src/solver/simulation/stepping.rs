@@ -82,7 +82,10 @@ impl Simulation<'_> {
     /// Whether the simulation has reached the model's end time (within the landing tolerance): a further
     /// [`Simulation::step`] does nothing.
     pub fn is_finished(&self) -> bool {
-        self.time >= self.model.time.end - self.landing_tolerance()
+        match self.arc_length_settings() {
+            Some(settings) => self.arc_length_finished(&settings),
+            None => self.time >= self.model.time.end - self.landing_tolerance(),
+        }
     }
 
     /// Times closer than this to a breakpoint or the end are that breakpoint: the model's landing tolerance
@@ -114,6 +117,9 @@ impl Simulation<'_> {
     /// # Errors
     /// As [`Simulation::step`].
     pub fn step_with(&mut self, observer: &mut dyn Observer) -> Result<StepOutcome, SolverError> {
+        if let Some(settings) = self.arc_length_settings() {
+            return self.arc_length_step(observer, settings);
+        }
         if self.is_finished() {
             return Ok(StepOutcome::Finished);
         }
@@ -228,6 +234,7 @@ impl Simulation<'_> {
                         cuts: std::mem::take(&mut self.step_cuts),
                         error_estimate: estimate,
                         rejected: std::mem::take(&mut self.control.rejections),
+                        load_factor: None,
                     };
                     match self.model.time.tolerance {
                         Some(tolerance) => {
