@@ -370,11 +370,11 @@ pub enum StudyCommand {
         /// Output folder.
         #[arg(short, long)]
         output: PathBuf,
-        /// Maps to draw: any of material, bend45, heating, release.
+        /// Maps to draw: any of material, bend45, heating, release, coarse.
         #[arg(
             long,
             value_delimiter = ',',
-            default_value = "material,bend45,heating,release"
+            default_value = "material,bend45,heating,release,coarse"
         )]
         maps: Vec<String>,
     },

@@ -138,13 +138,13 @@ pub fn time(
     Ok(())
 }
 
-/// `stentkit study stability`: the maps named in `maps` (any of material, bend45, heating, release), each
+/// `stentkit study stability`: the maps named in `maps` (any of material, bend45, heating, release, coarse), each
 /// written as `<map>.csv` and `<map>.svg` as soon as it is done, then `stability.md`.
 pub fn stability_maps(output: &Path, maps: &[String]) -> anyhow::Result<()> {
     for m in maps {
         anyhow::ensure!(
-            ["material", "bend45", "heating", "release"].contains(&m.as_str()),
-            "unknown map `{m}` (material, bend45, heating, release)"
+            ["material", "bend45", "heating", "release", "coarse"].contains(&m.as_str()),
+            "unknown map `{m}` (material, bend45, heating, release, coarse)"
         );
     }
     let mut study = StabilityStudy::default();
@@ -160,6 +160,9 @@ pub fn stability_maps(output: &Path, maps: &[String]) -> anyhow::Result<()> {
     }
     if !wanted("release") {
         study.release.clear();
+    }
+    if !wanted("coarse") {
+        study.coarse.clear();
     }
     create(output)?;
     let summary = stability(

@@ -374,13 +374,7 @@ impl Simulation<'_> {
                     *d += dl * q;
                 }
             }
-            let increment = self.increment_norm();
-            report.increments.push(increment);
-            report.iterations += 1;
-            if !increment.is_finite() {
-                report.diagnosis = Some(self.non_finite_increment(report.iterations));
-                return Err(NewtonFailure::NotConverged(report));
-            }
+            self.record_increment(&mut report)?;
             if !predictor {
                 corrections += 1;
             }

@@ -151,17 +151,7 @@ impl Simulation<'_> {
             if report.iterations == 0 {
                 stale_first = !fresh_tangent;
             }
-            let increment = self.increment_norm();
-            report.increments.push(increment);
-            report.iterations += 1;
-            if !increment.is_finite() {
-                report.diagnosis = Some(self.non_finite_increment(report.iterations));
-                return Err(NewtonFailure::NotConverged(report));
-            }
-            if increment > SINGULAR_INCREMENT {
-                report.diagnosis = Some(self.huge_increment(report.iterations, increment));
-                return Err(NewtonFailure::NotConverged(report));
-            }
+            self.record_increment(&mut report)?;
             self.state.apply_increment(&self.disc, &self.delta);
             if self.model.solver.extrapolate {
                 self.step_increment.resize(self.delta.len(), 0.0);
@@ -171,6 +161,24 @@ impl Simulation<'_> {
             }
             previous = if fresh_tangent { Real::INFINITY } else { r };
         }
+    }
+
+    /// Counts the increment in `self.delta` as one more iteration of `report` with its normalised norm, or
+    /// abandons the iteration where it is not finite or so large that the tangent must be (nearly) singular
+    /// ([`SINGULAR_INCREMENT`]), saying where.
+    pub(super) fn record_increment(&self, report: &mut NewtonReport) -> Result<(), NewtonFailure> {
+        let increment = self.increment_norm();
+        report.increments.push(increment);
+        report.iterations += 1;
+        if !increment.is_finite() {
+            report.diagnosis = Some(self.non_finite_increment(report.iterations));
+            return Err(NewtonFailure::NotConverged(std::mem::take(report)));
+        }
+        if increment > SINGULAR_INCREMENT {
+            report.diagnosis = Some(self.huge_increment(report.iterations, increment));
+            return Err(NewtonFailure::NotConverged(std::mem::take(report)));
+        }
+        Ok(())
     }
 
     /// The tolerance Newton stops at: `solver.tolerance`, and with error-controlled steps at least

@@ -14,8 +14,11 @@
 //!   iterations and cuts.
 //! * **release** — the release snap of a two-crown straight stent (designs/straight_stent.yaml with 2 crowns,
 //!   run to 2 s, released at 1.75 s): step size and release-ramp length against cuts and iterations.
+//! * **coarse** — the elastic 45° bend and roll-up on coarse and fine meshes, by load steps and by arc length
+//!   (issue 18): where load steps fail, whether the coarse model's own path has a limit point there (the largest
+//!   load factor before it falls), and how far its end state is from the fine model's.
 //!
-//! The last three are [`scenarios`] run through [`newton::newton_run`], which records what the solver did.
+//! The last four are [`scenarios`] run through [`newton::newton_run`], which records what the solver did.
 
 pub mod material;
 pub mod newton;
@@ -57,6 +60,8 @@ pub struct StabilityStudy {
     pub heating: Vec<(Real, Real)>,
     /// `(h [s], release ramp [s], control points per patch)` of the two-crown stent.
     pub release: Vec<(Real, Real, usize)>,
+    /// `(design, p, n)` of the coarse-model map.
+    pub coarse: Vec<(scenarios::CoarseDesign, usize, usize)>,
 }
 
 impl Default for StabilityStudy {
@@ -92,11 +97,22 @@ impl Default for StabilityStudy {
                 (0.01, 0.01, 14),
                 (0.01, 0.3, 14),
             ],
+            coarse: {
+                use scenarios::CoarseDesign::{Bend45, Rollup};
+                vec![
+                    (Bend45, 4, 10),
+                    (Bend45, 6, 20),
+                    (Rollup, 4, 8),
+                    (Rollup, 4, 10),
+                    (Rollup, 6, 8),
+                    (Rollup, 6, 30),
+                ]
+            },
         }
     }
 }
 
-/// Runs every map of `study` whose list is not empty, in the order material, bend45, heating, release. Each
+/// Runs every map of `study` whose list is not empty, in the order material, bend45, heating, release, coarse. Each
 /// finished map is handed to `done` (which writes it), so the maps finished before a failure are kept; the text
 /// of `stability.md` (a title and every map's paragraph) is returned. `progress` is told about each run.
 ///
@@ -137,6 +153,12 @@ pub fn stability<E: From<StudyError>>(
     if !study.release.is_empty() {
         let map = scenarios::release_map(&study.release, &mut progress)?;
         let report = scenarios::release_report(&map);
+        done(&report)?;
+        summary.push_str(&report.summary);
+    }
+    if !study.coarse.is_empty() {
+        let map = scenarios::coarse_map(&study.coarse, &mut progress)?;
+        let report = scenarios::coarse_report(&map);
         done(&report)?;
         summary.push_str(&report.summary);
     }

@@ -38,12 +38,27 @@ pub struct NewtonRun {
     pub failure: Option<String>,
     /// The solver's notices (e.g. the WLF freeze).
     pub notices: Vec<String>,
+    /// `(path parameter, load factor)` of every converged increment (arc-length runs; empty for time steps).
+    pub load_path: Vec<(Real, Real)>,
+    /// The displacement of the model's first probe at the end (or where the run stopped).
+    pub final_probe: Option<crate::math::Vec3>,
 }
 
 impl NewtonRun {
     /// Mean Newton iterations per converged step.
     pub fn iterations_per_step(&self) -> Real {
         self.iterations as Real / self.steps.max(1) as Real
+    }
+
+    /// The first extremum of the load factor along an arc-length path (a limit point in load; the path starts
+    /// at λ = 0 and rises, so a maximum), refined between the samples ([`crate::post::path::load_extrema`]);
+    /// `None` for time steps or a path whose load factor never turns.
+    pub fn first_limit_load_factor(&self) -> Option<Real> {
+        let mut path = vec![(0.0, 0.0)];
+        path.extend_from_slice(&self.load_path);
+        crate::post::path::load_extrema(&path)
+            .first()
+            .map(|&(_, l)| l)
     }
 
     /// `yes`, `cut` (completed with cuts) or `FAILED`.
@@ -91,10 +106,27 @@ pub fn newton_run(model: &Model) -> Result<NewtonRun, SolverError> {
     let mut run = watch.0;
     run.wall = started.elapsed().as_secs_f64();
     run.notices = sim.notices().to_vec();
+    run.final_probe = model
+        .probes
+        .first()
+        .map(|p| sim.probe_displacement(&p.location));
     match result {
         Ok(summary) => {
-            run.completed = !summary.stopped;
+            // An arc-length path that used its increments allowed before the end load factor did not complete.
+            let short = match model.solver.path {
+                crate::model::PathControl::ArcLength(a) => {
+                    sim.load_factor() != Some(a.end_load_factor)
+                }
+                crate::model::PathControl::Time => false,
+            };
+            run.completed = !summary.stopped && !short;
             run.cuts = summary.cuts;
+            if short {
+                run.failure = Some(format!(
+                    "the path ended at load factor {:.6} after its increments allowed",
+                    sim.load_factor().unwrap_or(0.0)
+                ));
+            }
         }
         Err(e) => {
             // A failed run returns no summary: its cuts are not known apart from the retries with a fresh
@@ -135,7 +167,7 @@ pub fn solver_csv(map: &SolverMap, header: &str) -> String {
     let _ = writeln!(s, "# {header}");
     let _ = writeln!(
         s,
-        "{},converged_without_cuts,completed,time_reached,steps,newton_iterations,iterations_per_step,max_step_iterations,cuts,failed_attempts,smallest_step,wall_s,failure",
+        "{},converged_without_cuts,completed,time_reached,steps,newton_iterations,iterations_per_step,max_step_iterations,cuts,failed_attempts,smallest_step,wall_s,first_limit_load_factor,failure",
         map.columns.join(",")
     );
     for p in &map.points {
@@ -143,7 +175,7 @@ pub fn solver_csv(map: &SolverMap, header: &str) -> String {
         let params: Vec<String> = p.parameters.iter().map(|v| format!("{v}")).collect();
         let _ = writeln!(
             s,
-            "{},{},{},{},{},{},{:.3},{},{},{},{:e},{:.3},{}",
+            "{},{},{},{},{},{},{:.3},{},{},{},{:e},{:.3},{},{}",
             params.join(","),
             r.completed && r.cuts == 0,
             r.completed,
@@ -156,6 +188,9 @@ pub fn solver_csv(map: &SolverMap, header: &str) -> String {
             r.failed_attempts,
             r.smallest_step,
             r.wall,
+            r.first_limit_load_factor()
+                .map(|l| format!("{l:.6}"))
+                .unwrap_or_default(),
             r.failure
                 .as_deref()
                 .map(|f| first_sentence(f).replace([',', '\n'], " "))
@@ -268,6 +303,8 @@ impl Observer for Watch {
         r.max_step_iterations = r.max_step_iterations.max(report.newton.iterations);
         r.smallest_step = r.smallest_step.min(report.dt);
         r.time = report.time;
+        r.load_path
+            .extend(report.load_factor.map(|l| (report.time, l)));
         ControlFlow::Continue(())
     }
 

@@ -23,6 +23,8 @@ pub mod designs {
     pub const ARCH: &str = include_str!("../../../designs/circular_arch.yaml");
     /// designs/straight_stent.yaml.
     pub const STRAIGHT_STENT: &str = include_str!("../../../designs/straight_stent.yaml");
+    /// designs/rollup.yaml.
+    pub const ROLLUP: &str = include_str!("../../../designs/rollup.yaml");
 }
 
 /// The 45° bend with each number of equal load steps.
@@ -164,6 +166,146 @@ pub fn release_map(
         ],
         points,
     })
+}
+
+/// An elastic design of the coarse-model map.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum CoarseDesign {
+    /// designs/bend45.yaml (10 load steps).
+    Bend45,
+    /// designs/rollup.yaml (20 load steps).
+    Rollup,
+}
+
+impl CoarseDesign {
+    /// The design's name and text.
+    fn source(self) -> (&'static str, &'static str) {
+        match self {
+            Self::Bend45 => ("bend45", designs::BEND45),
+            Self::Rollup => ("rollup", designs::ROLLUP),
+        }
+    }
+}
+
+/// Each `(design, p, n)` by its design's load steps and by arc length (its loads at the end scaled by a load
+/// factor, to λ = 1); the map's parameters are `design` (0 bend45, 1 rollup), `p`, `n` and `arc_length` (0/1).
+pub fn coarse_map(
+    cases: &[(CoarseDesign, usize, usize)],
+    mut progress: impl FnMut(&str),
+) -> Result<SolverMap, StudyError> {
+    let mut points = Vec::new();
+    for &(design, p, n) in cases {
+        let (name, text) = design.source();
+        let parsed = embedded(text, &format!("{name}.yaml"))?;
+        let remesh = Remesh {
+            degree: Some(p),
+            points: Some(n),
+            crowns: None,
+        };
+        let stepped = rebuild(&parsed, &remesh)?;
+        // Short arcs (the first 1 % of the load, growing at most fourfold) sample the path densely enough to
+        // locate its limit points to about 1e-3.
+        let mut arc = stepped.clone();
+        arc.time.step = arc.time.end / 100.0;
+        arc.time.min_step = arc.time.step / 1024.0;
+        arc.solver.path = crate::model::PathControl::ArcLength(crate::model::ArcLengthSettings {
+            max_growth: 4.0,
+            ..crate::model::ArcLengthSettings::default()
+        });
+        for (route, model) in [(0.0, &stepped), (1.0, &arc)] {
+            let run = newton_run(model)?;
+            progress(&format!(
+                "{name}, p = {p}, n = {n}, {}: {}",
+                if route == 0.0 {
+                    "load steps"
+                } else {
+                    "arc length"
+                },
+                describe(&run)
+            ));
+            points.push(SolverPoint {
+                parameters: vec![design as usize as Real, p as Real, n as Real, route],
+                run,
+            });
+        }
+    }
+    Ok(SolverMap {
+        name: "coarse",
+        columns: vec!["design", "p", "n", "arc_length"],
+        points,
+    })
+}
+
+/// The coarse map's files and paragraph: per run, the limit load factor of an arc-length path and how far the
+/// end state's probe (the tip) is from the finest completed load-stepped run of the same design.
+pub fn coarse_report(map: &SolverMap) -> MapReport {
+    let name = |d: Real| if d == 0.0 { "bend45" } else { "rollup" };
+    // The finest completed load-stepped run of each design: the reference end state.
+    let reference = |d: Real| {
+        map.points
+            .iter()
+            .filter(|q| q.parameters[0] == d && q.parameters[3] == 0.0 && q.run.completed)
+            .max_by(|a, b| (a.parameters[2]).total_cmp(&b.parameters[2]))
+            .and_then(|q| q.run.final_probe)
+    };
+    let mut summary = solver_summary(
+        map,
+        "coarse: coarse models by load steps and by arc length",
+        |p| {
+            let route = if p[3] == 0.0 {
+                "load steps"
+            } else {
+                "arc length"
+            };
+            let mut s = format!("{}, p = {}, n = {}, {route}", name(p[0]), p[1], p[2]);
+            let run = map
+                .points
+                .iter()
+                .find(|q| q.parameters == p)
+                .map(|q| &q.run);
+            if let Some(run) = run.filter(|_| p[3] == 1.0) {
+                match run.first_limit_load_factor() {
+                    Some(l) => {
+                        let _ = std::fmt::Write::write_fmt(
+                            &mut s,
+                            format_args!(" (the path's load factor peaks at {l:.4}, then falls"),
+                        );
+                    }
+                    None => s.push_str(" (the load factor rises monotonically"),
+                }
+                if let (Some(u), Some(r), true) = (run.final_probe, reference(p[0]), run.completed)
+                {
+                    let _ = std::fmt::Write::write_fmt(
+                        &mut s,
+                        format_args!(
+                            "; at λ = 1 the tip is {:.3} from the finest load-stepped run's, |u| = {:.3})",
+                            (u - r).norm(),
+                            r.norm()
+                        ),
+                    );
+                } else {
+                    s.push(')');
+                }
+            }
+            s
+        },
+    );
+    summary.push_str("A limit point of the coarse model's own path (its load factor peaks below 1 and falls) is where its load steps fail: no load step can pass it, whatever Newton does. Arc length passes it and then follows the coarse model's own path, which has little to do with the converged one: it reaches λ = 1 far from the converged tip, or wanders through further limit points until its increments run out. Such a coarse model is unresolved, not badly solved: refine it (the fine meshes here have no limit point). The limit load found by arc length and the failure time of the load steps differ slightly (bend45 p = 4, n = 10: 0.528 against 0.535) because a coarse discrete solution depends on the increments that reach it: at p = 4, n = 10 the bend's tip at half the load moves by 0.05 of its 39 between 5 and 20 load steps (2e-3 between 20 and 100), at p = 6, n = 20 by 1.1e-4 of 60 at the full load and at n = 80 by 2.5e-8, falling with refinement like a discretisation error.\n\n");
+    MapReport {
+        name: map.name,
+        csv: solver_csv(
+            map,
+            "coarse models of the elastic 45-degree bend (designs/bend45.yaml, design 0) and roll-up (designs/rollup.yaml, design 1), by load steps (arc_length 0) and arc length (1)",
+        ),
+        chart: solver_chart(
+            map,
+            "coarse models: Newton by load steps and by arc length",
+            2,
+            "control points per patch n",
+            &[0, 1, 3],
+        ),
+        summary,
+    }
 }
 
 /// The degree used with `n` control points in the release map: the design's `p = 6` at its `n = 20`, `p = 5`
