@@ -2,12 +2,12 @@
 //! output stood at that step ([`OutputsCheckpoint`]), from which `stentkit run --resume` continues a killed or
 //! interrupted run exactly.
 //!
-//! # Format (version 4; version 3 had no arc-length state, version 2 had 18 numbers per section law and no
+//! # Format (version 5; version 4 had no load factor per chart sample, version 3 no arc-length state, version 2 had 18 numbers per section law and no
 //! per-material recovery, version 1, before error-controlled stepping, no step-control memory)
 //!
 //! ```text
 //! magic     8 bytes   "STKCKPT\0"
-//! version   u32       4
+//! version   u32       5
 //! length    u64       bytes of the payload
 //! payload   …         the fields below, in order
 //! crc32     u32       CRC-32 (IEEE 802.3, as zlib and PNG) of everything before it
@@ -48,7 +48,7 @@ pub const FILE_NAME: &str = "checkpoint.bin";
 const MAGIC: &[u8; 8] = b"STKCKPT\0";
 
 /// The format version this build writes and reads.
-pub const VERSION: u32 = 4;
+pub const VERSION: u32 = 5;
 
 /// Bytes before the payload: magic, version, length.
 const HEADER: usize = 8 + 4 + 8;
@@ -590,6 +590,7 @@ fn encode_sample(e: &mut Encoder, s: &StateSample) {
     e.f64s(&s.residuals);
     e.usize(s.cuts);
     e.option(s.error_estimate.as_ref(), |e, v| e.f64(*v));
+    e.option(s.load_factor.as_ref(), |e, v| e.f64(*v));
     e.vec3s(&s.probes);
     e.option(s.recovery.as_ref(), |e, r| {
         e.f64(r.ratio_mean);
@@ -610,6 +611,7 @@ fn decode_sample(d: &mut Decoder<'_>) -> Result<StateSample, Problem> {
         residuals: d.f64s()?,
         cuts: d.usize()?,
         error_estimate: d.option(|d| d.f64())?,
+        load_factor: d.option(|d| d.f64())?,
         probes: d.vec3s()?,
         recovery: d.option(|d| {
             Ok(Recovery {
@@ -805,6 +807,7 @@ mod tests {
                 residuals: vec![1e-3, 1e-11],
                 cuts: 0,
                 error_estimate: Some(2.5e-4),
+                load_factor: Some(0.5),
                 probes: vec![Vec3::new(1.0, 2.0, 3.0)],
                 recovery: Some(Recovery {
                     ratio_mean: 0.5,

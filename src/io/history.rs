@@ -278,7 +278,7 @@ impl HistoryWriter {
             let u = sim.probe_displacement(&p.location);
             line.push_str(&format!(",{:.12e},{:.12e},{:.12e}", u.x, u.y, u.z));
         }
-        let temperature = sim.model().temperature.value(t);
+        let temperature = sim.model().temperature.value(sim.schedule_time());
         let (iterations, residual, cuts) = match report {
             Some(r) => (
                 r.newton.iterations,
@@ -290,7 +290,7 @@ impl HistoryWriter {
         line.push_str(&format!(
             ",{temperature:.6},{iterations},{residual:.3e},{cuts}"
         ));
-        if let Some((lo, hi)) = sim.temperature_extremes(t) {
+        if let Some((lo, hi)) = sim.temperature_extremes(sim.schedule_time()) {
             line.push_str(&format!(",{lo:.6},{hi:.6}"));
         }
         if sim.model().time.tolerance.is_some() {

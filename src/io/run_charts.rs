@@ -11,6 +11,8 @@
 //! * `recovery_by_material.svg` — the mean recovery ratio of each material region against time, with the
 //!   normalised temperature (devices of several materials: which part recovers first);
 //! * `delta_r.svg` — the mean radial contraction Δr against time (radial-contraction programmes);
+//! * `load_path.svg` — the load factor against every probe displacement component (arc-length runs: the
+//!   load–displacement curves, through limit points);
 //! * `newton.svg` — Newton iterations per step against time (every run);
 //! * `step_size.svg` — the step size and the time-error estimate over the tolerance against time, on log axes
 //!   (error-controlled runs, `time.tolerance`).
@@ -123,6 +125,30 @@ impl RunCharts {
             if !displacement.series.is_empty() {
                 charts.push(("displacement.svg", displacement));
                 charts.push(("normalised.svg", overlay));
+            }
+            if self.samples.iter().any(|s| s.load_factor.is_some()) {
+                let mut path = LineChart::new(
+                    format!("{name}: load factor against displacement"),
+                    format!("displacement [{length}]"),
+                    "load factor λ [-]",
+                );
+                for (p, probe) in model.probes.iter().enumerate() {
+                    for (c, axis) in ["ux", "uy", "uz"].iter().enumerate() {
+                        let points: Vec<(Real, Real)> = self
+                            .samples
+                            .iter()
+                            .map(|s| (s.probes[p][c], s.load_factor.unwrap_or(0.0)))
+                            .collect();
+                        if points.iter().all(|q| q.0 == 0.0) {
+                            continue;
+                        }
+                        path.series
+                            .push(Series::new(format!("{}.{axis}", probe.name), points));
+                    }
+                }
+                if !path.series.is_empty() {
+                    charts.push(("load_path.svg", path));
+                }
             }
         }
 

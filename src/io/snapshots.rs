@@ -320,7 +320,7 @@ impl SnapshotWriter {
         }
         self.configurations.push(Configuration {
             time,
-            temperature: model.temperature.value(time),
+            temperature: model.temperature.value(sim.schedule_time()),
             lines: device_centrelines(model, &current_device_shapes(sim, CENTRELINE_SAMPLES)),
         });
         Ok(())

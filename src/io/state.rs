@@ -198,6 +198,8 @@ pub struct StateSample {
     pub cuts: usize,
     /// The step's time-error estimate (error-controlled stepping), normalised as Newton's increments.
     pub error_estimate: Option<Real>,
+    /// The load factor (an arc-length path; `None` for time steps).
+    pub load_factor: Option<Real>,
     /// Displacement of every probe of the model, in its order [length].
     pub probes: Vec<Vec3>,
     /// Recovery measures, for a model with a programme.
@@ -213,12 +215,19 @@ impl StateSample {
             step: report.map_or(0, |r| r.step),
             time,
             dt: report.map_or(0.0, |r| r.dt),
-            temperature: model.temperature.value(time),
-            loads: channels.iter().map(|c| c.value(model, time)).collect(),
+            temperature: model.temperature.value(sim.schedule_time()),
+            loads: channels
+                .iter()
+                .map(|c| sim.load_scale() * c.value(model, sim.schedule_time()))
+                .collect(),
             iterations: report.map_or(0, |r| r.newton.iterations),
             residuals: report.map_or_else(Vec::new, |r| r.newton.residuals.clone()),
             cuts: report.map_or(0, |r| r.cuts),
             error_estimate: report.and_then(|r| r.error_estimate),
+            load_factor: match model.solver.path {
+                crate::model::PathControl::ArcLength(_) => Some(sim.load_scale()),
+                crate::model::PathControl::Time => None,
+            },
             probes: model
                 .probes
                 .iter()

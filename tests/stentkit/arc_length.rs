@@ -339,3 +339,57 @@ fn a_coarse_roll_up_fails_by_load_steps_at_a_limit_point_of_its_own_path() {
     );
     assert!((a - b).norm() < 1e-6 * a.norm(), "{a:?} against {b:?}");
 }
+
+/// The command line end to end on an arc-length design: the run folder's history has the load factor, ending at
+/// exactly 1 with the apex on the closed form's third branch (v = 2.2164652, bisection of the closed form;
+/// measured 4e-13 off, bound 1e-8: Newton's tolerance 1e-9 of the bar's length 10), the load–displacement chart
+/// is drawn, and the summary line names the load factor reached. (The folder is left for
+/// `scripts/check_outputs.py`, which reads every file with independent readers.)
+#[test]
+fn an_arc_length_run_writes_the_load_factor_and_its_load_path_chart() {
+    use crate::outputs::{design, run_ok, test_outputs, text};
+    let dir = test_outputs("arc_length_truss");
+    let out = run_ok(&design("von_mises_truss.yaml"), &dir, &[]);
+    assert!(
+        text(&out.stdout).contains("steps to load factor 1 (path parameter"),
+        "{}",
+        text(&out.stdout)
+    );
+    let history = std::fs::read_to_string(dir.join("history.csv")).expect("history.csv");
+    let header: Vec<&str> = history
+        .lines()
+        .next()
+        .expect("a header")
+        .split(',')
+        .collect();
+    assert_eq!(header[..2], ["time", "load_factor"]);
+    let uy = header
+        .iter()
+        .position(|h| *h == "apex.uy")
+        .expect("apex.uy");
+    let last: Vec<Real> = history
+        .lines()
+        .last()
+        .expect("rows")
+        .split(',')
+        .take(uy + 1)
+        .map(|x| x.parse().expect("a number"))
+        .collect();
+    assert_eq!(last[1], 1.0);
+    let mut v = (2.0, 3.0);
+    for _ in 0..60 {
+        let mid = 0.5 * (v.0 + v.1);
+        if truss_load(mid) < TRUSS_REFERENCE_LOAD {
+            v.0 = mid
+        } else {
+            v.1 = mid
+        }
+    }
+    assert!(
+        (-last[uy] - v.0).abs() < 1e-8,
+        "v = {} against {}",
+        -last[uy],
+        v.0
+    );
+    assert!(dir.join("charts/load_path.svg").is_file());
+}

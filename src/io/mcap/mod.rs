@@ -476,7 +476,7 @@ impl McapRecorder {
     fn centreline_message(&self, sim: &Simulation<'_>, log_time: u64) -> String {
         let shapes = current_device_shapes(sim, self.settings.centreline_points);
         let (lo, hi) = self.temperature_range;
-        let color = temperature_color(sim.model().temperature.value(sim.time()), lo, hi);
+        let color = temperature_color(sim.model().temperature.value(sim.schedule_time()), lo, hi);
         let mut lines = String::new();
         for (i, (points, thickness)) in device_centrelines(sim.model(), &shapes)
             .iter()

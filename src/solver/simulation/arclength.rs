@@ -106,6 +106,24 @@ impl Simulation<'_> {
         self.arc.as_ref().map(|a| a.load_factor)
     }
 
+    /// The time at which the model's schedules are read for the current state: its time, or `time.end` on an
+    /// arc-length path (whose loads are those at `time.end` scaled by the load factor, [`Self::load_scale`]).
+    pub fn schedule_time(&self) -> Real {
+        match self.model.solver.path {
+            PathControl::Time => self.time,
+            PathControl::ArcLength(_) => self.model.time.end,
+        }
+    }
+
+    /// The factor on the loads the schedules give at [`Self::schedule_time`]: 1, or an arc-length path's load
+    /// factor (0 before its first increment).
+    pub fn load_scale(&self) -> Real {
+        match self.model.solver.path {
+            PathControl::Time => 1.0,
+            PathControl::ArcLength(_) => self.load_factor().unwrap_or(0.0),
+        }
+    }
+
     /// Whether an arc-length run is over: the end load factor reached, or the increments allowed taken.
     pub(super) fn arc_length_finished(&self, settings: &ArcLengthSettings) -> bool {
         self.arc.as_ref().is_some_and(|a| a.reached_end) || self.step >= settings.max_increments

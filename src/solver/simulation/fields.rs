@@ -203,7 +203,7 @@ impl Simulation<'_> {
     /// along each patch).
     pub fn point_fields(&self) -> Vec<PointFields> {
         let (model, disc, state) = (self.model, &self.disc, &self.state);
-        let t = self.time;
+        let t = self.schedule_time();
         (0..disc.points.len())
             .map(|g| {
                 let point = &disc.points[g];
