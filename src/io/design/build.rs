@@ -195,7 +195,15 @@ pub fn build(dto: &DesignDto, default_name: &str) -> Result<Built> {
                 shortened: 0,
             }
         }
-        PathControl::Time => model.planned_steps(),
+        PathControl::Time => {
+            if dto.solver.as_ref().is_some_and(|s| s.arc_length.is_some()) {
+                return Err(issue(
+                    "solver.arc_length",
+                    "arc-length settings are given but the path is driven by time: add `path: arc-length` to `solver` (or remove `arc_length`)",
+                ));
+            }
+            model.planned_steps()
+        }
     };
     let memory = check_size(dto, &StepCount::planned(&plan, model.time.step, dto))?;
     if settings.tolerance.is_none()
