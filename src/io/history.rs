@@ -32,14 +32,6 @@ use std::path::{Path, PathBuf};
 /// The columns of `history.csv` that hold text (a patch's name) rather than numbers.
 pub const TEXT_COLUMNS: &[&str] = &["surface_strain_patch"];
 
-/// Whether the run follows its path by arc length (`history.csv` then has a `load_factor` column).
-fn arc_length(sim: &Simulation<'_>) -> bool {
-    matches!(
-        sim.model().solver.path,
-        crate::model::PathControl::ArcLength(_)
-    )
-}
-
 /// The materials with a strain limit, as `(material index, limit)`.
 fn limited_materials(strain_limits: &[Option<f64>]) -> Vec<(usize, f64)> {
     strain_limits
@@ -135,7 +127,7 @@ impl HistoryWriter {
         let limits = limited_materials(strain_limits);
         let mut out = BufWriter::new(File::create(path)?);
         let mut header = String::from("time");
-        if arc_length(sim) {
+        if sim.model().solver.path.arc_length().is_some() {
             header.push_str(",load_factor");
         }
         for p in &sim.model().probes {
@@ -271,7 +263,7 @@ impl HistoryWriter {
     fn row(&mut self, sim: &Simulation<'_>, report: Option<&StepReport>) -> ControlFlow<()> {
         let t = sim.time();
         let mut line = format!("{t:.10e}");
-        if arc_length(sim) {
+        if sim.model().solver.path.arc_length().is_some() {
             line.push_str(&format!(",{:.12e}", sim.load_factor().unwrap_or(0.0)));
         }
         for p in &sim.model().probes {

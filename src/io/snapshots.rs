@@ -52,9 +52,9 @@ impl SnapshotSchedule {
             every: settings.every,
             // An arc-length path's `time` is its path parameter, which passes `time.end` anywhere: its last state
             // is written by the writers' `finish`.
-            end: match model.solver.path {
-                crate::model::PathControl::Time => model.time.end,
-                crate::model::PathControl::ArcLength(_) => Real::INFINITY,
+            end: match model.solver.path.arc_length() {
+                None => model.time.end,
+                Some(_) => Real::INFINITY,
             },
             snap: crate::model::LANDING_TOLERANCE * model.time.step,
         }

@@ -324,6 +324,16 @@ pub enum PathControl {
     ArcLength(ArcLengthSettings),
 }
 
+impl PathControl {
+    /// The arc-length settings, when the path is driven by arc length.
+    pub fn arc_length(&self) -> Option<ArcLengthSettings> {
+        match self {
+            Self::ArcLength(a) => Some(*a),
+            Self::Time => None,
+        }
+    }
+}
+
 /// The arc-length constraint's form (Crisfield, *Non-linear Finite Element Analysis of Solids and Structures*,
 /// vol. 1, §9.3).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]

@@ -28,8 +28,9 @@
 //!
 //! **The end.** When an increment passes the end load factor, it is solved again from its start with the load
 //! factor held at the end value (a Newton solve at fixed load), so the path lands on it exactly; the run also
-//! ends after `max_increments`, with a notice. The run's "time" is the path parameter, the sum of the arc
-//! lengths (it grows, while λ may fall); [`super::StepReport::load_factor`] carries λ.
+//! ends after `max_increments`, with a notice. The run's "time" is the path parameter, the sum of the
+//! increments' `‖Δx‖` (the arc lengths of the cylindrical constraint; it grows while λ may fall);
+//! [`super::StepReport::load_factor`] carries λ.
 
 use super::newton::NewtonFailure;
 use super::report::NewtonReport;
@@ -39,6 +40,7 @@ use crate::math::Real;
 use crate::model::{ArcConstraint, ArcLengthSettings, PathControl};
 use crate::solver::SolverError;
 use crate::solver::assembly::Actions;
+use crate::solver::state::State;
 
 /// Where an arc-length run is on its path.
 #[derive(Debug, Clone, PartialEq, Default)]
@@ -95,10 +97,7 @@ fn constraint_root(a: Real, b: Real, c: Real, better: impl Fn(Real) -> Real) -> 
 impl Simulation<'_> {
     /// The arc-length settings, when the path is driven by arc length.
     pub(super) fn arc_length_settings(&self) -> Option<ArcLengthSettings> {
-        match self.model.solver.path {
-            PathControl::ArcLength(a) => Some(a),
-            PathControl::Time => None,
-        }
+        self.model.solver.path.arc_length()
     }
 
     /// The load factor of the current state (arc-length runs; `None` for time-driven ones).
@@ -235,18 +234,15 @@ impl Simulation<'_> {
                     return Ok(StepOutcome::Stepped(report));
                 }
                 Err(NewtonFailure::Fatal(e)) => {
-                    self.state = start;
-                    self.forget_factorisations();
+                    self.abandon_increment(start);
                     return Err(e);
                 }
                 Err(NewtonFailure::Interrupted) => {
-                    self.state = start;
-                    self.forget_factorisations();
+                    self.abandon_increment(start);
                     return Ok(StepOutcome::Interrupted);
                 }
                 Err(NewtonFailure::NotConverged(newton)) => {
-                    self.state = start;
-                    self.forget_factorisations();
+                    self.abandon_increment(start);
                     observer.step_failed(self.time + state.arc, state.arc, &newton);
                     if state.arc <= state.first_arc * min_ratio * (1.0 + 1e-12) {
                         return Err(SolverError::StepFailed {
@@ -329,7 +325,7 @@ impl Simulation<'_> {
                 .zip(&self.lin.residual)
                 .map(|(s, r)| -(s - r))
                 .collect();
-            self.active_system().0.solve_in_place(&mut dx_q);
+            self.solve_in_place(&mut dx_q);
             let predictor = report.iterations == 0;
             let dl = if predictor {
                 match constraint {
@@ -405,9 +401,10 @@ impl Simulation<'_> {
         }
     }
 
-    /// Forgets the factorisations and the materials' step after an abandoned increment (they belong to its
-    /// iterates).
-    fn forget_factorisations(&mut self) {
+    /// Undoes an abandoned increment: back to its start state `start`, the materials' step rolled back and the
+    /// factorisations forgotten (they belong to its iterates).
+    fn abandon_increment(&mut self, start: State) {
+        self.state = start;
         self.materials.roll_back(&self.model.materials);
         self.system.invalidate();
         self.tangent.invalidate();

@@ -304,12 +304,18 @@ impl Simulation<'_> {
     /// Solves for the Newton increment `δ = −K⁻¹ r` of the last assembled residual with the last factorisation,
     /// into `self.delta`.
     pub(super) fn solve_increment(&mut self) {
-        let start = Instant::now();
         let mut delta = std::mem::take(&mut self.delta);
         delta.clear();
         delta.extend(self.lin.residual.iter().map(|r| -r));
-        self.active_system().0.solve_in_place(&mut delta);
+        self.solve_in_place(&mut delta);
         self.delta = delta;
+    }
+
+    /// Solves the last factorised system for the right-hand side in `rhs`, in place (counted in
+    /// [`SolverTiming::solve`]).
+    pub(super) fn solve_in_place(&mut self, rhs: &mut [Real]) {
+        let start = Instant::now();
+        self.active_system().0.solve_in_place(rhs);
         SolverTiming::add(&mut self.timing.solve, start);
     }
 

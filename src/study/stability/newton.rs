@@ -113,12 +113,11 @@ pub fn newton_run(model: &Model) -> Result<NewtonRun, SolverError> {
     match result {
         Ok(summary) => {
             // An arc-length path that used its increments allowed before the end load factor did not complete.
-            let short = match model.solver.path {
-                crate::model::PathControl::ArcLength(a) => {
-                    sim.load_factor() != Some(a.end_load_factor)
-                }
-                crate::model::PathControl::Time => false,
-            };
+            let short = model
+                .solver
+                .path
+                .arc_length()
+                .is_some_and(|a| sim.load_factor() != Some(a.end_load_factor));
             run.completed = !summary.stopped && !short;
             run.cuts = summary.cuts;
             if short {

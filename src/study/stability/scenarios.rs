@@ -13,6 +13,7 @@ use crate::math::Real;
 use crate::model::TimeFunction;
 use crate::study::variant::{Remesh, TimeVariant, rebuild};
 use crate::study::{StudyError, positive};
+use std::fmt::Write as _;
 use std::path::Path;
 
 /// The designs the solver maps use, embedded so that the command runs from any folder.
@@ -266,22 +267,17 @@ pub fn coarse_report(map: &SolverMap) -> MapReport {
             if let Some(run) = run.filter(|_| p[3] == 1.0) {
                 match run.first_limit_load_factor() {
                     Some(l) => {
-                        let _ = std::fmt::Write::write_fmt(
-                            &mut s,
-                            format_args!(" (the path's load factor peaks at {l:.4}, then falls"),
-                        );
+                        let _ = write!(s, " (the path's load factor peaks at {l:.4}, then falls");
                     }
                     None => s.push_str(" (the load factor rises monotonically"),
                 }
                 if let (Some(u), Some(r), true) = (run.final_probe, reference(p[0]), run.completed)
                 {
-                    let _ = std::fmt::Write::write_fmt(
-                        &mut s,
-                        format_args!(
-                            "; at λ = 1 the tip is {:.3} from the finest load-stepped run's, |u| = {:.3})",
-                            (u - r).norm(),
-                            r.norm()
-                        ),
+                    let _ = write!(
+                        s,
+                        "; at λ = 1 the tip is {:.3} from the finest load-stepped run's, |u| = {:.3})",
+                        (u - r).norm(),
+                        r.norm()
                     );
                 } else {
                     s.push(')');
