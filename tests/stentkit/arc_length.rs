@@ -393,3 +393,18 @@ fn an_arc_length_run_writes_the_load_factor_and_its_load_path_chart() {
     );
     assert!(dir.join("charts/load_path.svg").is_file());
 }
+
+/// An arc-length design without any load has no path: the run fails at once and says why (it used to fail with
+/// a non-finite residual blamed on a support's equation).
+#[test]
+fn an_arc_length_path_without_a_load_says_so() {
+    let text = replace_line(
+        &design_text("von_mises_truss.yaml"),
+        "force:",
+        "force: [free, 0, free]",
+    );
+    let model = model_from_text(&text, "unloaded.yaml");
+    let mut sim = Simulation::new(&model).expect("valid");
+    let error = sim.step().expect_err("no path").to_string();
+    assert!(error.contains("the reference load is zero"), "{error}");
+}

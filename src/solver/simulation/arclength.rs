@@ -332,6 +332,10 @@ impl Simulation<'_> {
                     Constraint::Load(target) => target - lambda0,
                     Constraint::Arc(arc) => {
                         let qq = self.arc_dot(&dx_q, &dx_q);
+                        if !(qq + psi2 > 0.0) {
+                            report.diagnosis = Some("the reference load is zero (no load or prescribed value differs from zero at `time.end`): arc-length continuation has no path to follow".into());
+                            return Err(NewtonFailure::NotConverged(report));
+                        }
                         let arc = if arc > 0.0 {
                             arc
                         } else {
