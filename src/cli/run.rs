@@ -226,6 +226,15 @@ impl Outputs {
                 control.smallest_step = 0.0;
             }
         }
+        if let Some(summary) = &mut s.stabilisation {
+            let st = sim.stabilisation();
+            summary.damped_steps = st.damped_steps;
+            summary.dissipated_energy = st.dissipated;
+            summary.peak_strain_energy = st.peak_strain_energy;
+            summary.ratio = st.ratio();
+            summary.largest_step_ratio = st.largest_step_ratio;
+            summary.above_limit = st.ratio() > summary.limit;
+        }
         s.final_time = sim.time();
         s.snapshots = self.snapshots.snapshots().iter().map(Into::into).collect();
         s.final_state = self

@@ -2,12 +2,12 @@
 //! output stood at that step ([`OutputsCheckpoint`]), from which `stentkit run --resume` continues a killed or
 //! interrupted run exactly.
 //!
-//! # Format (version 5; version 4 had no load factor per chart sample, version 3 no arc-length state, version 2 had 18 numbers per section law and no
+//! # Format (version 6; version 5 had no stabiliser state, version 4 no load factor per chart sample, version 3 no arc-length state, version 2 had 18 numbers per section law and no
 //! per-material recovery, version 1, before error-controlled stepping, no step-control memory)
 //!
 //! ```text
 //! magic     8 bytes   "STKCKPT\0"
-//! version   u32       5
+//! version   u32       6
 //! length    u64       bytes of the payload
 //! payload   …         the fields below, in order
 //! crc32     u32       CRC-32 (IEEE 802.3, as zlib and PNG) of everything before it
@@ -17,7 +17,7 @@
 //! back exactly; a `usize` is a `u64`; a vector or string is its length (`u64`) then its items; an option is a
 //! byte 0/1 then the value. The payload is the model fingerprint of the outputs' settings, the solver's
 //! checkpoint (time, step, step control, state, materials, ramps, gauge, tangent origin, notices, timing, arc-length
-//! state) and the outputs'
+//! state, stabiliser) and the outputs'
 //! positions, in the order [`write()`] writes them.
 //!
 //! Why this format: a checkpoint must restore every number bit for bit (a text format would need round-trip
@@ -36,7 +36,7 @@ use crate::material::LAW_NUMBERS;
 use crate::math::{Mat3, Real, Vec3};
 use crate::solver::assembly::{Actions, ReleaseRamp};
 use crate::solver::simulation::adaptive::StepControl;
-use crate::solver::simulation::{ArcState, TangentOrigin};
+use crate::solver::simulation::{ArcState, StabiliserState, TangentOrigin};
 use crate::solver::state::State;
 use crate::solver::{Checkpoint, RunSummary, SolverTiming};
 use std::path::{Path, PathBuf};
@@ -48,7 +48,7 @@ pub const FILE_NAME: &str = "checkpoint.bin";
 const MAGIC: &[u8; 8] = b"STKCKPT\0";
 
 /// The format version this build writes and reads.
-pub const VERSION: u32 = 5;
+pub const VERSION: u32 = 6;
 
 /// Bytes before the payload: magic, version, length.
 const HEADER: usize = 8 + 4 + 8;
@@ -530,6 +530,15 @@ fn encode_solver(e: &mut Encoder, c: &Checkpoint) {
         });
         e.bool(a.reached_end);
     });
+    let s = &c.stabiliser;
+    e.option(s.factor.as_ref(), |e, f| e.f64(*f));
+    e.usize(s.escalations);
+    e.f64(s.base_factor);
+    e.f64(s.dissipated);
+    e.f64(s.peak_strain_energy);
+    e.f64(s.largest_step_ratio);
+    e.usize(s.damped_steps);
+    e.bool(s.warned);
 }
 
 fn decode_solver(d: &mut Decoder<'_>) -> Result<Checkpoint, Problem> {
@@ -577,6 +586,16 @@ fn decode_solver(d: &mut Decoder<'_>) -> Result<Checkpoint, Problem> {
                 reached_end: d.bool()?,
             })
         })?,
+        stabiliser: StabiliserState {
+            factor: d.option(|d| d.f64())?,
+            escalations: d.usize()?,
+            base_factor: d.f64()?,
+            dissipated: d.f64()?,
+            peak_strain_energy: d.f64()?,
+            largest_step_ratio: d.f64()?,
+            damped_steps: d.usize()?,
+            warned: d.bool()?,
+        },
     })
 }
 
@@ -773,6 +792,16 @@ mod tests {
                 previous: Some((vec![1.5; 12], -0.5)),
                 reached_end: false,
             }),
+            stabiliser: StabiliserState {
+                factor: Some(2.5e-6),
+                escalations: 2,
+                base_factor: 2.5e-8,
+                dissipated: 0.125,
+                peak_strain_energy: 3.5,
+                largest_step_ratio: 0.01,
+                damped_steps: 7,
+                warned: true,
+            },
         };
         let outputs = OutputsCheckpoint {
             settings: 42,

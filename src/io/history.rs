@@ -6,6 +6,10 @@
 //! With error-controlled stepping (`time.tolerance`) it adds `dt` (the step taken), `error_estimate` (its
 //! time-error estimate, normalised as Newton's increments; 0 for a material without internal variables) and
 //! `rejected` (attempts rejected by error control before it).
+//! With automatic stabilisation (`solver.stabilisation`) it adds `stabilisation_factor` (the damping factor `c`
+//! of the step, 0 when undamped), `strain_energy` (at the step's end), `dissipated_energy` (by the damping since
+//! the start) and `dissipated_ratio` (that over the largest strain energy so far;
+//! [`crate::solver::simulation::stabilisation`]).
 //! A design with a programme (stents) adds `recovery_ratio_mean` and `recovery_ratio_max`, the mean (weighted
 //! over the full device) and largest `‖η_l‖ / ‖η_temp,l‖` over the driven nodes — 1 at the temporary shape, 0 at
 //! the permanent one — and, for a radial contraction, `delta_r`: the mean radial contraction of the driven
@@ -141,6 +145,10 @@ impl HistoryWriter {
         }
         if sim.model().time.tolerance.is_some() {
             header.push_str(",dt,error_estimate,rejected");
+        }
+        if sim.model().solver.stabilisation.is_some() {
+            header
+                .push_str(",stabilisation_factor,strain_energy,dissipated_energy,dissipated_ratio");
         }
         if let Some(programme) = &sim.model().programme {
             header.push_str(",recovery_ratio_mean,recovery_ratio_max");
@@ -290,6 +298,17 @@ impl HistoryWriter {
                 (r.dt, r.error_estimate.unwrap_or(0.0), r.rejected)
             });
             line.push_str(&format!(",{dt:.6e},{estimate:.3e},{rejected}"));
+        }
+        if sim.model().solver.stabilisation.is_some() {
+            let s = report.and_then(|r| r.stabilisation);
+            let factor = s.map_or(0.0, |s| s.factor);
+            let energy = s.map_or_else(|| sim.strain_energy(), |s| s.strain_energy);
+            let totals = sim.stabilisation();
+            line.push_str(&format!(
+                ",{factor:.6e},{energy:.9e},{:.9e},{:.6e}",
+                totals.dissipated,
+                totals.ratio()
+            ));
         }
         if let Some(r) = super::state::recovery(sim) {
             line.push_str(&format!(",{:.9e},{:.9e}", r.ratio_mean, r.ratio_max));

@@ -313,6 +313,9 @@ pub struct RunSummaryFile {
     /// Error-controlled stepping, when the design asks for it (`time.tolerance`).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub time_error_control: Option<TimeErrorControl>,
+    /// Automatic stabilisation, when the design asks for it (`solver.stabilisation`).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub stabilisation: Option<StabilisationSummary>,
     /// Time reached [s].
     pub final_time: Real,
     /// End time of the design [s].
@@ -366,6 +369,28 @@ pub struct TimeErrorControl {
     pub largest_step: Real,
 }
 
+/// What automatic stabilisation did (`summary.json` `stabilisation`;
+/// [`crate::solver::simulation::stabilisation`]).
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct StabilisationSummary {
+    /// The dissipated-energy fraction the damping factor aims at.
+    pub dissipated_fraction: Real,
+    /// The limit on `ratio` above which the run is warned to be not quasi-static.
+    pub limit: Real,
+    /// Steps taken with the damping on.
+    pub damped_steps: usize,
+    /// Energy the damping dissipated [energy].
+    pub dissipated_energy: Real,
+    /// The largest strain energy of the run's states [energy].
+    pub peak_strain_energy: Real,
+    /// `dissipated_energy / peak_strain_energy`.
+    pub ratio: Real,
+    /// The largest ratio of one step's dissipated energy to the strain energy at its end.
+    pub largest_step_ratio: Real,
+    /// Whether `ratio` exceeds `limit`.
+    pub above_limit: bool,
+}
+
 impl RunSummaryFile {
     /// The summary of a run of `model` that is starting: `"status": "running"`, nothing done yet.
     pub fn start(
@@ -401,6 +426,16 @@ impl RunSummaryFile {
                 largest_estimate: 0.0,
                 smallest_step: 0.0,
                 largest_step: 0.0,
+            }),
+            stabilisation: model.solver.stabilisation.map(|s| StabilisationSummary {
+                dissipated_fraction: s.dissipated_fraction,
+                limit: s.limit,
+                damped_steps: 0,
+                dissipated_energy: 0.0,
+                peak_strain_energy: 0.0,
+                ratio: 0.0,
+                largest_step_ratio: 0.0,
+                above_limit: false,
             }),
             final_time: 0.0,
             end_time: model.time.end,

@@ -377,6 +377,38 @@ impl Default for ArcLengthSettings {
     }
 }
 
+/// Automatic stabilisation of time-driven runs (issue 18): where Newton stalls — a release snap, a buckling
+/// bridge, a limit point of a load that is not a free parameter — the equilibrium equations gain a viscous
+/// force `−c A (x − xₙ)/h` and couple `−c J Θ/h` per unit length (the section's area and second moments as
+/// the mass of a unit density; `Θ` the rotation since the last converged state), as Abaqus's `*STATIC,
+/// STABILIZE` does. The factor `c` is chosen so that the first damped step would dissipate
+/// `dissipated_fraction` of the strain energy if it moved as Newton's first (undamped) increment says, and
+/// made ten times larger while the damped step still fails. The damping stays on while a step dissipates more
+/// than that fraction, and the dissipated energy is reported per step and for the run, with a warning when
+/// it exceeds `limit` of the largest strain energy the run reached (the result is then not quasi-static).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct StabilisationSettings {
+    /// Dissipated energy aimed at by the first damped step, as a fraction of the strain energy.
+    pub dissipated_fraction: Real,
+    /// The run's dissipated energy above this fraction of its largest strain energy is warned about.
+    pub limit: Real,
+    /// A damping factor `c` \[1/time\] given outright, instead of the energy rule.
+    pub factor: Option<Real>,
+}
+
+impl Default for StabilisationSettings {
+    /// Abaqus's defaults: a dissipated-energy fraction of 2e-4 (`*STATIC, STABILIZE`) and an accuracy
+    /// tolerance of 0.05 on the ratio of stabilisation to strain energy (adaptive stabilisation), Abaqus
+    /// Analysis User's Guide §7.1.1 "Automatic stabilization of static problems".
+    fn default() -> Self {
+        Self {
+            dissipated_fraction: 2e-4,
+            limit: 0.05,
+            factor: None,
+        }
+    }
+}
+
 /// Newton settings.
 #[derive(Debug, Clone, PartialEq)]
 pub struct SolverSettings {
@@ -406,6 +438,9 @@ pub struct SolverSettings {
     pub linear: LinearMethod,
     /// What drives the path: time, or the load factor under an arc-length constraint.
     pub path: PathControl,
+    /// Viscous regularisation where Newton stalls (time-driven paths only); `None`: off (the default: a run
+    /// that converges is exactly quasi-static, and a stall cuts the step).
+    pub stabilisation: Option<StabilisationSettings>,
 }
 
 impl Default for SolverSettings {
@@ -422,6 +457,7 @@ impl Default for SolverSettings {
             extrapolate: false,
             linear: LinearMethod::Block,
             path: PathControl::Time,
+            stabilisation: None,
         }
     }
 }

@@ -32,7 +32,7 @@ use super::discretisation::{CollocationPoint, Discretisation};
 use super::gauge::Gauge;
 use super::state::State;
 use crate::material::{ConstitutiveLaw, SectionLaw, SectionStrains};
-use crate::math::so3::{hat, log};
+use crate::math::so3::{hat, log, right_jacobian_inverse};
 use crate::math::{Mat3, Real, Rot3, Vec3};
 use crate::model::{Component, Model};
 use rayon::prelude::*;
@@ -200,6 +200,36 @@ impl StepMaterial<'_> {
     }
 }
 
+/// Viscous regularisation of the equilibrium equations ([`crate::model::StabilisationSettings`], issue 18):
+/// at every interior collocation point a force density `−c A (x − xₙ)/h` (spatial) and a couple density
+/// `−c J Θ/h` (material, `Θ = log(Rₙᵀ R)`) oppose the motion since the last converged state `xₙ, Rₙ`, with
+/// the section's area `A` and its second moments `J = diag(I₂ + I₃, I₂, I₃)` as the mass of a unit density
+/// (Abaqus's automatic stabilisation scales its damping by such an artificial mass matrix).
+#[derive(Debug, Clone, Copy)]
+pub struct Damping<'a> {
+    /// The last converged state.
+    pub previous: &'a State,
+    /// `c / h`, the damping factor over the step \[1/time²\] (per unit density).
+    pub rate: Real,
+}
+
+impl Damping<'_> {
+    /// The unit-density translational mass `A` and rotational mass `diag(I₂ + I₃, I₂, I₃)` of a section shape.
+    pub fn masses(shape: &crate::material::SectionShape) -> (Real, Vec3) {
+        let (i2, i3) = (shape.moment.y, shape.moment.z);
+        (shape.force.x, Vec3::new(i2 + i3, i2, i3))
+    }
+
+    /// The motion of collocation point `g` since the last converged state: `(x − xₙ, Θ)` with `Θ = log(Rₙᵀ R)`
+    /// (material).
+    pub fn motion(&self, disc: &Discretisation, state: &State, g: usize) -> (Vec3, Vec3) {
+        let dx = point_position(disc, &state.control, g)
+            - point_position(disc, &self.previous.control, g);
+        let relative = self.previous.rotation[g].transpose() * state.rotation[g];
+        (dx, log(&Rot3::from_matrix_unchecked(relative)))
+    }
+}
+
 /// One end of a node, as the node equations see it.
 #[derive(Debug, Clone, PartialEq)]
 struct NodeEnd {
@@ -332,6 +362,7 @@ impl Assembler {
         state: &State,
         material: StepMaterial<'_>,
         actions: &Actions,
+        damping: Option<Damping<'_>>,
         gauge: Option<&Gauge>,
         lin: &mut Linearisation,
         sink: &mut Sink<'_>,
@@ -365,7 +396,8 @@ impl Assembler {
                     let mut sink = Sink::Values { values, next: 0 };
                     let point = &disc.points[g];
                     self.interior(
-                        disc, state, material, actions, g, point, residual, scale, &mut sink,
+                        disc, state, material, actions, damping, g, point, residual, scale,
+                        &mut sink,
                     );
                     if let Sink::Values { values, next } = sink {
                         debug_assert_eq!(
@@ -382,7 +414,7 @@ impl Assembler {
                     let (residual, scale) =
                         (&mut lin.residual[rows.clone()], &mut lin.row_scale[rows]);
                     self.interior(
-                        disc, state, material, actions, g, point, residual, scale, sink,
+                        disc, state, material, actions, damping, g, point, residual, scale, sink,
                     );
                 }
             }
@@ -473,6 +505,7 @@ impl Assembler {
         state: &State,
         material: StepMaterial<'_>,
         actions: &Actions,
+        damping: Option<Damping<'_>>,
         g: usize,
         point: &CollocationPoint,
         residual: &mut [Real],
@@ -493,15 +526,28 @@ impl Assembler {
         let K_s = state.kappa_s[g];
         let R = &state.rotation[g];
         let Rt = R.transpose();
-        let nbar = Rt * actions.dist_force[point.patch];
-        let mbar = Rt * actions.dist_couple[point.patch];
+        let shape = &disc.shapes[point.shape];
+        // Viscous regularisation: a spatial force density (it joins the distributed load, whose rotation
+        // derivative `hat(n̄)` the tangent has) and a material couple density (its own tangent below).
+        let mut force_density = actions.dist_force[point.patch];
+        let mut viscous = None;
+        if let Some(d) = damping {
+            let (area, inertia) = Damping::masses(shape);
+            let (dx, theta) = d.motion(disc, state, g);
+            force_density -= dx * (d.rate * area);
+            viscous = Some((d.rate * area, theta, inertia * d.rate));
+        }
+        let nbar = Rt * force_density;
+        let mut mbar = Rt * actions.dist_couple[point.patch];
+        if let Some((_, theta, c_inertia)) = viscous {
+            mbar -= c_inertia.component_mul(&theta);
+        }
         let F = K.cross(&N) + N_s + nbar;
         let T = K.cross(&M) + M_s + k.gamma.cross(&N) + mbar;
         let row = 6 * g;
         residual[..3].copy_from_slice(F.as_slice());
         residual[3..6].copy_from_slice(T.as_slice());
         let length = self.patch_length[point.patch];
-        let shape = &disc.shapes[point.shape];
         let modulus_scale = self.modulus_scale[point.patch];
         let force_scale = modulus_scale * shape.force.x / length;
         let moment_scale = modulus_scale * shape.moment.y / (length * length);
@@ -517,7 +563,19 @@ impl Assembler {
         let mut f_eta_s = (Kt * CN - CN * Kt) * Rt;
         let f_eta_ss = CN * Rt;
         let ng = -Nt + Gt * CN;
-        let mut t_th = -Mt * Kt + Kt * CM * Kt + CM * hat(&K_s) + ng * Gt + hat(&mbar);
+        // (The damping couple is material, not `Rᵀ m̄`: it is taken out of `hat(m̄)` and linearised as
+        // `δΘ = T(Θ)⁻¹ δθ`, the right trivialisation of `log(Rₙᵀ R exp(δθ̃))`.)
+        let material_couple =
+            viscous.map_or(Vec3::zeros(), |(_, theta, c)| -c.component_mul(&theta));
+        let mut t_th =
+            -Mt * Kt + Kt * CM * Kt + CM * hat(&K_s) + ng * Gt + hat(&(mbar - material_couple));
+        if let Some((_, theta, c_inertia)) = viscous {
+            t_th -= Mat3::from_diagonal(&c_inertia) * right_jacobian_inverse(&theta);
+        }
+        let mut f_eta = Mat3::zeros();
+        if let Some((c_area, ..)) = viscous {
+            f_eta = -Rt * c_area;
+        }
         let mut t_th_s = -Mt + Kt * CM + CM * Kt;
         if let Some((CN_s, CM_s)) = law.stiffness_slope_matrices() {
             // A modulus varying along s: N,s gains C̄_N,s δΓ = C̄_N,s (Γ × δΘ + Rᵀ δη,s), M,s gains C̄_M,s δK =
@@ -531,7 +589,7 @@ impl Assembler {
         let t_eta_s = ng * Rt;
         for (a, b) in point.basis.iter().enumerate() {
             let col = 6 * (point.first + a);
-            sink.block(row, col, &(f_eta_s * b[1] + f_eta_ss * b[2]));
+            sink.block(row, col, &(f_eta * b[0] + f_eta_s * b[1] + f_eta_ss * b[2]));
             sink.block(row, col + 3, &(f_th * b[0] + f_th_s * b[1]));
             sink.block(row + 3, col, &(t_eta_s * b[1]));
             sink.block(

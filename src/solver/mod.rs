@@ -19,7 +19,8 @@ pub mod state;
 
 pub use simulation::{
     Checkpoint, CheckpointError, NewtonReport, Observer, Observers, PeakSurfaceStrain, PointFields,
-    RunSummary, Simulation, SolverTiming, StepOutcome, StepReport,
+    RunSummary, Simulation, SolverTiming, StabiliserState, StepOutcome, StepReport,
+    StepStabilisation,
 };
 
 use crate::geometry::GeometryError;

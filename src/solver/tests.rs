@@ -1,7 +1,7 @@
 //! Unit tests of the solver internals: the consistent tangent against central differences of the residual,
 //! and Newton's quadratic convergence.
 
-use super::assembly::{Actions, Assembler, Linearisation, Sink, StepMaterial};
+use super::assembly::{Actions, Assembler, Damping, Linearisation, Sink, StepMaterial};
 use super::discretisation::Discretisation;
 use super::state::State;
 use crate::material::{CircularSection, ConstitutiveLaw, ElasticLaw, SectionLaw};
@@ -74,6 +74,7 @@ fn dense_tangent(
     state: &State,
     material: StepMaterial<'_>,
     actions: &Actions,
+    damping: Option<Damping<'_>>,
 ) -> Vec<Vec<Real>> {
     let n = disc.num_unknowns();
     let mut pattern = Vec::new();
@@ -83,6 +84,7 @@ fn dense_tangent(
         state,
         material,
         actions,
+        damping,
         None,
         &mut lin,
         &mut Sink::Pattern(&mut pattern),
@@ -93,6 +95,7 @@ fn dense_tangent(
         state,
         material,
         actions,
+        damping,
         None,
         &mut lin,
         &mut Sink::Values {
@@ -113,6 +116,7 @@ fn residual(
     state: &State,
     material: StepMaterial<'_>,
     actions: &Actions,
+    damping: Option<Damping<'_>>,
 ) -> Vec<Real> {
     let mut lin = Linearisation::default();
     asm.assemble(
@@ -120,6 +124,7 @@ fn residual(
         state,
         material,
         actions,
+        damping,
         None,
         &mut lin,
         &mut Sink::Discard,
@@ -145,7 +150,32 @@ fn tangent_matches_central_differences_of_the_residual() {
             law.section_law(&law.new_state(vec![disc.shapes[p.shape]]), 0)
         })
         .collect();
-    check_tangent(&model, &disc, &laws);
+    check_tangent(&model, &disc, &laws, None);
+}
+
+// Source: as above, with the viscous regularisation of automatic stabilisation (issue 18): the residual gains
+// `−c A (x − xₙ)/h` and `−c J log(Rₙᵀ R)/h` at the interior points, measured from the reference state as the
+// last converged one. `c/h = 1e5` makes the damping force (`1e5 · A · 0.05 ≈ 40`) and couple (`1e5 · 2I · 0.3 ≈
+// 0.3`) of the order of the structure's own residual terms, so a wrong or missing term would show as an O(1)
+// relative error. Same reference and tolerance.
+#[test]
+fn tangent_matches_central_differences_with_viscous_damping() {
+    let model = test_model();
+    let disc = Discretisation::new(&model).expect("discretisation");
+    let laws: Vec<SectionLaw> = disc
+        .points
+        .iter()
+        .map(|p| {
+            let law = &model.materials[model.patches[p.patch].material];
+            law.section_law(&law.new_state(vec![disc.shapes[p.shape]]), 0)
+        })
+        .collect();
+    let previous = State::reference(&disc);
+    let damping = Damping {
+        previous: &previous,
+        rate: 1e5,
+    };
+    check_tangent(&model, &disc, &laws, Some(damping));
 }
 
 // Source: as above, where the temperature varies along the rods: every point's law has a modulus slope `Ē,s`
@@ -174,12 +204,17 @@ fn tangent_matches_central_differences_with_a_modulus_varying_along_the_rod() {
         })
         .collect();
     assert!(laws.iter().all(|l| l.stiffness_slope_matrices().is_some()));
-    check_tangent(&model, &disc, &laws);
+    check_tangent(&model, &disc, &laws, None);
 }
 
 /// The tangent of `model` with the section laws `laws` against central differences of its residual (see the
 /// tests' sources).
-fn check_tangent(model: &Model, disc: &Discretisation, laws: &[SectionLaw]) {
+fn check_tangent(
+    model: &Model,
+    disc: &Discretisation,
+    laws: &[SectionLaw],
+    damping: Option<Damping<'_>>,
+) {
     let asm = Assembler::new(model, disc);
     let actions = Actions::at(model, 1.0, &[]);
     let material = StepMaterial { laws };
@@ -197,7 +232,7 @@ fn check_tangent(model: &Model, disc: &Discretisation, laws: &[SectionLaw]) {
         })
         .collect();
     state.apply_increment(disc, &delta);
-    let k = dense_tangent(disc, &asm, &state, material, &actions);
+    let k = dense_tangent(disc, &asm, &state, material, &actions, damping);
     let eps = 1e-6;
     let mut worst: Real = 0.0;
     let mut report = Vec::new();
@@ -209,8 +244,8 @@ fn check_tangent(model: &Model, disc: &Discretisation, laws: &[SectionLaw]) {
         plus.apply_increment(disc, &e);
         e[j] = -eps;
         minus.apply_increment(disc, &e);
-        let rp = residual(disc, &asm, &plus, material, &actions);
-        let rm = residual(disc, &asm, &minus, material, &actions);
+        let rp = residual(disc, &asm, &plus, material, &actions, damping);
+        let rm = residual(disc, &asm, &minus, material, &actions, damping);
         for i in 0..n {
             let fd = (rp[i] - rm[i]) / (2.0 * eps);
             let row_scale = k[i].iter().fold(0.0_f64, |m, v| m.max(v.abs())).max(1e-300);

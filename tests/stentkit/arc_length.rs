@@ -300,7 +300,9 @@ fn an_arc_length_path_continues_bit_for_bit_from_a_checkpoint() {
 /// its increments measured on the coarse bend, 0.528 against 0.535) and passes it, while the
 /// converged mesh (p = 6, n = 30) has no limit point and both routes end at the same tip (source: the two
 /// routes solve the same equations; bound 1e-6 of the tip's displacement, the fine mesh's path dependence being
-/// 1e-7 and below).
+/// 1e-7 and below). Automatic stabilisation (the third route) carries the coarse model's load steps past the
+/// same limit point to the full load, with its damping's energy reported, and leaves the fine mesh, which never
+/// stalls, bit for bit as it was (source: the damping is switched on only by a failed step).
 #[test]
 fn a_coarse_roll_up_fails_by_load_steps_at_a_limit_point_of_its_own_path() {
     use stentkit::study::stability::scenarios::{CoarseDesign, coarse_map};
@@ -309,8 +311,16 @@ fn a_coarse_roll_up_fails_by_load_steps_at_a_limit_point_of_its_own_path() {
         |_| {},
     )
     .expect("runs");
-    let [coarse_steps, coarse_arc, fine_steps, fine_arc] = &map.points[..] else {
-        panic!("four runs");
+    let [
+        coarse_steps,
+        coarse_arc,
+        coarse_stabilised,
+        fine_steps,
+        fine_arc,
+        fine_stabilised,
+    ] = &map.points[..]
+    else {
+        panic!("six runs");
     };
     assert!(
         !coarse_steps.run.completed,
@@ -338,6 +348,24 @@ fn a_coarse_roll_up_fails_by_load_steps_at_a_limit_point_of_its_own_path() {
         fine_arc.run.final_probe.expect("a probe"),
     );
     assert!((a - b).norm() < 1e-6 * a.norm(), "{a:?} against {b:?}");
+    let damped = coarse_stabilised.run.stabilisation.expect("stabilised");
+    println!(
+        "coarse roll-up stabilised: {} damped steps, dissipated {:.3e} of the peak strain energy",
+        damped.damped_steps,
+        damped.ratio()
+    );
+    assert!(
+        coarse_stabilised.run.completed,
+        "stabilisation passes the limit point"
+    );
+    assert!(damped.damped_steps > 0 && damped.dissipated > 0.0);
+    assert!(
+        damped.ratio() < 1.0,
+        "the damping took less energy than the rod stored"
+    );
+    let fine = fine_stabilised.run.stabilisation.expect("stabilised");
+    assert_eq!(fine.damped_steps, 0);
+    assert_eq!(fine_stabilised.run.final_probe, fine_steps.run.final_probe);
 }
 
 /// The command line end to end on an arc-length design: the run folder's history has the load factor, ending at

@@ -206,7 +206,7 @@ fn an_interrupted_simulation_continues_bit_for_bit() {
         let mut before = Vec::new();
         loop {
             match sim.step_with(&mut observer).expect("steps") {
-                StepOutcome::Stepped(report) => before.push(report),
+                StepOutcome::Stepped(report) => before.push(*report),
                 StepOutcome::Interrupted => break,
                 StepOutcome::Finished => panic!("not interrupted (poll {at})"),
             }

@@ -19,6 +19,7 @@ mod reliability;
 mod resume;
 mod run_folder;
 mod solver;
+mod stabilisation;
 mod stent;
 mod studies;
 mod sweep;

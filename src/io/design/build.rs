@@ -357,6 +357,7 @@ pub fn field_path(field: &Field, dto: &DesignDto) -> String {
             SolverField::MaxIterations => "solver.max_iterations",
             SolverField::Path => "solver.path",
             SolverField::ArcLength => "solver.arc_length",
+            SolverField::Stabilisation => "solver.stabilisation",
         }
         .into(),
         Field::Probe { index, field } => {
@@ -872,6 +873,17 @@ fn solver_settings(s: Option<&SolverDto>) -> SolverSettings {
             }
             out.path = PathControl::ArcLength(a);
         }
+        if let Some(d) = &s.stabilisation {
+            let mut st = crate::model::StabilisationSettings::default();
+            if let Some(Positive(f)) = d.dissipated_fraction {
+                st.dissipated_fraction = f;
+            }
+            if let Some(Positive(l)) = d.limit {
+                st.limit = l;
+            }
+            st.factor = d.factor.map(|f| f.0);
+            out.stabilisation = Some(st);
+        }
     }
     out
 }
@@ -897,7 +909,12 @@ fn hot_release_warnings(model: &crate::model::Model) -> Vec<String> {
             let tg = crate::material::ConstitutiveLaw::temperature_shift(law)?.tg();
             (temperature > tg).then(|| {
                 format!(
-                    "the programme releases its nodes at t = {release} at {temperature} °C, above the glass transition of material `{name}` (Tg = {tg} °C): the device is rubbery there and springs back, so no temporary shape is fixed; cool it below Tg before the release"
+                    "the programme releases its nodes at t = {release} at {temperature} °C, above the glass transition of material `{name}` (Tg = {tg} °C): the device is rubbery there and springs back, so no temporary shape is fixed; cool it below Tg before the release{}",
+                    if model.solver.stabilisation.is_some() {
+                        ""
+                    } else {
+                        " (to simulate the snap-back anyway, add `solver: {stabilisation: {}}`: Newton alone meets it with step cuts and may stall)"
+                    }
                 )
             })
         })

@@ -636,6 +636,26 @@ pub struct SolverDto {
     /// Arc-length settings (with `path: arc-length`).
     #[serde(default)]
     pub arc_length: Option<ArcLengthDto>,
+    /// Automatic stabilisation where Newton stalls (time-driven paths): viscous damping of the motion since
+    /// the last converged state, its dissipated energy reported (`{}` for the defaults).
+    #[serde(default)]
+    pub stabilisation: Option<StabilisationDto>,
+}
+
+/// Automatic stabilisation settings.
+#[derive(Debug, Clone, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct StabilisationDto {
+    /// Dissipated energy the first damped step aims at, as a fraction of the strain energy (default 2e-4).
+    #[serde(default)]
+    pub dissipated_fraction: Option<Positive>,
+    /// The run's dissipated energy over its largest strain energy above which a warning is given (default
+    /// 0.05).
+    #[serde(default)]
+    pub limit: Option<Positive>,
+    /// A damping factor c [1/time] given outright instead of the energy rule.
+    #[serde(default)]
+    pub factor: Option<Positive>,
 }
 
 /// What drives the path.

@@ -190,6 +190,8 @@ pub enum SolverField {
     Path,
     /// The arc-length settings.
     ArcLength,
+    /// The stabilisation settings.
+    Stabilisation,
 }
 
 /// A part of a probe.

@@ -1035,6 +1035,12 @@ fn check_path(
         return Ok(());
     };
     let path = |why: String| Err(BuildError::new(Field::Solver(SolverField::Path), why));
+    if s.stabilisation.is_some() {
+        return Err(BuildError::new(
+            Field::Solver(SolverField::Stabilisation),
+            "stabilisation damps time steps, and an arc-length path has none: it passes limit points by its constraint (remove `stabilisation`, or use `path: time`)",
+        ));
+    }
     if let Some(m) = materials
         .iter()
         .position(|m| !matches!(m, MaterialLaw::Elastic(_)))

@@ -150,6 +150,7 @@ impl Simulation<'_> {
             &self.state,
             StepMaterial { laws: &laws },
             &actions,
+            super::stabilisation::view(&self.damping),
             gauge,
             &mut self.lin,
             &mut Sink::Discard,

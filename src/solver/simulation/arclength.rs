@@ -224,6 +224,7 @@ impl Simulation<'_> {
                         error_estimate: None,
                         rejected: 0,
                         load_factor: Some(state.load_factor),
+                        stabilisation: None,
                     };
                     if !landed && self.step >= settings.max_increments {
                         self.notices.push(format!(
@@ -231,7 +232,7 @@ impl Simulation<'_> {
                             settings.max_increments, state.load_factor, settings.end_load_factor
                         ));
                     }
-                    return Ok(StepOutcome::Stepped(report));
+                    return Ok(StepOutcome::Stepped(Box::new(report)));
                 }
                 Err(NewtonFailure::Fatal(e)) => {
                     self.abandon_increment(start);

@@ -75,6 +75,8 @@ pub struct Checkpoint {
     pub timing: SolverTiming,
     /// Where an arc-length run is on its path (`None` for time-driven runs and before the first increment).
     pub arc: Option<super::ArcState>,
+    /// The stabiliser's memory ([`super::stabilisation`]).
+    pub stabiliser: super::StabiliserState,
 }
 
 /// The iterate at which the current factorisation's tangent was assembled (module docs).
@@ -327,6 +329,7 @@ impl Simulation<'_> {
             tangent,
             timing: self.timing.clone(),
             arc: self.arc.clone(),
+            stabiliser: self.stabiliser,
         }
     }
 
@@ -382,6 +385,8 @@ impl Simulation<'_> {
         self.ramps.clone_from(&checkpoint.ramps);
         self.last_increment.clone_from(&checkpoint.last_increment);
         self.arc.clone_from(&checkpoint.arc);
+        self.stabiliser = checkpoint.stabiliser;
+        self.damping = None;
         self.step_increment.clear();
         self.system.invalidate();
         self.tangent.invalidate();

@@ -323,7 +323,7 @@ impl Simulation<'_> {
     }
 
     /// The reference arc length of every collocation point from its patch's start ([`arc_lengths`], once).
-    fn arc_lengths(&self) -> &[Real] {
+    pub(super) fn arc_lengths(&self) -> &[Real] {
         self.arc_length
             .get_or_init(|| arc_lengths(self.model, &self.disc))
     }

@@ -71,6 +71,7 @@ mod newton;
 pub mod observer;
 mod releases;
 pub mod report;
+pub mod stabilisation;
 mod stepping;
 pub mod timing;
 
@@ -80,6 +81,7 @@ pub use fields::{PeakSurfaceStrain, PointFields, peak_surface_strain};
 pub use newton::ROUND_OFF_TOLERANCE;
 pub use observer::{NoObserver, Observer, Observers};
 pub use report::{NewtonReport, RunSummary, StepReport};
+pub use stabilisation::{StabiliserState, StepStabilisation};
 pub use stepping::{STEP_FACTOR, STEP_ROUND_OFF_ULPS, StepOutcome};
 pub use timing::SolverTiming;
 
@@ -149,6 +151,15 @@ pub struct Simulation<'m> {
     arc_length: std::sync::OnceLock<Vec<Real>>,
     /// Where an arc-length run is on its path (`None` for time-driven runs, and before the first increment).
     arc: Option<arclength::ArcState>,
+    /// The stabiliser's memory ([`stabilisation`]).
+    stabiliser: StabiliserState,
+    /// The damping of the attempt in progress: the last converged state and `c/h` (`None`: undamped).
+    damping: Option<(State, Real)>,
+    /// The first Newton increment of the last attempt (runs with stabilisation: the estimate of a stalled
+    /// step's motion, [`stabilisation`]).
+    first_increment: Vec<Real>,
+    /// Trapezoidal weights of the collocation points in the reference arc length (computed at the first use).
+    point_weights: std::sync::OnceLock<Vec<Real>>,
 }
 
 impl<'m> Simulation<'m> {
@@ -196,6 +207,7 @@ impl<'m> Simulation<'m> {
                 laws: &materials.laws,
             },
             &actions,
+            None,
             None,
             &mut lin,
             &mut Sink::Pattern(&mut pattern),
@@ -248,6 +260,10 @@ impl<'m> Simulation<'m> {
             control: adaptive::StepControl::default(),
             arc_length: std::sync::OnceLock::new(),
             arc: None,
+            stabiliser: StabiliserState::default(),
+            damping: None,
+            first_increment: Vec::new(),
+            point_weights: std::sync::OnceLock::new(),
         })
     }
 }

@@ -150,6 +150,9 @@ impl Simulation<'_> {
             fresh_last = fresh_tangent;
             if report.iterations == 0 {
                 stale_first = !fresh_tangent;
+                if self.model.solver.stabilisation.is_some() {
+                    self.first_increment.clone_from(&self.delta);
+                }
             }
             self.record_increment(&mut report)?;
             self.state.apply_increment(&self.disc, &self.delta);
@@ -234,6 +237,7 @@ impl Simulation<'_> {
             &self.state,
             material,
             actions,
+            super::stabilisation::view(&self.damping),
             gauge,
             &mut self.lin,
             &mut sink,

@@ -104,6 +104,7 @@ impl Simulation<'_> {
             &self.state,
             material,
             &actions,
+            None,
             Some(&gauge),
             &mut lin,
             &mut Sink::Pattern(&mut pattern),

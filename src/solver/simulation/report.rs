@@ -46,6 +46,8 @@ pub struct StepReport {
     pub rejected: usize,
     /// The load factor reached (arc-length continuation); `None` for time steps.
     pub load_factor: Option<Real>,
+    /// What the stabilisation did (runs with `solver.stabilisation`; `None` otherwise).
+    pub stabilisation: Option<super::StepStabilisation>,
 }
 
 /// Totals of a run.

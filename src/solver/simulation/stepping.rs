@@ -69,8 +69,9 @@ enum Abandon {
 /// What one call of [`Simulation::step_with`] did.
 #[derive(Debug, Clone, PartialEq)]
 pub enum StepOutcome {
-    /// One step converged (after the retries and cuts it needed): its report.
-    Stepped(StepReport),
+    /// One step converged (after the retries and cuts it needed): its report (boxed: it is large beside the
+    /// other outcomes).
+    Stepped(Box<StepReport>),
     /// The end time had been reached: nothing was done.
     Finished,
     /// The observer asked to stop within the step ([`Observer::interrupted`]), which was abandoned and rolled
@@ -104,7 +105,7 @@ impl Simulation<'_> {
     /// linear algebra and the material; the simulation is then at the last converged step.
     pub fn step(&mut self) -> Result<Option<StepReport>, SolverError> {
         Ok(match self.step_with(&mut NoObserver)? {
-            StepOutcome::Stepped(report) => Some(report),
+            StepOutcome::Stepped(report) => Some(*report),
             StepOutcome::Finished | StepOutcome::Interrupted => None,
         })
     }
@@ -146,6 +147,11 @@ impl Simulation<'_> {
             }
             let dt = target - self.time;
             let start = self.step_start();
+            // Damping, while the stabiliser has it on: measured from the last converged state over this step.
+            self.damping = self
+                .stabiliser
+                .factor
+                .map(|c| (start.state.clone(), c / dt));
             let captured = self.capture_releases(target);
             let prepared = self
                 .set_gauge(target)
@@ -207,6 +213,7 @@ impl Simulation<'_> {
                 Ok(newton) => {
                     self.tangent.end_attempt();
                     self.commit_step();
+                    let stabilisation = self.account_stabilisation(target);
                     // A schedule's rate changes at its breakpoints: no extrapolation across them.
                     let breakpoints = &self.breakpoints;
                     let nearest = breakpoints.partition_point(|&b| b < target - snap);
@@ -235,6 +242,7 @@ impl Simulation<'_> {
                         error_estimate: estimate,
                         rejected: std::mem::take(&mut self.control.rejections),
                         load_factor: None,
+                        stabilisation,
                     };
                     match self.model.time.tolerance {
                         Some(tolerance) => {
@@ -252,7 +260,7 @@ impl Simulation<'_> {
                         }
                         None => {}
                     }
-                    return Ok(StepOutcome::Stepped(report));
+                    return Ok(StepOutcome::Stepped(Box::new(report)));
                 }
                 Err(NewtonFailure::Fatal(e)) => {
                     self.roll_back(start, &captured, Abandon::Failed);
@@ -265,6 +273,10 @@ impl Simulation<'_> {
                 Err(NewtonFailure::NotConverged(newton)) => {
                     self.roll_back(start, &captured, Abandon::Failed);
                     observer.step_failed(target, dt, &newton);
+                    // Stabilisation: the same step again with the damping switched on or raised.
+                    if self.stabilise_retry(dt) {
+                        continue;
+                    }
                     if is_smallest_step(dt, min_step, target) {
                         return Err(SolverError::StepFailed {
                             time: target,
@@ -351,6 +363,7 @@ impl Simulation<'_> {
     /// a restored checkpoint taken now) repeats the uninterrupted run exactly.
     fn roll_back(&mut self, start: StepStart, captured: &[(usize, usize)], why: Abandon) {
         self.state = start.state;
+        self.damping = None;
         self.materials.roll_back(&self.model.materials);
         self.gauge_active = start.gauge_active;
         for &(k, i) in captured {
@@ -372,12 +385,17 @@ impl Simulation<'_> {
             Revert::Forget => false,
         };
         if !kept {
-            self.system.invalidate();
-            if let Some((_, system, _)) = &mut self.gauge {
-                system.invalidate();
-            }
-            self.tangent.invalidate();
+            self.forget_factorisation();
         }
+    }
+
+    /// Forgets every factorisation (the next Newton iteration assembles and factorises afresh).
+    pub(super) fn forget_factorisation(&mut self) {
+        self.system.invalidate();
+        if let Some((_, system, _)) = &mut self.gauge {
+            system.invalidate();
+        }
+        self.tangent.invalidate();
     }
 }
 

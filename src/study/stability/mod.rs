@@ -58,8 +58,8 @@ pub struct StabilityStudy {
     pub load_steps: Vec<usize>,
     /// `(heating duration [s], h [s])` of the arch.
     pub heating: Vec<(Real, Real)>,
-    /// `(h [s], release ramp [s], control points per patch)` of the two-crown stent.
-    pub release: Vec<(Real, Real, usize)>,
+    /// The runs of the two-crown stent's release.
+    pub release: Vec<scenarios::ReleaseCase>,
     /// `(design, p, n)` of the coarse-model map.
     pub coarse: Vec<(scenarios::CoarseDesign, usize, usize)>,
 }
@@ -81,22 +81,35 @@ impl Default for StabilityStudy {
                 (0.5, 0.1),
                 (0.1, 0.1),
             ],
-            release: vec![
-                (0.25, 0.001, 20),
-                (0.25, 0.25, 20),
-                (0.1, 0.001, 20),
-                (0.1, 0.1, 20),
-                (0.05, 0.05, 20),
-                (0.05, 0.2, 20),
-                (0.02, 0.001, 20),
-                (0.02, 0.02, 20),
-                (0.02, 0.2, 20),
-                (0.01, 0.001, 20),
-                (0.01, 0.01, 20),
-                (0.01, 0.2, 20),
-                (0.01, 0.01, 14),
-                (0.01, 0.3, 14),
-            ],
+            release: {
+                let plain = scenarios::ReleaseCase::plain;
+                let mut cases: Vec<scenarios::ReleaseCase> = [
+                    (0.25, 0.001, 20),
+                    (0.25, 0.25, 20),
+                    (0.1, 0.001, 20),
+                    (0.1, 0.1, 20),
+                    (0.05, 0.05, 20),
+                    (0.05, 0.2, 20),
+                    (0.02, 0.001, 20),
+                    (0.02, 0.02, 20),
+                    (0.02, 0.2, 20),
+                    (0.01, 0.001, 20),
+                    (0.01, 0.01, 20),
+                    (0.01, 0.2, 20),
+                ]
+                .into_iter()
+                .map(|(h, ramp, n)| plain(h, ramp, n))
+                .collect();
+                // The coarse stent whose release folds, and a hot release, each without and with stabilisation.
+                for case in [
+                    plain(0.01, 0.01, 14),
+                    plain(0.01, 0.3, 14),
+                    plain(0.01, 0.01, 20).hot(),
+                ] {
+                    cases.extend([case, case.stabilised()]);
+                }
+                cases
+            },
             coarse: {
                 use scenarios::CoarseDesign::{Bend45, Rollup};
                 vec![

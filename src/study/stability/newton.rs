@@ -42,6 +42,8 @@ pub struct NewtonRun {
     pub load_path: Vec<(Real, Real)>,
     /// The displacement of the model's first probe at the end (or where the run stopped).
     pub final_probe: Option<crate::math::Vec3>,
+    /// What automatic stabilisation did (runs with `solver.stabilisation`).
+    pub stabilisation: Option<crate::solver::StabiliserState>,
 }
 
 impl NewtonRun {
@@ -106,6 +108,7 @@ pub fn newton_run(model: &Model) -> Result<NewtonRun, SolverError> {
     let mut run = watch.0;
     run.wall = started.elapsed().as_secs_f64();
     run.notices = sim.notices().to_vec();
+    run.stabilisation = model.solver.stabilisation.map(|_| *sim.stabilisation());
     run.final_probe = model
         .probes
         .first()
@@ -166,7 +169,7 @@ pub fn solver_csv(map: &SolverMap, header: &str) -> String {
     let _ = writeln!(s, "# {header}");
     let _ = writeln!(
         s,
-        "{},converged_without_cuts,completed,time_reached,steps,newton_iterations,iterations_per_step,max_step_iterations,cuts,failed_attempts,smallest_step,wall_s,first_limit_load_factor,failure",
+        "{},converged_without_cuts,completed,time_reached,steps,newton_iterations,iterations_per_step,max_step_iterations,cuts,failed_attempts,smallest_step,wall_s,first_limit_load_factor,damped_steps,dissipated_ratio,failure",
         map.columns.join(",")
     );
     for p in &map.points {
@@ -174,7 +177,7 @@ pub fn solver_csv(map: &SolverMap, header: &str) -> String {
         let params: Vec<String> = p.parameters.iter().map(|v| format!("{v}")).collect();
         let _ = writeln!(
             s,
-            "{},{},{},{},{},{},{:.3},{},{},{},{:e},{:.3},{},{}",
+            "{},{},{},{},{},{},{:.3},{},{},{},{:e},{:.3},{},{},{},{}",
             params.join(","),
             r.completed && r.cuts == 0,
             r.completed,
@@ -189,6 +192,12 @@ pub fn solver_csv(map: &SolverMap, header: &str) -> String {
             r.wall,
             r.first_limit_load_factor()
                 .map(|l| format!("{l:.6}"))
+                .unwrap_or_default(),
+            r.stabilisation
+                .map(|s| s.damped_steps.to_string())
+                .unwrap_or_default(),
+            r.stabilisation
+                .map(|s| format!("{:.3e}", s.ratio()))
                 .unwrap_or_default(),
             r.failure
                 .as_deref()
@@ -282,7 +291,21 @@ pub fn solver_summary(
                 r.max_step_iterations
             ),
         };
-        let _ = writeln!(s, "- {}: {what}.", describe_point(&p.parameters));
+        let damped = match r.stabilisation {
+            Some(st) if st.damped_steps > 0 => format!(
+                "; {} damped steps dissipated {:.2e} of the largest strain energy{}",
+                st.damped_steps,
+                st.ratio(),
+                if st.warned {
+                    " (above the limit 0.05: not quasi-static there)"
+                } else {
+                    ""
+                }
+            ),
+            Some(_) => "; no step needed damping".to_string(),
+            None => String::new(),
+        };
+        let _ = writeln!(s, "- {}: {what}{damped}.", describe_point(&p.parameters));
         for n in &r.notices {
             let _ = writeln!(s, "  - notice: {n}");
         }

@@ -118,15 +118,67 @@ const RELEASE: Real = 1.75;
 /// End of the release runs \[s\].
 const RELEASE_END: Real = 2.0;
 
+/// One run of the release map.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ReleaseCase {
+    /// Time step \[s\].
+    pub h: Real,
+    /// Release ramp \[s\].
+    pub ramp: Real,
+    /// Control points per patch (degree by [`release_mesh`]).
+    pub n: usize,
+    /// With automatic stabilisation (`solver.stabilisation` at its defaults).
+    pub stabilised: bool,
+    /// Held at 90 °C throughout (a programme without cooling: a hot release), instead of the design's schedule.
+    pub hot: bool,
+}
+
+impl ReleaseCase {
+    /// The design's programme, Newton alone.
+    pub const fn plain(h: Real, ramp: Real, n: usize) -> Self {
+        Self {
+            h,
+            ramp,
+            n,
+            stabilised: false,
+            hot: false,
+        }
+    }
+
+    /// The same case with stabilisation.
+    pub const fn stabilised(self) -> Self {
+        Self {
+            stabilised: true,
+            ..self
+        }
+    }
+
+    /// The same case held at 90 °C.
+    pub const fn hot(self) -> Self {
+        Self { hot: true, ..self }
+    }
+}
+
+/// Temperature of a hot release \[°C\] (the straight stent's programming temperature, above its Tg = 70 °C).
+const HOT: Real = 90.0;
+
 /// A two-crown straight stent run to 2 s (released at 1.75 s) with step `h`, release ramp `ramp` and `n`
-/// control points per patch (degree by [`release_mesh`]): `(h [s], ramp [s], n)` triples.
+/// control points per patch (degree by [`release_mesh`]), with or without stabilisation, cooled before the
+/// release as designed or held hot.
 pub fn release_map(
-    cases: &[(Real, Real, usize)],
+    cases: &[ReleaseCase],
     mut progress: impl FnMut(&str),
 ) -> Result<SolverMap, StudyError> {
     let stent = embedded(designs::STRAIGHT_STENT, "straight_stent.yaml")?;
     let mut points = Vec::new();
-    for &(h, ramp, n) in cases {
+    for &ReleaseCase {
+        h,
+        ramp,
+        n,
+        stabilised,
+        hot,
+    } in cases
+    {
         positive("the time step h [s]", h)?;
         positive("the release ramp [s]", ramp)?;
         let remesh = Remesh {
@@ -134,13 +186,19 @@ pub fn release_map(
             points: Some(n),
             crowns: Some(2),
         };
-        let model = TimeVariant {
+        let mut model = TimeVariant {
             end: Some(RELEASE_END),
             step: Some(h),
             release_ramp: Some(ramp),
             ..TimeVariant::default()
         }
         .of(&rebuild(&stent, &remesh)?)?;
+        if stabilised {
+            model.solver.stabilisation = Some(crate::model::StabilisationSettings::default());
+        }
+        if hot {
+            model.temperature = TimeFunction::constant(HOT);
+        }
         let run = newton_run(&model)?;
         let at_release = run
             .failure_times
@@ -148,12 +206,21 @@ pub fn release_map(
             .filter(|&&t| t >= RELEASE && t <= RELEASE + ramp + h)
             .count();
         progress(&format!(
-            "2-crown stent, p = {}, n = {n}, h = {h}, release ramp {ramp} s: {} ({at_release} failed attempts at the release)",
+            "2-crown stent, p = {}, n = {n}, h = {h}, release ramp {ramp} s{}{}: {} ({at_release} failed attempts at the release)",
             release_mesh(n),
+            if hot { ", held at 90 °C" } else { "" },
+            if stabilised { ", stabilised" } else { "" },
             describe(&run)
         ));
         points.push(SolverPoint {
-            parameters: vec![h, ramp, n as Real, at_release as Real],
+            parameters: vec![
+                h,
+                ramp,
+                n as Real,
+                Real::from(u8::from(stabilised)),
+                Real::from(u8::from(hot)),
+                at_release as Real,
+            ],
             run,
         });
     }
@@ -163,6 +230,8 @@ pub fn release_map(
             "h_s",
             "release_ramp_s",
             "n",
+            "stabilised",
+            "hot",
             "failed_attempts_in_release_window",
         ],
         points,
@@ -188,8 +257,9 @@ impl CoarseDesign {
     }
 }
 
-/// Each `(design, p, n)` by its design's load steps and by arc length (its loads at the end scaled by a load
-/// factor, to λ = 1); the map's parameters are `design` (0 bend45, 1 rollup), `p`, `n` and `arc_length` (0/1).
+/// Each `(design, p, n)` by its design's load steps, by arc length (its loads at the end scaled by a load
+/// factor, to λ = 1) and by load steps with automatic stabilisation; the map's parameters are `design` (0
+/// bend45, 1 rollup), `p`, `n` and `route` ([`route_name`]).
 pub fn coarse_map(
     cases: &[(CoarseDesign, usize, usize)],
     mut progress: impl FnMut(&str),
@@ -213,15 +283,13 @@ pub fn coarse_map(
             max_growth: 4.0,
             ..crate::model::ArcLengthSettings::default()
         });
-        for (route, model) in [(0.0, &stepped), (1.0, &arc)] {
+        let mut stabilised = stepped.clone();
+        stabilised.solver.stabilisation = Some(crate::model::StabilisationSettings::default());
+        for (route, model) in [(0.0, &stepped), (1.0, &arc), (2.0, &stabilised)] {
             let run = newton_run(model)?;
             progress(&format!(
                 "{name}, p = {p}, n = {n}, {}: {}",
-                if route == 0.0 {
-                    "load steps"
-                } else {
-                    "arc length"
-                },
+                route_name(route),
                 describe(&run)
             ));
             points.push(SolverPoint {
@@ -232,9 +300,18 @@ pub fn coarse_map(
     }
     Ok(SolverMap {
         name: "coarse",
-        columns: vec!["design", "p", "n", "arc_length"],
+        columns: vec!["design", "p", "n", "route"],
         points,
     })
+}
+
+/// The coarse map's routes: 0 load steps, 1 arc length, 2 load steps with automatic stabilisation.
+pub fn route_name(route: Real) -> &'static str {
+    match route as usize {
+        0 => "load steps",
+        1 => "arc length",
+        _ => "stabilised load steps",
+    }
 }
 
 /// The coarse map's files and paragraph: per run, the limit load factor of an arc-length path and how far the
@@ -253,35 +330,37 @@ pub fn coarse_report(map: &SolverMap) -> MapReport {
         map,
         "coarse: coarse models by load steps and by arc length",
         |p| {
-            let route = if p[3] == 0.0 {
-                "load steps"
-            } else {
-                "arc length"
-            };
-            let mut s = format!("{}, p = {}, n = {}, {route}", name(p[0]), p[1], p[2]);
+            let mut s = format!(
+                "{}, p = {}, n = {}, {}",
+                name(p[0]),
+                p[1],
+                p[2],
+                route_name(p[3])
+            );
             let run = map
                 .points
                 .iter()
                 .find(|q| q.parameters == p)
                 .map(|q| &q.run);
-            if let Some(run) = run.filter(|_| p[3] == 1.0) {
-                match run.first_limit_load_factor() {
-                    Some(l) => {
-                        let _ = write!(s, " (the path's load factor peaks at {l:.4}, then falls");
-                    }
-                    None => s.push_str(" (the load factor rises monotonically"),
-                }
-                if let (Some(u), Some(r), true) = (run.final_probe, reference(p[0]), run.completed)
-                {
-                    let _ = write!(
-                        s,
-                        "; at λ = 1 the tip is {:.3} from the finest load-stepped run's, |u| = {:.3})",
-                        (u - r).norm(),
-                        r.norm()
-                    );
-                } else {
-                    s.push(')');
-                }
+            let Some(run) = run.filter(|_| p[3] != 0.0) else {
+                return s;
+            };
+            let mut notes = Vec::new();
+            if p[3] == 1.0 {
+                notes.push(match run.first_limit_load_factor() {
+                    Some(l) => format!("the path's load factor peaks at {l:.4}, then falls"),
+                    None => "the load factor rises monotonically".to_string(),
+                });
+            }
+            if let (Some(u), Some(r), true) = (run.final_probe, reference(p[0]), run.completed) {
+                notes.push(format!(
+                    "at the full load the tip is {:.3} from the finest load-stepped run's, |u| = {:.3}",
+                    (u - r).norm(),
+                    r.norm()
+                ));
+            }
+            if !notes.is_empty() {
+                let _ = write!(s, " ({})", notes.join("; "));
             }
             s
         },
@@ -291,7 +370,7 @@ pub fn coarse_report(map: &SolverMap) -> MapReport {
         name: map.name,
         csv: solver_csv(
             map,
-            "coarse models of the elastic 45-degree bend (designs/bend45.yaml, design 0) and roll-up (designs/rollup.yaml, design 1), by load steps (arc_length 0) and arc length (1)",
+            "coarse models of the elastic 45-degree bend (designs/bend45.yaml, design 0) and roll-up (designs/rollup.yaml, design 1), by load steps (route 0), arc length (1) and stabilised load steps (2)",
         ),
         chart: solver_chart(
             map,
@@ -368,17 +447,19 @@ pub fn release_report(map: &SolverMap) -> MapReport {
         "release: step size and release ramp of the stent's release snap",
         |p| {
             format!(
-                "p = {}, n = {}, h = {} s, release ramp {} s ({} failed attempts in [1.75 s, 1.75 s + ramp + h])",
+                "p = {}, n = {}, h = {} s, release ramp {} s{}{} ({} failed attempts in [1.75 s, 1.75 s + ramp + h])",
                 release_mesh(p[2] as usize),
                 p[2],
                 p[0],
                 p[1],
-                p[3]
+                if p[4] == 1.0 { ", held at 90 °C" } else { "" },
+                if p[3] == 1.0 { ", **stabilised**" } else { "" },
+                p[5]
             )
         },
     );
     summary.push_str(&format!(
-        "Release at t = {RELEASE} s; the reaction of each released component is ramped to zero over the release ramp (time.release_ramp, default one step).\n\n"
+        "Release at t = {RELEASE} s; the reaction of each released component is ramped to zero over the release ramp (time.release_ramp, default one step). Stabilised runs have `solver.stabilisation` at its defaults (dissipated fraction 2e-4, limit 0.05); a run held at 90 °C releases a rubbery device (a programme without cooling).\n\n"
     ));
     MapReport {
         name: map.name,
@@ -391,7 +472,7 @@ pub fn release_report(map: &SolverMap) -> MapReport {
             "release snap of a 2-crown stent: Newton against release ramp",
             1,
             "release ramp [s]",
-            &[2, 0],
+            &[2, 0, 3, 4],
         ),
         summary,
     }

@@ -1,0 +1,268 @@
+//! Automatic stabilisation of time-driven steps ([`crate::model::StabilisationSettings`], issue 18 item 2):
+//! viscous regularisation switched on where Newton stalls, its factor, and the energies it is judged by.
+//!
+//! **When.** A step whose Newton iteration fails (after the retry with a fresh tangent) is retried at the same
+//! size with the damping of [`crate::solver::assembly::Damping`] on, instead of being cut. A damped step that
+//! still fails is retried with the factor ten times larger, [`MAX_ESCALATIONS`] times, and then cut as before
+//! (halving the step raises `c/h` as well). After a damped step converges the damping stays on for the next
+//! step while the step dissipated more than `dissipated_fraction` of the strain energy — the motion is still
+//! faster than the rule's estimate — and is switched off otherwise; a later stall switches it on again with a
+//! new factor. Runs that never stall are unchanged to the bit.
+//!
+//! **The factor.** As Abaqus's automatic stabilisation (Abaqus Analysis User's Guide §7.1.1): `c` is chosen
+//! so that the damped step would dissipate `f` (`dissipated_fraction`) of the strain energy `E` if it moved as
+//! far as the estimate of its motion, here Newton's first increment `δ₁` of the failed attempt (the linearised
+//! response to the step's change of load, with the tangent at the last converged state):
+//! ```text
+//! D = (c/h) Q(δ),    Q(δ) = Σ_g w_g (A_g |δx_g|² + δΘ_g · J_g δΘ_g),    c = f E h / Q(δ₁)
+//! ```
+//! over the interior collocation points `g` (where the damping acts) with trapezoidal weights `w_g` of the
+//! reference arc length, the unit-density masses `A`, `J` of [`Damping::masses`], and `E` the strain energy at
+//! the last converged state (or the largest the run reached, if that is larger: a device that stalls while
+//! unloading still scales with the energy it stored). A given `factor` replaces the rule.
+//!
+//! **The energies.** The strain energy is `E = ½ Σ_g w_g (ΔΓ·N + ΔK·M)` over all collocation points (the
+//! stored energy of an elastic rod; for a viscoelastic one the same measure of the work held in the section's
+//! current forces), and a converged damped step dissipates `D = (c/h) Q` of its actual motion (`x − xₙ`,
+//! `log(Rₙᵀ R)`). The run's ratio is the dissipated total over the largest strain energy it reached — not the
+//! current one, which is zero once a released device is free — and a notice warns when it exceeds `limit`.
+//!
+//! **Checkpoints.** A damped tangent is never carried past its step (its factorisation is forgotten when the
+//! step converges), so a checkpoint's tangent is always an undamped one; the stabiliser's memory is in
+//! [`StabiliserState`].
+
+use super::Simulation;
+use crate::math::{Real, Vec3};
+use crate::solver::assembly::{Damping, point_strains};
+use crate::solver::state::State;
+
+/// How many times a damped step that still fails has its factor multiplied by [`ESCALATION`] before it is cut.
+pub const MAX_ESCALATIONS: usize = 3;
+
+/// The factor by which a failed damped step's damping is raised.
+pub const ESCALATION: Real = 10.0;
+
+/// The stabiliser's memory, kept over steps (and in checkpoints).
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct StabiliserState {
+    /// The damping factor `c` \[1/time\] while the damping is on; `None` when off.
+    pub factor: Option<Real>,
+    /// Escalations of the factor in the step in progress ([`MAX_ESCALATIONS`]).
+    pub escalations: usize,
+    /// The factor the damping was last switched on with (the energy rule's, or the given one) \[1/time\]: it
+    /// is lowered back towards this after each damped step.
+    pub base_factor: Real,
+    /// Energy dissipated by the damping so far \[energy\].
+    pub dissipated: Real,
+    /// The largest strain energy of the converged states so far \[energy\].
+    pub peak_strain_energy: Real,
+    /// The largest ratio of a step's dissipated energy to the strain energy at its end.
+    pub largest_step_ratio: Real,
+    /// Steps taken with the damping on.
+    pub damped_steps: usize,
+    /// Whether the run's ratio above the limit has been warned about.
+    pub warned: bool,
+}
+
+impl StabiliserState {
+    /// The run's dissipated energy over the largest strain energy it reached (0 before any energy).
+    pub fn ratio(&self) -> Real {
+        if self.peak_strain_energy > 0.0 {
+            self.dissipated / self.peak_strain_energy
+        } else {
+            0.0
+        }
+    }
+}
+
+/// What the stabilisation did in one converged step (runs with `solver.stabilisation`).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct StepStabilisation {
+    /// The damping factor `c` of the step \[1/time\]; 0 when the step was undamped.
+    pub factor: Real,
+    /// Energy the damping dissipated in the step \[energy\] (the run's total is in [`StabiliserState`]).
+    pub dissipated: Real,
+    /// Strain energy at the step's end \[energy\].
+    pub strain_energy: Real,
+}
+
+/// The damping of the attempt in progress as the assembly sees it.
+pub(super) fn view(damping: &Option<(State, Real)>) -> Option<Damping<'_>> {
+    damping.as_ref().map(|(previous, rate)| Damping {
+        previous,
+        rate: *rate,
+    })
+}
+
+impl Simulation<'_> {
+    /// The strain energy of the current state, `½ Σ_g w_g (ΔΓ·N + ΔK·M)` (module docs) \[energy\].
+    pub fn strain_energy(&self) -> Real {
+        let weights = self.point_weights();
+        (0..self.disc.points.len())
+            .map(|g| {
+                let strain = point_strains(&self.disc, &self.state, g);
+                let stress = self.materials.laws[g].stress(&strain);
+                0.5 * weights[g]
+                    * (strain.force.dot(&stress.force) + strain.moment.dot(&stress.moment))
+            })
+            .sum()
+    }
+
+    /// The stabiliser's memory: the damping factor, if on, and the dissipated and strain energies so far.
+    pub fn stabilisation(&self) -> &StabiliserState {
+        &self.stabiliser
+    }
+
+    /// `Q` of a motion given per interior collocation point by `motion(g) = (δx, δΘ)` (module docs).
+    fn motion_measure(&self, motion: impl Fn(usize) -> (Vec3, Vec3)) -> Real {
+        let weights = self.point_weights();
+        let disc = &self.disc;
+        (0..disc.points.len())
+            .filter(|&g| !disc.is_end(g))
+            .map(|g| {
+                let (area, inertia) = Damping::masses(&disc.shapes[disc.points[g].shape]);
+                let (dx, theta) = motion(g);
+                weights[g] * (area * dx.norm_squared() + theta.dot(&inertia.component_mul(&theta)))
+            })
+            .sum()
+    }
+
+    /// Trapezoidal weights of the collocation points in the reference arc length, patch by patch.
+    fn point_weights(&self) -> &[Real] {
+        self.point_weights.get_or_init(|| {
+            let s = self.arc_lengths();
+            let mut w = vec![0.0; s.len()];
+            for range in &self.disc.patches {
+                for g in range.offset..range.offset + range.n {
+                    let before = if g > range.offset {
+                        s[g] - s[g - 1]
+                    } else {
+                        0.0
+                    };
+                    let after = if g + 1 < range.offset + range.n {
+                        s[g + 1] - s[g]
+                    } else {
+                        0.0
+                    };
+                    w[g] = 0.5 * (before + after);
+                }
+            }
+            w
+        })
+    }
+
+    /// Called after a step of size `dt` failed and was rolled back: switches the damping on (or raises it) for a
+    /// retry at the same size, and says whether to retry. `false`: stabilisation is off, exhausted for this
+    /// step, or cannot be scaled; the step is then cut.
+    pub(super) fn stabilise_retry(&mut self, dt: Real) -> bool {
+        let Some(settings) = self.model.solver.stabilisation else {
+            return false;
+        };
+        match self.stabiliser.factor {
+            Some(c) if self.stabiliser.escalations < MAX_ESCALATIONS => {
+                self.stabiliser.factor = Some(c * ESCALATION);
+                self.stabiliser.escalations += 1;
+                true
+            }
+            Some(_) => false,
+            None => {
+                let c = settings.factor.unwrap_or_else(|| {
+                    let energy = self.strain_energy().max(self.stabiliser.peak_strain_energy);
+                    let n = self.disc.num_unknowns();
+                    let first = &self.first_increment;
+                    let motion = if first.len() >= n {
+                        self.motion_measure(|g| interpolate(&self.disc, first, g))
+                    } else {
+                        0.0
+                    };
+                    settings.dissipated_fraction * energy * dt / motion
+                });
+                if !(c.is_finite() && c > 0.0) {
+                    let notice = "stabilisation could not scale its damping factor (no strain energy yet, or no motion in Newton's first increment): the step is cut instead; give `solver.stabilisation.factor` to damp such a step".to_string();
+                    if !self.notices.contains(&notice) {
+                        self.notices.push(notice);
+                    }
+                    return false;
+                }
+                self.stabiliser.factor = Some(c);
+                self.stabiliser.base_factor = c;
+                self.stabiliser.escalations = 0;
+                true
+            }
+        }
+    }
+
+    /// After a converged step: its damping's dissipated energy and the strain energy (for runs with
+    /// stabilisation), the damping switched off when the step dissipated no more than the fraction aimed at, a
+    /// damped tangent forgotten, and the run's ratio warned about once above the limit.
+    pub(super) fn account_stabilisation(&mut self, t: Real) -> Option<StepStabilisation> {
+        let settings = self.model.solver.stabilisation?;
+        let energy = self.strain_energy();
+        let damping = self.damping.take();
+        let factor = self
+            .stabiliser
+            .factor
+            .filter(|_| damping.is_some())
+            .unwrap_or(0.0);
+        let dissipated = match &damping {
+            Some((previous, rate)) => {
+                let d = Damping {
+                    previous,
+                    rate: *rate,
+                };
+                rate * self.motion_measure(|g| d.motion(&self.disc, &self.state, g))
+            }
+            None => 0.0,
+        };
+        let s = &mut self.stabiliser;
+        s.escalations = 0;
+        s.peak_strain_energy = s.peak_strain_energy.max(energy);
+        if damping.is_some() {
+            s.damped_steps += 1;
+            s.dissipated += dissipated;
+            if energy > 0.0 {
+                s.largest_step_ratio = s.largest_step_ratio.max(dissipated / energy);
+            }
+            // The least damping that converges: lowered by the escalation factor after every damped step, and
+            // off once below the energy rule's value or once the step dissipated no more than it aims at.
+            let lowered = s
+                .factor
+                .map(|c| c / ESCALATION)
+                .filter(|&c| c >= s.base_factor);
+            s.factor = lowered.filter(|_| {
+                dissipated > settings.dissipated_fraction * energy.max(s.peak_strain_energy)
+            });
+            self.forget_factorisation();
+        }
+        let s = &mut self.stabiliser;
+        if !s.warned && s.ratio() > settings.limit {
+            s.warned = true;
+            let ratio = s.ratio();
+            self.notices.push(format!(
+                "at t = {t} the stabilisation has dissipated {ratio:.3e} of the largest strain energy, above the limit {}: the result is not quasi-static there (a smaller `solver.stabilisation.dissipated_fraction`, a slower programme or a finer mesh may keep it so)",
+                settings.limit
+            ));
+        }
+        Some(StepStabilisation {
+            factor,
+            dissipated,
+            strain_energy: energy,
+        })
+    }
+}
+
+/// The increment `delta`'s translation and rotation at collocation point `g` (basis values `N_a`).
+fn interpolate(
+    disc: &crate::solver::discretisation::Discretisation,
+    delta: &[Real],
+    g: usize,
+) -> (Vec3, Vec3) {
+    let point = &disc.points[g];
+    let (mut dx, mut theta) = (Vec3::zeros(), Vec3::zeros());
+    for (a, row) in point.basis.iter().enumerate() {
+        let j = 6 * (point.first + a);
+        dx += Vec3::new(delta[j], delta[j + 1], delta[j + 2]) * row[0];
+        theta += Vec3::new(delta[j + 3], delta[j + 4], delta[j + 5]) * row[0];
+    }
+    (dx, theta)
+}
