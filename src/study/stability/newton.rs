@@ -296,8 +296,10 @@ pub fn solver_summary(
                 "; {} damped steps dissipated {:.2e} of the largest strain energy{}",
                 st.damped_steps,
                 st.ratio(),
-                if st.warned {
-                    " (above the limit 0.05: not quasi-static there)"
+                if st.ratio() > crate::model::StabilisationSettings::default().limit {
+                    " (above the limit 0.05: not quasi-static)"
+                } else if st.warned {
+                    " (above the limit 0.05 for a while: see the notice)"
                 } else {
                     ""
                 }
