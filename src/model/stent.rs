@@ -13,7 +13,9 @@ use crate::geometry::GeometryError;
 use crate::geometry::fit::{FitSettings, best_fit_rigid, fit_curve};
 use crate::geometry::frame::basis_from_unit_axis;
 use crate::geometry::primitives;
-use crate::geometry::stent::{PatchRole, StentGeometry, StentSpec, TemporarySpec, WireEnd};
+use crate::geometry::stent::{
+    GeneratedPatch, PatchRole, StentGeometry, StentParameter, StentSpec, TemporarySpec, WireEnd,
+};
 use crate::material::{Section, SectionProperties};
 use crate::math::quote::quoted;
 use crate::math::{Real, Vec3};
@@ -147,6 +149,7 @@ pub fn generate(
                 if worst.is_none_or(|(w, _)| fit.max_deviation > w) {
                     worst = Some((fit.max_deviation, &g.name));
                 }
+                check_bend(g, &fit.curve, full.diameter())?;
                 (fit.curve, Some(fit.max_deviation))
             }
         };
@@ -217,6 +220,40 @@ pub fn generate(
         patches,
         nodes,
     })
+}
+
+/// A generated wire, as fitted for the analysis, must not bend tighter than its own radius: the inner fibre's
+/// length `1 − r κ` would be negative, the wire folded onto itself — a shape no rod (and no printer) can make.
+/// On a tight bend of the centreline the crowns come close on its inner side, and a bridge swept along the bent
+/// tube between them turns sharply or back on itself (issue 18: the 5-crown device on an S-shaped centreline,
+/// whose inner bridges bent with radii of 0.02–0.03 mm against a wire radius of 0.25 mm). The fitted curve is
+/// checked, with exact derivatives, rather than the generator's curve, whose derivatives are finite differences
+/// that a centreline's end (straight beyond it) disturbs. Refused, with what to change.
+fn check_bend(g: &GeneratedPatch, fitted: &crate::math::NurbsCurve, diameter: Real) -> Result<()> {
+    use crate::geometry::analytic::ParametricCurve;
+    let (radius, at) = fitted.tightest_bend();
+    if radius >= 0.5 * diameter {
+        return Ok(());
+    }
+    let (parameter, advice) = match g.role {
+        PatchRole::Bridge { .. } => (
+            StentParameter::Bridges,
+            "where the centreline bends, the crowns on its inner side come close and the bridge between them is squeezed or turns back: bend the centreline less, use fewer or lower crowns (more room between them), or a smaller bridge amplitude",
+        ),
+        PatchRole::Crown { .. } => (
+            StentParameter::Amplitude,
+            "lower the crown amplitude or the number of peaks, or raise the radius",
+        ),
+    };
+    Err(BuildError::new(
+        Field::Stent(StentField::Parameter(parameter)),
+        format!(
+            "stent patch `{}` bends with a radius of curvature {radius:.3e} (at {:.0} % of its length), less than the wire's radius {}: the wire would fold onto itself; {advice}",
+            g.name,
+            100.0 * at,
+            crate::math::Short(0.5 * diameter)
+        ),
+    ))
 }
 
 /// The symmetry planes of a generated stent as `(point, normal)`.

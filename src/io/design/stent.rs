@@ -320,10 +320,20 @@ pub fn spec(
     if let Some((bend, u)) = tightest_bend(&spec.centreline)
         && bend < largest
     {
+        let (field, advice) = match spec.centreline {
+            CentrelineSpec::Points { .. } => (
+                "stent.centreline.points",
+                "spread the points or lower their bend",
+            ),
+            _ => (
+                "stent.centreline.file",
+                "smooth it more or choose another segment",
+            ),
+        };
         return Err(issue(
-            "stent.centreline.file",
+            field,
             format!(
-                "the centreline bends with a radius of curvature {} (at {:.0} % of the segment), less than the stent radius {}: the crowns would fold onto themselves; smooth it more or choose another segment",
+                "the centreline bends with a radius of curvature {} (at {:.0} % of its length), less than the stent radius {}: the crowns would fold onto themselves; {advice}",
                 crate::math::Short(bend),
                 100.0 * u,
                 crate::math::Short(largest)

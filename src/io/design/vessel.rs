@@ -198,19 +198,28 @@ fn cut(line: &Polyline, from: Real, to: Real) -> Polyline {
     }
 }
 
-/// The smallest radius of curvature of `spec`'s spline and the normalised parameter where it is, sampled at
-/// 1000 points (`None` for other centrelines).
+/// The smallest radius of curvature of `spec`'s spline (a file's, or the cubic through a point list) and the
+/// normalised parameter where it is, sampled at 1000 points (`None` for other centrelines, and for a point list
+/// that makes no curve, which the geometry reports).
 pub fn tightest_bend(spec: &CentrelineSpec) -> Option<(Real, Real)> {
-    let CentrelineSpec::Spline { curve, .. } = spec else {
-        return None;
+    let points_curve;
+    let curve = match spec {
+        CentrelineSpec::Spline { curve, .. } => curve,
+        CentrelineSpec::Points { points, .. } => {
+            points_curve = crate::geometry::analytic::point_list_curve(points).ok()?;
+            &points_curve
+        }
+        _ => return None,
     };
+    let (a, b) = crate::geometry::analytic::ParametricCurve::domain(curve);
     (0..=1000)
         .map(|k| {
-            let u = k as Real / 1000.0;
+            let f = k as Real / 1000.0;
+            let u = a + f * (b - a);
             let d = curve.derivatives(u, 2);
             let speed = d[1].norm();
             let curvature = d[1].cross(&d[2]).norm() / (speed * speed * speed);
-            (1.0 / curvature, u)
+            (1.0 / curvature, f)
         })
         .min_by(|a, b| a.0.total_cmp(&b.0))
 }
