@@ -527,8 +527,8 @@ impl Assembler {
         let R = &state.rotation[g];
         let Rt = R.transpose();
         let shape = &disc.shapes[point.shape];
-        // Viscous regularisation: a spatial force density (it joins the distributed load, whose rotation
-        // derivative `hat(n̄)` the tangent has) and a material couple density (its own tangent below).
+        // Viscous regularisation ([`Damping`]): a spatial force density that joins the distributed load (whose
+        // rotation derivative `hat(n̄)` the tangent has) and a material couple density, `(c A/h, Θ, c J/h)`.
         let mut force_density = actions.dist_force[point.patch];
         let mut viscous = None;
         if let Some(d) = damping {
@@ -537,13 +537,12 @@ impl Assembler {
             force_density -= dx * (d.rate * area);
             viscous = Some((d.rate * area, theta, inertia * d.rate));
         }
+        let viscous_couple =
+            viscous.map_or(Vec3::zeros(), |(_, theta, c)| -c.component_mul(&theta));
         let nbar = Rt * force_density;
-        let mut mbar = Rt * actions.dist_couple[point.patch];
-        if let Some((_, theta, c_inertia)) = viscous {
-            mbar -= c_inertia.component_mul(&theta);
-        }
+        let mbar = Rt * actions.dist_couple[point.patch];
         let F = K.cross(&N) + N_s + nbar;
-        let T = K.cross(&M) + M_s + k.gamma.cross(&N) + mbar;
+        let T = K.cross(&M) + M_s + k.gamma.cross(&N) + mbar + viscous_couple;
         let row = 6 * g;
         residual[..3].copy_from_slice(F.as_slice());
         residual[3..6].copy_from_slice(T.as_slice());
@@ -563,18 +562,13 @@ impl Assembler {
         let mut f_eta_s = (Kt * CN - CN * Kt) * Rt;
         let f_eta_ss = CN * Rt;
         let ng = -Nt + Gt * CN;
-        // (The damping couple is material, not `Rᵀ m̄`: it is taken out of `hat(m̄)` and linearised as
-        // `δΘ = T(Θ)⁻¹ δθ`, the right trivialisation of `log(Rₙᵀ R exp(δθ̃))`.)
-        let material_couple =
-            viscous.map_or(Vec3::zeros(), |(_, theta, c)| -c.component_mul(&theta));
-        let mut t_th =
-            -Mt * Kt + Kt * CM * Kt + CM * hat(&K_s) + ng * Gt + hat(&(mbar - material_couple));
-        if let Some((_, theta, c_inertia)) = viscous {
-            t_th -= Mat3::from_diagonal(&c_inertia) * right_jacobian_inverse(&theta);
-        }
+        let mut t_th = -Mt * Kt + Kt * CM * Kt + CM * hat(&K_s) + ng * Gt + hat(&mbar);
         let mut f_eta = Mat3::zeros();
-        if let Some((c_area, ..)) = viscous {
+        if let Some((c_area, theta, c_inertia)) = viscous {
+            // δ(−c A Δx/h) in the material frame is −(c A/h) Rᵀ δη; the couple's `δΘ = T(Θ)⁻¹ δθ` is the right
+            // trivialisation of `log(Rₙᵀ R exp(δθ̃))`.
             f_eta = -Rt * c_area;
+            t_th -= Mat3::from_diagonal(&c_inertia) * right_jacobian_inverse(&theta);
         }
         let mut t_th_s = -Mt + Kt * CM + CM * Kt;
         if let Some((CN_s, CM_s)) = law.stiffness_slope_matrices() {

@@ -142,14 +142,7 @@ fn residual(
 fn tangent_matches_central_differences_of_the_residual() {
     let model = test_model();
     let disc = Discretisation::new(&model).expect("discretisation");
-    let laws: Vec<SectionLaw> = disc
-        .points
-        .iter()
-        .map(|p| {
-            let law = &model.materials[model.patches[p.patch].material];
-            law.section_law(&law.new_state(vec![disc.shapes[p.shape]]), 0)
-        })
-        .collect();
+    let laws = initial_laws(&model, &disc);
     check_tangent(&model, &disc, &laws, None);
 }
 
@@ -162,14 +155,7 @@ fn tangent_matches_central_differences_of_the_residual() {
 fn tangent_matches_central_differences_with_viscous_damping() {
     let model = test_model();
     let disc = Discretisation::new(&model).expect("discretisation");
-    let laws: Vec<SectionLaw> = disc
-        .points
-        .iter()
-        .map(|p| {
-            let law = &model.materials[model.patches[p.patch].material];
-            law.section_law(&law.new_state(vec![disc.shapes[p.shape]]), 0)
-        })
-        .collect();
+    let laws = initial_laws(&model, &disc);
     let previous = State::reference(&disc);
     let damping = Damping {
         previous: &previous,
@@ -205,6 +191,17 @@ fn tangent_matches_central_differences_with_a_modulus_varying_along_the_rod() {
         .collect();
     assert!(laws.iter().all(|l| l.stiffness_slope_matrices().is_some()));
     check_tangent(&model, &disc, &laws, None);
+}
+
+/// Every collocation point's section law of `model` at rest (its material's law before any step).
+fn initial_laws(model: &Model, disc: &Discretisation) -> Vec<SectionLaw> {
+    disc.points
+        .iter()
+        .map(|p| {
+            let law = &model.materials[model.patches[p.patch].material];
+            law.section_law(&law.new_state(vec![disc.shapes[p.shape]]), 0)
+        })
+        .collect()
 }
 
 /// The tangent of `model` with the section laws `laws` against central differences of its residual (see the
