@@ -381,7 +381,7 @@ pub fn parse_design_with(
     let (mut dto, source, applied) = if overrides.sets.is_empty() {
         let deserializer = serde_yaml::Deserializer::from_str(text);
         let dto: dto::DesignDto = serde_path_to_error::deserialize(deserializer)
-            .map_err(|e| read_error(&e, &locator, &file))?;
+            .map_err(|e| design_read_error(&e, text, &locator, &file))?;
         (dto, text.to_string(), Vec::new())
     } else {
         let mut root: serde_yaml::Value = match serde_yaml::from_str(text) {
@@ -486,6 +486,70 @@ pub fn parse_design_with(
 /// The design error of a deserialisation error `e` of the text indexed by `locator` (module docs: the
 /// position of a syntax error is the problem's own, a rejected value is found by its path, serde_yaml's
 /// position is best for unknown and missing fields).
+/// The error of reading `text` into a design. A YAML syntax error is reported where the parser found it, also
+/// when the design's reader met a missing field first: an over-indented key ends its mapping early, and the
+/// reader then misses a field of that mapping at the wrong line (issue 19), so a reading error is checked
+/// against a plain YAML parse of the text.
+fn design_read_error(
+    e: &serde_path_to_error::Error<serde_yaml::Error>,
+    text: &str,
+    locator: &locate::Locator,
+    file: &Path,
+) -> DesignError {
+    if is_syntax_error(e.inner()) {
+        return not_yaml(read_error(e, locator, file), false);
+    }
+    match serde_path_to_error::deserialize::<_, serde_yaml::Value>(
+        serde_yaml::Deserializer::from_str(text),
+    ) {
+        Err(syntax) if is_syntax_error(syntax.inner()) => {
+            not_yaml(read_error(&syntax, locator, file), true)
+        }
+        _ => read_error(e, locator, file),
+    }
+}
+
+/// Whether `e` is one of libyaml's syntax errors (they name the construct being parsed: "…, while parsing a
+/// block mapping").
+fn is_syntax_error(e: &serde_yaml::Error) -> bool {
+    e.to_string().contains(", while ")
+}
+
+/// A syntax error's message says it is one, and where a block structure broke, the usual cause; `clear_field`
+/// drops a field path that a plain parse cannot know.
+fn not_yaml(error: DesignError, clear_field: bool) -> DesignError {
+    match error {
+        DesignError::Invalid {
+            file,
+            line,
+            column,
+            field,
+            message,
+        } => DesignError::Invalid {
+            file,
+            line,
+            column,
+            // (A key the parser had not read yet shows as `?`: the mapping around it is what is known.)
+            field: if clear_field {
+                String::new()
+            } else {
+                field
+                    .trim_end_matches('?')
+                    .trim_end_matches('.')
+                    .to_string()
+            },
+            message: if message.contains("while parsing a block") {
+                format!(
+                    "not valid YAML: {message} (a key indented more or less than its neighbours does this)"
+                )
+            } else {
+                format!("not valid YAML: {message}")
+            },
+        },
+        other => other,
+    }
+}
+
 fn read_error(
     e: &serde_path_to_error::Error<serde_yaml::Error>,
     locator: &locate::Locator,
