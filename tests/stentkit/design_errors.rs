@@ -492,6 +492,41 @@ fn a_design_name_is_one_folder_name() {
     }
 }
 
+/// Issue 19 item 4: a temperature table that ends before the run (the straight stent's cut at 1.75 s of 3.25 s)
+/// is accepted with a warning naming where it ends, the run's end and the value held; the design's own schedule,
+/// which reaches 3.25 s, has none.
+#[test]
+fn a_temperature_schedule_that_ends_early_is_a_warning() {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("designs/straight_stent.yaml");
+    let text = std::fs::read_to_string(&path).expect("design");
+    let short = stentkit::io::design::parse_design_with(
+        &text,
+        &path,
+        &stentkit::io::design::DesignOverrides::sets(vec![
+            "temperature=[[0, 90], [1, 90], [1.75, 45]]"
+                .parse()
+                .expect("set"),
+        ]),
+    )
+    .expect("accepted with a warning");
+    assert!(
+        short.warnings.iter().any(|w| w
+            .contains("the temperature schedule ends at t = 1.75, before the run does (3.25)")
+            && w.contains("45 °C")),
+        "{:?}",
+        short.warnings
+    );
+    let full = stentkit::io::design::parse_design(&text, &path).expect("design");
+    assert!(
+        !full
+            .warnings
+            .iter()
+            .any(|w| w.contains("temperature schedule")),
+        "{:?}",
+        full.warnings
+    );
+}
+
 /// Source: the shape-memory cycle itself (paper §1): a temporary shape is fixed by cooling below Tg before the
 /// load is removed. The straight stent held at 90 °C through its release (1.75 s), above the PLA's Tg = 70 °C,
 /// is accepted with a warning naming the release, the temperature and Tg; the paper's schedule (45 °C at the

@@ -233,6 +233,7 @@ pub fn build(dto: &DesignDto, default_name: &str) -> Result<Built> {
         ));
     }
     warnings.extend(hot_release_warnings(&model));
+    warnings.extend(short_schedule_warning(&model));
     Ok(Built {
         model,
         output,
@@ -886,6 +887,23 @@ fn solver_settings(s: Option<&SolverDto>) -> SolverSettings {
         }
     }
     out
+}
+
+/// A temperature schedule that ends before the run does is held at its last value from there, which a table
+/// written for a shorter run (1.75 s of a 3.25 s programme, issue 19) does silently. Time-driven runs only (an
+/// arc-length path reads its schedules at `time.end`).
+fn short_schedule_warning(model: &crate::model::Model) -> Option<String> {
+    let schedule = &model.temperature;
+    let &(last, value) = schedule.points().last()?;
+    let end = model.time.end;
+    (model.solver.path.arc_length().is_none()
+        && !schedule.is_constant()
+        && last < end - crate::model::LANDING_TOLERANCE * model.time.step)
+        .then(|| {
+            format!(
+                "the temperature schedule ends at t = {last}, before the run does ({end}): the temperature is held at its last value, {value} °C, from there (extend the table to the end if that is not meant)"
+            )
+        })
 }
 
 /// A programme that releases its nodes above a material's glass transition fixes no temporary shape: the
