@@ -562,7 +562,7 @@ fn read_error(
     let inner = e.inner().to_string();
     let (message, named) = split_message(&inner);
     // Only libyaml's syntax errors name the position of the problem itself.
-    let named = named.filter(|_| inner.contains(", while "));
+    let named = named.filter(|_| is_syntax_error(e.inner()));
     let serde_position = e.inner().location().map(|l| locate::Position {
         line: l.line(),
         column: l.column(),

@@ -411,8 +411,7 @@ impl Simulation<'_> {
     fn abandon_increment(&mut self, start: State) {
         self.state = start;
         self.materials.roll_back(&self.model.materials);
-        self.system.invalidate();
-        self.tangent.invalidate();
+        self.forget_factorisation();
     }
 }
 

@@ -204,16 +204,9 @@ impl Simulation<'_> {
             .factor
             .filter(|_| damping.is_some())
             .unwrap_or(0.0);
-        let dissipated = match &damping {
-            Some((previous, rate)) => {
-                let d = Damping {
-                    previous,
-                    rate: *rate,
-                };
-                rate * self.motion_measure(|g| d.motion(&self.disc, &self.state, g))
-            }
-            None => 0.0,
-        };
+        let dissipated = view(&damping).map_or(0.0, |d| {
+            d.rate * self.motion_measure(|g| d.motion(&self.disc, &self.state, g))
+        });
         let s = &mut self.stabiliser;
         s.escalations = 0;
         s.peak_strain_energy = s.peak_strain_energy.max(energy);
