@@ -235,9 +235,13 @@ def check_run_folder(folder):
     require(steps[0] == 0, "no initial snapshot")
     require(steps == sorted(set(steps)), "snapshot steps not increasing")
     for s in summary["snapshots"]:
-        for key in ("stl", "obj"):
+        # The design chooses the mesh formats (STL by default, OBJ on request); each file listed must exist.
+        listed = [key for key in ("stl", "obj", "vtp") if key in s]
+        require("stl" in listed or "obj" in listed, f"snapshot at step {s['step']} lists no mesh file")
+        for key in listed:
             require((folder / s[key]).is_file(), f"missing {s[key]}")
-        SNAPSHOT_VOLUMES[(folder / s["stl"]).resolve()] = s["volume"]
+        if "stl" in s:
+            SNAPSHOT_VOLUMES[(folder / s["stl"]).resolve()] = s["volume"]
     for chart in summary["files"]["charts"]:
         if chart.endswith(".png"):
             check_png(folder / chart)

@@ -166,17 +166,29 @@ pub fn describe(design: &Design, file: &str) -> String {
     }
     let _ = writeln!(s);
     let disk = estimated_disk(design);
-    let mb = |bytes: u64| bytes as f64 / 1e6;
+    let mb = |bytes: u64| format!("{:.1} MB", bytes as f64 / 1e6);
+    // Only the parts the design writes.
+    let parts: Vec<String> = [
+        ("STL", disk.snapshot_stl),
+        ("OBJ", disk.snapshot_obj),
+        ("fields", disk.snapshot_vtp),
+    ]
+    .into_iter()
+    .filter(|&(_, bytes)| bytes > 0)
+    .map(|(name, bytes)| format!("{name} {}", mb(bytes)))
+    .collect();
+    let recording = if design.output.recording.enabled {
+        format!("run.mcap {}", mb(disk.recording))
+    } else {
+        "no recording".to_string()
+    };
     let _ = writeln!(
         s,
-        "disk                about {:.1} MB: {} snapshots {:.1} MB (STL {:.1} MB + OBJ {:.1} MB + fields {:.1} MB), run.mcap {:.1} MB, history.csv {:.1} MB, charts {:.1} MB, summary.json {:.1} MB",
+        "disk                run folder about {}: {} snapshots {} ({}), {recording}, history.csv {}, charts {}, summary.json {}",
         mb(disk.total()),
         disk.snapshots,
         mb(disk.snapshots_bytes()),
-        mb(disk.snapshot_stl),
-        mb(disk.snapshot_obj),
-        mb(disk.snapshot_vtp),
-        mb(disk.recording),
+        parts.join(" + "),
         mb(disk.history),
         mb(disk.charts),
         mb(disk.summary)

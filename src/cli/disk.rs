@@ -61,8 +61,8 @@ fn largest_part(estimate: &DiskEstimate) -> (&'static str, &'static str) {
     let snapshots = estimate.snapshots_bytes();
     if snapshots >= estimate.recording && snapshots >= estimate.history {
         (
-            "output.snapshots.every",
-            "take fewer snapshots (a larger `every`, fewer `times`) or smaller ones (fewer `rings`, `segments`)",
+            "output.snapshots",
+            "take fewer snapshots (fewer `between` or `times`, a larger `every`) or smaller ones (fewer `rings`, `segments`, one of the `formats`)",
         )
     } else if estimate.recording >= estimate.history {
         (

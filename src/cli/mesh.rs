@@ -1,15 +1,39 @@
-//! `stentkit mesh`: the reference shape of the full device as a closed tube surface.
+//! `stentkit mesh`: the full device as a closed tube surface, in its permanent shape (the shape a 4D printer
+//! prints) or in the temporary shape its programme drives it to (the shape a designer previews), without
+//! simulating.
+//!
+//! The temporary shape is the device generated in the programme's temporary placement
+//! ([`crate::geometry::stent::StentSpec::generate_temporary`]: every crown shrunk by Δr for a radial
+//! contraction; the `temporary` centreline and radius for a target shape), then moved by the rigid motion that
+//! takes its driven nodes onto the programme's targets `P_0 + η` (the identity, unless the target shape is
+//! aligned). Its driven nodes then sit where the programme prescribes them at the end of its ramp, which the
+//! command checks and prints. The wires between the nodes follow the generator, not a simulation: the
+//! simulated programmed shape is `stentkit export RUN_DIR --phase programmed`.
 
+use super::BadInput;
+use crate::geometry::fit::best_fit_rigid;
 use crate::io::design::{DesignOverrides, SetOverride, load_design_with};
 use crate::io::{obj, stl};
+use crate::math::{Real, Vec3};
+use crate::model::{End, Model};
 use crate::post::device::reference_device_mesh;
 use anyhow::{Context, bail};
 use std::path::Path;
 
-/// Writes the reference shape of the design (with the `--set` overrides `sets`) to `output` (`.stl` or `.obj`).
+/// Which shape `mesh` writes.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum State {
+    /// The shape the device is made in (and recovers to).
+    Permanent,
+    /// The shape the programme drives it to, before it is released.
+    Temporary,
+}
+
+/// Writes the shape `state` of the design (with the `--set` overrides `sets`) to `output` (`.stl` or `.obj`).
 pub fn run(
     design: &Path,
     output: &Path,
+    state: State,
     segments: usize,
     samples: usize,
     sets: Vec<SetOverride>,
@@ -21,14 +45,49 @@ pub fn run(
     if !matches!(extension.as_deref(), Some("stl" | "obj")) {
         bail!("{}: the output must end in .stl or .obj", output.display());
     }
-    let design = load_design_with(design, &DesignOverrides::sets(sets))?;
-    let model = &design.model;
-    let mesh = reference_device_mesh(model, segments, samples)?;
+    let permanent = load_design_with(design, &DesignOverrides::sets(sets.clone()))?;
+    let (model, placed) = match state {
+        State::Permanent => (permanent.model, None),
+        State::Temporary => {
+            if permanent.model.programme.is_none() {
+                return Err(BadInput(format!(
+                    "{}: the design has no programme, so no temporary shape: its permanent shape is the only one",
+                    design.display()
+                ))
+                .into());
+            }
+            let temporary = load_design_with(
+                design,
+                &DesignOverrides {
+                    sets,
+                    temporary_shape: true,
+                    ..DesignOverrides::default()
+                },
+            )?;
+            for w in &temporary.warnings {
+                eprintln!("warning: {w}");
+            }
+            let placement = placement(&permanent.model, &temporary.model)?;
+            (temporary.model, Some(placement))
+        }
+    };
+    let mut mesh = reference_device_mesh(&model, segments, samples)?;
+    let mut misfit = None;
+    if let Some((r, t, off)) = placed {
+        for v in &mut mesh.vertices {
+            *v = r * *v + t;
+        }
+        misfit = Some(off);
+    }
     mesh.check_closed()
         .context("the tube surface is not closed (please report this)")?;
     let header = format!(
-        "{} reference shape, units {} (lengths in {})",
+        "{} {} shape, units {} (lengths in {})",
         model.name,
+        match state {
+            State::Permanent => "reference (permanent)",
+            State::Temporary => "temporary (programmed)",
+        },
         model.units.name(),
         model.units.length()
     );
@@ -51,5 +110,54 @@ pub fn run(
         mesh.volume(),
         model.units.length()
     );
+    if let Some(off) = misfit {
+        println!(
+            "temporary shape: the driven nodes are within {off:.3e} {} of the programme's targets",
+            model.units.length()
+        );
+    }
     Ok(())
+}
+
+/// Where node `k` of `model` is in its reference shape: the end of its first patch.
+fn node_position(model: &Model, k: usize) -> Option<Vec3> {
+    let end = model.nodes[k].ends.first()?;
+    let curve = &model.patches[end.patch].curve;
+    Some(curve.point(match end.end {
+        End::Start => 0.0,
+        End::End => 1.0,
+    }))
+}
+
+/// The rigid motion `(R, t)` that takes the driven nodes of the device in its temporary placement
+/// (`temporary`, nodes named as in `permanent`) onto the programme's targets `P_0 + η` (weighted as the
+/// programme weighs them), and the largest distance left between a moved node and its target.
+fn placement(
+    permanent: &Model,
+    temporary: &Model,
+) -> anyhow::Result<(crate::math::Mat3, Vec3, Real)> {
+    let Some(programme) = &permanent.programme else {
+        bail!("no programme");
+    };
+    let (mut from, mut to, mut weights) = (Vec::new(), Vec::new(), Vec::new());
+    for d in &programme.nodes {
+        let name = &permanent.nodes[d.node].name;
+        let position = temporary
+            .nodes
+            .iter()
+            .position(|n| &n.name == name)
+            .and_then(|k| node_position(temporary, k))
+            .with_context(|| format!("node `{name}` is missing from the temporary shape"))?;
+        from.push(position);
+        to.push(d.position + d.target);
+        weights.push(d.weight);
+    }
+    let (r, t) = best_fit_rigid(&from, &to, &weights)
+        .context("the driven nodes do not define a rigid placement")?;
+    let off = from
+        .iter()
+        .zip(&to)
+        .map(|(p, q)| (r * p + t - q).norm())
+        .fold(0.0, Real::max);
+    Ok((r, t, off))
 }

@@ -4,6 +4,7 @@
 
 pub mod check;
 pub mod disk;
+pub mod export;
 pub mod mesh;
 pub mod render;
 pub mod repair;
@@ -100,6 +101,34 @@ pub enum Command {
         #[arg(long = "set", value_name = "PATH=VALUE")]
         set: Vec<SetOverride>,
     },
+    /// Write the full device's tube mesh in any state of a finished run: at a time, or at an event of its
+    /// shape-memory cycle (initial, programmed, fixed, released, final). The run's design (summary.json's
+    /// design_file with its --set overrides, checked against the run's model fingerprint) is simulated again to
+    /// the first step at or after that time, which is the run's own state.
+    ///
+    /// Example: stentkit export runs/straight_stent --phase released -o released.stl
+    Export {
+        /// The run folder.
+        run_dir: PathBuf,
+        /// The first step at or after this time.
+        #[arg(long, conflicts_with = "phase", required_unless_present = "phase")]
+        time: Option<f64>,
+        /// An event of the cycle: initial, programmed, fixed, released, final.
+        #[arg(long)]
+        phase: Option<String>,
+        /// Output file, `.stl` or `.obj`.
+        #[arg(short, long)]
+        output: PathBuf,
+        /// The design file, when it is no longer where the run found it (summary.json's design_file).
+        #[arg(long)]
+        design: Option<PathBuf>,
+        /// Segments around each tube.
+        #[arg(long, default_value_t = 16)]
+        segments: usize,
+        /// Rings along each patch, about.
+        #[arg(long, default_value_t = 41)]
+        rings: usize,
+    },
     /// Find the cheapest degree p, points per patch n and time-error tolerance whose results (every probe, Δr,
     /// the recovery ratios) stay within --tol of a finer run over the design's whole schedule: the space error
     /// screened on a short horizon (n against 2n), then the time tolerance (τ against τ/10), then the choice
@@ -178,15 +207,22 @@ pub enum Command {
         #[arg(long, default_value_t = crate::io::render::PANEL_WIDTH)]
         width: u32,
     },
-    /// Write the reference (permanent) shape as a closed tube surface: binary STL or OBJ by extension.
+    /// Write the reference (permanent) shape as a closed tube surface, or with `--state temporary` the shape
+    /// the programme drives it to: binary STL or OBJ by extension.
     ///
     /// Example: stentkit mesh designs/circular_arch.yaml -o arch.stl
+    ///
+    /// Example: stentkit mesh designs/curved_stent.yaml --state temporary -o crimped.stl
     Mesh {
         /// The design file (YAML).
         design: PathBuf,
         /// Output file, `.stl` or `.obj`.
         #[arg(short, long)]
         output: PathBuf,
+        /// Which shape: the permanent one (printed), or the temporary one the programme drives it to (generated
+        /// in the programme's placement, not simulated).
+        #[arg(long, value_enum, default_value = "permanent")]
+        state: mesh::State,
         /// Segments around each tube.
         #[arg(long, default_value_t = 16)]
         segments: usize,
@@ -475,6 +511,27 @@ pub fn main() -> ExitCode {
                 sets: set,
             },
         ),
+        Command::Export {
+            run_dir,
+            time,
+            phase,
+            output,
+            design,
+            segments,
+            rings,
+        } => export::run(
+            &run_dir,
+            &export::ExportOptions {
+                which: match (time, phase) {
+                    (Some(t), _) => export::Which::Time(t),
+                    (None, phase) => export::Which::Phase(phase.unwrap_or_default()),
+                },
+                output,
+                design,
+                segments,
+                rings,
+            },
+        ),
         Command::Tune {
             design,
             tol,
@@ -535,10 +592,11 @@ pub fn main() -> ExitCode {
         Command::Mesh {
             design,
             output,
+            state,
             segments,
             samples,
             set,
-        } => mesh::run(&design, &output, segments, samples, set),
+        } => mesh::run(&design, &output, state, segments, samples, set),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

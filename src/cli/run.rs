@@ -70,7 +70,15 @@ struct Progress {
     said: usize,
     /// Print every failed Newton attempt.
     verbose: bool,
+    /// Step cuts so far (failed attempts retried shorter).
+    cuts: usize,
+    /// The message of the last converged step, which a failed attempt's note is appended to.
+    last: String,
 }
+
+/// How often the progress bar is redrawn when nothing is reported (a step being cut): its elapsed time keeps
+/// moving.
+const PROGRESS_TICK: Duration = Duration::from_millis(250);
 
 impl Progress {
     fn new(end: Real, quiet: bool, verbose: bool) -> Self {
@@ -87,11 +95,16 @@ impl Progress {
             .expect("valid progress template")
             .progress_chars("=> "),
         );
+        if !quiet {
+            bar.enable_steady_tick(PROGRESS_TICK);
+        }
         Self {
             bar,
             end,
             said: 0,
             verbose,
+            cuts: 0,
+            last: String::new(),
         }
     }
 
@@ -118,14 +131,30 @@ impl Observer for Progress {
         };
         self.bar
             .set_position((fraction * PROGRESS_RESOLUTION as Real).round() as u64);
-        self.bar.set_message(format!(
-            "t = {:.4}/{} s  T = {:.1} °C  step {}  {} it",
+        // The phase of the shape-memory cycle, when the model has one.
+        let phase = sim
+            .model()
+            .phase_at(report.time)
+            .map(|p| format!("{p}  "))
+            .unwrap_or_default();
+        let cuts = match self.cuts {
+            0 => String::new(),
+            n => format!("  {n} cut{}", if n == 1 { "" } else { "s" }),
+        };
+        self.last = format!(
+            "{phase}t = {:.4}/{} s  T = {:.1} °C  step {}  {} it{cuts}",
             report.time, self.end, report.temperature, report.step, report.newton.iterations
-        ));
+        );
+        self.bar.set_message(self.last.clone());
         ControlFlow::Continue(())
     }
 
     fn step_failed(&mut self, time: Real, dt: Real, newton: &NewtonReport) {
+        self.cuts += 1;
+        self.bar.set_message(format!(
+            "{}  cutting: the step to t = {time:.6} (dt = {dt:.2e}) failed, {} so far",
+            self.last, self.cuts
+        ));
         if self.verbose {
             self.bar.suspend(|| {
                 eprintln!(
@@ -142,7 +171,8 @@ impl Observer for Progress {
 struct Outputs {
     history: HistoryWriter,
     snapshots: SnapshotWriter,
-    recorder: McapRecorder,
+    /// The recording, unless the design turns it off (`output.recording.enabled`).
+    recorder: Option<McapRecorder>,
     charts: RunCharts,
     progress: Progress,
     /// Wall time spent in each output during the run, as named in [`Outputs::RECORDING`].
@@ -197,7 +227,11 @@ impl Outputs {
             history: self.history.position(),
             snapshots: self.snapshots.snapshots().to_vec(),
             snapshots_last: self.snapshots.last_seen(),
-            recording: self.recorder.position(),
+            recording: self
+                .recorder
+                .as_ref()
+                .map(McapRecorder::position)
+                .unwrap_or_default(),
             samples: self.charts.samples().to_vec(),
             totals: self.totals.clone(),
             spent: self.spent.map(|d| d.as_secs_f64()),
@@ -323,7 +357,12 @@ impl RunObserver<'_> {
             return ControlFlow::Continue(());
         }
         self.outputs.beat = Instant::now();
-        if let Err(e) = self.outputs.recorder.flush_chunk() {
+        if let Some(Err(e)) = self
+            .outputs
+            .recorder
+            .as_mut()
+            .map(McapRecorder::flush_chunk)
+        {
             self.summary.problem = Some(anyhow::Error::new(e));
             return ControlFlow::Break(());
         }
@@ -709,10 +748,11 @@ fn run_in(
         (Ok(_), Some(p)) if stopped => (RunStatus::Stopped, Some(p)),
         (Ok(_), p) => (RunStatus::Completed, p),
     };
-    let failure = result
-        .as_ref()
-        .err()
-        .map(|e| FailureReport::of(e, outputs.totals.steps, sim.time()));
+    let failure = result.as_ref().err().map(|e| {
+        let mut report = FailureReport::of(e, outputs.totals.steps, sim.time());
+        report.suggestions = suggestions(model, &report);
+        report
+    });
     let mcap_bytes = finished.mcap_bytes;
     let write = summary.write(|s| {
         outputs.fill(s, &sim);
@@ -753,6 +793,15 @@ fn run_in(
         eprintln!("{}", files.trim_start_matches("; "));
     }
     if let Err(e) = result {
+        // A step that did not converge is told in full by the failure report printed above: the error line only
+        // points there (the residuals and the equation once, not twice).
+        if let crate::solver::SolverError::StepFailed { time, step, .. } = &e {
+            return Err(anyhow::anyhow!(
+                "{}: no convergence in step {step} to t = {} s (the failure report above)",
+                where_("the run failed"),
+                short_time(*time)
+            ));
+        }
         return Err(anyhow::Error::new(e).context(where_("the run failed")));
     }
     if stopped && interrupted {
@@ -784,7 +833,7 @@ fn run_in(
         None => format!("t = {} s", Short(totals.time)),
     };
     println!(
-        "{}: {} steps to {reached}, {} Newton iterations ({:.2} per step), {} factorisations, {} step cuts, {} snapshots, run.mcap {}, wall time {:.2} s, peak memory {} → {}",
+        "{}: {} steps to {reached}, {} Newton iterations ({:.2} per step), {} factorisations, {} step cuts, {} snapshots, {}, folder {}, wall time {:.2} s, peak memory {} → {}",
         model.name,
         totals.steps,
         totals.iterations,
@@ -792,7 +841,12 @@ fn run_in(
         totals.factorisations,
         totals.cuts,
         summary.summary.snapshots.len(),
-        human_bytes(mcap_bytes as Real),
+        if design.output.recording.enabled {
+            format!("run.mcap {}", human_bytes(mcap_bytes as Real))
+        } else {
+            "no recording".to_string()
+        },
+        human_bytes(folder_bytes(dir) as Real),
         summary.summary.wall_time_s,
         summary
             .summary
@@ -801,6 +855,20 @@ fn run_in(
         dir.display()
     );
     Ok(())
+}
+
+/// Bytes of the files under `dir` (what a run folder takes on disk, about).
+fn folder_bytes(dir: &Path) -> u64 {
+    std::fs::read_dir(dir)
+        .into_iter()
+        .flatten()
+        .flatten()
+        .map(|entry| match entry.file_type() {
+            Ok(t) if t.is_dir() => folder_bytes(&entry.path()),
+            Ok(_) => entry.metadata().map_or(0, |m| m.len()),
+            Err(_) => 0,
+        })
+        .sum()
 }
 
 /// Creates the writers of the run folder, each file listed in the manifest first.
@@ -820,13 +888,17 @@ fn create_outputs(
         .with_context(|| format!("cannot write {}", history_path.display()))?;
     let snapshots = SnapshotWriter::create(dir, &design.output.snapshots, model)?
         .with_manifest(manifest.clone());
-    manifest.claim(Path::new("run.mcap"))?;
-    let recorder = McapRecorder::create(
-        &dir.join("run.mcap"),
-        design,
-        info,
-        &design.output.snapshots,
-    )?;
+    let recorder = if design.output.recording.enabled {
+        manifest.claim(Path::new("run.mcap"))?;
+        Some(McapRecorder::create(
+            &dir.join("run.mcap"),
+            design,
+            info,
+            &design.output.snapshots,
+        )?)
+    } else {
+        None
+    };
     Ok(Outputs {
         history,
         snapshots,
@@ -876,7 +948,11 @@ fn resume_outputs(
     let snapshots = SnapshotWriter::create(dir, &design.output.snapshots, model)?
         .with_manifest(manifest.clone())
         .resumed(saved.snapshots.clone(), saved.snapshots_last);
-    let recorder = resume_recording(design, dir, info, &saved.recording)?;
+    let recorder = if design.output.recording.enabled {
+        Some(resume_recording(design, dir, info, &saved.recording)?)
+    } else {
+        None
+    };
     let mut progress = Progress::new(model.time.end, options.quiet, options.verbose);
     progress.said = sim.notices().len();
     Ok(Outputs {
@@ -942,7 +1018,9 @@ fn interrupted_in_setup(
     sim: &Simulation<'_>,
     started: Instant,
 ) -> anyhow::Result<()> {
-    let _ = outputs.recorder.close();
+    if let Some(recorder) = &mut outputs.recorder {
+        let _ = recorder.close();
+    }
     let message = format!(
         "interrupted by {} during setup, before the first step",
         signals::first().unwrap_or("a signal")
@@ -1020,71 +1098,76 @@ fn finish(
     }
 
     // The recording first: salvaging a recording cut short by a full disk frees the space of its broken chunk.
-    let record_error = outputs.recorder.take_error().map(anyhow::Error::from);
-    // A writer that failed once refuses every later write: only the salvage can finish the file.
-    let closed = if record_error.is_some() || hurry {
-        outputs.recorder.close()
-    } else {
-        outputs.recorder.finish(sim)
-    };
-    let mcap_path = dir.join("run.mcap");
-    let complete_to = format!("complete up to {}", upto(outputs.recorder.last_time()));
-    // The first error is the cause; closing after it fails for that reason too.
-    let (closed_bytes, cause) = match closed {
-        Ok(bytes) => (bytes, record_error),
-        Err(e) => (0, Some(record_error.unwrap_or_else(|| e.into()))),
-    };
-    let mcap_bytes = match cause {
-        None => {
-            state("run.mcap", true, complete_to);
-            closed_bytes
-        }
-        Some(e) => {
-            let bytes = match salvage(&mcap_path) {
-                Ok(Salvage::Finished {
-                    after,
-                    last_log_time,
-                    ..
-                }) => {
-                    let t = last_log_time.map(|ns| ns as Real * 1e-9);
-                    state(
-                        "run.mcap",
-                        true,
-                        format!(
-                            "finalised up to {}; later states not recorded: {}",
-                            upto(t),
-                            error_text(&e)
-                        ),
-                    );
-                    after
+    let mcap_bytes = match outputs.recorder.as_mut() {
+        None => 0,
+        Some(recorder) => {
+            let record_error = recorder.take_error().map(anyhow::Error::from);
+            // A writer that failed once refuses every later write: only the salvage can finish the file.
+            let closed = if record_error.is_some() || hurry {
+                recorder.close()
+            } else {
+                recorder.finish(sim)
+            };
+            let mcap_path = dir.join("run.mcap");
+            let complete_to = format!("complete up to {}", upto(recorder.last_time()));
+            // The first error is the cause; closing after it fails for that reason too.
+            let (closed_bytes, cause) = match closed {
+                Ok(bytes) => (bytes, record_error),
+                Err(e) => (0, Some(record_error.unwrap_or_else(|| e.into()))),
+            };
+            match cause {
+                None => {
+                    state("run.mcap", true, complete_to);
+                    closed_bytes
                 }
-                Ok(Salvage::AlreadyValid { bytes }) => {
-                    state(
-                        "run.mcap",
-                        true,
-                        format!(
-                            "{complete_to}; later states not recorded: {}",
-                            error_text(&e)
-                        ),
-                    );
+                Some(e) => {
+                    let bytes = match salvage(&mcap_path) {
+                        Ok(Salvage::Finished {
+                            after,
+                            last_log_time,
+                            ..
+                        }) => {
+                            let t = last_log_time.map(|ns| ns as Real * 1e-9);
+                            state(
+                                "run.mcap",
+                                true,
+                                format!(
+                                    "finalised up to {}; later states not recorded: {}",
+                                    upto(t),
+                                    error_text(&e)
+                                ),
+                            );
+                            after
+                        }
+                        Ok(Salvage::AlreadyValid { bytes }) => {
+                            state(
+                                "run.mcap",
+                                true,
+                                format!(
+                                    "{complete_to}; later states not recorded: {}",
+                                    error_text(&e)
+                                ),
+                            );
+                            bytes
+                        }
+                        Err(salvage_error) => {
+                            let removed = std::fs::remove_file(&mcap_path).is_ok();
+                            state(
+                                "run.mcap",
+                                false,
+                                format!(
+                                    "incomplete ({}) and cannot be finished ({salvage_error}){}",
+                                    error_text(&e),
+                                    if removed { ": removed" } else { "" }
+                                ),
+                            );
+                            0
+                        }
+                    };
+                    problems.push(e);
                     bytes
                 }
-                Err(salvage_error) => {
-                    let removed = std::fs::remove_file(&mcap_path).is_ok();
-                    state(
-                        "run.mcap",
-                        false,
-                        format!(
-                            "incomplete ({}) and cannot be finished ({salvage_error}){}",
-                            error_text(&e),
-                            if removed { ": removed" } else { "" }
-                        ),
-                    );
-                    0
-                }
-            };
-            problems.push(e);
-            bytes
+            }
         }
     };
 
@@ -1184,6 +1267,78 @@ fn file_report(finished: &Finished) -> String {
     format!("; the run folder holds:{}", lines.concat())
 }
 
+/// What to change after a step that did not converge, most likely first: from the phase of the cycle it
+/// failed in, the patch of the equation with the largest residual and the design's settings.
+fn suggestions(model: &crate::model::Model, failure: &FailureReport) -> Vec<String> {
+    use crate::model::cycle::Phase;
+    let Some(time) = failure.time else {
+        return Vec::new();
+    };
+    let mut out = Vec::new();
+    let h = model.time.step;
+    match model.phase_at(time) {
+        Some(Phase::Programming) => out.push(match &model.programme {
+            Some(p) => format!(
+                "a slower programme: its ramp over a longer time (`programme.ramp`, now {}–{} s), or a smaller `time.step` (now {} s)",
+                short_time(p.ramp.0),
+                short_time(p.ramp.1),
+                short_time(h)
+            ),
+            None => format!(
+                "slower loading, or a smaller `time.step` (now {} s)",
+                short_time(h)
+            ),
+        }),
+        Some(Phase::Releasing | Phase::Released) => out.push(format!(
+            "a gentler release: a longer `time.release_ramp` (now {} s) lets the step cuts follow the springback",
+            short_time(model.time.release_ramp)
+        )),
+        _ => out.push(format!(
+            "a smaller `time.step` (now {} s) or a smaller `time.min_step` (now {} s)",
+            short_time(h),
+            short_time(model.time.min_step)
+        )),
+    }
+    // The patch of the worst equation, as `describe_row` quotes it.
+    let patch = failure.worst_equation.as_deref().and_then(|w| {
+        model
+            .patches
+            .iter()
+            .find(|p| w.contains(&format!("`{}`", p.name)))
+    });
+    if let Some(patch) = patch {
+        let d = model.sections[patch.section].diameter();
+        if patch
+            .fit_error
+            .is_some_and(|e| e > crate::model::builder::FIT_WARNING_FRACTION * d)
+        {
+            out.push(format!(
+                "more control points on patch `{}` (`mesh.n`, now {}): its spline fit deviates {:.1} % of the wire diameter from the curve",
+                patch.name,
+                patch.curve.num_points(),
+                100.0 * patch.fit_error.unwrap_or(0.0) / d
+            ));
+        }
+        // A generated stent's bridges are `b<crown>_<k>` (geometry::stent::bridges).
+        let bridge = model.programme.is_some()
+            && patch.name.starts_with('b')
+            && patch.name[1..].starts_with(|c: char| c.is_ascii_digit());
+        if bridge {
+            out.push(format!(
+                "stiffer or shorter bridges: the largest residual is on bridge `{}`, and slender bridges buckle into loops under the programme (straight bridges, a smaller `stent.bridges.amplitude`, a thicker `section`)",
+                patch.name
+            ));
+        }
+    }
+    if model.solver.stabilisation.is_none() {
+        out.push(
+            "automatic stabilisation, `solver: {stabilisation: {}}`, carries a run through a buckle or a snap; summary.json then says how much energy it dissipated"
+                .to_string(),
+        );
+    }
+    out
+}
+
 /// The failure report printed by a failed run (the same facts are in summary.json under `failure`).
 fn failure_report(failure: &FailureReport, summary: &RunSummaryFile) -> String {
     let mut lines = vec!["failure report:".to_string()];
@@ -1205,6 +1360,9 @@ fn failure_report(failure: &FailureReport, summary: &RunSummaryFile) -> String {
         }
         _ => lines.push(format!("  {} ({})", failure.message, failure.kind)),
     }
+    if let Some(w) = &failure.worst_equation {
+        lines.push(format!("  largest residual: in the equation of {w}"));
+    }
     if let Some(w) = &failure.diagnosis {
         lines.push(format!("  diagnosis: {w}"));
     }
@@ -1212,7 +1370,11 @@ fn failure_report(failure: &FailureReport, summary: &RunSummaryFile) -> String {
         .snapshots
         .last()
         .filter(|s| s.step == failure.last_converged_step)
-        .and_then(|s| s.files.get(crate::io::snapshots::FORMATS[0].extension()))
+        .and_then(|s| {
+            crate::io::formats::FORMATS
+                .iter()
+                .find_map(|f| s.files.get(f.extension()))
+        })
         .map(|f| format!(", snapshot {f}"))
         .unwrap_or_default();
     lines.push(format!(
@@ -1220,5 +1382,11 @@ fn failure_report(failure: &FailureReport, summary: &RunSummaryFile) -> String {
         failure.last_converged_step,
         short_time(failure.last_converged_time)
     ));
+    for (k, suggestion) in failure.suggestions.iter().enumerate() {
+        lines.push(format!(
+            "  {} {suggestion}",
+            if k == 0 { "try:" } else { "  or" }
+        ));
+    }
     lines.join("\n")
 }

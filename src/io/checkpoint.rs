@@ -2,12 +2,12 @@
 //! output stood at that step ([`OutputsCheckpoint`]), from which `stentkit run --resume` continues a killed or
 //! interrupted run exactly.
 //!
-//! # Format (version 6; version 5 had no stabiliser state, version 4 no load factor per chart sample, version 3 no arc-length state, version 2 had 18 numbers per section law and no
+//! # Format (version 7; version 6 had no snapshot phase, version 5 no stabiliser state, version 4 no load factor per chart sample, version 3 no arc-length state, version 2 had 18 numbers per section law and no
 //! per-material recovery, version 1, before error-controlled stepping, no step-control memory)
 //!
 //! ```text
 //! magic     8 bytes   "STKCKPT\0"
-//! version   u32       6
+//! version   u32       7
 //! length    u64       bytes of the payload
 //! payload   …         the fields below, in order
 //! crc32     u32       CRC-32 (IEEE 802.3, as zlib and PNG) of everything before it
@@ -34,6 +34,7 @@ use super::snapshots::Snapshot;
 use super::state::{Recovery, StateSample};
 use crate::material::LAW_NUMBERS;
 use crate::math::{Mat3, Real, Vec3};
+use crate::model::cycle::Phase;
 use crate::solver::assembly::{Actions, ReleaseRamp};
 use crate::solver::simulation::adaptive::StepControl;
 use crate::solver::simulation::{ArcState, StabiliserState, TangentOrigin};
@@ -48,7 +49,7 @@ pub const FILE_NAME: &str = "checkpoint.bin";
 const MAGIC: &[u8; 8] = b"STKCKPT\0";
 
 /// The format version this build writes and reads.
-pub const VERSION: u32 = 6;
+pub const VERSION: u32 = 7;
 
 /// Bytes before the payload: magic, version, length.
 const HEADER: usize = 8 + 4 + 8;
@@ -651,6 +652,7 @@ fn encode_outputs(e: &mut Encoder, o: &OutputsCheckpoint) {
     e.list(&o.snapshots, |e, s| {
         e.usize(s.step);
         e.f64(s.time);
+        e.option(s.phase.as_ref(), |e, p| e.str(p.name()));
         e.list(&s.files, |e, f| e.str(&f.to_string_lossy()));
         e.usize(s.triangles);
         e.f64(s.volume);
@@ -691,6 +693,12 @@ fn decode_outputs(d: &mut Decoder<'_>) -> Result<OutputsCheckpoint, Problem> {
             Ok(Snapshot {
                 step: d.usize()?,
                 time: d.f64()?,
+                phase: d.option(|d| {
+                    let name = d.str()?;
+                    Phase::parse(&name).ok_or_else(|| {
+                        Problem::Damaged(format!("an unknown snapshot phase `{name}`"))
+                    })
+                })?,
                 files: d.list(8, |d| Ok(PathBuf::from(d.str()?)))?,
                 triangles: d.usize()?,
                 volume: d.f64()?,
@@ -813,9 +821,10 @@ mod tests {
             snapshots: vec![Snapshot {
                 step: 0,
                 time: 0.0,
+                phase: Some(Phase::Initial),
                 files: vec![
-                    "snapshots/step_00000.stl".into(),
-                    "snapshots/step_00000.obj".into(),
+                    "snapshots/t0.000_initial.stl".into(),
+                    "snapshots/t0.000_initial.obj".into(),
                 ],
                 triangles: 88,
                 volume: 1.5,

@@ -8,6 +8,7 @@ pub mod checkpoint;
 pub mod configurations;
 pub mod design;
 pub mod estimate;
+pub mod formats;
 pub mod history;
 pub mod mcap;
 pub mod mcap_salvage;

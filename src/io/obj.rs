@@ -11,7 +11,7 @@ use std::path::Path;
 use crate::geometry::mesh::TriangleMesh;
 use crate::io::stl::{MeshIoError, check_writable, write_atomically};
 
-/// OBJ snapshots ([`super::snapshots::FORMATS`]): a comment naming the design, step, time and units.
+/// OBJ snapshots ([`super::formats::FORMATS`]): a comment naming the design, step, time and units.
 pub struct Obj;
 
 impl super::mesh_format::MeshFormat for Obj {

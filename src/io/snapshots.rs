@@ -1,15 +1,11 @@
 //! Snapshots of a run: the full device as closed tubes swept along the deformed centrelines with the solver's
-//! section frames, written in every registered [`MeshFormat`] — binary STL and OBJ (`snapshots/step_NNNNN.stl`,
-//! `.obj`) — at the initial state, at the final one, every `every` steps and at the requested times (time
-//! stepping lands on those: they are the model's record times). With each snapshot, unless the design turns
-//! them off, the fields along the rods for ParaView (`snapshots/step_NNNNN.vtp`, [`super::vtk`], listed with
-//! their times in `run.pvd`); and the full device's centrelines are kept for the configuration figures drawn at
-//! the end ([`super::configurations`]).
-//!
-//! **A new snapshot file format is a new module plus one registration line**: write `io/<format>.rs` with a
-//! type implementing [`MeshFormat`] (in [`super::mesh_format`]: its extension and how it writes a mesh), declare the module in `io/mod.rs`,
-//! and add the type to [`FORMATS`]. Each snapshot then lists its file under the extension as key in
-//! summary.json, the run folder's manifest claims it, and `--resume` keeps or rewrites it with the others.
+//! section frames, written in the design's formats ([`super::formats`]; binary STL by default, OBJ on request)
+//! at the initial state, at the final one, at the events of the shape-memory cycle ([`crate::model::cycle`]:
+//! programmed, fixed, released), at a few times between them, every `every` steps and at the requested times
+//! (time stepping lands on those: they are the model's record times). Each is named by its time and phase,
+//! `snapshots/t1.750_fixed.stl` ([`snapshot_name`]). With each snapshot, unless the design turns them off, the
+//! fields along the rods for ParaView (`.vtp`, [`super::vtk`], listed with their times in `run.pvd`); and the
+//! full device's centrelines are kept for the configuration figures drawn at the end ([`super::configurations`]).
 
 use super::chart::ChartError;
 use super::configurations::{self, CENTRELINE_SAMPLES, Configuration};
@@ -17,11 +13,12 @@ use super::design::SnapshotSettings;
 use super::mesh_format::{MeshFormat, SnapshotState};
 use super::run_folder::Manifest;
 use super::stl::MeshIoError;
-use super::{obj, render, stl, vtk};
+use super::{formats, render, stl, vtk};
 use crate::geometry::device_tubes::DeviceMeshError;
 use crate::geometry::mesh::TriangleMesh;
 use crate::math::Real;
 use crate::model::Model;
+use crate::model::cycle::Phase;
 use crate::post::device::{
     current_device_shapes, decimated, device_centrelines, device_tube_mesh, reference_patch_shapes,
     samples_per_point,
@@ -33,7 +30,7 @@ use std::path::{Path, PathBuf};
 /// Decides which states get a snapshot (shared by the snapshot files and the meshes of the recording).
 #[derive(Debug, Clone, PartialEq)]
 pub struct SnapshotSchedule {
-    /// Requested times, sorted.
+    /// The times due, sorted: the requested ones, the cycle's events, the cuts between them.
     times: Vec<Real>,
     /// Every this many steps (0: never).
     every: usize,
@@ -47,36 +44,92 @@ pub struct SnapshotSchedule {
 impl SnapshotSchedule {
     /// The schedule of a design's snapshot settings for its model.
     pub fn new(settings: &SnapshotSettings, model: &Model) -> Self {
+        let snap = crate::model::LANDING_TOLERANCE * model.time.step;
+        let mut times = settings.times.clone();
+        // An arc-length path's `time` is its path parameter, which passes `time.end` anywhere: its last state
+        // is written by the writers' `finish`, and it has neither events nor times between them.
+        let end = match model.solver.path.arc_length() {
+            None => {
+                let events: Vec<Real> = model.events().iter().map(|&(t, _)| t).collect();
+                if settings.events {
+                    times.extend(&events);
+                }
+                times.extend(between_events(&events, settings.between));
+                model.time.end
+            }
+            Some(_) => Real::INFINITY,
+        };
+        times.sort_by(Real::total_cmp);
+        times.dedup_by(|a, b| (*a - *b).abs() <= snap);
         Self {
-            times: settings.times.clone(),
+            times,
             every: settings.every,
-            // An arc-length path's `time` is its path parameter, which passes `time.end` anywhere: its last state
-            // is written by the writers' `finish`.
-            end: match model.solver.path.arc_length() {
-                None => model.time.end,
-                Some(_) => Real::INFINITY,
-            },
-            snap: crate::model::LANDING_TOLERANCE * model.time.step,
+            end,
+            snap,
         }
+    }
+
+    /// The times due (sorted), besides step 0, the end and every `every` steps: the first step at or after
+    /// each gets a snapshot.
+    pub fn times(&self) -> &[Real] {
+        &self.times
     }
 
     /// Whether the state of step `step` at `time`, reached from `previous` (the time of the step before),
     /// gets a snapshot: step 0 and the end always; every `every` steps; and the first step at or after each
-    /// requested time (which is the step landing on it).
+    /// time due (which is the step landing on it, for requested times and events).
     pub fn is_due(&self, step: usize, previous: Real, time: Real) -> bool {
         step == 0
             || (self.every > 0 && step.is_multiple_of(self.every))
             || time >= self.end - self.snap
             || self
                 .times
-                // Sorted: the first requested time after `previous` decides (one binary search per step).
+                // Sorted: the first time due after `previous` decides (one binary search per step).
                 .get(self.times.partition_point(|&t| t <= previous + self.snap))
                 .is_some_and(|&t| t <= time + self.snap)
     }
 }
 
-/// The formats every snapshot is written in, in this order: the registration list of [`MeshFormat`]s.
-pub const FORMATS: &[&dyn MeshFormat] = &[&stl::Stl, &obj::Obj];
+/// The times between `events` (sorted, the first 0 and the last the end of the run) that divide the run into
+/// about `pieces` equal pieces: each interval between two events into `max(1, round(pieces · length / run))`
+/// equal parts.
+fn between_events(events: &[Real], pieces: usize) -> Vec<Real> {
+    let (Some(first), Some(last)) = (events.first(), events.last()) else {
+        return Vec::new();
+    };
+    let run = last - first;
+    if pieces == 0 || run <= 0.0 {
+        return Vec::new();
+    }
+    events
+        .windows(2)
+        .flat_map(|w| {
+            let (a, b) = (w[0], w[1]);
+            let parts = ((pieces as Real * (b - a) / run).round() as usize).max(1);
+            (1..parts).map(move |k| a + (b - a) * k as Real / parts as Real)
+        })
+        .collect()
+}
+
+/// The name of the snapshot of step `step` at `time` (without extension): its time with at least three
+/// decimals and its phase in the model's cycle, `t1.750_fixed` (`t0.500` for a model without a cycle), or
+/// `step_00012` on an arc-length path, whose `time` is the path parameter.
+pub fn snapshot_name(model: &Model, step: usize, time: Real) -> String {
+    if model.solver.path.arc_length().is_some() {
+        return format!("step_{step:05}");
+    }
+    // The fewest decimals, at least three, that write the time exactly (to 1e-9 of it): 1.750, 1.7525.
+    let decimals = (3..=6)
+        .find(|&d| {
+            let scale = Real::powi(10.0, d);
+            ((time * scale).round() / scale - time).abs() <= 1e-9 * time.abs().max(1.0)
+        })
+        .unwrap_or(6) as usize;
+    match model.phase_at(time) {
+        Some(phase) => format!("t{time:.decimals$}_{phase}"),
+        None => format!("t{time:.decimals$}"),
+    }
+}
 
 /// One written snapshot.
 #[derive(Debug, Clone, PartialEq)]
@@ -85,8 +138,11 @@ pub struct Snapshot {
     pub step: usize,
     /// Time [time].
     pub time: Real,
-    /// Its files relative to the run folder, one per format of [`FORMATS`] in that order, each with its
-    /// format's extension, then the fields for ParaView (`.vtp`) when the design writes them.
+    /// Its phase in the model's cycle ([`Model::phase_at`]).
+    pub phase: Option<Phase>,
+    /// Its files relative to the run folder, one per format of the design in the registry's order
+    /// ([`super::formats::FORMATS`]), each with its format's extension, then the fields for ParaView (`.vtp`)
+    /// when the design writes them.
     pub files: Vec<PathBuf>,
     /// Triangles of the mesh.
     pub triangles: usize,
@@ -162,8 +218,12 @@ pub struct SnapshotWriter {
     /// The run folder (file names in [`Snapshot`] are relative to it).
     run_dir: PathBuf,
     schedule: SnapshotSchedule,
+    /// The times the design lists (`output.snapshots.times`): the configuration figures show these.
+    requested: Vec<Real>,
     segments: usize,
     rings: usize,
+    /// The formats each snapshot is written in.
+    formats: Vec<&'static dyn MeshFormat>,
     /// Time and step of the last state seen.
     last: Option<(usize, Real)>,
     written: Vec<Snapshot>,
@@ -203,8 +263,14 @@ impl SnapshotWriter {
         Ok(Self {
             run_dir: run_dir.to_path_buf(),
             schedule: SnapshotSchedule::new(settings, model),
+            requested: settings.times.clone(),
             segments: settings.segments,
             rings: settings.rings,
+            formats: settings
+                .formats
+                .iter()
+                .filter_map(|e| formats::format(e))
+                .collect(),
             last: None,
             written: Vec::new(),
             error: None,
@@ -271,8 +337,9 @@ impl SnapshotWriter {
                 source: e.source,
             }
         })?;
-        let name = format!("step_{step:05}");
-        let files: Vec<PathBuf> = FORMATS
+        let name = self.unique_name(snapshot_name(model, step, time), step);
+        let files: Vec<PathBuf> = self
+            .formats
             .iter()
             .map(|f| Path::new(Self::FOLDER).join(format!("{name}.{}", f.extension())))
             .collect();
@@ -282,7 +349,7 @@ impl SnapshotWriter {
             }
         }
         let state = SnapshotState { model, step, time };
-        for (format, path) in FORMATS.iter().zip(&files) {
+        for (format, path) in self.formats.iter().zip(&files) {
             format.write(&self.run_dir.join(path), &mesh, &state)?;
         }
         let mut files = files;
@@ -311,6 +378,7 @@ impl SnapshotWriter {
         self.written.push(Snapshot {
             step,
             time,
+            phase: model.phase_at(time),
             files,
             triangles: mesh.triangles.len(),
             volume: mesh.volume(),
@@ -324,6 +392,22 @@ impl SnapshotWriter {
             lines: device_centrelines(model, &current_device_shapes(sim, CENTRELINE_SAMPLES)),
         });
         Ok(())
+    }
+
+    /// `name`, or `name_stepN` when an earlier snapshot has it (times closer than a microsecond apart, as step
+    /// cuts can make them).
+    fn unique_name(&self, name: String, step: usize) -> String {
+        let taken = self.written.iter().any(|s| {
+            s.files
+                .first()
+                .and_then(|f| f.file_stem())
+                .is_some_and(|stem| stem == name.as_str())
+        });
+        if taken {
+            format!("{name}_step{step}")
+        } else {
+            name
+        }
     }
 
     /// Draws the configuration figures ([`crate::io::configurations`]) of the snapshots written by this process
@@ -348,8 +432,7 @@ impl SnapshotWriter {
             lines: device_centrelines(model, &shapes),
         };
         let times: Vec<Real> = self.configurations.iter().map(|c| c.time).collect();
-        let picked =
-            configurations::chosen_indices(&times, &self.schedule.times, self.schedule.snap);
+        let picked = configurations::chosen_indices(&times, &self.requested, self.schedule.snap);
         if picked.is_empty() {
             return Ok(Vec::new());
         }
@@ -500,5 +583,24 @@ impl Observer for SnapshotWriter {
 
     fn step(&mut self, sim: &Simulation<'_>, report: &StepReport) -> ControlFlow<()> {
         self.observe(sim, report.step)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_run_is_cut_between_its_events_in_proportion() {
+        // The straight stent's events (0, 1, 1.75, 1.7525, 3.25) in 6 pieces: the intervals get
+        // round(6 · length / 3.25) = 2, 1, 1 (at least one) and 3 parts.
+        let cuts = between_events(&[0.0, 1.0, 1.75, 1.7525, 3.25], 6);
+        let expected = [0.5, 1.7525 + 1.4975 / 3.0, 1.7525 + 2.0 * 1.4975 / 3.0];
+        assert_eq!(cuts.len(), expected.len(), "{cuts:?}");
+        for (c, e) in cuts.iter().zip(expected) {
+            assert!((c - e).abs() < 1e-12, "{cuts:?}");
+        }
+        assert!(between_events(&[0.0, 1.0], 0).is_empty());
+        assert!(between_events(&[0.0], 6).is_empty());
     }
 }

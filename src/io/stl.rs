@@ -34,7 +34,7 @@ pub fn write_stl(path: &Path, mesh: &TriangleMesh) -> Result<(), MeshIoError> {
     write_stl_with_header(path, mesh, "")
 }
 
-/// Binary STL snapshots ([`super::snapshots::FORMATS`]): an 80-byte header naming the design, step, time and
+/// Binary STL snapshots ([`super::formats::FORMATS`]): an 80-byte header naming the design, step, time and
 /// unit system.
 pub struct Stl;
 

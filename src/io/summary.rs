@@ -69,6 +69,13 @@ pub struct FailureReport {
     /// an increment too large for a regular tangent was largest.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub diagnosis: Option<String>,
+    /// The equation whose normalised residual was largest at the last assembly (no convergence only): patch,
+    /// collocation point or node, and which balance.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub worst_equation: Option<String>,
+    /// What to change, most likely first (filled by `stentkit run` from the model and where it failed).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub suggestions: Vec<String>,
     /// The last converged step (0: the initial state), whose state the outputs end with.
     pub last_converged_step: usize,
     /// Its time [s].
@@ -97,6 +104,8 @@ impl FailureReport {
             iterations: None,
             residuals: Vec::new(),
             diagnosis: None,
+            worst_equation: None,
+            suggestions: Vec::new(),
             last_converged_step: step,
             last_converged_time: time,
             message: error.to_string(),
@@ -108,8 +117,10 @@ impl FailureReport {
             iterations,
             residuals,
             diagnosis,
+            worst_equation,
         } = error
         {
+            report.worst_equation = worst_equation.clone();
             report.time = Some(*time);
             report.step = Some(*step);
             report.dt = Some(*dt);
@@ -180,7 +191,11 @@ pub struct SnapshotEntry {
     pub step: usize,
     /// Time [s].
     pub time: Real,
-    /// Its files relative to the run folder by extension: `"stl"`, `"obj"` ([`crate::io::snapshots::FORMATS`])
+    /// Its phase in the shape-memory cycle ([`crate::model::cycle::Phase`]: `programmed`, `fixed`, …), when
+    /// the model has a cycle.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub phase: Option<String>,
+    /// Its files relative to the run folder by extension: `"stl"`, `"obj"` ([`crate::io::formats::FORMATS`])
     /// and `"vtp"` (the fields for ParaView, [`crate::io::vtk`]).
     #[serde(flatten)]
     pub files: std::collections::BTreeMap<String, String>,
@@ -195,6 +210,7 @@ impl From<&Snapshot> for SnapshotEntry {
         Self {
             step: s.step,
             time: s.time,
+            phase: s.phase.map(|p| p.name().to_string()),
             files: s
                 .files
                 .iter()
@@ -273,6 +289,9 @@ pub struct RunSummaryFile {
     pub design: String,
     /// The design file as given on the command line.
     pub design_file: String,
+    /// The fingerprint of the model that ran ([`crate::solver::simulation::model_fingerprint`], 16 hex
+    /// digits): `stentkit export` checks the design it re-runs against it.
+    pub model_fingerprint: String,
     /// The `--set` overrides applied to it, as given.
     #[serde(skip_serializing_if = "Vec::is_empty")]
     pub overrides: Vec<String>,
@@ -403,6 +422,10 @@ impl RunSummaryFile {
         Self {
             design: model.name.clone(),
             design_file: design_file.to_string(),
+            model_fingerprint: format!(
+                "{:016x}",
+                crate::solver::simulation::model_fingerprint(model)
+            ),
             overrides: Vec::new(),
             resolved_design: None,
             stentkit_version: version.to_string(),

@@ -8,6 +8,7 @@
 //! ([`Units`]); temperatures are in °C.
 
 pub mod builder;
+pub mod cycle;
 pub mod programme;
 pub mod schedule;
 pub mod stent;

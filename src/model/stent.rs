@@ -108,6 +108,27 @@ fn geometry_error(e: GeometryError) -> BuildError {
     }
 }
 
+/// Where a programme's temporary shape puts the device: the placement and how much every crown's radius
+/// shrinks ([`StentSpec::generate_temporary`]).
+pub type Placement = (TemporarySpec, Real);
+
+impl ProgrammeSpec {
+    /// The temporary placement of the programme's target: a radial contraction keeps the centreline and
+    /// shrinks every crown by Δr; a target shape is its `temporary` placement.
+    pub fn placement(&self) -> Placement {
+        match &self.target {
+            ProgrammeTarget::RadialContraction { delta_r } => (
+                TemporarySpec {
+                    centreline: crate::geometry::stent::TemporaryCentreline::Same,
+                    radius: None,
+                },
+                *delta_r,
+            ),
+            ProgrammeTarget::TargetShape { temporary, .. } => (temporary.clone(), 0.0),
+        }
+    }
+}
+
 /// Generates the stent: fitted patches (section 0, or a half section for patches lying in a symmetry plane,
 /// appended to `sections`; `poisson` gives its shear factor), of the materials `materials` gives per role
 /// (already checked against the number of crowns), nodes with their symmetry conditions.
@@ -117,9 +138,14 @@ pub fn generate(
     materials: &StentMaterials,
     sections: &mut Vec<Section>,
     poisson: Real,
+    placement: Option<&Placement>,
     warnings: &mut Vec<String>,
 ) -> Result<GeneratedStent> {
-    let geometry = spec.generate().map_err(geometry_error)?;
+    let geometry = match placement {
+        None => spec.generate(),
+        Some((temporary, shrink)) => spec.generate_temporary(temporary, *shrink),
+    }
+    .map_err(geometry_error)?;
     for (bridge, (p, n)) in [(false, mesh.crown), (true, mesh.bridge)] {
         check_discretisation(
             p,
@@ -129,9 +155,14 @@ pub fn generate(
         )?;
     }
     let full = sections[0];
+    if let Some(w) = crowns_touch(&geometry, full.diameter()) {
+        warnings.push(w);
+    }
     let mut half_section = None;
     let mut patches = Vec::with_capacity(geometry.patches.len());
     let mut worst: Option<(Real, &str)> = None;
+    // In a temporary placement: how many patches fold, and the first one's message.
+    let mut folds: Option<(usize, String)> = None;
     let whole = |message: String| BuildError::new(Field::Stent(StentField::Whole), message);
     for g in &geometry.patches {
         let (p, n) = match g.role {
@@ -149,7 +180,16 @@ pub fn generate(
                 if worst.is_none_or(|(w, _)| fit.max_deviation > w) {
                     worst = Some((fit.max_deviation, &g.name));
                 }
-                check_bend(g, &fit.curve, full.diameter())?;
+                match check_bend(g, &fit.curve, full.diameter()) {
+                    // The temporary placement keeps the crowns' amplitude on a smaller radius: its wires are
+                    // where the nodes go, not how the wires bend (module docs of `cli::mesh`), so a fold is said.
+                    Err(e) if placement.is_some() => {
+                        // Its message without the advice for a permanent shape.
+                        let what = e.message.split("; ").next().unwrap_or_default().to_string();
+                        folds.get_or_insert((0, what)).0 += 1;
+                    }
+                    result => result?,
+                }
                 (fit.curve, Some(fit.max_deviation))
             }
         };
@@ -175,6 +215,12 @@ pub fn generate(
             material: materials.of(&g.role),
             fit_error,
         });
+    }
+    if let Some((count, first)) = folds {
+        warnings.push(format!(
+            "the generated temporary shape folds in {count} patch{}: {first}. The programme prescribes only where the nodes go; how the wires between them bend is the simulation's (`stentkit export RUN_DIR --phase programmed`)",
+            if count == 1 { "" } else { "es" }
+        ));
     }
     if let Some((dev, name)) = worst {
         let d = full.diameter();
@@ -254,6 +300,36 @@ fn check_bend(g: &GeneratedPatch, fitted: &crate::math::NurbsCurve, diameter: Re
             crate::math::Short(0.5 * diameter)
         ),
     ))
+}
+
+/// A warning when the wires of two consecutive crowns come closer, centre to centre, than the wire's
+/// `diameter`: the closest crest of one crown to a trough of the next (the crowns' axial extremes, so the
+/// distance across the gap between them). Their surfaces then touch or overlap: a printer fuses them, and the rods
+/// know of no contact. Said, not refused: the simulation runs all the same.
+fn crowns_touch(geometry: &StentGeometry, diameter: Real) -> Option<String> {
+    use crate::geometry::stent::NodeKind;
+    let (gap, crest) = geometry
+        .nodes
+        .iter()
+        .filter(|c| c.kind == NodeKind::Crest)
+        .flat_map(|c| {
+            geometry
+                .nodes
+                .iter()
+                .filter(move |q| q.kind == NodeKind::Trough && q.crown == c.crown + 1)
+                .map(move |q| ((q.position - c.position).norm(), c))
+        })
+        .min_by(|a, b| a.0.total_cmp(&b.0))?;
+    (gap < diameter).then(|| {
+        format!(
+            "crowns {} and {} come within {} of each other (a crest to the next crown's trough, centre to centre, at ϑ = {:.1}°), less than the wire's diameter {}: their wires touch or overlap there, which a printer fuses and the rods do not model (no contact); widen `stent.spacing`, or lower `stent.amplitude` or the wire",
+            crest.crown + 1,
+            crest.crown + 2,
+            crate::math::Short(gap),
+            crest.angle.to_degrees(),
+            crate::math::Short(diameter)
+        )
+    })
 }
 
 /// The symmetry planes of a generated stent as `(point, normal)`.

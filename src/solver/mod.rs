@@ -71,8 +71,10 @@ pub enum SolverError {
     },
     /// Newton failed even at the smallest allowed step.
     #[error(
-        "no convergence at t = {} (step {step}, dt = {dt:.3e} ≤ min_step): after {iterations} Newton iterations the normalised residuals were {residuals:?}{}",
+        "no convergence at t = {} (step {step}, dt = {dt:.3e} ≤ min_step) after {iterations} Newton iterations{}{}{}",
         crate::math::Short(*time),
+        residuals.last().map(|r| format!(", normalised residual {r:.3e}")).unwrap_or_default(),
+        worst_equation.as_ref().map(|w| format!(", largest in the equation of {w}")).unwrap_or_default(),
         diagnosis.as_ref().map(|w| format!("; {w}")).unwrap_or_default()
     )]
     StepFailed {
@@ -89,6 +91,8 @@ pub enum SolverError {
         /// Why the last attempt was abandoned at once, if it was: where a NaN or infinity first appeared, or
         /// where an increment too large for a regular tangent was largest.
         diagnosis: Option<String>,
+        /// The equation whose normalised residual was largest at the last assembly.
+        worst_equation: Option<String>,
     },
 }
 

@@ -9,6 +9,7 @@ mod checkpoint;
 mod cli;
 mod design_errors;
 mod designs;
+mod export;
 mod fields;
 mod fuzz;
 mod materials;

@@ -295,3 +295,96 @@ fn tangential_joints_stay_manifold_after_vertex_merging() {
         assert!(measured.volume > 0.0);
     }
 }
+
+/// The largest distance of `points` from the line through their centroid along their principal direction.
+fn distance_from_principal_line(points: &[Vec3]) -> Real {
+    let n = points.len() as Real;
+    let centroid = points.iter().sum::<Vec3>() / n;
+    let covariance = points
+        .iter()
+        .map(|p| (p - centroid) * (p - centroid).transpose())
+        .sum::<stentkit::math::Mat3>();
+    let eigen = covariance.symmetric_eigen();
+    let k = eigen.eigenvalues.imax();
+    let axis = eigen.eigenvectors.column(k).into_owned();
+    points
+        .iter()
+        .map(|p| {
+            let d = p - centroid;
+            (d - axis * axis.dot(&d)).norm()
+        })
+        .fold(0.0, Real::max)
+}
+
+#[test]
+fn the_temporary_shape_is_the_device_where_its_programme_takes_it() {
+    // `stentkit mesh --state temporary` generates the device in its programme's temporary placement, without
+    // simulating. References, from the designs: the straight stent contracts radially by Δr = 15 mm from
+    // R = 20 mm, and the curved stent's target is straightened with crowns of radius 5 mm; both have a wire of
+    // diameter 0.6 mm. So the straight stent's temporary device lies within 5 + 0.3 mm of a straight axis (its
+    // crown wires on the cylinder of radius 5, its straight bridges' chords inside it), and the curved stent's
+    // within 5 + 2.5 + 0.3 mm (its radial sine bridges, amplitude h_b = 2.5 mm, bulge out by that), and each
+    // reaches its bound, to the section polygon: its vertices there lie on the bound, or up to
+    // 0.3 (1 − cos(π/16)) = 5.8e-3 mm inside it with 16 segments. The axis is found as the vertices' principal
+    // line, which on the straight stent is off its true axis x1 by 3.7e-5 mm (measured; STL's f32 adds 1e-5
+    // at most): 2e-4 is allowed above the bound. The curved stent's permanent shape is 20 mm in radius on a 45°
+    // arc: tens of mm off any line. The driven nodes must meet the programme's targets P_0 + η to round-off
+    // (the fitted wires' ends are exact).
+    let dir = TempDir::new("temporary_shape");
+    for (name, radius) in [("straight_stent.yaml", 5.3), ("curved_stent.yaml", 7.8)] {
+        let out_path = dir.join(&format!("{name}.stl"));
+        let out = crate::outputs::stentkit(&[
+            "mesh",
+            crate::outputs::path_str(&crate::outputs::design(name)),
+            "--state",
+            "temporary",
+            "-o",
+            crate::outputs::path_str(&out_path),
+        ]);
+        let stdout = crate::outputs::text(&out.stdout);
+        assert!(
+            out.status.success(),
+            "{}",
+            crate::outputs::text(&out.stderr)
+        );
+        let misfit: Real = stdout
+            .split("within ")
+            .nth(1)
+            .and_then(|s| s.split_whitespace().next())
+            .and_then(|s| s.parse().ok())
+            .unwrap_or_else(|| panic!("{stdout}"));
+        assert!(
+            misfit < 1e-9,
+            "{name}: driven nodes {misfit} off their targets"
+        );
+        let mesh = stl::read_stl(&out_path).expect("STL");
+        mesh.check_closed().expect("closed");
+        let far = distance_from_principal_line(&mesh.vertices);
+        assert!(
+            (radius - 5.8e-3..=radius + 2e-4).contains(&far),
+            "{name}: the temporary device reaches {far} from its axis"
+        );
+    }
+    // The permanent curved stent, for contrast, is far from straight.
+    let permanent = dir.join("curved_permanent.stl");
+    let out = crate::outputs::stentkit(&[
+        "mesh",
+        crate::outputs::path_str(&crate::outputs::design("curved_stent.yaml")),
+        "-o",
+        crate::outputs::path_str(&permanent),
+    ]);
+    assert!(out.status.success());
+    let far = distance_from_principal_line(&stl::read_stl(&permanent).expect("STL").vertices);
+    assert!(far > 20.3, "{far}");
+    // A design without a programme has no temporary shape.
+    let out = crate::outputs::stentkit(&[
+        "mesh",
+        crate::outputs::path_str(&crate::outputs::design("bend45.yaml")),
+        "--state",
+        "temporary",
+        "-o",
+        crate::outputs::path_str(&dir.join("bend.stl")),
+    ]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(crate::outputs::text(&out.stderr).contains("no programme, so no temporary shape"));
+}

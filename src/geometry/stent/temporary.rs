@@ -7,16 +7,17 @@ use super::{
     TemporarySpec, invalid,
 };
 use crate::geometry::GeometryError;
-use crate::math::Vec3;
+use crate::math::{Real, Vec3};
 
 impl StentSpec {
-    /// Positions of the nodes of `geometry` (generated from `self`) in a temporary placement: the same crowns at
-    /// the same stations and angles on another centreline and/or radius (paper Eq. `target_disp`: `P_temp`).
-    pub fn temporary_node_positions(
+    /// The axis of a temporary placement: the permanent one, its tangent line at the middle station between the
+    /// first and last crown (`straighten`), or a given centreline long enough for the crowns' `stations`.
+    fn temporary_axis(
         &self,
-        geometry: &StentGeometry,
+        permanent: Axis,
+        stations: &[Real],
         temporary: &TemporarySpec,
-    ) -> Result<Vec<Vec3>, GeometryError> {
+    ) -> Result<Axis, GeometryError> {
         if let Some(radius) = temporary.radius
             && !(radius.is_finite() && radius > 0.0)
         {
@@ -25,9 +26,7 @@ impl StentSpec {
                 format!("must be > 0, got {radius}"),
             ));
         }
-        let permanent = Axis::new(&self.centreline)?;
-        let stations = &geometry.stations;
-        let axis = match &temporary.centreline {
+        Ok(match &temporary.centreline {
             TemporaryCentreline::Same => permanent,
             TemporaryCentreline::Straightened => {
                 let mid = 0.5 * (stations[0] + stations[stations.len() - 1]);
@@ -57,7 +56,18 @@ impl StentSpec {
                 }
                 axis
             }
-        };
+        })
+    }
+
+    /// Positions of the nodes of `geometry` (generated from `self`) in a temporary placement: the same crowns at
+    /// the same stations and angles on another centreline and/or radius (paper Eq. `target_disp`: `P_temp`).
+    pub fn temporary_node_positions(
+        &self,
+        geometry: &StentGeometry,
+        temporary: &TemporarySpec,
+    ) -> Result<Vec<Vec3>, GeometryError> {
+        let axis =
+            self.temporary_axis(Axis::new(&self.centreline)?, &geometry.stations, temporary)?;
         let h = self.crown.amplitude;
         Ok(geometry
             .nodes
@@ -70,5 +80,39 @@ impl StentSpec {
                 c + r * Vec3::new(x, radius * ca, radius * sa)
             })
             .collect())
+    }
+
+    /// The whole device in a temporary placement: the crowns at the same arc-length stations on the temporary
+    /// axis ([`Self::temporary_node_positions`]), every crown at the temporary radius, or at its own radius less
+    /// `shrink` (a radial contraction by Δr), wires and bridges generated there as on the permanent axis. Its
+    /// nodes are where [`Self::temporary_node_positions`] puts them. Not checked against the permanent shape's
+    /// limits (bend radius, clearance between crowns): a programmed device is compacted on purpose.
+    ///
+    /// # Errors
+    /// [`GeometryError::InvalidStent`] for a specification the permanent shape refuses, a temporary radius
+    /// that is not positive (or a shrink that leaves none), a temporary centreline too short.
+    pub fn generate_temporary(
+        &self,
+        temporary: &TemporarySpec,
+        shrink: Real,
+    ) -> Result<StentGeometry, GeometryError> {
+        self.check_numbers()?;
+        let permanent = Axis::new(&self.centreline)?;
+        let stations = self.stations(&permanent)?;
+        let axis = self.temporary_axis(permanent, &stations, temporary)?;
+        let radii: Vec<Real> = (0..self.crowns)
+            .map(|k| temporary.radius.unwrap_or(self.radius_of(k) - shrink))
+            .collect();
+        if let Some(&r) = radii.iter().find(|r| !(**r > 0.0)) {
+            return Err(invalid(
+                StentParameter::TemporaryRadius,
+                format!("a crown's temporary radius must be > 0, got {r}"),
+            ));
+        }
+        let placed = StentSpec {
+            crown_radii: Some(radii),
+            ..self.clone()
+        };
+        placed.generate_on(std::sync::Arc::new(axis), stations, false)
     }
 }

@@ -47,9 +47,9 @@ pub struct Built {
     pub steps: StepPlan,
 }
 
-/// Builds and validates the model; returns it with the output settings, the warnings found and the memory
-/// estimate.
-pub fn build(dto: &DesignDto, default_name: &str) -> Result<Built> {
+/// Builds and validates the model (with `temporary_shape`, the device in its programme's temporary shape,
+/// without the programme); returns it with the output settings, the warnings found and the memory estimate.
+pub fn build(dto: &DesignDto, default_name: &str, temporary_shape: bool) -> Result<Built> {
     if let Some(v) = dto.version
         && v != 1
     {
@@ -101,6 +101,9 @@ pub fn build(dto: &DesignDto, default_name: &str) -> Result<Built> {
     if let Some(p) = &dto.programme {
         builder.programme(stent::programme(p, metres_per_unit)?);
     }
+    if temporary_shape {
+        builder.temporary_shape();
+    }
     patches(dto, &mut builder, circular, shear_factor, &material_names)?;
     if let Some(j) = &dto.joints {
         builder.joints(JointRule {
@@ -149,19 +152,6 @@ pub fn build(dto: &DesignDto, default_name: &str) -> Result<Built> {
         builder.probe(p.name.clone(), at);
     }
     let mut output = output_settings(dto, &settings)?;
-    let snapshots_given = dto
-        .output
-        .as_ref()
-        .and_then(|o| o.snapshots.as_ref())
-        .is_some_and(|s| s.every.is_some() || s.times.is_some());
-    if settings.tolerance.is_some() && !snapshots_given {
-        // Error-controlled steps have no step count to space snapshots by: about DEFAULT_COUNT of them evenly in
-        // time instead (landing times of the run).
-        let count = super::SnapshotSettings::DEFAULT_COUNT;
-        output.snapshots.times = (1..count)
-            .map(|k| settings.end * k as Real / count as Real)
-            .collect();
-    }
     builder.record_times(
         output
             .snapshots
@@ -206,7 +196,8 @@ pub fn build(dto: &DesignDto, default_name: &str) -> Result<Built> {
         }
     };
     let memory = check_size(dto, &StepCount::planned(&plan, model.time.step, dto))?;
-    if settings.tolerance.is_none()
+    // An arc-length path has no times to place snapshots at: about DEFAULT_COUNT over its increments.
+    if model.solver.path.arc_length().is_some()
         && dto
             .output
             .as_ref()
@@ -449,10 +440,40 @@ fn output_settings(dto: &DesignDto, time: &TimeSettings) -> Result<super::Output
     }
     times.sort_by(Real::total_cmp);
     times.dedup();
+    let mut formats = crate::io::formats::DEFAULT_FORMATS.to_vec();
+    if let Some(names) = snapshots.and_then(|s| s.formats.as_ref()) {
+        formats.clear();
+        for (k, name) in names.iter().enumerate() {
+            let Some(format) = crate::io::formats::format(&name.to_ascii_lowercase()) else {
+                return Err(issue(
+                    format!("output.snapshots.formats[{k}]"),
+                    format!(
+                        "`{name}` is not a snapshot format; allowed: {}",
+                        crate::io::formats::extensions()
+                    ),
+                ));
+            };
+            formats.push(format.extension());
+        }
+    }
+    // The registry's order, once each.
+    let formats = crate::io::formats::FORMATS
+        .iter()
+        .map(|f| f.extension())
+        .filter(|e| formats.contains(e))
+        .collect();
+    let chosen = snapshots.is_some_and(|s| s.every.is_some() || s.times.is_some());
     let snapshot_settings = SnapshotSettings {
         times,
-        // The default (about DEFAULT_COUNT over the run) is set by `build` once the steps are planned.
+        // An arc-length path's default is set by `build` once its increments are known.
         every: snapshots.and_then(|s| s.every).unwrap_or(0),
+        events: snapshots.and_then(|s| s.events).unwrap_or(true),
+        between: snapshots.and_then(|s| s.between).unwrap_or(if chosen {
+            0
+        } else {
+            SnapshotSettings::DEFAULT_BETWEEN
+        }),
+        formats,
         segments: at_least(
             snapshots.and_then(|s| s.segments),
             SnapshotSettings::DEFAULT_SEGMENTS,
@@ -495,6 +516,7 @@ fn output_settings(dto: &DesignDto, time: &TimeSettings) -> Result<super::Output
     };
     let recording = output.and_then(|o| o.recording.as_ref());
     let recording_settings = RecordingSettings {
+        enabled: recording.and_then(|r| r.enabled).unwrap_or(true),
         centreline_points: at_least(
             recording.and_then(|r| r.centreline_points),
             RecordingSettings::DEFAULT_CENTRELINE_POINTS,

@@ -544,7 +544,8 @@ pub struct ConditionDto {
     /// Node name (or `patch.start` / `patch.end`).
     #[serde(default)]
     pub node: Option<String>,
-    /// Node set name (e.g. a generated stent's `all_joints`, `crown_1`).
+    /// Node set name: a generated stent's `all_joints`, `crests`, `troughs`, `crown_<k>` (k = 1, 2, … along
+    /// the centreline), `bridge_ends` or `symmetry`.
     #[serde(default)]
     pub node_set: Option<String>,
     /// Local basis: three rows, the unit axes e1, e2, e3 (orthonormal, right-handed).
@@ -716,13 +717,14 @@ pub struct OutputDto {
     /// Recorded points.
     #[serde(default)]
     pub probes: Vec<ProbeDto>,
-    /// Tube meshes of the full device written during a run (`snapshots/step_NNNNN.stl`, `.obj`).
+    /// Tube meshes of the full device written during a run (`snapshots/t1.750_fixed.stl`: named by time and
+    /// phase of the shape-memory cycle).
     #[serde(default)]
     pub snapshots: Option<SnapshotsDto>,
     /// What `run.mcap` holds besides the state per step.
     #[serde(default)]
     pub recording: Option<RecordingDto>,
-    /// Fields along the rods for ParaView with every snapshot (`snapshots/step_NNNNN.vtp`, listed in `run.pvd`
+    /// Fields along the rods for ParaView with every snapshot (`snapshots/t1.750_fixed.vtp`, listed in `run.pvd`
     /// with their times); default true.
     #[serde(default)]
     pub vtk: Option<bool>,
@@ -745,18 +747,31 @@ pub struct ConfigurationsDto {
     pub render: Option<bool>,
 }
 
-/// Snapshots: the initial and final shapes always, plus every `every` steps and at the given times.
+/// Snapshots: the initial and final shapes always, the cycle's events (programmed, fixed, released), and a few
+/// between them; or every `every` steps and at the given times. Each is named by its time and phase
+/// (`t1.750_fixed.stl`; `step_00012.stl` on an arc-length path).
 #[derive(Debug, Clone, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct SnapshotsDto {
     /// Times at which to write a snapshot [time], within [0, time.end]; time stepping lands on each.
     #[serde(default)]
     pub times: Option<Vec<NonNegative>>,
-    /// A snapshot every this many converged steps (0: none besides `times`, the initial and the final
-    /// shape). Default: about 20 snapshots over the run, ⌈steps / 20⌉ (counting the steps that land on
-    /// schedule breakpoints).
+    /// A snapshot every this many converged steps (0: none). Default: none (on an arc-length path, about 20
+    /// over its increments).
     #[serde(default)]
     pub every: Option<usize>,
+    /// A snapshot at each event of the shape-memory cycle: the end of programming, the release (still held:
+    /// `fixed`) and its end (`released`); default true.
+    #[serde(default)]
+    pub events: Option<bool>,
+    /// Snapshots between the events: the run, cut at its events, is divided into about this many equal
+    /// pieces, a snapshot at the first step at or after each cut (no step lands on them). Default 6 when
+    /// neither `every` nor `times` is given, else 0.
+    #[serde(default)]
+    pub between: Option<usize>,
+    /// File formats: `stl`, `obj` (default `[stl]`).
+    #[serde(default)]
+    pub formats: Option<Vec<String>>,
     /// Vertices around each tube section (default 16, at least 3).
     #[serde(default)]
     pub segments: Option<usize>,
@@ -765,10 +780,13 @@ pub struct SnapshotsDto {
     pub rings: Option<usize>,
 }
 
-/// Resolution of the recording (`run.mcap`).
+/// The recording (`run.mcap`): whether, and at which resolution.
 #[derive(Debug, Clone, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct RecordingDto {
+    /// Write `run.mcap` at all (default true).
+    #[serde(default)]
+    pub enabled: Option<bool>,
     /// Points per patch of the centrelines recorded at every step (default 21, at least 2; never more than
     /// one per control point).
     #[serde(default)]
@@ -1111,7 +1129,8 @@ pub enum ProgrammeKindDto {
 pub struct ProgrammeDto {
     /// `radial_contraction` or `target_shape`.
     pub kind: ProgrammeKindDto,
-    /// The driven node set (default `all_joints`).
+    /// The driven node set (default `all_joints`): `all_joints`, `crests`, `troughs`, `crown_<k>` (k = 1, 2, …
+    /// along the centreline), `bridge_ends` or `symmetry`.
     #[serde(default)]
     pub nodes: Option<String>,
     /// Radial contraction `Δr` [length] (radial_contraction).

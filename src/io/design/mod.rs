@@ -38,6 +38,15 @@ pub struct SnapshotSettings {
     pub times: Vec<Real>,
     /// A snapshot every this many converged steps; 0 for none.
     pub every: usize,
+    /// A snapshot at each event of the model's cycle ([`crate::model::cycle`]: programmed, fixed, released)
+    /// besides the initial and final states (`output.snapshots.events`, default true).
+    pub events: bool,
+    /// Snapshots between the events: the run, cut at its events, is divided into about this many equal pieces
+    /// ([`crate::io::snapshots::SnapshotSchedule`]); 0 for none. Default [`Self::DEFAULT_BETWEEN`] when the
+    /// design sets neither `every` nor `times`.
+    pub between: usize,
+    /// The file formats, by extension, in the registry's order ([`crate::io::formats`]; default STL only).
+    pub formats: Vec<&'static str>,
     /// Vertices around each tube section.
     pub segments: usize,
     /// Rings (sections) along each patch, about: every k-th of the samples taken at a whole number of samples
@@ -55,19 +64,27 @@ pub struct SnapshotSettings {
 }
 
 impl SnapshotSettings {
-    /// Default number of periodic snapshots over a run: `every = ⌈steps / 20⌉`, counting the steps that land
-    /// on breakpoints ([`crate::model::Model::planned_steps`]).
+    /// Default number of periodic snapshots over an arc-length path, which has no times to place them at:
+    /// `every = ⌈increments / 20⌉`.
     pub const DEFAULT_COUNT: usize = 20;
-    /// Default vertices around a section: 16, the section polygon has 97.4 % of the circle's area.
-    pub const DEFAULT_SEGMENTS: usize = 16;
+    /// Default pieces between the events ([`Self::between`]): 6. With the events this gives the straight stent 8
+    /// snapshots (t = 0, 0.5, 1 programmed, 1.75 fixed, 1.7525 released, 2.25, 2.75, 3.25 final), a 40 MB
+    /// folder; the recording holds every step besides.
+    pub const DEFAULT_BETWEEN: usize = 6;
+    /// Default vertices around a section: 12, the section polygon has 95.5 % of the circle's area (16 would
+    /// have 97.4 %, in files a third larger). A snapshot is a preview: `stentkit mesh` writes finer ones.
+    pub const DEFAULT_SEGMENTS: usize = 12;
     /// Default rings per patch: 41, about one per wire diameter along a crown wire of the paper's stents
-    /// (the full straight stent: 134 000 triangles, 6.7 MB of binary STL), whatever the patch's `n`.
+    /// (the full straight stent at 12 segments: 100 000 triangles, 5 MB of binary STL), whatever the patch's
+    /// `n`.
     pub const DEFAULT_RINGS: usize = 41;
 }
 
 /// What `run.mcap` records (the design's `output.recording`).
 #[derive(Debug, Clone, PartialEq)]
 pub struct RecordingSettings {
+    /// Whether `run.mcap` is written at all.
+    pub enabled: bool,
     /// Points per patch of the centrelines recorded every step (about: every k-th point of one sample per
     /// control point, the ends always included).
     pub centreline_points: usize,
@@ -298,6 +315,9 @@ pub struct DesignOverrides {
     /// `--set PATH=VALUE` overrides of any field, applied in order to the file's YAML before it is read
     /// ([`set`]); the others above are applied after them.
     pub sets: Vec<SetOverride>,
+    /// Build the device in the temporary shape its programme drives it to, without the programme
+    /// ([`crate::model::builder::ModelBuilder::temporary_shape`]; `stentkit mesh --state temporary`).
+    pub temporary_shape: bool,
 }
 
 impl DesignOverrides {
@@ -457,7 +477,7 @@ pub fn parse_design_with(
             message: "the crown count is overridden, but the design has no `stent` block".into(),
         });
     }
-    let built = build::build(&dto, &stem).map_err(|issue| {
+    let built = build::build(&dto, &stem, overrides.temporary_shape).map_err(|issue| {
         let pos = locator.find(&issue.path);
         owned(
             DesignError::Invalid {

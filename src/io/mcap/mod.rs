@@ -117,7 +117,7 @@ pub enum McapError {
 }
 
 /// How far a recording has got: what a checkpoint records and a resumed run continues from.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct RecordingPosition {
     /// Sequence number of the last message written (messages are numbered from 1 across channels).
     pub sequence: u32,

@@ -418,6 +418,8 @@ pub struct ModelBuilder {
     stent: Option<(StentSpec, StentMesh)>,
     stent_materials: stent_model::StentMaterials,
     programme: Option<ProgrammeSpec>,
+    /// Generate the stent in its programme's temporary placement, without the programme.
+    temporary_shape: bool,
     patches: Vec<PatchInput>,
     nodes: Vec<(String, NodeEnds)>,
     joints: JointRule,
@@ -450,6 +452,7 @@ impl ModelBuilder {
             stent: None,
             stent_materials: stent_model::StentMaterials::default(),
             programme: None,
+            temporary_shape: false,
             patches: Vec::new(),
             nodes: Vec::new(),
             joints: JointRule {
@@ -526,6 +529,15 @@ impl ModelBuilder {
     /// Drives a node set of the generated stent to a temporary shape ([`ProgrammeSpec`]).
     pub fn programme(&mut self, programme: ProgrammeSpec) -> &mut Self {
         self.programme = Some(programme);
+        self
+    }
+
+    /// Builds the stent in the temporary shape its programme drives it to — generated in that placement
+    /// ([`crate::model::stent::ProgrammeSpec::placement`]) — and without the programme: the shape a designer
+    /// previews (`stentkit mesh --state temporary`). A design without a programme has no temporary shape: `build`
+    /// refuses it.
+    pub fn temporary_shape(&mut self) -> &mut Self {
+        self.temporary_shape = true;
         self
     }
 
@@ -626,6 +638,16 @@ impl ModelBuilder {
         check_solver(&self.solver)?;
         self.check_materials()?;
         let mut sections = self.sections.clone();
+        let placement = match (&self.programme, self.temporary_shape) {
+            (_, false) => None,
+            (Some(p), true) => Some(p.placement()),
+            (None, true) => {
+                return Err(BuildError::new(
+                    Field::Programme(ProgrammeField::Whole),
+                    "the design has no programme, so no temporary shape: its permanent shape is the only one",
+                ));
+            }
+        };
         let mut stent = match &self.stent {
             Some((spec, mesh)) => Some(stent_model::generate(
                 spec,
@@ -633,6 +655,7 @@ impl ModelBuilder {
                 &self.stent_materials,
                 &mut sections,
                 self.materials[0].poisson(),
+                placement.as_ref(),
                 &mut warnings,
             )?),
             None => None,
@@ -680,7 +703,7 @@ impl ModelBuilder {
                 }
             }
         }
-        let programme = match &self.programme {
+        let programme = match self.programme.as_ref().filter(|_| placement.is_none()) {
             Some(p) => {
                 let Some(stent) = &stent else {
                     return Err(BuildError::new(

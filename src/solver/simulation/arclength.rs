@@ -242,7 +242,8 @@ impl Simulation<'_> {
                     self.abandon_increment(start);
                     return Ok(StepOutcome::Interrupted);
                 }
-                Err(NewtonFailure::NotConverged(newton)) => {
+                Err(NewtonFailure::NotConverged(mut newton)) => {
+                    newton.worst_equation = self.worst_equation();
                     self.abandon_increment(start);
                     observer.step_failed(self.time + state.arc, state.arc, &newton);
                     if state.arc <= state.first_arc * min_ratio * (1.0 + 1e-12) {
@@ -252,6 +253,7 @@ impl Simulation<'_> {
                             dt: state.arc,
                             iterations: newton.iterations,
                             residuals: newton.residuals,
+                            worst_equation: newton.worst_equation,
                             diagnosis: newton.diagnosis.or_else(|| {
                                 Some(format!(
                                     "the arc-length increment from load factor {:.6} failed at the smallest arc length {:.3e}",

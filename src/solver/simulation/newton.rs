@@ -325,6 +325,29 @@ impl Simulation<'_> {
 
     /// Where the residual in `self.lin` is not finite, after `iteration` Newton iterations: its first such
     /// equation, and how many there are.
+    pub(super) fn worst_equation(&self) -> Option<String> {
+        // The first of the largest, a NaN counting as infinite: where a non-finite residual appeared first.
+        let mut worst: Option<(usize, Real)> = None;
+        for (row, (r, s)) in self
+            .lin
+            .residual
+            .iter()
+            .zip(&self.lin.row_scale)
+            .enumerate()
+        {
+            let v = (r / s).abs();
+            let v = if v.is_nan() { Real::INFINITY } else { v };
+            if worst.is_none_or(|(_, w)| v > w) {
+                worst = Some((row, v));
+            }
+        }
+        let (row, _) = worst?;
+        Some(crate::solver::diagnose::describe_row(
+            self.model, &self.disc, row,
+        ))
+    }
+
+    /// Names the equations whose residual is not finite after `iteration` iterations.
     pub(super) fn non_finite_residual(&self, iteration: usize) -> String {
         let bad: Vec<usize> = self
             .lin

@@ -1,4 +1,5 @@
-//! Who is told about a run: the [`Observer`] seam (the engine reports, observers record), [`NoObserver`], and
+//! Who is told about a run: the [`Observer`] seam (the engine reports, observers record), [`NoObserver`], an
+//! absent observer (`Option`), and
 //! [`Observers`], a list of observers the caller owns, told in its order.
 
 use super::{NewtonReport, Simulation, StepReport};
@@ -48,6 +49,36 @@ pub struct NoObserver;
 impl Observer for NoObserver {
     fn step(&mut self, _: &Simulation<'_>, _: &StepReport) -> ControlFlow<()> {
         ControlFlow::Continue(())
+    }
+}
+
+/// An observer that may be absent (an output the design turned off): `None` records nothing and never stops
+/// or interrupts the run.
+impl<O: Observer> Observer for Option<O> {
+    fn start(&mut self, sim: &Simulation<'_>) -> ControlFlow<()> {
+        self.as_mut()
+            .map_or(ControlFlow::Continue(()), |o| o.start(sim))
+    }
+
+    fn step(&mut self, sim: &Simulation<'_>, report: &StepReport) -> ControlFlow<()> {
+        self.as_mut()
+            .map_or(ControlFlow::Continue(()), |o| o.step(sim, report))
+    }
+
+    fn step_failed(&mut self, time: Real, dt: Real, newton: &NewtonReport) {
+        if let Some(o) = self {
+            o.step_failed(time, dt, newton);
+        }
+    }
+
+    fn step_rejected(&mut self, time: Real, dt: Real, estimate: Real) {
+        if let Some(o) = self {
+            o.step_rejected(time, dt, estimate);
+        }
+    }
+
+    fn interrupted(&self) -> bool {
+        self.as_ref().is_some_and(O::interrupted)
     }
 }
 

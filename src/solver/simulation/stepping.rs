@@ -270,7 +270,8 @@ impl Simulation<'_> {
                     self.roll_back(start, &captured, Abandon::Interrupted);
                     return Ok(StepOutcome::Interrupted);
                 }
-                Err(NewtonFailure::NotConverged(newton)) => {
+                Err(NewtonFailure::NotConverged(mut newton)) => {
+                    newton.worst_equation = self.worst_equation();
                     self.roll_back(start, &captured, Abandon::Failed);
                     observer.step_failed(target, dt, &newton);
                     // Stabilisation: the same step again with the damping switched on or raised.
@@ -285,6 +286,7 @@ impl Simulation<'_> {
                             iterations: newton.iterations,
                             residuals: newton.residuals,
                             diagnosis: newton.diagnosis,
+                            worst_equation: newton.worst_equation,
                         });
                     }
                     self.step_size = halved_step(dt, min_step, target);

@@ -1,0 +1,160 @@
+//! `stentkit export RUN_DIR --time T | --phase P -o FILE`: the full device's tube mesh in any state of a
+//! finished run, at any resolution, not only at the snapshots the run wrote.
+//!
+//! A run folder holds no full state per step (the recording's centrelines are decimated), so the state is
+//! computed again: the design that ran (`summary.json`'s `design_file` with its `--set` overrides, or `--design`)
+//! is simulated from the start to the first step at or after the time asked for, with no outputs. Steps are
+//! deterministic, so that step is the run's own state to the bit; a phase's time is an event of the cycle
+//! ([`crate::model::cycle`]), on which the run landed. The design is checked against the run's model
+//! fingerprint (`summary.json`'s `model_fingerprint`) first: a changed design would export another device.
+//! Costs what the run's solver cost up to that time (the straight stent to its end: about 6 s).
+
+use super::BadInput;
+use crate::io::design::{DesignOverrides, SetOverride, load_design_with};
+use crate::io::formats;
+use crate::io::mesh_format::SnapshotState;
+use crate::io::snapshots::{current_device_mesh, snapshot_name};
+use crate::math::Real;
+use crate::model::cycle::Phase;
+use crate::solver::Simulation;
+use crate::solver::simulation::model_fingerprint;
+use anyhow::Context;
+use std::path::{Path, PathBuf};
+
+/// Which state of the run to export.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Which {
+    /// The first step at or after this time.
+    Time(Real),
+    /// An event of the cycle: `initial`, `programmed`, `fixed`, `released`, `final`.
+    Phase(String),
+}
+
+/// What to export and how finely.
+#[derive(Debug, Clone)]
+pub struct ExportOptions {
+    /// The state.
+    pub which: Which,
+    /// The mesh file (`.stl` or `.obj`).
+    pub output: PathBuf,
+    /// The design, instead of the run's `design_file`.
+    pub design: Option<PathBuf>,
+    /// Vertices around each tube section.
+    pub segments: usize,
+    /// Rings along each patch, about.
+    pub rings: usize,
+}
+
+/// Exports the state `options.which` of the run in `run_dir` to `options.output`.
+///
+/// # Errors
+/// [`BadInput`] for a folder that is not a run folder, a design that is not the one that ran, a phase the
+/// model does not have or a time outside what the run reached; the design's errors; a step that fails.
+pub fn run(run_dir: &Path, options: &ExportOptions) -> anyhow::Result<()> {
+    let extension = options
+        .output
+        .extension()
+        .and_then(|e| e.to_str())
+        .map(str::to_ascii_lowercase)
+        .unwrap_or_default();
+    let Some(format) = formats::format(&extension) else {
+        return Err(BadInput(format!(
+            "{}: the output must end in one of: {}",
+            options.output.display(),
+            formats::extensions()
+        ))
+        .into());
+    };
+    let summary_path = run_dir.join("summary.json");
+    let summary: serde_json::Value = std::fs::read_to_string(&summary_path)
+        .ok()
+        .and_then(|text| serde_json::from_str(&text).ok())
+        .ok_or_else(|| {
+            BadInput(format!(
+                "{}: not a run folder (no readable summary.json)",
+                run_dir.display()
+            ))
+        })?;
+    let design_path = match &options.design {
+        Some(path) => path.clone(),
+        None => PathBuf::from(summary["design_file"].as_str().unwrap_or_default()),
+    };
+    let sets = summary["overrides"]
+        .as_array()
+        .into_iter()
+        .flatten()
+        .filter_map(|v| v.as_str())
+        .map(str::parse::<SetOverride>)
+        .collect::<Result<Vec<_>, _>>()
+        .map_err(|e| BadInput(format!("{}: overrides: {e}", summary_path.display())))?;
+    let design = load_design_with(&design_path, &DesignOverrides::sets(sets))?;
+    let model = &design.model;
+    let fingerprint = format!("{:016x}", model_fingerprint(model));
+    if let Some(ran) = summary["model_fingerprint"].as_str()
+        && ran != fingerprint
+    {
+        return Err(BadInput(format!(
+            "{}: this design (with the run's overrides) is not the model that ran in {} (fingerprint {fingerprint}, the run's {ran}): restore the design as it ran, or give it with --design",
+            design_path.display(),
+            run_dir.display()
+        ))
+        .into());
+    }
+    let snap = crate::model::LANDING_TOLERANCE * model.time.step;
+    let target = match &options.which {
+        Which::Time(t) => *t,
+        Which::Phase(name) => {
+            let events = model.events();
+            let found = Phase::parse(name)
+                .and_then(|p| events.iter().find(|(_, e)| *e == p))
+                .map(|&(t, _)| t);
+            found.ok_or_else(|| {
+                let known: Vec<String> = events
+                    .iter()
+                    .map(|(t, p)| format!("{p} (t = {})", super::short_time(*t)))
+                    .collect();
+                BadInput(format!(
+                    "`{name}` is not an event of {}; its events: {}",
+                    model.name,
+                    known.join(", ")
+                ))
+            })?
+        }
+    };
+    let reached = summary["final_time"].as_f64().unwrap_or(model.time.end);
+    if !(0.0..=reached + snap).contains(&target) {
+        return Err(BadInput(format!(
+            "t = {} is outside the run in {}, which reached t = {}",
+            super::short_time(target),
+            run_dir.display(),
+            super::short_time(reached)
+        ))
+        .into());
+    }
+
+    let mut sim = Simulation::new(model)?;
+    let mut step = 0;
+    while sim.time() < target - snap {
+        match sim
+            .step()
+            .with_context(|| format!("re-running {} to t = {}", model.name, target))?
+        {
+            Some(report) => step = report.step,
+            None => break,
+        }
+    }
+    let mesh = current_device_mesh(&sim, options.segments, options.rings)
+        .map_err(|e| anyhow::anyhow!("patch `{}`: {}", model.patches[e.rod].name, e.source))?;
+    let time = sim.time();
+    let state = SnapshotState { model, step, time };
+    format.write(&options.output, &mesh, &state)?;
+    println!(
+        "wrote {} ({}, step {step}: {} triangles, volume {:.6e} {}³)",
+        options.output.display(),
+        snapshot_name(model, step, time),
+        mesh.triangles.len(),
+        mesh.volume(),
+        model.units.length()
+    );
+    Ok(())
+}
