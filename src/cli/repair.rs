@@ -134,8 +134,8 @@ fn repair_history(path: &Path) -> anyhow::Result<(Vec<f64>, usize)> {
 }
 
 /// Turns a `running` summary into the summary of a killed run: status, error, the time and steps the history
-/// holds, the recording's size, and every snapshot whose two files are on disk (a snapshot written after the
-/// last summary is added with the time of its history row).
+/// holds, the recording's size, and every snapshot whose files are all on disk (a snapshot written after the
+/// last summary is added with the step and time of the history row of the time in its name).
 fn mark_killed(
     summary: &mut Value,
     rows: &[f64],
@@ -158,45 +158,85 @@ fn mark_killed(
     if let Some(bytes) = mcap_bytes {
         summary["files"]["mcap_bytes"] = json!(bytes);
     }
+    // A listed snapshot is kept when every file it lists is on disk.
+    let files_of = |s: &Value| -> Vec<String> {
+        ["stl", "obj", "vtp"]
+            .iter()
+            .filter_map(|k| s[k].as_str().map(str::to_string))
+            .collect()
+    };
     let mut snapshots: Vec<Value> = summary["snapshots"]
         .as_array()
         .cloned()
         .unwrap_or_default()
         .into_iter()
         .filter(|s| {
-            ["stl", "obj"]
-                .iter()
-                .all(|k| s[k].as_str().is_some_and(|f| dir.join(f).is_file()))
+            let files = files_of(s);
+            !files.is_empty() && files.iter().all(|f| dir.join(f).is_file())
         })
         .collect();
     let known: Vec<u64> = snapshots
         .iter()
         .filter_map(|s| s["step"].as_u64())
         .collect();
-    for stl in listed
-        .iter()
-        .filter(|p| p.extension().is_some_and(|e| e == "stl"))
-    {
-        let obj = stl.with_extension("obj");
-        let Some(step) = stl
-            .file_stem()
+    // A snapshot written after the last summary: the files the manifest lists under one name
+    // (`snapshots/t1.750_fixed.stl`, `.obj`, `.vtp`), complete when all of them are on disk. Its step is the
+    // history row of the time in its name (`step_NNNNN` on an arc-length path).
+    let mut unlisted: std::collections::BTreeMap<PathBuf, Vec<&PathBuf>> = Default::default();
+    for file in listed.iter().filter(|p| {
+        p.starts_with(crate::io::snapshots::SnapshotWriter::FOLDER)
+            && p.extension()
+                .is_some_and(|e| e == "stl" || e == "obj" || e == "vtp")
+            && p.file_name()
+                .is_some_and(|n| n != crate::io::snapshots::VESSEL_FILE)
+    }) {
+        unlisted
+            .entry(file.with_extension(""))
+            .or_default()
+            .push(file);
+    }
+    for (stem, files) in unlisted {
+        let name = stem
+            .file_name()
             .and_then(|s| s.to_str())
-            .and_then(|s| s.strip_prefix("step_"))
-            .and_then(|s| s.parse::<u64>().ok())
-        else {
-            continue;
+            .unwrap_or_default();
+        let step = match name.strip_prefix("step_") {
+            Some(n) => n.parse::<u64>().ok(),
+            None => name
+                .strip_prefix('t')
+                .and_then(|t| t.split('_').next())
+                .and_then(|t| t.parse::<f64>().ok())
+                .and_then(|t| {
+                    // The name's time has at least three decimals: the row within half its last digit.
+                    rows.iter()
+                        .position(|&r| (r - t).abs() <= 0.5e-6 * t.abs().max(1.0) + 5e-7)
+                })
+                .map(|k| k as u64),
         };
-        if known.contains(&step) || !dir.join(stl).is_file() || !dir.join(&obj).is_file() {
+        let Some(step) = step else { continue };
+        if known.contains(&step) || !files.iter().all(|f| dir.join(f).is_file()) {
             continue;
         }
-        snapshots.push(json!({
+        let mut entry = json!({
             "step": step,
             "time": rows.get(step as usize).copied(),
-            "stl": stl.display().to_string(),
-            "obj": obj.display().to_string(),
-            "triangles": stl_triangles(&dir.join(stl)),
+            "triangles": null,
             "volume": null,
-        }));
+        });
+        if let Some(phase) = name.split_once('_').map(|(_, p)| p)
+            && crate::model::cycle::Phase::parse(phase).is_some()
+        {
+            entry["phase"] = json!(phase);
+        }
+        for f in &files {
+            if let Some(e) = f.extension().and_then(|e| e.to_str()) {
+                entry[e] = json!(f.display().to_string());
+                if e == "stl" {
+                    entry["triangles"] = json!(stl_triangles(&dir.join(f)));
+                }
+            }
+        }
+        snapshots.push(entry);
     }
     snapshots.sort_by_key(|s| s["step"].as_u64());
     summary["snapshots"] = Value::Array(snapshots);

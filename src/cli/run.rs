@@ -70,8 +70,10 @@ struct Progress {
     said: usize,
     /// Print every failed Newton attempt.
     verbose: bool,
-    /// Step cuts so far (failed attempts retried shorter).
+    /// Step cuts so far (attempts retried shorter).
     cuts: usize,
+    /// Failed Newton attempts so far (retried with a fresh tangent, damped, or shorter).
+    failed: usize,
     /// The message of the last converged step, which a failed attempt's note is appended to.
     last: String,
 }
@@ -104,6 +106,7 @@ impl Progress {
             said: 0,
             verbose,
             cuts: 0,
+            failed: 0,
             last: String::new(),
         }
     }
@@ -137,6 +140,7 @@ impl Observer for Progress {
             .phase_at(report.time)
             .map(|p| format!("{p}  "))
             .unwrap_or_default();
+        self.cuts += report.cuts;
         let cuts = match self.cuts {
             0 => String::new(),
             n => format!("  {n} cut{}", if n == 1 { "" } else { "s" }),
@@ -150,10 +154,10 @@ impl Observer for Progress {
     }
 
     fn step_failed(&mut self, time: Real, dt: Real, newton: &NewtonReport) {
-        self.cuts += 1;
+        self.failed += 1;
         self.bar.set_message(format!(
-            "{}  cutting: the step to t = {time:.6} (dt = {dt:.2e}) failed, {} so far",
-            self.last, self.cuts
+            "{}  retrying: the attempt to reach t = {time:.6} (dt = {dt:.2e}) failed ({} failed attempts)",
+            self.last, self.failed
         ));
         if self.verbose {
             self.bar.suspend(|| {

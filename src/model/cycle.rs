@@ -105,14 +105,14 @@ impl std::fmt::Display for Phase {
 }
 
 /// A drive's let-go: `(fixed, released)`, and the function whose breakpoints before it are its programming.
-fn let_go(model: &Model, c: &Component) -> Option<((Real, Real), TimeFunction)> {
+fn let_go<'m>(model: &Model, c: &'m Component) -> Option<((Real, Real), &'m TimeFunction)> {
     match c {
         Component::Prescribed {
             value,
             release: Some(r),
             ..
-        } => Some(((*r, r + model.time.release_ramp), value.clone())),
-        Component::Load(f) => load_let_go(f).map(|times| (times, f.clone())),
+        } => Some(((*r, r + model.time.release_ramp), value)),
+        Component::Load(f) => load_let_go(f).map(|times| (times, f)),
         Component::Prescribed { release: None, .. } => None,
     }
 }
@@ -142,7 +142,7 @@ impl Model {
                 self.distributed_loads
                     .iter()
                     .flat_map(|l| l.force.iter().chain(&l.couple))
-                    .filter_map(|f| load_let_go(f).map(|times| (times, f.clone()))),
+                    .filter_map(|f| load_let_go(f).map(|times| (times, f))),
             )
             .collect::<Vec<_>>();
         let fixed = drives.iter().map(|((f, _), _)| *f).reduce(Real::min)?;

@@ -237,13 +237,15 @@ pub(crate) fn check_snapshots(dir: &Path) -> Vec<(Real, usize)> {
         mesh.check_closed()
             .unwrap_or_else(|e| panic!("{}: {e}", stl.display()));
         let volume = mesh.volume();
-        let reported = snapshot["volume"].as_f64().expect("volume");
         assert!(volume > 0.0, "{}: volume {volume}", stl.display());
-        assert!(
-            (volume / reported - 1.0).abs() < 1e-5,
-            "{}: {volume} vs {reported}",
-            stl.display()
-        );
+        // A snapshot `repair` found on disk has no volume reported.
+        if let Some(reported) = snapshot["volume"].as_f64() {
+            assert!(
+                (volume / reported - 1.0).abs() < 1e-5,
+                "{}: {volume} vs {reported}",
+                stl.display()
+            );
+        }
         assert_eq!(
             mesh.triangles.len() as u64,
             snapshot["triangles"].as_u64().expect("triangles")
@@ -693,4 +695,53 @@ fn interrupted_run_leaves_every_file_valid() {
     assert_eq!(last, Some(steps), "the last state has a snapshot");
     check_snapshots(&dir);
     check_recording(&dir, &design("straight_stent.yaml"));
+}
+
+#[test]
+fn a_stent_whose_bridges_buckle_is_told_to_change_its_bridges() {
+    // Issue 19's hostile case: the full straight stent (no symmetry cut) with circumferential sine bridges of
+    // amplitude 2 mm. Its slender bridges buckle into loops as the programme contracts the crowns, and Newton
+    // fails within the first 0.01 s (measured: step 11 at t = 0.0088 s, the largest residual in a moment
+    // balance of bridge `b5_7`). The failure report must name a bridge as the place of the largest residual and
+    // say what to change: a slower programme (it failed while programming), more control points on that
+    // bridge (its fit deviates 5.1 % of the wire diameter, above the 1 % the fit warns at), stiffer or shorter
+    // bridges, and stabilisation.
+    let dir = test_outputs("buckling_bridges");
+    let out = stentkit(&[
+        "run",
+        path_str(&design("straight_stent.yaml")),
+        "-o",
+        path_str(&dir),
+        "--quiet",
+        "--set",
+        "stent.symmetry=none",
+        "--set",
+        "stent.bridges={shape: sinusoidal, amplitude: 2, waves: 1, direction: circumferential}",
+        "--set",
+        "time.end=0.05",
+    ]);
+    let stderr = text(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{stderr}");
+    let largest = stderr
+        .lines()
+        .find(|l| l.contains("largest residual: in the equation of patch `b"))
+        .unwrap_or_else(|| panic!("no bridge named: {stderr}"));
+    let bridge = largest
+        .split('`')
+        .nth(1)
+        .unwrap_or_else(|| panic!("{largest}"));
+    for expected in [
+        "try: a slower programme: its ramp over a longer time (`programme.ramp`, now 0–1 s)"
+            .to_string(),
+        format!("or more control points on patch `{bridge}` (`mesh.n`, now 20)"),
+        format!("or stiffer or shorter bridges: the largest residual is on bridge `{bridge}`"),
+        "or automatic stabilisation".to_string(),
+    ] {
+        assert!(stderr.contains(&expected), "{expected}\n{stderr}");
+    }
+    let s = summary(&dir);
+    assert_eq!(
+        s["failure"]["suggestions"].as_array().map(Vec::len),
+        Some(4)
+    );
 }

@@ -326,6 +326,11 @@ fn sigkill_leaves_a_folder_that_repair_makes_whole() {
     );
     // As a run killed in the middle of an atomic summary write would leave it.
     std::fs::write(dir.join(".summary.json.4242.0.tmp"), "{\"partial").expect("write");
+    // And as a summary written before its snapshots: repair finds them from the manifest and the files on
+    // disk, by the time in their names (the initial one, `t0.000_initial`, at least).
+    let mut stale = killed.clone();
+    stale["snapshots"] = serde_json::json!([]);
+    std::fs::write(dir.join("summary.json"), stale.to_string()).expect("write");
 
     let out = stentkit(&["repair", path_str(&dir)]);
     assert_eq!(out.status.code(), Some(0), "{}", text(&out.stderr));
@@ -337,6 +342,16 @@ fn sigkill_leaves_a_folder_that_repair_makes_whole() {
     assert!(!dir.join(".summary.json.4242.0.tmp").exists());
     let s = summary(&dir);
     assert_eq!(s["status"], "killed");
+    let first = &s["snapshots"][0];
+    assert_eq!(
+        (&first["step"], &first["phase"], &first["stl"]),
+        (
+            &serde_json::json!(0),
+            &serde_json::json!("initial"),
+            &serde_json::json!("snapshots/t0.000_initial.stl")
+        ),
+        "{s}"
+    );
     let steps = s["steps"].as_u64().expect("steps") as usize;
     assert!(steps >= killed["steps"].as_u64().expect("steps") as usize);
     check_history(&dir, steps, s["final_time"].as_f64().expect("time"));
