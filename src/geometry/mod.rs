@@ -11,6 +11,7 @@ pub mod frame;
 pub mod mesh;
 pub mod polyline;
 pub mod primitives;
+pub mod solid;
 pub mod sphere;
 pub mod stent;
 #[cfg(test)]
