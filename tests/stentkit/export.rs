@@ -123,27 +123,23 @@ fn a_design_changed_since_the_run_is_not_exported() {
     std::fs::copy(design("bend45.yaml"), &file).expect("copy");
     let run = dir.join("run");
     run_ok(&file, &run, &["--quiet"]);
-    let out = stentkit(&[
-        "export",
-        path_str(&run),
-        "--time",
-        "0.5",
-        "-o",
-        path_str(&dir.join("a.stl")),
-    ]);
+    let export = |name: &str| {
+        stentkit(&[
+            "export",
+            path_str(&run),
+            "--time",
+            "0.5",
+            "-o",
+            path_str(&dir.join(name)),
+        ])
+    };
+    let out = export("a.stl");
     assert!(out.status.success(), "{}", text(&out.stderr));
     let edited = std::fs::read_to_string(&file)
         .expect("design")
         .replace("E_inf: 1.0e7", "E_inf: 2.0e7");
     std::fs::write(&file, edited).expect("edit");
-    let out = stentkit(&[
-        "export",
-        path_str(&run),
-        "--time",
-        "0.5",
-        "-o",
-        path_str(&dir.join("b.stl")),
-    ]);
+    let out = export("b.stl");
     assert_eq!(out.status.code(), Some(2), "{}", text(&out.stderr));
     assert!(
         text(&out.stderr).contains("is not the model that ran"),
