@@ -2,8 +2,9 @@
 //! finished run, at any resolution, not only at the snapshots the run wrote.
 //!
 //! A run folder holds no full state per step (the recording's centrelines are decimated), so the state is
-//! computed again: the design that ran (`summary.json`'s `design_file` with its `--set` overrides, or `--design`)
-//! is simulated from the start to the first step at or after the time asked for, with no outputs. Steps are
+//! computed again: the design that ran (`summary.json`'s `design_file` with its `--set` overrides, or `--design`,
+//! and, for an error-controlled run, its time tolerance) is simulated from the start to the first step at or
+//! after the time asked for, with no outputs. Steps are
 //! deterministic, so that step is the run's own state to the bit; a phase's time is an event of the cycle
 //! ([`crate::model::cycle`]), on which the run landed. The design is checked against the run's model
 //! fingerprint (`summary.json`'s `model_fingerprint`) first: a changed design would export another device.
@@ -87,7 +88,13 @@ pub fn run(run_dir: &Path, options: &ExportOptions) -> anyhow::Result<()> {
         .map(str::parse::<SetOverride>)
         .collect::<Result<Vec<_>, _>>()
         .map_err(|e| BadInput(format!("{}: overrides: {e}", summary_path.display())))?;
-    let design = load_design_with(&design_path, &DesignOverrides::sets(sets))?;
+    // A run with `--tol` stepped at that tolerance, which summary.json records.
+    let overrides = DesignOverrides {
+        sets,
+        time_tolerance: summary["time_error_control"]["tolerance"].as_f64(),
+        ..DesignOverrides::default()
+    };
+    let design = load_design_with(&design_path, &overrides)?;
     let model = &design.model;
     let fingerprint = format!("{:016x}", model_fingerprint(model));
     if let Some(ran) = summary["model_fingerprint"].as_str()

@@ -117,6 +117,7 @@ fn the_flagship_run_folder_is_lean_and_its_snapshots_are_named_by_phase_and_expo
 #[test]
 fn a_design_changed_since_the_run_is_not_exported() {
     // The 45° bend run, then its design edited: the model fingerprint in summary.json no longer matches.
+    // Before the edit, its run and a run with `--tol` export.
     let dir = test_outputs("export_changed_design");
     std::fs::create_dir_all(&dir).expect("folder");
     let file = dir.join("bend45.yaml");
@@ -134,6 +135,18 @@ fn a_design_changed_since_the_run_is_not_exported() {
         ])
     };
     let out = export("a.stl");
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    // A run with `--tol` is re-run at the tolerance its summary records: the same model.
+    let adaptive = dir.join("adaptive");
+    run_ok(&file, &adaptive, &["--quiet", "--tol", "1e-3"]);
+    let out = stentkit(&[
+        "export",
+        path_str(&adaptive),
+        "--phase",
+        "final",
+        "-o",
+        path_str(&dir.join("adaptive.stl")),
+    ]);
     assert!(out.status.success(), "{}", text(&out.stderr));
     let edited = std::fs::read_to_string(&file)
         .expect("design")
