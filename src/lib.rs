@@ -18,9 +18,9 @@
 //! | module | owns |
 //! |---|---|
 //! | [`math`] | vocabulary types, knot vectors, B-spline/NURBS basis, curves, SO(3) maps |
-//! | [`geometry`] | exact NURBS primitives, analytic curves and their spline fits, rotation-minimising frames, tube surfaces |
+//! | [`geometry`] | exact NURBS primitives, analytic curves and their spline fits, rotation-minimising frames, tube surfaces, the union of tubes as one solid |
 //! | [`material`] | the constitutive interface and its laws (elastic, Maxwell/WLF), Prony series, WLF shift, section stiffness |
-//! | [`model`] | the continuous problem: patches, nodes, conditions, loads, schedules; [`model::builder`], which makes and checks one in Rust, and [`model::stent`], a generated stent and its programme in it |
+//! | [`model`] | the continuous problem: patches, nodes, conditions, loads, schedules; [`model::builder`], which makes and checks one in Rust, and [`model::stent`], a generated stent and its programme in it; [`model::cycle`], the shape-memory cycle read off the conditions |
 //! | [`solver`] | collocation, residual and tangent, Newton, time stepping as an API (step, checkpoint, restore) |
 //! | [`post`] | the full device from a (symmetry-reduced) model or state: sampled shapes, mirror copies, tube meshes |
 //! | [`io`] | YAML design files (a translation into [`model::builder`] calls); writers of STL/OBJ, the run folder, checkpoints, charts |

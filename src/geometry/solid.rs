@@ -37,7 +37,7 @@ pub struct Capsule {
     pub a: Vec3,
     /// The other end.
     pub b: Vec3,
-    /// Radius [length].
+    /// Radius \[length\].
     pub radius: Real,
 }
 

@@ -20,7 +20,7 @@
 use super::{Component, Model, TimeFunction};
 use crate::math::Real;
 
-/// The events of a model's shape-memory cycle [time] (see the module documentation).
+/// The events of a model's shape-memory cycle \[time\] (see the module documentation).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Cycle {
     /// End of programming: the last change of a drive before it is let go; `None` when the drives are held
