@@ -217,9 +217,16 @@ fn mark_killed(
         if known.contains(&step) || !files.iter().all(|f| dir.join(f).is_file()) {
             continue;
         }
+        // The time in full: the ParaView collection's, when it lists the snapshot's field file (history.csv
+        // writes 11 digits).
+        let time = files
+            .iter()
+            .find(|f| f.extension().is_some_and(|e| e == "vtp"))
+            .and_then(|f| collection_time(dir, f))
+            .or_else(|| rows.get(step as usize).copied());
         let mut entry = json!({
             "step": step,
-            "time": rows.get(step as usize).copied(),
+            "time": time,
             "triangles": null,
             "volume": null,
         });
@@ -242,6 +249,20 @@ fn mark_killed(
     summary["snapshots"] = Value::Array(snapshots);
 }
 
+/// The time `run.pvd` gives the field file `file` (relative to the run folder), if it lists it.
+fn collection_time(dir: &Path, file: &Path) -> Option<f64> {
+    let text = std::fs::read_to_string(dir.join(crate::io::snapshots::COLLECTION_FILE)).ok()?;
+    let line = text
+        .lines()
+        .find(|l| l.contains(&format!("file=\"{}\"", file.display())))?;
+    line.split("timestep=\"")
+        .nth(1)?
+        .split('"')
+        .next()?
+        .parse()
+        .ok()
+}
+
 /// The triangle count a binary STL declares (bytes 80–83), if the file is that long; reads those bytes only.
 fn stl_triangles(path: &Path) -> Option<u32> {
     use std::io::{Read, Seek};
@@ -250,4 +271,25 @@ fn stl_triangles(path: &Path) -> Option<u32> {
     file.seek(std::io::SeekFrom::Start(80)).ok()?;
     file.read_exact(&mut count).ok()?;
     Some(u32::from_le_bytes(count))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_field_files_time_comes_from_the_collection_in_full() {
+        // As `io::vtk::write_collection` writes it (`{:e}`): 0.5000000000000003, which history.csv's 11 digits
+        // would round to 0.5 (CI's check compares the field file's TimeValue with the summary's time exactly).
+        let dir = std::env::temp_dir().join(format!("stentkit-repair-pvd-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).expect("folder");
+        std::fs::write(
+            dir.join(crate::io::snapshots::COLLECTION_FILE),
+            "<VTKFile>\n  <Collection>\n    <DataSet timestep=\"0e0\" group=\"\" part=\"0\" file=\"snapshots/t0.000_initial.vtp\"/>\n    <DataSet timestep=\"5.000000000000003e-1\" group=\"\" part=\"0\" file=\"snapshots/t0.500_programming.vtp\"/>\n  </Collection>\n</VTKFile>\n",
+        )
+        .expect("write");
+        let time = collection_time(&dir, Path::new("snapshots/t0.500_programming.vtp"));
+        let _ = std::fs::remove_dir_all(&dir);
+        assert_eq!(time, Some(0.5000000000000003));
+    }
 }
