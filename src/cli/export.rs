@@ -15,10 +15,10 @@ use crate::io::design::{DesignOverrides, SetOverride, load_design_with};
 use crate::io::formats;
 use crate::io::mesh_format::SnapshotState;
 use crate::io::snapshots::{current_device_mesh, snapshot_name};
+use crate::io::summary::model_fingerprint_text;
 use crate::math::Real;
 use crate::model::cycle::Phase;
 use crate::solver::Simulation;
-use crate::solver::simulation::model_fingerprint;
 use anyhow::Context;
 use std::path::{Path, PathBuf};
 
@@ -96,7 +96,7 @@ pub fn run(run_dir: &Path, options: &ExportOptions) -> anyhow::Result<()> {
     };
     let design = load_design_with(&design_path, &overrides)?;
     let model = &design.model;
-    let fingerprint = format!("{:016x}", model_fingerprint(model));
+    let fingerprint = model_fingerprint_text(model);
     if let Some(ran) = summary["model_fingerprint"].as_str()
         && ran != fingerprint
     {
@@ -107,7 +107,7 @@ pub fn run(run_dir: &Path, options: &ExportOptions) -> anyhow::Result<()> {
         ))
         .into());
     }
-    let snap = crate::model::LANDING_TOLERANCE * model.time.step;
+    let snap = model.time.landing_tolerance();
     let target = match &options.which {
         Which::Time(t) => *t,
         Which::Phase(name) => {
@@ -158,7 +158,7 @@ pub fn run(run_dir: &Path, options: &ExportOptions) -> anyhow::Result<()> {
     println!(
         "wrote {} ({}, step {step}: {} triangles, volume {:.6e} {}³)",
         options.output.display(),
-        snapshot_name(model, step, time),
+        snapshot_name(model, step, time, model.phase_at(time)),
         mesh.triangles.len(),
         mesh.volume(),
         model.units.length()

@@ -10,12 +10,11 @@
 //! command checks and prints. The wires between the nodes follow the generator, not a simulation: the
 //! simulated programmed shape is `stentkit export RUN_DIR --phase programmed`.
 
-use super::BadInput;
 use crate::geometry::fit::best_fit_rigid;
 use crate::io::design::{DesignOverrides, SetOverride, load_design_with};
 use crate::io::{obj, stl};
 use crate::math::{Real, Vec3};
-use crate::model::{End, Model};
+use crate::model::Model;
 use crate::post::device::reference_device_mesh;
 use anyhow::{Context, bail};
 use std::path::Path;
@@ -49,13 +48,7 @@ pub fn run(
     let (model, placed) = match state {
         State::Permanent => (permanent.model, None),
         State::Temporary => {
-            if permanent.model.programme.is_none() {
-                return Err(BadInput(format!(
-                    "{}: the design has no programme, so no temporary shape: its permanent shape is the only one",
-                    design.display()
-                ))
-                .into());
-            }
+            // A design without a programme is refused by the builder, at its `programme` field.
             let temporary = load_design_with(
                 design,
                 &DesignOverrides {
@@ -72,12 +65,10 @@ pub fn run(
         }
     };
     let mut mesh = reference_device_mesh(&model, segments, samples)?;
-    let mut misfit = None;
-    if let Some((r, t, off)) = placed {
+    if let Some((r, t, _)) = placed {
         for v in &mut mesh.vertices {
             *v = r * *v + t;
         }
-        misfit = Some(off);
     }
     mesh.check_closed()
         .context("the tube surface is not closed (please report this)")?;
@@ -110,23 +101,13 @@ pub fn run(
         mesh.volume(),
         model.units.length()
     );
-    if let Some(off) = misfit {
+    if let Some((_, _, off)) = placed {
         println!(
             "temporary shape: the driven nodes are within {off:.3e} {} of the programme's targets",
             model.units.length()
         );
     }
     Ok(())
-}
-
-/// Where node `k` of `model` is in its reference shape: the end of its first patch.
-fn node_position(model: &Model, k: usize) -> Option<Vec3> {
-    let end = model.nodes[k].ends.first()?;
-    let curve = &model.patches[end.patch].curve;
-    Some(curve.point(match end.end {
-        End::Start => 0.0,
-        End::End => 1.0,
-    }))
 }
 
 /// The rigid motion `(R, t)` that takes the driven nodes of the device in its temporary placement
@@ -145,8 +126,8 @@ fn placement(
         let position = temporary
             .nodes
             .iter()
-            .position(|n| &n.name == name)
-            .and_then(|k| node_position(temporary, k))
+            .find(|n| &n.name == name)
+            .map(|n| n.position)
             .with_context(|| format!("node `{name}` is missing from the temporary shape"))?;
         from.push(position);
         to.push(d.position + d.target);

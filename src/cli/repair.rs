@@ -159,19 +159,18 @@ fn mark_killed(
         summary["files"]["mcap_bytes"] = json!(bytes);
     }
     // A listed snapshot is kept when every file it lists is on disk.
-    let files_of = |s: &Value| -> Vec<String> {
-        ["stl", "obj", "vtp"]
-            .iter()
-            .filter_map(|k| s[k].as_str().map(str::to_string))
-            .collect()
-    };
+    let kinds: Vec<&str> = crate::io::formats::FORMATS
+        .iter()
+        .map(|f| f.extension())
+        .chain(["vtp"])
+        .collect();
     let mut snapshots: Vec<Value> = summary["snapshots"]
         .as_array()
         .cloned()
         .unwrap_or_default()
         .into_iter()
         .filter(|s| {
-            let files = files_of(s);
+            let files: Vec<&str> = kinds.iter().filter_map(|k| s[k].as_str()).collect();
             !files.is_empty() && files.iter().all(|f| dir.join(f).is_file())
         })
         .collect();
@@ -181,48 +180,53 @@ fn mark_killed(
         .collect();
     // A snapshot written after the last summary: the files the manifest lists under one name
     // (`snapshots/t1.750_fixed.stl`, `.obj`, `.vtp`), complete when all of them are on disk. Its step is the
-    // history row of the time in its name (`step_NNNNN` on an arc-length path).
+    // history row of the time in its name (`step_NNNNN` on an arc-length path); its time in full is the
+    // ParaView collection's, when it lists the snapshot's field file (history.csv writes 11 digits).
     let mut unlisted: std::collections::BTreeMap<PathBuf, Vec<&PathBuf>> = Default::default();
     for file in listed.iter().filter(|p| {
         p.starts_with(crate::io::snapshots::SnapshotWriter::FOLDER)
             && p.extension()
-                .is_some_and(|e| e == "stl" || e == "obj" || e == "vtp")
-            && p.file_name()
-                .is_some_and(|n| n != crate::io::snapshots::VESSEL_FILE)
+                .and_then(|e| e.to_str())
+                .is_some_and(|e| kinds.contains(&e))
     }) {
         unlisted
             .entry(file.with_extension(""))
             .or_default()
             .push(file);
     }
+    let collection = std::fs::read_to_string(dir.join(crate::io::snapshots::COLLECTION_FILE))
+        .map(|text| crate::io::vtk::collection_entries(&text))
+        .unwrap_or_default();
     for (stem, files) in unlisted {
+        use crate::io::snapshots::{SnapshotAt, parse_snapshot_name};
         let name = stem
             .file_name()
             .and_then(|s| s.to_str())
             .unwrap_or_default();
-        let step = match name.strip_prefix("step_") {
-            Some(n) => n.parse::<u64>().ok(),
-            None => name
-                .strip_prefix('t')
-                .and_then(|t| t.split('_').next())
-                .and_then(|t| t.parse::<f64>().ok())
-                .and_then(|t| {
-                    // The name's time has at least three decimals: the row within half its last digit.
-                    rows.iter()
-                        .position(|&r| (r - t).abs() <= 0.5e-6 * t.abs().max(1.0) + 5e-7)
-                })
-                .map(|k| k as u64),
+        let Some((at, phase)) = parse_snapshot_name(name) else {
+            continue;
         };
-        let Some(step) = step else { continue };
+        let step = match at {
+            SnapshotAt::Step(step) => Some(step),
+            // Within the name's rounding: half its sixth decimal.
+            SnapshotAt::Time(t) => rows
+                .iter()
+                .position(|&r| (r - t).abs() <= 0.5e-6 * t.abs().max(1.0) + 5e-7),
+        };
+        let Some(step) = step.map(|k| k as u64) else {
+            continue;
+        };
         if known.contains(&step) || !files.iter().all(|f| dir.join(f).is_file()) {
             continue;
         }
-        // The time in full: the ParaView collection's, when it lists the snapshot's field file (history.csv
-        // writes 11 digits).
         let time = files
             .iter()
-            .find(|f| f.extension().is_some_and(|e| e == "vtp"))
-            .and_then(|f| collection_time(dir, f))
+            .find_map(|f| {
+                collection
+                    .iter()
+                    .find(|(_, listed)| Path::new(listed) == f.as_path())
+            })
+            .map(|&(t, _)| t)
             .or_else(|| rows.get(step as usize).copied());
         let mut entry = json!({
             "step": step,
@@ -230,10 +234,8 @@ fn mark_killed(
             "triangles": null,
             "volume": null,
         });
-        if let Some(phase) = name.split_once('_').map(|(_, p)| p)
-            && crate::model::cycle::Phase::parse(phase).is_some()
-        {
-            entry["phase"] = json!(phase);
+        if let Some(phase) = phase {
+            entry["phase"] = json!(phase.name());
         }
         for f in &files {
             if let Some(e) = f.extension().and_then(|e| e.to_str()) {
@@ -249,20 +251,6 @@ fn mark_killed(
     summary["snapshots"] = Value::Array(snapshots);
 }
 
-/// The time `run.pvd` gives the field file `file` (relative to the run folder), if it lists it.
-fn collection_time(dir: &Path, file: &Path) -> Option<f64> {
-    let text = std::fs::read_to_string(dir.join(crate::io::snapshots::COLLECTION_FILE)).ok()?;
-    let line = text
-        .lines()
-        .find(|l| l.contains(&format!("file=\"{}\"", file.display())))?;
-    line.split("timestep=\"")
-        .nth(1)?
-        .split('"')
-        .next()?
-        .parse()
-        .ok()
-}
-
 /// The triangle count a binary STL declares (bytes 80–83), if the file is that long; reads those bytes only.
 fn stl_triangles(path: &Path) -> Option<u32> {
     use std::io::{Read, Seek};
@@ -271,25 +259,4 @@ fn stl_triangles(path: &Path) -> Option<u32> {
     file.seek(std::io::SeekFrom::Start(80)).ok()?;
     file.read_exact(&mut count).ok()?;
     Some(u32::from_le_bytes(count))
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn a_field_files_time_comes_from_the_collection_in_full() {
-        // As `io::vtk::write_collection` writes it (`{:e}`): 0.5000000000000003, which history.csv's 11 digits
-        // would round to 0.5 (CI's check compares the field file's TimeValue with the summary's time exactly).
-        let dir = std::env::temp_dir().join(format!("stentkit-repair-pvd-{}", std::process::id()));
-        std::fs::create_dir_all(&dir).expect("folder");
-        std::fs::write(
-            dir.join(crate::io::snapshots::COLLECTION_FILE),
-            "<VTKFile>\n  <Collection>\n    <DataSet timestep=\"0e0\" group=\"\" part=\"0\" file=\"snapshots/t0.000_initial.vtp\"/>\n    <DataSet timestep=\"5.000000000000003e-1\" group=\"\" part=\"0\" file=\"snapshots/t0.500_programming.vtp\"/>\n  </Collection>\n</VTKFile>\n",
-        )
-        .expect("write");
-        let time = collection_time(&dir, Path::new("snapshots/t0.500_programming.vtp"));
-        let _ = std::fs::remove_dir_all(&dir);
-        assert_eq!(time, Some(0.5000000000000003));
-    }
 }

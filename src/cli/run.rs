@@ -76,6 +76,8 @@ struct Progress {
     failed: usize,
     /// The message of the last converged step, which a failed attempt's note is appended to.
     last: String,
+    /// The model's cycle, for the phase of each step.
+    phases: crate::model::cycle::Phases,
 }
 
 /// How often the progress bar is redrawn when nothing is reported (a step being cut): its elapsed time keeps
@@ -83,7 +85,7 @@ struct Progress {
 const PROGRESS_TICK: Duration = Duration::from_millis(250);
 
 impl Progress {
-    fn new(end: Real, quiet: bool, verbose: bool) -> Self {
+    fn new(model: &crate::model::Model, quiet: bool, verbose: bool) -> Self {
         let bar = if quiet {
             ProgressBar::hidden()
         } else {
@@ -102,12 +104,13 @@ impl Progress {
         }
         Self {
             bar,
-            end,
+            end: model.time.end,
             said: 0,
             verbose,
             cuts: 0,
             failed: 0,
             last: String::new(),
+            phases: model.phases(),
         }
     }
 
@@ -135,9 +138,9 @@ impl Observer for Progress {
         self.bar
             .set_position((fraction * PROGRESS_RESOLUTION as Real).round() as u64);
         // The phase of the shape-memory cycle, when the model has one.
-        let phase = sim
-            .model()
-            .phase_at(report.time)
+        let phase = self
+            .phases
+            .at(report.time)
             .map(|p| format!("{p}  "))
             .unwrap_or_default();
         self.cuts += report.cuts;
@@ -850,7 +853,7 @@ fn run_in(
         } else {
             "no recording".to_string()
         },
-        human_bytes(folder_bytes(dir) as Real),
+        human_bytes(folder.written_bytes() as Real),
         summary.summary.wall_time_s,
         summary
             .summary
@@ -859,20 +862,6 @@ fn run_in(
         dir.display()
     );
     Ok(())
-}
-
-/// Bytes of the files under `dir` (what a run folder takes on disk, about).
-fn folder_bytes(dir: &Path) -> u64 {
-    std::fs::read_dir(dir)
-        .into_iter()
-        .flatten()
-        .flatten()
-        .map(|entry| match entry.file_type() {
-            Ok(t) if t.is_dir() => folder_bytes(&entry.path()),
-            Ok(_) => entry.metadata().map_or(0, |m| m.len()),
-            Err(_) => 0,
-        })
-        .sum()
 }
 
 /// Creates the writers of the run folder, each file listed in the manifest first.
@@ -908,7 +897,7 @@ fn create_outputs(
         snapshots,
         recorder,
         charts: RunCharts::new(model),
-        progress: Progress::new(model.time.end, options.quiet, options.verbose),
+        progress: Progress::new(model, options.quiet, options.verbose),
         spent: [Duration::ZERO; 4],
         beat: Instant::now(),
         totals: crate::solver::RunSummary::default(),
@@ -957,7 +946,7 @@ fn resume_outputs(
     } else {
         None
     };
-    let mut progress = Progress::new(model.time.end, options.quiet, options.verbose);
+    let mut progress = Progress::new(model, options.quiet, options.verbose);
     progress.said = sim.notices().len();
     Ok(Outputs {
         history,
@@ -1102,78 +1091,9 @@ fn finish(
     }
 
     // The recording first: salvaging a recording cut short by a full disk frees the space of its broken chunk.
-    let mcap_bytes = match outputs.recorder.as_mut() {
-        None => 0,
-        Some(recorder) => {
-            let record_error = recorder.take_error().map(anyhow::Error::from);
-            // A writer that failed once refuses every later write: only the salvage can finish the file.
-            let closed = if record_error.is_some() || hurry {
-                recorder.close()
-            } else {
-                recorder.finish(sim)
-            };
-            let mcap_path = dir.join("run.mcap");
-            let complete_to = format!("complete up to {}", upto(recorder.last_time()));
-            // The first error is the cause; closing after it fails for that reason too.
-            let (closed_bytes, cause) = match closed {
-                Ok(bytes) => (bytes, record_error),
-                Err(e) => (0, Some(record_error.unwrap_or_else(|| e.into()))),
-            };
-            match cause {
-                None => {
-                    state("run.mcap", true, complete_to);
-                    closed_bytes
-                }
-                Some(e) => {
-                    let bytes = match salvage(&mcap_path) {
-                        Ok(Salvage::Finished {
-                            after,
-                            last_log_time,
-                            ..
-                        }) => {
-                            let t = last_log_time.map(|ns| ns as Real * 1e-9);
-                            state(
-                                "run.mcap",
-                                true,
-                                format!(
-                                    "finalised up to {}; later states not recorded: {}",
-                                    upto(t),
-                                    error_text(&e)
-                                ),
-                            );
-                            after
-                        }
-                        Ok(Salvage::AlreadyValid { bytes }) => {
-                            state(
-                                "run.mcap",
-                                true,
-                                format!(
-                                    "{complete_to}; later states not recorded: {}",
-                                    error_text(&e)
-                                ),
-                            );
-                            bytes
-                        }
-                        Err(salvage_error) => {
-                            let removed = std::fs::remove_file(&mcap_path).is_ok();
-                            state(
-                                "run.mcap",
-                                false,
-                                format!(
-                                    "incomplete ({}) and cannot be finished ({salvage_error}){}",
-                                    error_text(&e),
-                                    if removed { ": removed" } else { "" }
-                                ),
-                            );
-                            0
-                        }
-                    };
-                    problems.push(e);
-                    bytes
-                }
-            }
-        }
-    };
+    let mcap_bytes = outputs.recorder.as_mut().map_or(0, |recorder| {
+        finish_recording(recorder, sim, hurry, dir, &upto, &mut state, &mut problems)
+    });
 
     let snapshot_error = outputs.snapshots.take_error().map(anyhow::Error::from);
     // After any output error (most often a full disk) the final snapshot is not attempted: the room left is
@@ -1248,6 +1168,86 @@ fn finish(
         states,
         mcap_bytes,
         charts,
+    }
+}
+
+/// Finishes the recording (or, after a write error or a second signal, closes it and salvages what it holds),
+/// says how it stands with `state`, and returns its size \[bytes\]; its error joins `problems`.
+fn finish_recording(
+    recorder: &mut McapRecorder,
+    sim: &Simulation<'_>,
+    hurry: bool,
+    dir: &Path,
+    upto: &dyn Fn(Option<Real>) -> String,
+    state: &mut dyn FnMut(&str, bool, String),
+    problems: &mut Vec<anyhow::Error>,
+) -> u64 {
+    let record_error = recorder.take_error().map(anyhow::Error::from);
+    // A writer that failed once refuses every later write: only the salvage can finish the file.
+    let closed = if record_error.is_some() || hurry {
+        recorder.close()
+    } else {
+        recorder.finish(sim)
+    };
+    let mcap_path = dir.join("run.mcap");
+    let complete_to = format!("complete up to {}", upto(recorder.last_time()));
+    // The first error is the cause; closing after it fails for that reason too.
+    let (closed_bytes, cause) = match closed {
+        Ok(bytes) => (bytes, record_error),
+        Err(e) => (0, Some(record_error.unwrap_or_else(|| e.into()))),
+    };
+    match cause {
+        None => {
+            state("run.mcap", true, complete_to);
+            closed_bytes
+        }
+        Some(e) => {
+            let bytes = match salvage(&mcap_path) {
+                Ok(Salvage::Finished {
+                    after,
+                    last_log_time,
+                    ..
+                }) => {
+                    let t = last_log_time.map(|ns| ns as Real * 1e-9);
+                    state(
+                        "run.mcap",
+                        true,
+                        format!(
+                            "finalised up to {}; later states not recorded: {}",
+                            upto(t),
+                            error_text(&e)
+                        ),
+                    );
+                    after
+                }
+                Ok(Salvage::AlreadyValid { bytes }) => {
+                    state(
+                        "run.mcap",
+                        true,
+                        format!(
+                            "{complete_to}; later states not recorded: {}",
+                            error_text(&e)
+                        ),
+                    );
+                    bytes
+                }
+                Err(salvage_error) => {
+                    let removed = std::fs::remove_file(&mcap_path).is_ok();
+                    state(
+                        "run.mcap",
+                        false,
+                        format!(
+                            "incomplete ({}) and cannot be finished ({salvage_error}){}",
+                            error_text(&e),
+                            if removed { ": removed" } else { "" }
+                        ),
+                    );
+                    0
+                }
+            };
+            problems.push(e);
+            bytes
+        }
     }
 }
 

@@ -261,11 +261,7 @@ impl FitFolder {
 
     /// Bytes of the earlier run's files: what `--force` will free.
     pub fn previous_bytes(&self) -> u64 {
-        self.previous
-            .iter()
-            .filter_map(|p| fs::metadata(self.dir.join(p)).ok())
-            .map(|m| m.len())
-            .sum()
+        files_bytes(&self.dir, &self.previous)
     }
 
     /// Takes the folder: creates it, takes its lock and opens the manifest. Nothing is removed yet.
@@ -275,6 +271,15 @@ impl FitFolder {
     pub fn open(self) -> Result<RunFolder, RunFolderError> {
         RunFolder::take(self.dir, self.previous)
     }
+}
+
+/// Bytes of the files `files` (relative to `dir`) that exist.
+fn files_bytes(dir: &Path, files: &BTreeSet<PathBuf>) -> u64 {
+    files
+        .iter()
+        .filter_map(|p| fs::metadata(dir.join(p)).ok())
+        .map(|m| m.len())
+        .sum()
 }
 
 /// A run folder held by this process: locked, with its manifest open for appending.
@@ -419,6 +424,11 @@ impl RunFolder {
     /// The manifest, for the writers of the run.
     pub fn manifest(&self) -> &Manifest {
         &self.manifest
+    }
+
+    /// Bytes of the files this run wrote (those its manifest lists) as they are now.
+    pub fn written_bytes(&self) -> u64 {
+        files_bytes(&self.dir, &self.manifest.listed())
     }
 
     /// Writes a hidden file of `bytes` zeros (real blocks, not a sparse file), deleted when the returned

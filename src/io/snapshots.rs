@@ -44,7 +44,7 @@ pub struct SnapshotSchedule {
 impl SnapshotSchedule {
     /// The schedule of a design's snapshot settings for its model.
     pub fn new(settings: &SnapshotSettings, model: &Model) -> Self {
-        let snap = crate::model::LANDING_TOLERANCE * model.time.step;
+        let snap = model.time.landing_tolerance();
         let mut times = settings.times.clone();
         // An arc-length path's `time` is its path parameter, which passes `time.end` anywhere: its last state
         // is written by the writers' `finish`, and it has neither events nor times between them.
@@ -111,10 +111,32 @@ fn between_events(events: &[Real], pieces: usize) -> Vec<Real> {
         .collect()
 }
 
-/// The name of the snapshot of step `step` at `time` (without extension): its time with at least three
-/// decimals and its phase in the model's cycle, `t1.750_fixed` (`t0.500` for a model without a cycle), or
+/// What a snapshot's name ([`snapshot_name`], without extension) says of it: its step (`step_00012`) or its
+/// time as written (`t1.750_fixed`), and its phase.
+pub fn parse_snapshot_name(name: &str) -> Option<(SnapshotAt, Option<Phase>)> {
+    if let Some(step) = name.strip_prefix("step_") {
+        return Some((SnapshotAt::Step(step.parse().ok()?), None));
+    }
+    let (time, phase) = match name.strip_prefix('t')?.split_once('_') {
+        Some((time, phase)) => (time, Phase::parse(phase)),
+        None => (name.strip_prefix('t')?, None),
+    };
+    Some((SnapshotAt::Time(time.parse().ok()?), phase))
+}
+
+/// Where a snapshot's name places it ([`parse_snapshot_name`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum SnapshotAt {
+    /// The step (an arc-length path's names).
+    Step(usize),
+    /// The time, to the name's decimals (at least three, at most six: within 5e-7 of the state's).
+    Time(Real),
+}
+
+/// The name of the snapshot of step `step` at `time` in `phase` of the model's cycle (without extension): its
+/// time with at least three decimals and its phase, `t1.750_fixed` (`t0.500` without a phase), or
 /// `step_00012` on an arc-length path, whose `time` is the path parameter.
-pub fn snapshot_name(model: &Model, step: usize, time: Real) -> String {
+pub fn snapshot_name(model: &Model, step: usize, time: Real, phase: Option<Phase>) -> String {
     if model.solver.path.arc_length().is_some() {
         return format!("step_{step:05}");
     }
@@ -125,7 +147,7 @@ pub fn snapshot_name(model: &Model, step: usize, time: Real) -> String {
             ((time * scale).round() / scale - time).abs() <= 1e-9 * time.abs().max(1.0)
         })
         .unwrap_or(6) as usize;
-    match model.phase_at(time) {
+    match phase {
         Some(phase) => format!("t{time:.decimals$}_{phase}"),
         None => format!("t{time:.decimals$}"),
     }
@@ -224,6 +246,8 @@ pub struct SnapshotWriter {
     rings: usize,
     /// The formats each snapshot is written in.
     formats: Vec<&'static dyn MeshFormat>,
+    /// The model's cycle, which names the snapshots.
+    phases: crate::model::cycle::Phases,
     /// Time and step of the last state seen.
     last: Option<(usize, Real)>,
     written: Vec<Snapshot>,
@@ -271,6 +295,7 @@ impl SnapshotWriter {
                 .iter()
                 .filter_map(|e| formats::format(e))
                 .collect(),
+            phases: model.phases(),
             last: None,
             written: Vec::new(),
             error: None,
@@ -337,7 +362,8 @@ impl SnapshotWriter {
                 source: e.source,
             }
         })?;
-        let name = self.unique_name(snapshot_name(model, step, time), step);
+        let phase = self.phases.at(time);
+        let name = self.unique_name(snapshot_name(model, step, time, phase), step);
         let files: Vec<PathBuf> = self
             .formats
             .iter()
@@ -378,7 +404,7 @@ impl SnapshotWriter {
         self.written.push(Snapshot {
             step,
             time,
-            phase: model.phase_at(time),
+            phase,
             files,
             triangles: mesh.triangles.len(),
             volume: mesh.volume(),
@@ -602,5 +628,22 @@ mod tests {
         }
         assert!(between_events(&[0.0, 1.0], 0).is_empty());
         assert!(between_events(&[0.0], 6).is_empty());
+    }
+
+    #[test]
+    fn snapshot_names_read_back() {
+        assert_eq!(
+            parse_snapshot_name("t1.7525_released"),
+            Some((SnapshotAt::Time(1.7525), Some(Phase::Released)))
+        );
+        assert_eq!(
+            parse_snapshot_name("t0.500"),
+            Some((SnapshotAt::Time(0.5), None))
+        );
+        assert_eq!(
+            parse_snapshot_name("step_00012"),
+            Some((SnapshotAt::Step(12), None))
+        );
+        assert_eq!(parse_snapshot_name("vessel_lumen"), None);
     }
 }

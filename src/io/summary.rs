@@ -410,6 +410,15 @@ pub struct StabilisationSummary {
     pub above_limit: bool,
 }
 
+/// A model's fingerprint as summary.json writes it: 16 hex digits of
+/// [`crate::solver::simulation::model_fingerprint`].
+pub fn model_fingerprint_text(model: &Model) -> String {
+    format!(
+        "{:016x}",
+        crate::solver::simulation::model_fingerprint(model)
+    )
+}
+
 impl RunSummaryFile {
     /// The summary of a run of `model` that is starting: `"status": "running"`, nothing done yet.
     pub fn start(
@@ -422,10 +431,7 @@ impl RunSummaryFile {
         Self {
             design: model.name.clone(),
             design_file: design_file.to_string(),
-            model_fingerprint: format!(
-                "{:016x}",
-                crate::solver::simulation::model_fingerprint(model)
-            ),
+            model_fingerprint: model_fingerprint_text(model),
             overrides: Vec::new(),
             resolved_design: None,
             stentkit_version: version.to_string(),

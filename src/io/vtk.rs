@@ -267,9 +267,42 @@ pub fn write_collection(path: &Path, entries: &[(Real, String)]) -> std::io::Res
     super::stl::write_bytes_atomically(path, collection(entries).as_bytes())
 }
 
+/// The `(time, file)` entries of a collection's text as [`write_collection`] writes it (the times in full).
+pub fn collection_entries(text: &str) -> Vec<(Real, String)> {
+    let attribute = |line: &str, name: &str| -> Option<String> {
+        Some(
+            line.split(&format!("{name}=\""))
+                .nth(1)?
+                .split('"')
+                .next()?
+                .to_string(),
+        )
+    };
+    text.lines()
+        .filter_map(|line| {
+            let time = attribute(line, "timestep")?.parse().ok()?;
+            Some((time, attribute(line, "file")?))
+        })
+        .collect()
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A collection read back gives its entries, the times to the bit (`stentkit repair` takes a snapshot's
+    /// time from it: history.csv's 11 digits would round 0.5000000000000003 to 0.5).
+    #[test]
+    fn a_collection_reads_back_to_its_entries() {
+        let entries = vec![
+            (0.0, "snapshots/t0.000_initial.vtp".to_string()),
+            (
+                0.5000000000000003,
+                "snapshots/t0.500_programming.vtp".to_string(),
+            ),
+        ];
+        assert_eq!(collection_entries(&collection(&entries)), entries);
+    }
 
     /// Source: VTK's XML format (header UInt64 little-endian byte count, then the data, base64 together).
     #[test]

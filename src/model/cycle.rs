@@ -147,7 +147,7 @@ impl Model {
             .collect::<Vec<_>>();
         let fixed = drives.iter().map(|((f, _), _)| *f).reduce(Real::min)?;
         let released = drives.iter().map(|((_, r), _)| *r).reduce(Real::max)?;
-        let tolerance = super::LANDING_TOLERANCE * self.time.step;
+        let tolerance = self.time.landing_tolerance();
         let programmed = drives
             .iter()
             .flat_map(|(_, f)| f.breakpoints())
@@ -160,32 +160,61 @@ impl Model {
         })
     }
 
-    /// The events of the run: t = 0, the cycle's events that fall inside the run, and its end, in time
-    /// order.
-    pub fn events(&self) -> Vec<(Real, Phase)> {
+    /// The model's cycle and the events of its run, read once for many [`Phases::at`].
+    pub fn phases(&self) -> Phases {
         let end = self.time.end;
+        let tolerance = self.time.landing_tolerance();
+        let cycle = self.cycle();
         let mut events = vec![(0.0, Phase::Initial)];
-        if let Some(c) = self.cycle() {
+        if let Some(c) = cycle {
             events.extend(c.programmed.map(|t| (t, Phase::Programmed)));
             events.push((c.fixed, Phase::Fixed));
             events.push((c.released, Phase::Released));
         }
-        let tolerance = super::LANDING_TOLERANCE * self.time.step;
         events.retain(|&(t, _)| t < end - tolerance);
         if self.solver.path.arc_length().is_none() {
             events.push((end, Phase::Final));
         }
-        events
+        Phases {
+            cycle,
+            events,
+            tolerance,
+        }
     }
 
-    /// The phase of the state at time `t` (`None` for a model without a cycle, between its start and end).
+    /// The events of the run ([`Phases::events`]).
+    pub fn events(&self) -> Vec<(Real, Phase)> {
+        self.phases().events
+    }
+
+    /// The phase of the state at time `t` ([`Phases::at`]).
     pub fn phase_at(&self, t: Real) -> Option<Phase> {
-        let tolerance = super::LANDING_TOLERANCE * self.time.step;
-        let events = self.events();
-        if let Some(&(_, phase)) = events.iter().find(|(e, _)| (t - e).abs() <= tolerance) {
+        self.phases().at(t)
+    }
+}
+
+/// A model's cycle and the events of its run ([`Model::phases`]).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Phases {
+    cycle: Option<Cycle>,
+    /// t = 0, the cycle's events that fall inside the run, and its end (on a time-driven path), in time order.
+    pub events: Vec<(Real, Phase)>,
+    /// Times closer than this are one time: the model's landing tolerance.
+    tolerance: Real,
+}
+
+impl Phases {
+    /// The phase of the state at time `t`: the event there, else the interval between events it lies in
+    /// (`None` for a model without a cycle, between its start and end).
+    pub fn at(&self, t: Real) -> Option<Phase> {
+        if let Some(&(_, phase)) = self
+            .events
+            .iter()
+            .find(|(e, _)| (t - e).abs() <= self.tolerance)
+        {
             return Some(phase);
         }
-        let c = self.cycle()?;
+        let c = self.cycle?;
         Some(if c.programmed.is_some_and(|p| t < p) {
             Phase::Programming
         } else if t < c.fixed {

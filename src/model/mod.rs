@@ -274,6 +274,11 @@ impl TimeSettings {
         self.tolerance?;
         materials.iter().find_map(|m| m.time_error_unsupported())
     }
+
+    /// Times closer than this are one time: [`LANDING_TOLERANCE`] of the nominal step \[time\].
+    pub fn landing_tolerance(&self) -> Real {
+        LANDING_TOLERANCE * self.step
+    }
 }
 
 /// Times closer than this fraction of the nominal step are one time when time stepping lands on schedule
@@ -587,7 +592,7 @@ impl Model {
     /// 100 000); step cuts add steps too.
     pub fn planned_steps(&self) -> StepPlan {
         let (end, h) = (self.time.end, self.time.step);
-        let tolerance = LANDING_TOLERANCE * h;
+        let tolerance = self.time.landing_tolerance();
         let mut plan = StepPlan::default();
         let mut time = 0.0;
         for landing in self.schedule_breakpoints().into_iter().chain([end]) {

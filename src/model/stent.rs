@@ -180,15 +180,13 @@ pub fn generate(
                 if worst.is_none_or(|(w, _)| fit.max_deviation > w) {
                     worst = Some((fit.max_deviation, &g.name));
                 }
-                match check_bend(g, &fit.curve, full.diameter()) {
+                if let Some(fold) = Fold::of(&fit.curve, full.diameter()) {
                     // The temporary placement keeps the crowns' amplitude on a smaller radius: its wires are
                     // where the nodes go, not how the wires bend (module docs of `cli::mesh`), so a fold is said.
-                    Err(e) if placement.is_some() => {
-                        // Its message without the advice for a permanent shape.
-                        let what = e.message.split("; ").next().unwrap_or_default().to_string();
-                        folds.get_or_insert((0, what)).0 += 1;
+                    if placement.is_none() {
+                        return Err(fold.refusal(g));
                     }
-                    result => result?,
+                    folds.get_or_insert((0, fold.describe(&g.name))).0 += 1;
                 }
                 (fit.curve, Some(fit.max_deviation))
             }
@@ -275,31 +273,54 @@ pub fn generate(
 /// whose inner bridges bent with radii of 0.02–0.03 mm against a wire radius of 0.25 mm). The fitted curve is
 /// checked, with exact derivatives, rather than the generator's curve, whose derivatives are finite differences
 /// that a centreline's end (straight beyond it) disturbs. Refused, with what to change.
-fn check_bend(g: &GeneratedPatch, fitted: &crate::math::NurbsCurve, diameter: Real) -> Result<()> {
-    use crate::geometry::analytic::ParametricCurve;
-    let (radius, at) = fitted.tightest_bend();
-    if radius >= 0.5 * diameter {
-        return Ok(());
+struct Fold {
+    /// The tightest radius of curvature \[length\].
+    radius: Real,
+    /// Where, as a fraction of the curve parameter.
+    at: Real,
+    /// The wire's radius \[length\].
+    wire: Real,
+}
+
+impl Fold {
+    /// The fold of the fitted wire `fitted` of diameter `diameter`, if it bends tighter than its radius.
+    fn of(fitted: &crate::math::NurbsCurve, diameter: Real) -> Option<Self> {
+        use crate::geometry::analytic::ParametricCurve;
+        let (radius, at) = fitted.tightest_bend();
+        (radius < 0.5 * diameter).then_some(Self {
+            radius,
+            at,
+            wire: 0.5 * diameter,
+        })
     }
-    let (parameter, advice) = match g.role {
-        PatchRole::Bridge { .. } => (
-            StentParameter::Bridges,
-            "where the centreline bends, the crowns on its inner side come close and the bridge between them is squeezed or turns back: bend the centreline less, use fewer or lower crowns (more room between them), or a smaller bridge amplitude",
-        ),
-        PatchRole::Crown { .. } => (
-            StentParameter::Amplitude,
-            "lower the crown amplitude or the number of peaks, or raise the radius",
-        ),
-    };
-    Err(BuildError::new(
-        Field::Stent(StentField::Parameter(parameter)),
+
+    /// What folds, where.
+    fn describe(&self, name: &str) -> String {
         format!(
-            "stent patch `{}` bends with a radius of curvature {radius:.3e} (at {:.0} % of its length), less than the wire's radius {}: the wire would fold onto itself; {advice}",
-            g.name,
-            100.0 * at,
-            crate::math::Short(0.5 * diameter)
-        ),
-    ))
+            "stent patch `{name}` bends with a radius of curvature {:.3e} (at {:.0} % of its length), less than the wire's radius {}: the wire would fold onto itself",
+            self.radius,
+            100.0 * self.at,
+            crate::math::Short(self.wire)
+        )
+    }
+
+    /// The refusal of a permanent shape with this fold, with what to change.
+    fn refusal(&self, g: &GeneratedPatch) -> BuildError {
+        let (parameter, advice) = match g.role {
+            PatchRole::Bridge { .. } => (
+                StentParameter::Bridges,
+                "where the centreline bends, the crowns on its inner side come close and the bridge between them is squeezed or turns back: bend the centreline less, use fewer or lower crowns (more room between them), or a smaller bridge amplitude",
+            ),
+            PatchRole::Crown { .. } => (
+                StentParameter::Amplitude,
+                "lower the crown amplitude or the number of peaks, or raise the radius",
+            ),
+        };
+        BuildError::new(
+            Field::Stent(StentField::Parameter(parameter)),
+            format!("{}; {advice}", self.describe(&g.name)),
+        )
+    }
 }
 
 /// A warning when the wires of two consecutive crowns come closer, centre to centre, than the wire's

@@ -325,9 +325,9 @@ fn the_temporary_shape_is_the_device_where_its_programme_takes_it() {
     // crown wires on the cylinder of radius 5, its straight bridges' chords inside it), and the curved stent's
     // within 5 + 2.5 + 0.3 mm (its radial sine bridges, amplitude h_b = 2.5 mm, bulge out by that), and each
     // reaches its bound, to the section polygon: its vertices there lie on the bound, or up to
-    // 0.3 (1 − cos(π/16)) = 5.8e-3 mm inside it with 16 segments. The axis is found as the vertices' principal
-    // line, which on the straight stent is off its true axis x1 by 3.7e-5 mm (measured; STL's f32 adds 1e-5
-    // at most): 2e-4 is allowed above the bound. The curved stent's permanent shape is 20 mm in radius on a 45°
+    // 0.3 (1 − cos(π/16)) = 5.8e-3 mm inside it with 16 segments; the fitted wires stray outside by up to their
+    // fit error, and STL's f32 adds 1e-5 at most. The straight stent is measured from its axis x1, the curved
+    // one from the vertices' principal line. The curved stent's permanent shape is 20 mm in radius on a 45°
     // arc: tens of mm off any line. The driven nodes must meet the programme's targets P_0 + η to round-off
     // (the fitted wires' ends are exact).
     let dir = TempDir::new("temporary_shape");
@@ -359,10 +359,34 @@ fn the_temporary_shape_is_the_device_where_its_programme_takes_it() {
         );
         let mesh = stl::read_stl(&out_path).expect("STL");
         mesh.check_closed().expect("closed");
-        let far = distance_from_principal_line(&mesh.vertices);
+        // The wires are the generated curves as fitted: their centrelines stray from the bound's cylinder by
+        // up to the fit's deviation.
+        let fit = stentkit::io::design::load_design_with(
+            &crate::outputs::design(name),
+            &stentkit::io::design::DesignOverrides {
+                temporary_shape: true,
+                ..Default::default()
+            },
+        )
+        .expect("temporary design")
+        .model
+        .patches
+        .iter()
+        .filter_map(|p| p.fit_error)
+        .fold(0.0, Real::max);
+        // The straight stent's axis is x1 (its design's centreline); the curved one's, placed by the fit, is
+        // found as the principal line.
+        let far = if name == "straight_stent.yaml" {
+            mesh.vertices
+                .iter()
+                .map(|v| v.y.hypot(v.z))
+                .fold(0.0, Real::max)
+        } else {
+            distance_from_principal_line(&mesh.vertices)
+        };
         assert!(
-            (radius - 5.8e-3..=radius + 2e-4).contains(&far),
-            "{name}: the temporary device reaches {far} from its axis"
+            (radius - 5.8e-3..=radius + fit + 1e-5).contains(&far),
+            "{name}: the temporary device reaches {far} from its axis (fit error {fit})"
         );
     }
     // The permanent curved stent, for contrast, is far from straight.

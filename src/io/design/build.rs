@@ -165,20 +165,22 @@ pub fn build(dto: &DesignDto, default_name: &str, temporary_shape: bool) -> Resu
         model,
         mut warnings,
     } = builder.build().map_err(|e| builder_issue(e, dto))?;
-    // The steps the run takes, landing on every breakpoint: refused if their memory is too much, and the
-    // default snapshot spacing follows them. An arc-length path takes at most its increments allowed.
+    // The steps the run takes, landing on every breakpoint: refused if their memory is too much. An arc-length
+    // path takes at most its increments allowed, and has no times to place snapshots at: by default about
+    // DEFAULT_COUNT of them over its increments.
+    let snapshots = dto.output.as_ref().and_then(|o| o.snapshots.as_ref());
     let plan = match model.solver.path {
         PathControl::ArcLength(a) => {
-            if dto
-                .output
-                .as_ref()
-                .and_then(|o| o.snapshots.as_ref())
-                .is_some_and(|s| s.times.is_some())
-            {
+            if snapshots.is_some_and(|s| s.times.is_some()) {
                 return Err(issue(
                     "output.snapshots.times",
                     "an arc-length path has no times to land on (its `time` is the path parameter, known only as it is followed): use `output.snapshots.every`",
                 ));
+            }
+            if snapshots.and_then(|s| s.every).is_none() {
+                output.snapshots.every = a
+                    .max_increments
+                    .div_ceil(super::SnapshotSettings::DEFAULT_COUNT);
             }
             StepPlan {
                 full: a.max_increments,
@@ -196,19 +198,6 @@ pub fn build(dto: &DesignDto, default_name: &str, temporary_shape: bool) -> Resu
         }
     };
     let memory = check_size(dto, &StepCount::planned(&plan, model.time.step, dto))?;
-    // An arc-length path has no times to place snapshots at: about DEFAULT_COUNT over its increments.
-    if model.solver.path.arc_length().is_some()
-        && dto
-            .output
-            .as_ref()
-            .and_then(|o| o.snapshots.as_ref())
-            .and_then(|s| s.every)
-            .is_none()
-    {
-        output.snapshots.every = plan
-            .total()
-            .div_ceil(super::SnapshotSettings::DEFAULT_COUNT);
-    }
     // A part no condition holds can move as a rigid body: `run` refuses it (the solver's check), `check` warns.
     for body in crate::solver::diagnose::free_bodies(&model) {
         let names: Vec<String> = body
@@ -440,22 +429,25 @@ fn output_settings(dto: &DesignDto, time: &TimeSettings) -> Result<super::Output
     }
     times.sort_by(Real::total_cmp);
     times.dedup();
-    let mut formats = crate::io::formats::DEFAULT_FORMATS.to_vec();
-    if let Some(names) = snapshots.and_then(|s| s.formats.as_ref()) {
-        formats.clear();
-        for (k, name) in names.iter().enumerate() {
-            let Some(format) = crate::io::formats::format(&name.to_ascii_lowercase()) else {
-                return Err(issue(
-                    format!("output.snapshots.formats[{k}]"),
-                    format!(
-                        "`{name}` is not a snapshot format; allowed: {}",
-                        crate::io::formats::extensions()
-                    ),
-                ));
-            };
-            formats.push(format.extension());
-        }
-    }
+    let formats: Vec<&str> = match snapshots.and_then(|s| s.formats.as_ref()) {
+        None => crate::io::formats::DEFAULT_FORMATS.to_vec(),
+        Some(names) => names
+            .iter()
+            .enumerate()
+            .map(
+                |(k, name)| match crate::io::formats::format(&name.to_ascii_lowercase()) {
+                    Some(format) => Ok(format.extension()),
+                    None => Err(issue(
+                        format!("output.snapshots.formats[{k}]"),
+                        format!(
+                            "`{name}` is not a snapshot format; allowed: {}",
+                            crate::io::formats::extensions()
+                        ),
+                    )),
+                },
+            )
+            .collect::<Result<_>>()?,
+    };
     // The registry's order, once each.
     let formats = crate::io::formats::FORMATS
         .iter()
@@ -920,7 +912,7 @@ fn short_schedule_warning(model: &crate::model::Model) -> Option<String> {
     let end = model.time.end;
     (model.solver.path.arc_length().is_none()
         && !schedule.is_constant()
-        && last < end - crate::model::LANDING_TOLERANCE * model.time.step)
+        && last < end - model.time.landing_tolerance())
         .then(|| {
             format!(
                 "the temperature schedule ends at t = {last}, before the run does ({end}): the temperature is held at its last value, {value} °C, from there (extend the table to the end if that is not meant)"

@@ -772,7 +772,7 @@ pub struct SnapshotsDto {
     /// File formats: `stl`, `obj` (default `[stl]`).
     #[serde(default)]
     pub formats: Option<Vec<String>>,
-    /// Vertices around each tube section (default 16, at least 3).
+    /// Vertices around each tube section (default 12, at least 3).
     #[serde(default)]
     pub segments: Option<usize>,
     /// Rings (sections) along each patch, about (default 41, at least 2).

@@ -68,8 +68,8 @@ impl SnapshotSettings {
     /// `every = ⌈increments / 20⌉`.
     pub const DEFAULT_COUNT: usize = 20;
     /// Default pieces between the events ([`Self::between`]): 6. With the events this gives the straight stent 8
-    /// snapshots (t = 0, 0.5, 1 programmed, 1.75 fixed, 1.7525 released, 2.25, 2.75, 3.25 final), a 40 MB
-    /// folder; the recording holds every step besides.
+    /// snapshots (t = 0, 0.5, 1 programmed, 1.75 fixed, 1.7525 released, 2.2525, 2.7525, 3.25 final), a
+    /// 58 MB folder with the recording, which holds every step besides.
     pub const DEFAULT_BETWEEN: usize = 6;
     /// Default vertices around a section: 12, the section polygon has 95.5 % of the circle's area (16 would
     /// have 97.4 %, in files a third larger). A snapshot is a preview: `stentkit mesh` writes finer ones.
@@ -503,9 +503,6 @@ pub fn parse_design_with(
     })
 }
 
-/// The design error of a deserialisation error `e` of the text indexed by `locator` (module docs: the
-/// position of a syntax error is the problem's own, a rejected value is found by its path, serde_yaml's
-/// position is best for unknown and missing fields).
 /// The error of reading `text` into a design. A YAML syntax error is reported where the parser found it, also
 /// when the design's reader met a missing field first: an over-indented key ends its mapping early, and the
 /// reader then misses a field of that mapping at the wrong line (issue 19), so a reading error is checked
@@ -537,39 +534,30 @@ fn is_syntax_error(e: &serde_yaml::Error) -> bool {
 
 /// A syntax error's message says it is one, and where a block structure broke, the usual cause; `clear_field`
 /// drops a field path that a plain parse cannot know.
-fn not_yaml(error: DesignError, clear_field: bool) -> DesignError {
-    match error {
-        DesignError::Invalid {
-            file,
-            line,
-            column,
-            field,
-            message,
-        } => DesignError::Invalid {
-            file,
-            line,
-            column,
-            // (A key the parser had not read yet shows as `?`: the mapping around it is what is known.)
-            field: if clear_field {
-                String::new()
-            } else {
-                field
-                    .trim_end_matches('?')
-                    .trim_end_matches('.')
-                    .to_string()
-            },
-            message: if message.contains("while parsing a block") {
-                format!(
-                    "not valid YAML: {message} (a key indented more or less than its neighbours does this)"
-                )
-            } else {
-                format!("not valid YAML: {message}")
-            },
-        },
-        other => other,
+fn not_yaml(mut error: DesignError, clear_field: bool) -> DesignError {
+    if let DesignError::Invalid { field, message, .. } = &mut error {
+        // (A key the parser had not read yet shows as `?`: the mapping around it is what is known.)
+        *field = if clear_field {
+            String::new()
+        } else {
+            field
+                .trim_end_matches('?')
+                .trim_end_matches('.')
+                .to_string()
+        };
+        let hint = if message.contains("while parsing a block") {
+            " (a key indented more or less than its neighbours does this)"
+        } else {
+            ""
+        };
+        *message = format!("not valid YAML: {message}{hint}");
     }
+    error
 }
 
+/// The design error of a deserialisation error `e` of the text indexed by `locator` (module docs: the
+/// position of a syntax error is the problem's own, a rejected value is found by its path, serde_yaml's
+/// position is best for unknown and missing fields).
 fn read_error(
     e: &serde_path_to_error::Error<serde_yaml::Error>,
     locator: &locate::Locator,

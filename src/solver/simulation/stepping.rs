@@ -92,7 +92,7 @@ impl Simulation<'_> {
     /// Times closer than this to a breakpoint or the end are that breakpoint: the model's landing tolerance
     /// ([`crate::model::LANDING_TOLERANCE`] of the nominal step) \[time\].
     fn landing_tolerance(&self) -> Real {
-        crate::model::LANDING_TOLERANCE * self.model.time.step
+        self.model.time.landing_tolerance()
     }
 
     /// Takes one step — the next converged one, with the retries and cuts it needed — and returns its report,
