@@ -11,6 +11,7 @@ pub mod frame;
 pub mod mesh;
 pub mod polyline;
 pub mod primitives;
+pub mod simplify;
 pub mod solid;
 pub mod sphere;
 pub mod stent;

@@ -1,0 +1,510 @@
+//! Fewer triangles for the same closed surface: quadric-error edge collapse (Garland & Heckbert, "Surface
+//! simplification using quadric error metrics", SIGGRAPH 1997) that keeps a closed 2-manifold closed and
+//! 2-manifold. It is what makes the union solid of [`super::solid`] (millions of grid-sized triangles, most of
+//! them on tubes that are straight for many grid cells) small enough to write.
+//!
+//! **Method.** Every vertex carries the quadric `Q(x) = Σ Aᵢ (nᵢ·x + dᵢ)²` of the planes of the input
+//! triangles around it, weighted by their areas, so that `Q / Σ Aᵢ` is the mean squared distance to them.
+//! Edges are collapsed cheapest first (to within a quarter octave of cost, [`CostQueue`]): the two ends merge
+//! into one vertex at the point of least summed quadric among those that keep the enclosed volume (Lindstrom
+//! & Turk 1998: the volume is linear in the merged vertex's position), and the merged vertex carries the sum.
+//! The volume is kept exactly, collapse by collapse: a surface whose vertices lie on a convex shape (chords
+//! inside it) is not shrunk further by its coarser chords. A collapse is made only when
+//! - its cost is at most `tolerance²`: the merged vertex is within `tolerance` of the planes it replaces, in
+//!   the root-mean-square;
+//! - the link condition holds (the ends share exactly the two neighbours of the edge's triangles; Dey et al.,
+//!   "Topology preserving edge contraction", 1999): the surface stays a 2-manifold of the same topology;
+//! - no triangle around it turns by more than [`MAX_TURN_COS`]'s angle or becomes degenerate: no fold-over,
+//!   so, with `tolerance` far below the gaps between separate parts of the surface, no self-intersection.
+//!
+//! Orientation is kept: a collapse only renames a vertex in the surviving triangles. Passes over all edges
+//! repeat until one collapses nothing (a refused collapse is queued again only when an end of it changes).
+//!
+//! Measured: the straight stent's union contour at a 0.1 mm grid, 2.02 million triangles, becomes 149 000
+//! within 6 µm in about 17 s.
+
+use super::mesh::TriangleMesh;
+use crate::math::{Mat3, Real, Vec3};
+
+/// The least cosine between a triangle's normal before and after a collapse (about 72°): a larger turn is a
+/// fold in the making and the collapse is refused.
+pub const MAX_TURN_COS: Real = 0.3;
+
+/// The area-weighted quadric `Σ wᵢ (nᵢ·x + dᵢ)² = xᵀ A x + 2 bᵀ x + c` of a set of planes, and the weights'
+/// sum `w`: `Q(x) / w` is the mean squared distance from `x` to the planes.
+#[derive(Debug, Clone, Copy)]
+struct Quadric {
+    a: Mat3,
+    b: Vec3,
+    c: Real,
+    w: Real,
+}
+
+impl Quadric {
+    /// The plane through `point` with unit normal `normal`, weighted by `weight` (its triangle's area).
+    fn plane(normal: &Vec3, point: &Vec3, weight: Real) -> Self {
+        let d = -normal.dot(point);
+        Quadric {
+            a: normal * normal.transpose() * weight,
+            b: normal * (d * weight),
+            c: d * d * weight,
+            w: weight,
+        }
+    }
+
+    fn zero() -> Self {
+        Quadric {
+            a: Mat3::zeros(),
+            b: Vec3::zeros(),
+            c: 0.0,
+            w: 0.0,
+        }
+    }
+
+    fn add(&self, other: &Quadric) -> Quadric {
+        Quadric {
+            a: self.a + other.a,
+            b: self.b + other.b,
+            c: self.c + other.c,
+            w: self.w + other.w,
+        }
+    }
+
+    /// The mean squared distance from `x` to the planes.
+    fn mean_square(&self, x: &Vec3) -> Real {
+        if self.w <= 0.0 {
+            return 0.0;
+        }
+        ((x.dot(&(self.a * x)) + 2.0 * self.b.dot(x) + self.c) / self.w).max(0.0)
+    }
+
+    /// The point near `start` where the quadric is least on the plane `g·x = volume` (the collapse keeps the
+    /// enclosed volume; Lindstrom & Turk, "Fast and memory efficient polygonal simplification", 1998), or
+    /// anywhere when `g` vanishes. Regularised: `start + δ` minimises `Q(start + δ) + ε |δ|²` with
+    /// `ε = 10⁻³ tr A / 3`, which keeps the step finite where `A` is singular (along a cylinder's axis, where
+    /// every point is as good and `start` is kept) and shortens the others by 0.1 % at most.
+    fn minimiser(&self, start: &Vec3, g: &Vec3, volume: Real) -> Vec3 {
+        let epsilon = 1e-3 * self.a.trace() / 3.0;
+        let Some(inverse) = (self.a + Mat3::identity() * epsilon).try_inverse() else {
+            return *start;
+        };
+        if epsilon <= 0.0 {
+            return *start;
+        }
+        let free = -(inverse * (self.a * start + self.b));
+        let towards = inverse * g;
+        let gg = g.dot(&towards);
+        if gg <= 1e-12 * g.norm_squared() / epsilon.max(Real::MIN_POSITIVE) || gg <= 0.0 {
+            return start + free;
+        }
+        // δ = δ₀ + M⁻¹ g μ with μ chosen so that g·(start + δ) = volume.
+        let mu = (volume - g.dot(&(start + free))) / gg;
+        start + free + towards * mu
+    }
+}
+
+/// What [`simplify`] did.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SimplifyReport {
+    /// Triangles before.
+    pub triangles_before: usize,
+    /// Triangles after.
+    pub triangles_after: usize,
+    /// The largest cost of a collapse made: a bound on the squared distance of a merged vertex from the
+    /// input planes it replaced \[length²\].
+    pub largest_cost: Real,
+}
+
+/// A candidate collapse in the queue: the edge and its ends' versions when it was costed (stale once either
+/// end has changed).
+type Candidate = [u32; 4];
+
+/// Passes of [`simplify`] at most (each queues every edge left; the flagship stent needs 3 or 4).
+const MAX_PASSES: usize = 8;
+
+/// Buckets per halving of the cost in [`CostQueue`].
+const BUCKETS_PER_OCTAVE: Real = 4.0;
+/// Octaves of cost below the limit that [`CostQueue`] tells apart; cheaper collapses share its first bucket.
+const OCTAVES: Real = 48.0;
+
+/// The collapses to make, cheapest first to within a quarter octave: a bucket queue on `log₂(cost / limit)`
+/// (constant-time push and pop where a binary heap of millions of candidates spent a third of the run in its
+/// `pop`). Within a bucket the order is last in, first out. Candidates above the limit are never queued.
+struct CostQueue {
+    limit: Real,
+    buckets: Vec<Vec<Candidate>>,
+    /// No bucket below this one holds a candidate.
+    lowest: usize,
+}
+
+impl CostQueue {
+    fn new(limit: Real) -> Self {
+        CostQueue {
+            limit,
+            buckets: vec![Vec::new(); (OCTAVES * BUCKETS_PER_OCTAVE) as usize + 1],
+            lowest: 0,
+        }
+    }
+
+    /// Queues `candidate` of cost `cost`, unless the cost is above the limit.
+    fn push(&mut self, cost: Real, candidate: Candidate) {
+        if !(cost <= self.limit) {
+            return;
+        }
+        let octaves = if cost > 0.0 {
+            (cost / self.limit).log2() + OCTAVES
+        } else {
+            0.0
+        };
+        let b = ((octaves * BUCKETS_PER_OCTAVE).max(0.0) as usize).min(self.buckets.len() - 1);
+        self.buckets[b].push(candidate);
+        self.lowest = self.lowest.min(b);
+    }
+
+    fn pop(&mut self) -> Option<Candidate> {
+        while self.lowest < self.buckets.len() {
+            if let Some(c) = self.buckets[self.lowest].pop() {
+                return Some(c);
+            }
+            self.lowest += 1;
+        }
+        None
+    }
+}
+
+/// The working mesh of [`simplify`].
+struct Collapser {
+    positions: Vec<Vec3>,
+    quadrics: Vec<Quadric>,
+    triangles: Vec<[u32; 3]>,
+    alive: Vec<bool>,
+    /// The triangles around each vertex (dead ones removed when the vertex changes).
+    around: Vec<Vec<u32>>,
+    removed: Vec<bool>,
+    version: Vec<u32>,
+    queue: CostQueue,
+    triangles_left: usize,
+}
+
+impl Collapser {
+    fn neighbours(&self, v: u32) -> Vec<u32> {
+        let mut n: Vec<u32> = self.around[v as usize]
+            .iter()
+            .filter(|&&t| self.alive[t as usize])
+            .flat_map(|&t| self.triangles[t as usize])
+            .filter(|&w| w != v)
+            .collect();
+        n.sort_unstable();
+        n.dedup();
+        n
+    }
+
+    /// The merged vertex of edge `u`–`v` and its cost.
+    fn target(&self, u: u32, v: u32) -> (Vec3, Real) {
+        let q = self.quadrics[u as usize].add(&self.quadrics[v as usize]);
+        let mid = 0.5 * (self.positions[u as usize] + self.positions[v as usize]);
+        let (g, volume) = self.volume_plane(u, v);
+        let x = q.minimiser(&mid, &g, volume);
+        (x, q.mean_square(&x))
+    }
+
+    /// The plane `g·x = volume` of merged positions `x` that keep the volume the triangles around `u` and `v`
+    /// enclose with the origin: each triangle `(p, q₁, q₂)` counter-clockwise from its moving corner `p`
+    /// encloses `p·(q₁ × q₂)/6`, linear in `p`; the two triangles on the edge disappear.
+    fn volume_plane(&self, u: u32, v: u32) -> (Vec3, Real) {
+        let (mut g, mut volume) = (Vec3::zeros(), 0.0);
+        for &w in &[u, v] {
+            for &t in &self.around[w as usize] {
+                let tri = self.triangles[t as usize];
+                if !self.alive[t as usize] || (w == v && tri.contains(&u)) {
+                    continue;
+                }
+                let p = tri.map(|i| self.positions[i as usize]);
+                if tri.contains(&u) && tri.contains(&v) {
+                    volume += p[0].dot(&p[1].cross(&p[2])) / 6.0;
+                    continue;
+                }
+                let k = tri.iter().position(|&i| i == w).unwrap_or(0);
+                let (q1, q2) = (p[(k + 1) % 3], p[(k + 2) % 3]);
+                let gt = q1.cross(&q2) / 6.0;
+                g += gt;
+                volume += gt.dot(&p[k]);
+            }
+        }
+        (g, volume)
+    }
+
+    fn push(&mut self, u: u32, v: u32) {
+        let (_, cost) = self.target(u, v);
+        let (u, v) = (u.min(v), u.max(v));
+        self.queue.push(
+            cost,
+            [u, v, self.version[u as usize], self.version[v as usize]],
+        );
+    }
+
+    /// Whether moving `u` and `v` to `x` keeps every triangle around them (but the two on the edge) from
+    /// turning over or degenerating.
+    fn keeps_normals(&self, u: u32, v: u32, x: &Vec3) -> bool {
+        for &w in &[u, v] {
+            for &t in &self.around[w as usize] {
+                let tri = self.triangles[t as usize];
+                if !self.alive[t as usize] || (tri.contains(&u) && tri.contains(&v)) {
+                    continue;
+                }
+                let p = tri.map(|i| self.positions[i as usize]);
+                let q = tri.map(|i| {
+                    if i == u || i == v {
+                        *x
+                    } else {
+                        self.positions[i as usize]
+                    }
+                });
+                let before = (p[1] - p[0]).cross(&(p[2] - p[0]));
+                let after = (q[1] - q[0]).cross(&(q[2] - q[0]));
+                let longest = (q[1] - q[0])
+                    .norm_squared()
+                    .max((q[2] - q[1]).norm_squared())
+                    .max((q[0] - q[2]).norm_squared());
+                if after.norm() <= 1e-9 * longest
+                    || before.dot(&after) < MAX_TURN_COS * before.norm() * after.norm()
+                {
+                    return false;
+                }
+            }
+        }
+        true
+    }
+
+    /// Collapses `v` into `u` at `x`.
+    fn collapse(&mut self, u: u32, v: u32, x: Vec3) {
+        let (ui, vi) = (u as usize, v as usize);
+        self.positions[ui] = x;
+        self.quadrics[ui] = self.quadrics[ui].add(&self.quadrics[vi]);
+        let moved = std::mem::take(&mut self.around[vi]);
+        for t in moved {
+            let ti = t as usize;
+            if !self.alive[ti] {
+                continue;
+            }
+            if self.triangles[ti].contains(&u) {
+                self.alive[ti] = false;
+                self.triangles_left -= 1;
+            } else {
+                for i in &mut self.triangles[ti] {
+                    if *i == v {
+                        *i = u;
+                    }
+                }
+                self.around[ui].push(t);
+            }
+        }
+        let alive = &self.alive;
+        self.around[ui].retain(|&t| alive[t as usize]);
+        self.removed[vi] = true;
+        self.version[ui] += 1;
+        for w in self.neighbours(u) {
+            self.push(u, w);
+        }
+    }
+}
+
+/// `mesh` (closed, 2-manifold, consistently oriented) with edges collapsed while every merged vertex stays
+/// within `tolerance` of the input planes it replaces (see the module documentation), and a report.
+pub fn simplify(mesh: &TriangleMesh, tolerance: Real) -> (TriangleMesh, SimplifyReport) {
+    let n = mesh.vertices.len();
+    let mut quadrics = vec![Quadric::zero(); n];
+    let mut around = vec![Vec::new(); n];
+    for (t, tri) in mesh.triangles.iter().enumerate() {
+        let [a, b, c] = tri.map(|i| mesh.vertices[i as usize]);
+        let normal = (b - a).cross(&(c - a));
+        let area = 0.5 * normal.norm();
+        let q = match normal.try_normalize(0.0) {
+            Some(normal) => Quadric::plane(&normal, &a, area),
+            None => Quadric::zero(),
+        };
+        for &i in tri {
+            quadrics[i as usize] = quadrics[i as usize].add(&q);
+            around[i as usize].push(t as u32);
+        }
+    }
+    let mut work = Collapser {
+        positions: mesh.vertices.clone(),
+        quadrics,
+        triangles: mesh.triangles.clone(),
+        alive: vec![true; mesh.triangles.len()],
+        around,
+        removed: vec![false; n],
+        version: vec![0; n],
+        queue: CostQueue::new(tolerance * tolerance),
+        triangles_left: mesh.triangles.len(),
+    };
+    let mut largest_cost: Real = 0.0;
+    // Passes over every edge left, until one collapses nothing: a collapse refused for its neighbourhood is
+    // queued again only when one of its ends changes, which a neighbour's collapse may not do.
+    for _ in 0..MAX_PASSES {
+        // Each edge once: as the directed edge of a triangle that runs from the lower index to the higher.
+        for t in 0..work.triangles.len() {
+            if !work.alive[t] {
+                continue;
+            }
+            let tri = work.triangles[t];
+            for k in 0..3 {
+                let (a, b) = (tri[k], tri[(k + 1) % 3]);
+                if a < b {
+                    work.push(a, b);
+                }
+            }
+        }
+        let before = work.triangles_left;
+        while let Some([u, v, version_u, version_v]) = work.queue.pop() {
+            if work.removed[u as usize]
+                || work.removed[v as usize]
+                || work.version[u as usize] != version_u
+                || work.version[v as usize] != version_v
+            {
+                continue;
+            }
+            // The link condition: the ends share exactly the two vertices opposite the edge.
+            let (nu, nv) = (work.neighbours(u), work.neighbours(v));
+            let shared = nu.iter().filter(|w| nv.binary_search(w).is_ok()).count();
+            if shared != 2 || work.triangles_left <= 4 {
+                continue;
+            }
+            // Costed again: the volume plane moves with the neighbours, which do not change the version.
+            let (x, cost) = work.target(u, v);
+            if cost > work.queue.limit || !work.keeps_normals(u, v, &x) {
+                continue;
+            }
+            largest_cost = largest_cost.max(cost);
+            work.collapse(u, v, x);
+        }
+        if work.triangles_left == before {
+            break;
+        }
+    }
+    // The surviving vertices and triangles, renumbered in their input order.
+    let mut index = vec![u32::MAX; n];
+    let mut out = TriangleMesh::default();
+    for (i, p) in work.positions.iter().enumerate() {
+        if !work.removed[i] {
+            index[i] = out.vertices.len() as u32;
+            out.vertices.push(*p);
+        }
+    }
+    out.triangles = work
+        .triangles
+        .iter()
+        .zip(&work.alive)
+        .filter(|(_, alive)| **alive)
+        .map(|(tri, _)| tri.map(|i| index[i as usize]))
+        .collect();
+    let report = SimplifyReport {
+        triangles_before: mesh.triangles.len(),
+        triangles_after: out.triangles.len(),
+        largest_cost,
+    };
+    (out, report)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::geometry::solid::{Capsule, union_surface};
+
+    #[test]
+    fn a_capsule_keeps_its_shape_and_volume_with_far_fewer_triangles() {
+        // The union mesher's capsule at h = r/8, simplified at a tolerance of r/100. Closed and oriented still;
+        // most triangles gone (a cylinder needs few along its axis; measured 40 824 → 610); the volume kept to
+        // rounding (each collapse keeps it exactly, so 1e-12 relative is rounding over a few thousand
+        // collapses); and the vertices near the capsule: the criterion bounds the root-mean-square distance to
+        // the merged planes by the tolerance, and keeping the volume of chords puts the vertices outside the
+        // surface, measured 2.1 tolerances at most; 3 catches a simplifier that drifts.
+        let r = 0.3;
+        let tolerance = r / 100.0;
+        let capsule = Capsule {
+            a: Vec3::new(0.05, 0.1, 0.2),
+            b: Vec3::new(3.0, 0.9, 0.4),
+            radius: r,
+        };
+        let fine = union_surface(&[capsule], r / 8.0).mesh;
+        let (coarse, report) = simplify(&fine, tolerance);
+        coarse.check_closed().expect("still closed and oriented");
+        assert_eq!(report.triangles_after, coarse.triangles.len());
+        assert!(
+            coarse.triangles.len() * 20 < fine.triangles.len(),
+            "{} of {} triangles left",
+            coarse.triangles.len(),
+            fine.triangles.len()
+        );
+        let (v0, v1) = (fine.volume(), coarse.volume());
+        assert!((v1 / v0 - 1.0).abs() < 1e-12, "{v1} vs {v0}");
+        assert!(report.largest_cost <= tolerance * tolerance);
+        let off = coarse
+            .vertices
+            .iter()
+            .map(|p| capsule.distance(p).abs())
+            .fold(0.0, Real::max);
+        assert!(off < 3.0 * tolerance, "a vertex {off} off the capsule");
+    }
+
+    /// The surface of the unit cube, every face split into `n × n` squares of two triangles each.
+    fn tessellated_cube(n: i64) -> TriangleMesh {
+        let mut mesh = TriangleMesh::default();
+        let mut index = std::collections::HashMap::new();
+        let mut vertex = |p: [i64; 3], mesh: &mut TriangleMesh| -> u32 {
+            *index.entry(p).or_insert_with(|| {
+                mesh.vertices
+                    .push(Vec3::new(p[0] as Real, p[1] as Real, p[2] as Real) / n as Real);
+                (mesh.vertices.len() - 1) as u32
+            })
+        };
+        for axis in 0..3 {
+            let (e1, e2) = ((axis + 1) % 3, (axis + 2) % 3);
+            for side in [0, n] {
+                for i in 0..n {
+                    for j in 0..n {
+                        let corner = |di: i64, dj: i64| {
+                            let mut p = [0; 3];
+                            p[axis] = side;
+                            p[e1] = i + di;
+                            p[e2] = j + dj;
+                            p
+                        };
+                        let q = [corner(0, 0), corner(1, 0), corner(1, 1), corner(0, 1)]
+                            .map(|p| vertex(p, &mut mesh));
+                        // e1 × e2 is the axis: counter-clockwise seen from outside on the far side.
+                        let (a, b) = if side == n {
+                            ([0, 1, 2], [0, 2, 3])
+                        } else {
+                            ([0, 2, 1], [0, 3, 2])
+                        };
+                        mesh.triangles.push(a.map(|k| q[k]));
+                        mesh.triangles.push(b.map(|k| q[k]));
+                    }
+                }
+            }
+        }
+        mesh
+    }
+
+    #[test]
+    fn flat_faces_collapse_for_free_and_keep_the_volume_exactly() {
+        // A cube's faces are planes: collapses inside a face cost nothing, so a zero tolerance removes almost
+        // every vertex (a cube needs 12 triangles; what is left is what the link condition and the fold check
+        // keep), the corners stay put and the volume stays 1 to rounding.
+        let fine = tessellated_cube(8);
+        fine.check_closed().expect("the test cube is closed");
+        assert!((fine.volume() - 1.0).abs() < 1e-12);
+        let (coarse, report) = simplify(&fine, 0.0);
+        coarse.check_closed().expect("still closed");
+        assert_eq!(report.triangles_before, 768);
+        assert!(
+            coarse.triangles.len() < 100,
+            "{} left",
+            coarse.triangles.len()
+        );
+        assert!((coarse.volume() - 1.0).abs() < 1e-12, "{}", coarse.volume());
+        assert_eq!(report.largest_cost, 0.0);
+    }
+}
