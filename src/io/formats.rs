@@ -8,10 +8,10 @@
 //! it with the others.
 
 use super::mesh_format::MeshFormat;
-use super::{obj, stl};
+use super::{obj, stl, threemf};
 
 /// Every snapshot format, in the order a snapshot writes them.
-pub const FORMATS: &[&dyn MeshFormat] = &[&stl::Stl, &obj::Obj];
+pub const FORMATS: &[&dyn MeshFormat] = &[&stl::Stl, &obj::Obj, &threemf::ThreeMf];
 
 /// The formats a run writes by default: binary STL only. STL is what slicers, mesh repair tools and
 /// `stentkit`'s own picture read; OBJ holds the same triangles (with shared vertices, about as large: 6.2 MB

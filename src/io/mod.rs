@@ -21,4 +21,5 @@ pub mod snapshots;
 pub mod state;
 pub mod stl;
 pub mod summary;
+pub mod threemf;
 pub mod vtk;
