@@ -9,13 +9,18 @@
 //! aligned). Its driven nodes then sit where the programme prescribes them at the end of its ramp, which the
 //! command checks and prints. The wires between the nodes follow the generator, not a simulation: the
 //! simulated programmed shape is `stentkit export RUN_DIR --phase programmed`.
+//!
+//! With `--print`, either shape is written as one printable solid ([`crate::post::print`]) instead of one
+//! tube per rod.
 
 use crate::geometry::fit::best_fit_rigid;
 use crate::io::design::{DesignOverrides, SetOverride, load_design_with};
-use crate::io::{obj, stl};
+use crate::io::{obj, stl, threemf};
 use crate::math::{Real, Vec3};
 use crate::model::Model;
 use crate::post::device::reference_device_mesh;
+use crate::post::device::{device_rods, reference_patch_shapes};
+use crate::post::print::{PrintSettings, print_solid};
 use anyhow::{Context, bail};
 use std::path::Path;
 
@@ -28,21 +33,35 @@ pub enum State {
     Temporary,
 }
 
-/// Writes the shape `state` of the design (with the `--set` overrides `sets`) to `output` (`.stl` or `.obj`).
+/// How finely `mesh` draws the device.
+#[derive(Debug, Clone, Copy)]
+pub struct Resolution {
+    /// Vertices around each tube.
+    pub segments: usize,
+    /// Samples along each patch per control point.
+    pub samples: usize,
+    /// One print solid instead of tubes, and how fine.
+    pub print: Option<PrintSettings>,
+}
+
+/// Writes the shape `state` of the design (with the `--set` overrides `sets`) to `output` (`.stl`, `.obj` or
+/// `.3mf`).
 pub fn run(
     design: &Path,
     output: &Path,
     state: State,
-    segments: usize,
-    samples: usize,
+    resolution: Resolution,
     sets: Vec<SetOverride>,
 ) -> anyhow::Result<()> {
     let extension = output
         .extension()
         .and_then(|e| e.to_str())
         .map(str::to_ascii_lowercase);
-    if !matches!(extension.as_deref(), Some("stl" | "obj")) {
-        bail!("{}: the output must end in .stl or .obj", output.display());
+    if !matches!(extension.as_deref(), Some("stl" | "obj" | "3mf" | "csv")) {
+        bail!(
+            "{}: the output must end in .stl, .obj, .3mf or .csv",
+            output.display()
+        );
     }
     let permanent = load_design_with(design, &DesignOverrides::sets(sets.clone()))?;
     let (model, placed) = match state {
@@ -64,16 +83,36 @@ pub fn run(
             (temporary.model, Some(placement))
         }
     };
-    let mut mesh = reference_device_mesh(&model, segments, samples)?;
-    if let Some((r, t, _)) = placed {
+    let shapes = || {
+        reference_patch_shapes(&model, resolution.samples)
+            .map_err(|(k, e)| anyhow::anyhow!("patch `{}`: {e}", model.patches[k].name))
+    };
+    if extension.as_deref() == Some("csv") {
+        return write_centrelines(&model, &shapes()?, placed.map(|(r, t, _)| (r, t)), output);
+    }
+    let (mut mesh, solid) = match resolution.print {
+        None => (
+            reference_device_mesh(&model, resolution.segments, resolution.samples)?,
+            None,
+        ),
+        Some(settings) => {
+            let shapes = shapes()?;
+            // The solid stands upright whatever the placement: a rigid motion first would change nothing.
+            let solid = print_solid(&model, &shapes, &settings);
+            let text = solid.describe(model.units.length());
+            (solid.mesh, Some(text))
+        }
+    };
+    if let (Some((r, t, _)), None) = (placed, &solid) {
         for v in &mut mesh.vertices {
             *v = r * *v + t;
         }
     }
     mesh.check_closed()
-        .context("the tube surface is not closed (please report this)")?;
+        .context("the surface is not closed (please report this)")?;
     let header = format!(
-        "{} {} shape, units {} (lengths in {})",
+        "{}{} {} shape, units {} (lengths in {})",
+        if solid.is_some() { "print solid: " } else { "" },
         model.name,
         match state {
             State::Permanent => "reference (permanent)",
@@ -84,6 +123,7 @@ pub fn run(
     );
     match extension.as_deref() {
         Some("stl") => stl::write_stl_with_header(output, &mesh, &header)?,
+        Some("3mf") => threemf::write_3mf(output, &mesh, model.units, &header)?,
         _ => obj::write_obj(output, &mesh, &header)?,
     }
     println!(
@@ -101,12 +141,46 @@ pub fn run(
         mesh.volume(),
         model.units.length()
     );
+    if let Some(text) = &solid {
+        println!("{text}");
+    }
     if let Some((_, _, off)) = placed {
         println!(
             "temporary shape: the driven nodes are within {off:.3e} {} of the programme's targets",
             model.units.length()
         );
     }
+    Ok(())
+}
+
+/// Writes the full device's wires in the shape `shapes` as centrelines to `output` (CSV: `rod,point,x,y,z,
+/// radius`, one row per sample; rods numbered in the order of the model's patches and their mirror copies),
+/// moved by `motion`: the device for CAD tools, and the input of the independent check of the print solid's
+/// volume (`scripts/check_print.py`).
+pub(super) fn write_centrelines(
+    model: &Model,
+    shapes: &[crate::solver::shape::PatchShape],
+    motion: Option<(crate::math::Mat3, Vec3)>,
+    output: &Path,
+) -> anyhow::Result<()> {
+    use std::fmt::Write as _;
+    let mut text = format!(
+        "# {}: wire centrelines, lengths in {}\nrod,point,x,y,z,radius\n",
+        model.name,
+        model.units.length()
+    );
+    let mut rods = 0;
+    for (rod, (patch, line)) in device_rods(model, shapes).enumerate() {
+        let radius = 0.5 * model.sections[model.patches[patch].section].diameter();
+        for (k, p) in line.iter().enumerate() {
+            let p = motion.map_or(*p, |(r, t)| r * p + t);
+            let _ = writeln!(text, "{rod},{k},{},{},{},{radius}", p.x, p.y, p.z);
+        }
+        rods += 1;
+    }
+    crate::io::stl::write_bytes_atomically(output, text.as_bytes())
+        .with_context(|| format!("cannot write {}", output.display()))?;
+    println!("wrote {} ({rods} rods)", output.display());
     Ok(())
 }
 

@@ -107,6 +107,8 @@ pub enum Command {
     /// the first step at or after that time, which is the run's own state.
     ///
     /// Example: stentkit export runs/straight_stent --phase released -o released.stl
+    ///
+    /// Example: stentkit export runs/straight_stent --phase final --print -o final.3mf
     Export {
         /// The run folder.
         run_dir: PathBuf,
@@ -116,7 +118,8 @@ pub enum Command {
         /// An event of the cycle: initial, programmed, fixed, released, final.
         #[arg(long)]
         phase: Option<String>,
-        /// Output file, `.stl` or `.obj`.
+        /// Output file, `.stl`, `.obj` or `.3mf`; or `.csv` for the wires' centrelines (rod, point, x, y, z,
+        /// radius).
         #[arg(short, long)]
         output: PathBuf,
         /// The design file, when it is no longer where the run found it (summary.json's design_file).
@@ -128,6 +131,8 @@ pub enum Command {
         /// Rings along each patch, about.
         #[arg(long, default_value_t = 41)]
         rings: usize,
+        #[command(flatten)]
+        print: PrintArgs,
     },
     /// Find the cheapest degree p, points per patch n and time-error tolerance whose results (every probe, Δr,
     /// the recovery ratios) stay within --tol of a finer run over the design's whole schedule: the space error
@@ -208,15 +213,19 @@ pub enum Command {
         width: u32,
     },
     /// Write the reference (permanent) shape as a closed tube surface, or with `--state temporary` the shape
-    /// the programme drives it to: binary STL or OBJ by extension.
+    /// the programme drives it to: binary STL, OBJ or 3MF by extension. With `--print`, one solid for a
+    /// printer instead: the union of the wires, joints filled, standing on its axis on z = 0.
     ///
     /// Example: stentkit mesh designs/circular_arch.yaml -o arch.stl
+    ///
+    /// Example: stentkit mesh designs/straight_stent.yaml --print -o stent.3mf
     ///
     /// Example: stentkit mesh designs/curved_stent.yaml --state temporary -o crimped.stl
     Mesh {
         /// The design file (YAML).
         design: PathBuf,
-        /// Output file, `.stl` or `.obj`.
+        /// Output file, `.stl`, `.obj` or `.3mf`; or `.csv` for the wires' centrelines (rod, point, x, y, z,
+        /// radius).
         #[arg(short, long)]
         output: PathBuf,
         /// Which shape: the permanent one (printed), or the temporary one the programme drives it to (generated
@@ -234,7 +243,36 @@ pub enum Command {
         /// and checked as if written in the file.
         #[arg(long = "set", value_name = "PATH=VALUE")]
         set: Vec<SetOverride>,
+        #[command(flatten)]
+        print: PrintArgs,
     },
+}
+
+/// The print-solid options of `mesh` and `export`.
+#[derive(Debug, Clone, Copy, clap::Args)]
+pub struct PrintArgs {
+    /// Write one closed, manifold solid for a printer (the union of the wires, joints filled, simplified,
+    /// standing on its axis on z = 0) instead of one tube per rod.
+    #[arg(long)]
+    pub print: bool,
+    /// Grid spacing of the print solid, in the design's length unit (default: a fifth of the thinnest wire's
+    /// radius).
+    #[arg(long, requires = "print")]
+    pub grid: Option<f64>,
+    /// How far the print solid's simplification may move the surface, in the design's length unit (default: a
+    /// fiftieth of the thinnest wire's radius).
+    #[arg(long, requires = "print")]
+    pub deviation: Option<f64>,
+}
+
+impl PrintArgs {
+    /// The print settings, if `--print` was given.
+    pub fn settings(self) -> Option<crate::post::print::PrintSettings> {
+        self.print.then_some(crate::post::print::PrintSettings {
+            spacing: self.grid,
+            tolerance: self.deviation,
+        })
+    }
 }
 
 /// `stentkit sweep`: a sweep to run, or one of its subcommands.
@@ -519,6 +557,7 @@ pub fn main() -> ExitCode {
             design,
             segments,
             rings,
+            print,
         } => export::run(
             &run_dir,
             &export::ExportOptions {
@@ -530,6 +569,7 @@ pub fn main() -> ExitCode {
                 design,
                 segments,
                 rings,
+                print: print.settings(),
             },
         ),
         Command::Tune {
@@ -596,7 +636,18 @@ pub fn main() -> ExitCode {
             segments,
             samples,
             set,
-        } => mesh::run(&design, &output, state, segments, samples, set),
+            print,
+        } => mesh::run(
+            &design,
+            &output,
+            state,
+            mesh::Resolution {
+                segments,
+                samples,
+                print: print.settings(),
+            },
+            set,
+        ),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

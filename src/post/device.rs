@@ -229,19 +229,27 @@ pub fn reflect(model: &Model, planes: &[usize], point: Vec3) -> Vec3 {
 /// The centrelines of the full device: every patch's points and their mirror images (a quarter model gives
 /// four polylines per patch off the planes, two for a patch lying in one).
 pub fn device_centrelines(model: &Model, shapes: &[PatchShape]) -> Vec<Vec<Vec3>> {
-    shapes
-        .iter()
-        .enumerate()
-        .flat_map(|(k, shape)| {
-            patch_copies(model, k).into_iter().map(move |planes| {
+    device_rods(model, shapes).map(|(_, line)| line).collect()
+}
+
+/// The rods of the full device: each patch's points in `shapes` and their mirror images, with the index of
+/// the patch each copies ([`device_centrelines`] without the indices).
+pub fn device_rods<'a>(
+    model: &'a Model,
+    shapes: &'a [PatchShape],
+) -> impl Iterator<Item = (usize, Vec<Vec3>)> + 'a {
+    shapes.iter().enumerate().flat_map(move |(k, shape)| {
+        patch_copies(model, k).into_iter().map(move |planes| {
+            (
+                k,
                 shape
                     .points
                     .iter()
                     .map(|&x| reflect(model, &planes, x))
-                    .collect()
-            })
+                    .collect(),
+            )
         })
-        .collect()
+    })
 }
 
 #[cfg(test)]

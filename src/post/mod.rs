@@ -12,4 +12,5 @@
 
 pub mod device;
 pub mod path;
+pub mod print;
 pub mod vessel;

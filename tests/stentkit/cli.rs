@@ -201,7 +201,7 @@ fn mesh_refuses_other_extensions() {
         assert_no_panic(&out);
         assert!(!out.status.success(), "{name} accepted");
         assert!(
-            text(&out.stderr).contains(".stl or .obj"),
+            text(&out.stderr).contains(".stl, .obj, .3mf or .csv"),
             "{}",
             text(&out.stderr)
         );

@@ -16,6 +16,7 @@ mod materials;
 mod mesh;
 mod outputs;
 mod overrides;
+mod print;
 mod reliability;
 mod resume;
 mod run_folder;

@@ -1,0 +1,173 @@
+#!/usr/bin/env python3
+"""Independent checks of stentkit's print solids (issue 19, item 1), run by .ci/run on what
+tests/stentkit/print.rs leaves in $STENTKIT_TEST_OUTPUTS/print.
+
+For every `<name>_print.stl` / `<name>_print.3mf` there:
+
+1. trimesh reads it: one body, watertight, consistently wound, and, for 3MF, the unit the file states.
+2. Its volume is within 1 % of the union of the device's tubes, computed here without stentkit's mesher:
+   `<name>_centrelines.csv` (the same wires, `stentkit mesh -o ….csv`) is swept into one closed tube per rod
+   (128 segments around, rings mitred in the bisector planes at the polyline's vertices, so each piece is a
+   cylinder of its segment cut by oblique planes), a ball of the wire's radius is put on each rod end (the
+   joints filled, as the print solid fills them), and Manifold (manifold3d, exact booleans on meshes) unites
+   them all: the sum of the tubes minus their overlaps. A 128-gon keeps 99.96 % of the circle's area, so the
+   reference is that close.
+3. Debian's PrusaSlicer slices it to G-code (`--export-gcode`) with a profile for wires this thin (0.25 mm
+   nozzle, 0.1 mm layers: a 0.6 mm wire is marginal for the 0.4 mm default, whose perimeters drop some of the
+   curved stent's layers as "negligibly small extrusions"), and prints no repair message, warning or error.
+
+Usage: check_print.py FOLDER...  Exits non-zero on any failure, naming it.
+"""
+
+import csv
+import subprocess
+import sys
+from collections import defaultdict
+from pathlib import Path
+
+import manifold3d
+import numpy as np
+import trimesh
+
+SEGMENTS = 128
+SLICER_PROFILE = [
+    "--nozzle-diameter", "0.25",
+    "--layer-height", "0.1",
+    "--first-layer-height", "0.15",
+]
+FORBIDDEN = ("repair", "warning", "error", "empty layer", "printable", "manifold")
+
+
+def rods(path):
+    """{rod: (points (n, 3), radius)} from a centreline CSV."""
+    points, radius = defaultdict(list), {}
+    with open(path) as f:
+        rows = csv.DictReader(line for line in f if not line.startswith("#"))
+        for row in rows:
+            rod = int(row["rod"])
+            points[rod].append([float(row["x"]), float(row["y"]), float(row["z"])])
+            radius[rod] = float(row["radius"])
+    return {k: (np.array(v), radius[k]) for k, v in points.items()}
+
+
+def perpendicular(t):
+    a = np.array([1.0, 0.0, 0.0]) if abs(t[0]) < 0.9 else np.array([0.0, 1.0, 0.0])
+    u = a - t * np.dot(a, t)
+    return u / np.linalg.norm(u)
+
+
+def mitred_tube(points, r):
+    """A closed tube around the polyline `points`: rings of SEGMENTS vertices in the planes perpendicular to
+    the ends and bisecting each interior vertex, on the cylinders of the adjacent segments (a parallel-
+    transported frame), and a flat cap at each end."""
+    keep = np.concatenate([[True], np.linalg.norm(np.diff(points, axis=0), axis=1) > 1e-12])
+    p = points[keep]
+    t = np.diff(p, axis=0)
+    t /= np.linalg.norm(t, axis=1)[:, None]
+    n = len(p)
+    phi = 2 * np.pi * np.arange(SEGMENTS) / SEGMENTS
+    u = perpendicular(t[0])
+    rings = []
+    for i in range(n):
+        t_in = t[max(i - 1, 0)]
+        t_out = t[min(i, n - 2)]
+        if i > 0:
+            # Parallel transport of u from the incoming segment's direction to the outgoing one's.
+            axis = np.cross(t[i - 1], t_out)
+            s, c = np.linalg.norm(axis), np.dot(t[i - 1], t_out)
+            if s > 1e-15:
+                k = axis / s
+                u = u * c + np.cross(k, u) * s + k * np.dot(k, u) * (1 - c)
+            u -= t_out * np.dot(u, t_out)
+            u /= np.linalg.norm(u)
+        # A frame of the incoming segment (u transported back to it) gives points on its cylinder.
+        w_in = u - t_in * np.dot(u, t_in)
+        w_in /= np.linalg.norm(w_in)
+        v_in = np.cross(t_in, w_in)
+        m = t_in + t_out
+        m /= np.linalg.norm(m)
+        d = r * (np.cos(phi)[:, None] * w_in + np.sin(phi)[:, None] * v_in)
+        # Slide along the segment's axis onto the bisecting plane.
+        s_along = -(d @ m) / np.dot(t_in, m)
+        rings.append(p[i] + d + s_along[:, None] * t_in)
+    vertices = np.vstack(rings + [p[0][None, :], p[-1][None, :]])
+    j = np.arange(SEGMENTS)
+    k = (j + 1) % SEGMENTS
+    a = (np.arange(n - 1) * SEGMENTS)[:, None]
+    b = a + SEGMENTS
+    sides = np.concatenate([
+        np.stack([a + j, a + k, b + k], axis=-1).reshape(-1, 3),
+        np.stack([a + j, b + k, b + j], axis=-1).reshape(-1, 3),
+    ])
+    start, end, last = n * SEGMENTS, n * SEGMENTS + 1, (n - 1) * SEGMENTS
+    caps = np.concatenate([
+        np.stack([np.full(SEGMENTS, start), k, j], axis=-1),
+        np.stack([np.full(SEGMENTS, end), last + j, last + k], axis=-1),
+    ])
+    faces = np.concatenate([sides, caps])
+    mesh = trimesh.Trimesh(vertices, faces, process=False)
+    if mesh.volume < 0:
+        faces = faces[:, ::-1]
+    return manifold3d.Manifold(
+        manifold3d.Mesh(vert_properties=np.asarray(vertices, dtype=np.float32),
+                        tri_verts=np.asarray(faces, dtype=np.uint32)))
+
+
+def union_volume(centrelines):
+    parts = []
+    for points, r in rods(centrelines).values():
+        tube = mitred_tube(points, r)
+        if tube.status() != manifold3d.Error.NoError:
+            raise RuntimeError(f"a reference tube is not a manifold: {tube.status()}")
+        parts.append(tube)
+        for end in (points[0], points[-1]):
+            parts.append(manifold3d.Manifold.sphere(r, SEGMENTS).translate(tuple(end)))
+    union = manifold3d.Manifold.batch_boolean(parts, manifold3d.OpType.Add)
+    return union.volume(), len(parts)
+
+
+def main():
+    failures = 0
+    solids = []
+    for folder in map(Path, sys.argv[1:]):
+        found = sorted(folder.glob("*_print.stl")) + sorted(folder.glob("*_print.3mf"))
+        if not found:
+            print(f"FAIL  no print solids in {folder}")
+            failures += 1
+        solids += found
+
+    def check(ok, what):
+        nonlocal failures
+        print(("ok    " if ok else "FAIL  ") + what)
+        failures += not ok
+
+    for solid in solids:
+        name = solid.name.rsplit("_print.", 1)[0]
+        mesh = trimesh.load(solid, force="mesh")
+        check(mesh.is_watertight and mesh.is_winding_consistent,
+              f"{solid.name}: watertight and consistently wound")
+        check(mesh.body_count == 1, f"{solid.name}: one body (trimesh counts {mesh.body_count})")
+        if solid.suffix == ".3mf":
+            units = getattr(mesh, "units", None)
+            check(units in ("millimeter", "millimeters", "mm"), f"{solid.name}: units in the file ({units})")
+        reference, parts = union_volume(solid.parent / f"{name}_centrelines.csv")
+        error = mesh.volume / reference - 1
+        check(abs(error) < 0.01,
+              f"{solid.name}: volume {mesh.volume:.4f} against the union of {parts} tubes and balls "
+              f"{reference:.4f} ({error:+.3%})")
+        gcode = solid.parent / f"{solid.stem}.gcode"
+        run = subprocess.run(
+            ["prusa-slicer", "--export-gcode", str(solid), *SLICER_PROFILE, "--output", str(gcode)],
+            capture_output=True, text=True)
+        said = [line for line in (run.stdout + run.stderr).splitlines()
+                if "[trace]" not in line and any(w in line.lower() for w in FORBIDDEN)]
+        check(run.returncode == 0 and gcode.exists() and gcode.stat().st_size > 0,
+              f"{solid.name}: prusa-slicer wrote {gcode.name} (exit {run.returncode})")
+        check(not said, f"{solid.name}: prusa-slicer said nothing of repairs, warnings or errors"
+              + ("" if not said else ": " + " | ".join(said[:5])))
+    print(f"check_print: {failures} failed")
+    return 1 if failures else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
