@@ -23,7 +23,7 @@ use crate::io::summary::model_fingerprint_text;
 use crate::math::Real;
 use crate::model::cycle::Phase;
 use crate::post::device::current_device_shapes;
-use crate::post::print::{PrintSettings, print_solid};
+use crate::post::print::PrintSettings;
 use crate::solver::Simulation;
 use anyhow::Context;
 use std::path::{Path, PathBuf};
@@ -166,11 +166,11 @@ pub fn run(run_dir: &Path, options: &ExportOptions) -> anyhow::Result<()> {
     let mesh = match &options.print {
         None => current_device_mesh(&sim, options.segments, options.rings)
             .map_err(|e| anyhow::anyhow!("patch `{}`: {}", model.patches[e.rod].name, e.source))?,
-        Some(settings) => {
-            let solid = print_solid(model, &current_device_shapes(&sim, options.rings), settings);
-            println!("{}", solid.describe(model.units.length()));
-            solid.mesh
-        }
+        Some(settings) => super::mesh::print_solid_mesh(
+            model,
+            &current_device_shapes(&sim, options.rings),
+            settings,
+        ),
     };
     let time = sim.time();
     let state = SnapshotState { model, step, time };

@@ -90,20 +90,13 @@ pub fn run(
     if extension.as_deref() == Some("csv") {
         return write_centrelines(&model, &shapes()?, placed.map(|(r, t, _)| (r, t)), output);
     }
-    let (mut mesh, solid) = match resolution.print {
-        None => (
-            reference_device_mesh(&model, resolution.segments, resolution.samples)?,
-            None,
-        ),
-        Some(settings) => {
-            let shapes = shapes()?;
-            // The solid stands upright whatever the placement: a rigid motion first would change nothing.
-            let solid = print_solid(&model, &shapes, &settings);
-            let text = solid.describe(model.units.length());
-            (solid.mesh, Some(text))
-        }
+    let solid = resolution.print.is_some();
+    let mut mesh = match resolution.print {
+        None => reference_device_mesh(&model, resolution.segments, resolution.samples)?,
+        // The solid stands upright whatever the placement: a rigid motion first would change nothing.
+        Some(settings) => print_solid_mesh(&model, &shapes()?, &settings),
     };
-    if let (Some((r, t, _)), None) = (placed, &solid) {
+    if let (Some((r, t, _)), false) = (placed, solid) {
         for v in &mut mesh.vertices {
             *v = r * *v + t;
         }
@@ -112,7 +105,7 @@ pub fn run(
         .context("the surface is not closed (please report this)")?;
     let header = format!(
         "{}{} {} shape, units {} (lengths in {})",
-        if solid.is_some() { "print solid: " } else { "" },
+        if solid { "print solid: " } else { "" },
         model.name,
         match state {
             State::Permanent => "reference (permanent)",
@@ -141,9 +134,6 @@ pub fn run(
         mesh.volume(),
         model.units.length()
     );
-    if let Some(text) = &solid {
-        println!("{text}");
-    }
     if let Some((_, _, off)) = placed {
         println!(
             "temporary shape: the driven nodes are within {off:.3e} {} of the programme's targets",
@@ -151,6 +141,19 @@ pub fn run(
         );
     }
     Ok(())
+}
+
+/// The print solid of `model` in the shape `shapes` ([`print_solid`]), saying that it is being made (it takes
+/// about 20 s for the paper's stents) and how it was made.
+pub(super) fn print_solid_mesh(
+    model: &Model,
+    shapes: &[crate::solver::shape::PatchShape],
+    settings: &PrintSettings,
+) -> crate::geometry::mesh::TriangleMesh {
+    eprintln!("making the print solid (about 20 s for the paper's stents)");
+    let solid = print_solid(model, shapes, settings);
+    println!("{}", solid.describe(model.units.length()));
+    solid.mesh
 }
 
 /// Writes the full device's wires in the shape `shapes` as centrelines to `output` (CSV: `rod,point,x,y,z,

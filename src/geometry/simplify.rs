@@ -5,7 +5,7 @@
 //!
 //! **Method.** Every vertex carries the quadric `Q(x) = Σ Aᵢ (nᵢ·x + dᵢ)²` of the planes of the input
 //! triangles around it, weighted by their areas, so that `Q / Σ Aᵢ` is the mean squared distance to them.
-//! Edges are collapsed cheapest first (to within a quarter octave of cost, [`CostQueue`]): the two ends merge
+//! Edges are collapsed cheapest first (to within a quarter octave of cost, in a bucket queue): the two ends merge
 //! into one vertex at the point of least summed quadric among those that keep the enclosed volume (Lindstrom
 //! & Turk 1998: the volume is linear in the merged vertex's position), and the merged vertex carries the sum.
 //! The volume is kept exactly, collapse by collapse: a surface whose vertices lie on a convex shape (chords
@@ -15,13 +15,14 @@
 //! - the link condition holds (the ends share exactly the two neighbours of the edge's triangles; Dey et al.,
 //!   "Topology preserving edge contraction", 1999): the surface stays a 2-manifold of the same topology;
 //! - no triangle around it turns by more than [`MAX_TURN_COS`]'s angle or becomes degenerate: no fold-over,
-//!   so, with `tolerance` far below the gaps between separate parts of the surface, no self-intersection.
+//!   so, with `tolerance` far below the gaps between separate parts of the surface, no self-intersection
+//!   (the print tests look for crossing triangles in the stents' solids and find none).
 //!
 //! Orientation is kept: a collapse only renames a vertex in the surviving triangles. Passes over all edges
 //! repeat until one collapses nothing (a refused collapse is queued again only when an end of it changes).
 //!
-//! Measured: the straight stent's union contour at a 0.1 mm grid, 2.02 million triangles, becomes 149 000
-//! within 6 µm in about 17 s.
+//! Measured: the straight stent's union contour at a 0.1 mm grid, 2.02 million triangles, becomes 152 836
+//! within 6 µm in about 16 s.
 
 use super::mesh::TriangleMesh;
 use crate::math::{Mat3, Real, Vec3};
@@ -85,16 +86,16 @@ impl Quadric {
     /// every point is as good and `start` is kept) and shortens the others by 0.1 % at most.
     fn minimiser(&self, start: &Vec3, g: &Vec3, volume: Real) -> Vec3 {
         let epsilon = 1e-3 * self.a.trace() / 3.0;
-        let Some(inverse) = (self.a + Mat3::identity() * epsilon).try_inverse() else {
-            return *start;
-        };
         if epsilon <= 0.0 {
             return *start;
         }
+        let Some(inverse) = (self.a + Mat3::identity() * epsilon).try_inverse() else {
+            return *start;
+        };
         let free = -(inverse * (self.a * start + self.b));
         let towards = inverse * g;
         let gg = g.dot(&towards);
-        if gg <= 1e-12 * g.norm_squared() / epsilon.max(Real::MIN_POSITIVE) || gg <= 0.0 {
+        if gg <= 0.0 {
             return start + free;
         }
         // δ = δ₀ + M⁻¹ g μ with μ chosen so that g·(start + δ) = volume.

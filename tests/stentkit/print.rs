@@ -115,9 +115,13 @@ fn crossing_pairs(mesh: &stentkit::geometry::mesh::TriangleMesh, cell: f64) -> u
     crossing.len()
 }
 
-/// The volume a `--print` command reported for its solid.
+/// The volume a `--print` command reported (`… volume 3.430483e2 mm³ …` on its `wrote` line).
 fn reported_volume(stdout: &str) -> f64 {
-    let words: Vec<&str> = stdout.split_whitespace().collect();
+    let line = stdout
+        .lines()
+        .find(|l| l.starts_with("wrote"))
+        .expect("a wrote line");
+    let words: Vec<&str> = line.split_whitespace().collect();
     let at = words
         .iter()
         .position(|w| *w == "volume")
