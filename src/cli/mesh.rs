@@ -18,8 +18,7 @@ use crate::io::design::{DesignOverrides, SetOverride, load_design_with};
 use crate::io::{obj, stl, threemf};
 use crate::math::{Real, Vec3};
 use crate::model::Model;
-use crate::post::device::reference_device_mesh;
-use crate::post::device::{device_rods, reference_patch_shapes};
+use crate::post::device::{device_rods, reference_device_mesh, reference_patch_shapes};
 use crate::post::print::{PrintSettings, print_solid};
 use anyhow::{Context, bail};
 use std::path::Path;
@@ -174,7 +173,7 @@ pub(super) fn write_centrelines(
     );
     let mut rods = 0;
     for (rod, (patch, line)) in device_rods(model, shapes).enumerate() {
-        let radius = 0.5 * model.sections[model.patches[patch].section].diameter();
+        let radius = model.wire_radius(patch);
         for (k, p) in line.iter().enumerate() {
             let p = motion.map_or(*p, |(r, t)| r * p + t);
             let _ = writeln!(text, "{rod},{k},{},{},{},{radius}", p.x, p.y, p.z);

@@ -255,7 +255,7 @@ pub struct PrintArgs {
     /// standing on its axis on z = 0) instead of one tube per rod.
     #[arg(long)]
     pub print: bool,
-    /// Grid spacing of the print solid, in the design's length unit (default: a fifth of the thinnest wire's
+    /// Grid spacing of the print solid, in the design's length unit (default: a third of the thinnest wire's
     /// radius).
     #[arg(long, requires = "print")]
     pub grid: Option<f64>,

@@ -111,8 +111,8 @@ pub struct SimplifyReport {
     pub triangles_before: usize,
     /// Triangles after.
     pub triangles_after: usize,
-    /// The largest cost of a collapse made: a bound on the squared distance of a merged vertex from the
-    /// input planes it replaced \[length²\].
+    /// The largest cost of a collapse made: the mean squared distance of a merged vertex from the input
+    /// planes it replaced, weighted by their areas \[length²\].
     pub largest_cost: Real,
 }
 
@@ -185,19 +185,24 @@ struct Collapser {
     version: Vec<u32>,
     queue: CostQueue,
     triangles_left: usize,
+    /// A buffer for the neighbours of a collapsed vertex.
+    scratch: Vec<u32>,
 }
 
 impl Collapser {
-    fn neighbours(&self, v: u32) -> Vec<u32> {
-        let mut n: Vec<u32> = self.around[v as usize]
-            .iter()
-            .filter(|&&t| self.alive[t as usize])
-            .flat_map(|&t| self.triangles[t as usize])
-            .filter(|&w| w != v)
-            .collect();
-        n.sort_unstable();
-        n.dedup();
-        n
+    /// The vertices joined to `v` by an edge, sorted, into `out` (a buffer reused across calls: this runs
+    /// for every candidate popped and every collapse).
+    fn neighbours(&self, v: u32, out: &mut Vec<u32>) {
+        out.clear();
+        out.extend(
+            self.around[v as usize]
+                .iter()
+                .filter(|&&t| self.alive[t as usize])
+                .flat_map(|&t| self.triangles[t as usize])
+                .filter(|&w| w != v),
+        );
+        out.sort_unstable();
+        out.dedup();
     }
 
     /// The merged vertex of edge `u`–`v` and its cost.
@@ -304,9 +309,12 @@ impl Collapser {
         self.around[ui].retain(|&t| alive[t as usize]);
         self.removed[vi] = true;
         self.version[ui] += 1;
-        for w in self.neighbours(u) {
+        let mut around_u = std::mem::take(&mut self.scratch);
+        self.neighbours(u, &mut around_u);
+        for &w in &around_u {
             self.push(u, w);
         }
+        self.scratch = around_u;
     }
 }
 
@@ -339,7 +347,9 @@ pub fn simplify(mesh: &TriangleMesh, tolerance: Real) -> (TriangleMesh, Simplify
         version: vec![0; n],
         queue: CostQueue::new(tolerance * tolerance),
         triangles_left: mesh.triangles.len(),
+        scratch: Vec::new(),
     };
+    let (mut nu, mut nv) = (Vec::new(), Vec::new());
     let mut largest_cost: Real = 0.0;
     // Passes over every edge left, until one collapses nothing: a collapse refused for its neighbourhood is
     // queued again only when one of its ends changes, which a neighbour's collapse may not do.
@@ -367,7 +377,8 @@ pub fn simplify(mesh: &TriangleMesh, tolerance: Real) -> (TriangleMesh, Simplify
                 continue;
             }
             // The link condition: the ends share exactly the two vertices opposite the edge.
-            let (nu, nv) = (work.neighbours(u), work.neighbours(v));
+            work.neighbours(u, &mut nu);
+            work.neighbours(v, &mut nv);
             let shared = nu.iter().filter(|w| nv.binary_search(w).is_ok()).count();
             if shared != 2 || work.triangles_left <= 4 {
                 continue;
@@ -491,9 +502,10 @@ mod tests {
 
     #[test]
     fn flat_faces_collapse_for_free_and_keep_the_volume_exactly() {
-        // A cube's faces are planes: collapses inside a face cost nothing, so a zero tolerance removes almost
-        // every vertex (a cube needs 12 triangles; what is left is what the link condition and the fold check
-        // keep), the corners stay put and the volume stays 1 to rounding.
+        // A cube's faces are planes: collapses inside a face cost nothing, so a zero tolerance removes most
+        // vertices (a cube needs 12 triangles; what is left is what the link condition and the fold check keep:
+        // measured 66 of 768; a single pass over the edges left 168, which the bound of 100 catches), the
+        // corners stay put (the bounding box is the unit cube to rounding) and the volume stays 1 to rounding.
         let fine = tessellated_cube(8);
         fine.check_closed().expect("the test cube is closed");
         assert!((fine.volume() - 1.0).abs() < 1e-12);
@@ -506,6 +518,8 @@ mod tests {
             coarse.triangles.len()
         );
         assert!((coarse.volume() - 1.0).abs() < 1e-12, "{}", coarse.volume());
+        let (lo, hi) = coarse.bounding_box().expect("not empty");
+        assert!(lo.norm() < 1e-12 && (hi - Vec3::new(1.0, 1.0, 1.0)).norm() < 1e-12);
         assert_eq!(report.largest_cost, 0.0);
     }
 }

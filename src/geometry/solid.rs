@@ -137,8 +137,8 @@ impl UnionSurface {
 
 /// Moves every vertex of the closed surface `mesh` along its normal (the area-weighted mean of its triangles')
 /// by the one distance that makes the enclosed volume `volume` (rounds of the volume's shortfall over the
-/// area, until it is below `1e-9` of the volume; the vertex normals make each round take up about 98 % of it). Meant for offsets far below the triangles' size, such as
-/// restoring the second-order volume of a contour ([`UnionSurface::volume_second_order`]): a uniform offset
+/// area, until it is below `1e-9` of the volume; the vertex normals make each round take up about 98 % of
+/// it). Meant for offsets far below the triangles' size, such as restoring the second-order volume of a contour ([`UnionSurface::volume_second_order`]): a uniform offset
 /// smaller than every feature of the surface keeps it closed, manifold and free of self-intersections.
 /// Returns the offset made (outward positive).
 pub fn offset_to_volume(mesh: &mut TriangleMesh, volume: Real) -> Real {
@@ -278,27 +278,24 @@ pub fn union_surface(capsules: &[Capsule], spacing: Real) -> UnionSurface {
             ]
         };
         for tet in TETRAHEDRA {
-            let points = tet.map(corner);
-            let inside: Vec<Point> = points.iter().copied().filter(|p| value(p) < 0.0).collect();
-            let outside: Vec<Point> = points.iter().copied().filter(|p| value(p) >= 0.0).collect();
-            let polygon: Vec<u32> = match (inside.len(), outside.len()) {
-                (1, 3) => outside
-                    .iter()
-                    .map(|&q| crossing(inside[0], q, &mut mesh, &mut normals))
-                    .collect(),
-                (3, 1) => inside
-                    .iter()
-                    .map(|&p| crossing(p, outside[0], &mut mesh, &mut normals))
-                    .collect(),
-                // A quadrilateral, its corners in cyclic order.
-                (2, 2) => vec![
-                    crossing(inside[0], outside[0], &mut mesh, &mut normals),
-                    crossing(inside[0], outside[1], &mut mesh, &mut normals),
-                    crossing(inside[1], outside[1], &mut mesh, &mut normals),
-                    crossing(inside[1], outside[0], &mut mesh, &mut normals),
-                ],
+            // The corners inside first, each side in the tetrahedron's order (no allocation: this runs six
+            // times per cube of the band).
+            let mut points = tet.map(corner);
+            points.sort_by_key(|p| value(p) >= 0.0);
+            let count = points.iter().filter(|p| value(p) < 0.0).count();
+            let (inside, outside) = points.split_at(count);
+            // The polygon's corners as (inside, outside) ends of the edges it crosses, in cyclic order.
+            let edges: &[(usize, usize)] = match count {
+                1 => &[(0, 0), (0, 1), (0, 2)],
+                3 => &[(0, 0), (1, 0), (2, 0)],
+                2 => &[(0, 0), (0, 1), (1, 1), (1, 0)],
                 _ => continue,
             };
+            let mut polygon = [0u32; 4];
+            for (k, &(i, o)) in edges.iter().enumerate() {
+                polygon[k] = crossing(inside[i], outside[o], &mut mesh, &mut normals);
+            }
+            let polygon = &polygon[..edges.len()];
             // Oriented with the outside in front: from an inside corner to an outside one.
             let direction = position(&outside[0]) - position(&inside[0]);
             for k in 1..polygon.len() - 1 {

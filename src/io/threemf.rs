@@ -70,21 +70,6 @@ const RELATIONSHIPS: &str = r#"<?xml version="1.0" encoding="UTF-8"?>
 </Relationships>
 "#;
 
-/// `text` with the five XML special characters escaped, for an attribute or element value.
-fn xml_escaped(text: &str) -> String {
-    text.chars()
-        .map(|c| match c {
-            '&' => "&amp;".to_owned(),
-            '<' => "&lt;".to_owned(),
-            '>' => "&gt;".to_owned(),
-            '"' => "&quot;".to_owned(),
-            '\'' => "&apos;".to_owned(),
-            c if c.is_control() => " ".to_owned(),
-            c => c.to_string(),
-        })
-        .collect()
-}
-
 /// Writes the 3MF package of `mesh` to `w` (see [`write_3mf`]).
 ///
 /// # Errors
@@ -115,7 +100,7 @@ pub fn write_3mf_to<W: Write + Seek>(
     writeln!(
         model,
         r#" <metadata name="Title">{}</metadata>"#,
-        xml_escaped(title)
+        super::vtk::escape(title)
     )?;
     writeln!(
         model,

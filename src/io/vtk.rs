@@ -106,8 +106,8 @@ fn f64_block(values: &[Real]) -> String {
     le_block(values, f64::to_le_bytes)
 }
 
-/// Escapes the five XML special characters of an attribute or text value.
-fn escape(text: &str) -> String {
+/// Escapes the five XML special characters of an attribute or text value (also for the 3MF writer).
+pub(crate) fn escape(text: &str) -> String {
     text.replace('&', "&amp;")
         .replace('<', "&lt;")
         .replace('>', "&gt;")

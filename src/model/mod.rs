@@ -560,6 +560,12 @@ impl Model {
         self.nodes.iter().position(|n| n.ends.contains(&end))
     }
 
+    /// The radius of patch `patch`'s wire as drawn: half its section's diameter (the drawing diameter of a
+    /// section given by its properties).
+    pub fn wire_radius(&self, patch: usize) -> Real {
+        0.5 * self.sections[self.patches[patch].section].diameter()
+    }
+
     /// The symmetry plane (index into [`Model::symmetry_planes`]) that patch `patch` lies in, if any: every
     /// control point within `1e-9` of the model size from the plane.
     pub fn patch_symmetry_plane(&self, patch: usize) -> Option<usize> {

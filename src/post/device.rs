@@ -158,15 +158,12 @@ pub fn device_tube_mesh(
     let rods: Vec<RodTube<'_>> = shapes
         .iter()
         .enumerate()
-        .map(|(k, shape)| {
-            let patch = &model.patches[k];
-            RodTube {
-                centre: &shape.points,
-                frames: &shape.frames,
-                radius: 0.5 * model.sections[patch.section].diameter(),
-                phase: section_phase(k),
-                in_plane: model.patch_symmetry_plane(k),
-            }
+        .map(|(k, shape)| RodTube {
+            centre: &shape.points,
+            frames: &shape.frames,
+            radius: model.wire_radius(k),
+            phase: section_phase(k),
+            in_plane: model.patch_symmetry_plane(k),
         })
         .collect();
     device_mesh(&rods, &model.symmetry_planes, &settings)

@@ -86,8 +86,7 @@ impl PrintSolid {
 pub fn device_capsules(model: &Model, shapes: &[PatchShape]) -> Vec<Capsule> {
     device_rods(model, shapes)
         .flat_map(|(patch, line)| {
-            let radius = 0.5 * model.sections[model.patches[patch].section].diameter();
-            Capsule::along(&line, radius).collect::<Vec<_>>()
+            Capsule::along(&line, model.wire_radius(patch)).collect::<Vec<_>>()
         })
         .collect()
 }

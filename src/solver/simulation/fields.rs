@@ -311,7 +311,7 @@ impl Simulation<'_> {
         let (model, disc, state) = (self.model, &self.disc, &self.state);
         let point = &disc.points[g];
         let strain = point_strains(disc, state, g);
-        let radius = 0.5 * model.sections[model.patches[point.patch].section].diameter();
+        let radius = model.wire_radius(point.patch);
         let stretch = SectionStretch::new(
             point.gamma0 + strain.force,
             state.kappa[g],
