@@ -26,7 +26,7 @@ fn scratch(name: &str) -> PathBuf {
 }
 
 /// The two-crown straight stent, written into `dir`.
-fn two_crown_stent(dir: &Path) -> PathBuf {
+pub(crate) fn two_crown_stent(dir: &Path) -> PathBuf {
     let text = replace_line(&design_text("straight_stent.yaml"), "crowns:", "crowns: 2");
     let path = dir.join("two_crowns.yaml");
     std::fs::write(&path, text).expect("design written");
@@ -34,7 +34,7 @@ fn two_crown_stent(dir: &Path) -> PathBuf {
 }
 
 /// Starts `stentkit run DESIGN -o DIR --quiet --checkpoint-every 0.1`.
-fn spawn(design: &Path, dir: &Path) -> Child {
+pub(crate) fn spawn(design: &Path, dir: &Path) -> Child {
     Command::new(env!("CARGO_BIN_EXE_stentkit"))
         .args(["run", path_str(design), "-o", path_str(dir), "--quiet"])
         .args(["--checkpoint-every", "0.1"])
@@ -46,7 +46,7 @@ fn spawn(design: &Path, dir: &Path) -> Child {
 
 /// Waits (at most two minutes) until `dir` holds a checkpoint and `rows` history rows, while `child` runs;
 /// panics if the run ended first.
-fn wait_for_checkpoint(child: &mut Child, dir: &Path, rows: usize) {
+pub(crate) fn wait_for_checkpoint(child: &mut Child, dir: &Path, rows: usize) {
     let started = Instant::now();
     loop {
         let history = std::fs::read_to_string(dir.join("history.csv")).unwrap_or_default();
@@ -97,7 +97,7 @@ fn snapshot_files(dir: &Path) -> BTreeMap<String, Vec<u8>> {
 }
 
 /// Resumes `dir` with `design`: the status and the standard error.
-fn resume(design: &Path, dir: &Path) -> (Option<i32>, String) {
+pub(crate) fn resume(design: &Path, dir: &Path) -> (Option<i32>, String) {
     let out = stentkit(&[
         "run",
         path_str(design),
