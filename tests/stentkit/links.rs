@@ -246,3 +246,183 @@ fn a_refused_resume_changes_nothing_and_the_run_resumes_later() {
     assert_eq!(code, Some(0), "{stderr}");
     assert_eq!(summary(&dir)["status"], "completed");
 }
+
+/// `mesh -o FILE` over an existing file (a mesh, the wires' CSV, a print solid): before, the file was replaced
+/// silently. Now each is refused (exit status 2, the path named, the file unchanged); with `--force` it is
+/// replaced — and a link in its place is replaced by the file, not written through.
+#[test]
+fn mesh_refuses_an_existing_file_without_force() {
+    let dir = scratch("mesh");
+    let file = design("bend45.yaml");
+    let design = path_str(&file);
+    for (name, extra) in [
+        ("shape.stl", &[][..]),
+        ("wires.csv", &[][..]),
+        ("solid.3mf", &["--print"][..]),
+    ] {
+        let output = dir.join(name);
+        std::fs::write(&output, "the user's").expect("written");
+        let mut args = vec!["mesh", design, "-o", path_str(&output)];
+        args.extend_from_slice(extra);
+        assert_refused(&stentkit(&args), &[path_str(&output), "--force"]);
+        assert_eq!(
+            std::fs::read(&output).expect("kept"),
+            b"the user's",
+            "{name}"
+        );
+    }
+    // With --force: replaced.
+    for name in ["shape.stl", "wires.csv"] {
+        let output = dir.join(name);
+        let out = stentkit(&["mesh", design, "-o", path_str(&output), "--force"]);
+        assert_eq!(out.status.code(), Some(0), "{}", text(&out.stderr));
+        assert_ne!(std::fs::read(&output).expect("written"), b"the user's");
+    }
+    // A link in the output's place: refused without --force, replaced (not written through) with it.
+    let users = dir.join("users.stl");
+    std::fs::write(&users, "the user's").expect("written");
+    let link = dir.join("link.stl");
+    symlink(&users, &link).expect("link");
+    assert_refused(
+        &stentkit(&["mesh", design, "-o", path_str(&link)]),
+        &[path_str(&link)],
+    );
+    let out = stentkit(&["mesh", design, "-o", path_str(&link), "--force"]);
+    assert_eq!(out.status.code(), Some(0), "{}", text(&out.stderr));
+    assert!(
+        !std::fs::symlink_metadata(&link)
+            .expect("there")
+            .is_symlink()
+    );
+    assert_eq!(std::fs::read(&users).expect("kept"), b"the user's");
+}
+
+/// `export -o FILE` and `render -o FILE.png` over an existing file: refused without `--force` (exit status 2,
+/// the path named, the file unchanged), replaced with it.
+#[test]
+fn export_and_render_refuse_an_existing_file_without_force() {
+    let dir = scratch("export-render");
+    let run = dir.join("run");
+    let out = run_bend45(&run, &[]);
+    assert_eq!(out.status.code(), Some(0), "{}", text(&out.stderr));
+    let stl = dir.join("state.stl");
+    let png = dir.join("picture.png");
+    let export = |extra: &[&str]| {
+        let mut args = vec!["export", path_str(&run), "--time", "0.5"];
+        args.extend_from_slice(&["-o", path_str(&stl)]);
+        args.extend_from_slice(extra);
+        stentkit(&args)
+    };
+    let render = |extra: &[&str]| {
+        let mut args = vec!["render", path_str(&run), "-o", path_str(&png)];
+        args.extend_from_slice(extra);
+        stentkit(&args)
+    };
+    for (output, command) in [
+        (&stl, &export as &dyn Fn(&[&str]) -> Output),
+        (&png, &render),
+    ] {
+        std::fs::write(output, "the user's").expect("written");
+        assert_refused(&command(&[]), &[path_str(output), "--force"]);
+        assert_eq!(std::fs::read(output).expect("kept"), b"the user's");
+        let out = command(&["--force"]);
+        assert_eq!(out.status.code(), Some(0), "{}", text(&out.stderr));
+        assert_ne!(std::fs::read(output).expect("written"), b"the user's");
+    }
+}
+
+/// `study … -o DIR` over a folder holding a file the study writes (`convergence.csv`, `error_vs_h.svg`,
+/// `stability.md`): before, `study convergence` overwrote the user's CSV. Now each is refused before any run
+/// (exit status 2, the file named, unchanged). A folder holding only other files is used, and they stay; with
+/// `--force` the study's files are replaced. The convergence study is the cheapest there is (pure bending,
+/// p = 4, n = 8 against n = 12, to t = 0.5: 0.2 s).
+#[test]
+fn studies_refuse_to_replace_their_files_without_force() {
+    let dir = scratch("studies");
+    let pure_bending = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/pure_bending.yaml");
+    let bending = path_str(&pure_bending);
+    let convergence = |out: &Path, extra: &[&str]| {
+        let mut args = vec!["study", "convergence", bending, "--degrees", "4"];
+        args.extend_from_slice(&["--points", "8", "--reference", "4,12", "--time", "0.5"]);
+        args.extend_from_slice(&["--time-tolerance", "none", "-o", path_str(out)]);
+        args.extend_from_slice(extra);
+        stentkit(&args)
+    };
+    let cases: [(&str, Vec<&str>); 3] = [
+        ("convergence.csv", vec![]),
+        (
+            "error_vs_h.svg",
+            vec!["study", "time", bending, "--steps", "0.1"],
+        ),
+        (
+            "stability.md",
+            vec!["study", "stability", "--maps", "material"],
+        ),
+    ];
+    for (file, command) in cases {
+        let out_dir = dir.join(file.replace('.', "_"));
+        std::fs::create_dir_all(&out_dir).expect("mkdir");
+        let users = out_dir.join(file);
+        std::fs::write(&users, "the user's").expect("written");
+        let out = if command.is_empty() {
+            convergence(&out_dir, &[])
+        } else {
+            let mut args = command.clone();
+            args.extend_from_slice(&["-o", path_str(&out_dir)]);
+            stentkit(&args)
+        };
+        assert_refused(&out, &[path_str(&users), "--force"]);
+        assert_eq!(
+            std::fs::read(&users).expect("kept"),
+            b"the user's",
+            "{file}"
+        );
+    }
+
+    // A folder with the user's notes only: used, the notes kept.
+    let notes_dir = dir.join("with_notes");
+    std::fs::create_dir_all(&notes_dir).expect("mkdir");
+    std::fs::write(notes_dir.join("notes.txt"), "the user's").expect("written");
+    let out = convergence(&notes_dir, &[]);
+    assert_eq!(out.status.code(), Some(0), "{}", text(&out.stderr));
+    assert_eq!(
+        std::fs::read(notes_dir.join("notes.txt")).expect("kept"),
+        b"the user's"
+    );
+    // With --force over the refused folder: replaced.
+    let refused = dir.join("convergence_csv");
+    let out = convergence(&refused, &["--force"]);
+    assert_eq!(out.status.code(), Some(0), "{}", text(&out.stderr));
+    let csv = std::fs::read_to_string(refused.join("convergence.csv")).expect("written");
+    assert!(csv.contains("pure_bending"), "{csv}");
+}
+
+/// `tune -o FILE` refused an existing file before this issue (with no way to replace it) and still does, now
+/// through the same check as every command (exit status 2, the path named); `sweep -o DIR` refuses a folder
+/// that is not empty and holds no sweep (its own rule, unchanged). Neither touches the user's file.
+#[test]
+fn tune_and_sweep_refuse_the_users_files() {
+    let dir = scratch("tune-sweep");
+    let users = dir.join("tuned.yaml");
+    std::fs::write(&users, "the user's").expect("written");
+    let file = design("bend45.yaml");
+    let out = stentkit(&[
+        "tune",
+        path_str(&file),
+        "--tol",
+        "1e-2",
+        "-o",
+        path_str(&users),
+    ]);
+    assert_refused(&out, &[path_str(&users), "--force"]);
+    let out = stentkit(&[
+        "sweep",
+        path_str(&file),
+        "--set",
+        "time.step=0.1,0.05",
+        "-o",
+        path_str(&dir),
+    ]);
+    assert_refused(&out, &["holds no sweep"]);
+    assert_eq!(std::fs::read(&users).expect("kept"), b"the user's");
+}
