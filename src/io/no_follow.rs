@@ -12,7 +12,10 @@
 //!   component at a time (`openat`), then `unlinkat` ([`remove_inside`]): no component below the root is a
 //!   link at the moment of the removal, whatever happens to the paths meanwhile;
 //! - a folder that holds links where stentkit writes is refused before anything is changed, naming them
-//!   ([`links_inside`]; [`crate::io::run_folder::classify`] refuses a run folder that holds any).
+//!   ([`links_inside`]; [`crate::io::run_folder::classify`] refuses a run folder that holds any);
+//! - a sweep folder's own files (`sweep.sbatch`, `slurm.json`, a variant's `log.txt` and `task_error.txt`, the
+//!   table's temporary) are written with [`write`] or [`open`], so a link in their place is an error, not a
+//!   way into a user's file.
 //!
 //! The folder the user names (`-o DIR`, `RUN_DIR`) may itself be a link: the user chose that place, as they
 //! choose any path they type. Only what lies inside it is held to the rule. A file written atomically (a
@@ -49,6 +52,15 @@ pub fn create(path: &Path) -> io::Result<File> {
         path,
         OpenOptions::new().write(true).create(true).truncate(true),
     )
+}
+
+/// Writes `bytes` to `path`, created or truncated, refusing a link in its place ([`create`]): `std::fs::write`
+/// for a file stentkit owns.
+///
+/// # Errors
+/// As [`open`], and the write's.
+pub fn write(path: &Path, bytes: &[u8]) -> io::Result<()> {
+    io::Write::write_all(&mut create(path)?, bytes)
 }
 
 /// Removes the file `root/relative` without following a link below `root`: each folder of `relative` is

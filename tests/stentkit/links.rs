@@ -426,3 +426,39 @@ fn tune_and_sweep_refuse_the_users_files() {
     assert_refused(&out, &["holds no sweep"]);
     assert_eq!(std::fs::read(&users).expect("kept"), b"the user's");
 }
+
+/// A sweep folder's own files are not written through links either: `sweep --slurm --dry-run` rewrites
+/// `sweep.sbatch` on every call, and before it wrote the script into whatever a link in its place pointed at.
+/// Now the write fails, naming the link, and the user's file is unchanged.
+#[test]
+fn a_sweeps_script_is_not_written_through_a_link() {
+    let root = scratch("sweep-script");
+    let dir = root.join("sweep");
+    let file = design("bend45.yaml");
+    let sweep = || {
+        stentkit(&[
+            "sweep",
+            path_str(&file),
+            "--set",
+            "time.step=0.1,0.05",
+            "-o",
+            path_str(&dir),
+            "--slurm",
+            "--dry-run",
+        ])
+    };
+    let out = sweep();
+    assert_eq!(out.status.code(), Some(0), "{}", text(&out.stderr));
+    let users = root.join("job.sh");
+    std::fs::write(&users, "the user's").expect("written");
+    std::fs::remove_file(dir.join("sweep.sbatch")).expect("removed");
+    symlink(&users, dir.join("sweep.sbatch")).expect("link");
+    let out = sweep();
+    assert_ne!(out.status.code(), Some(0));
+    assert!(
+        text(&out.stderr).contains("is a symbolic link"),
+        "{}",
+        text(&out.stderr)
+    );
+    assert_eq!(std::fs::read(&users).expect("kept"), b"the user's");
+}
