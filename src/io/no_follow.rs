@@ -77,21 +77,7 @@ pub fn remove_inside(root: &Path, relative: &Path) -> io::Result<bool> {
             format!("{}: does not name a file", root.join(relative).display()),
         ));
     };
-    let folder = open_folder_inside(root, folder)?;
-    let name = c_name(name)?;
-    // SAFETY: `folder` is an open directory descriptor owned by this function for the call's length and `name`
-    // a NUL-terminated string that outlives it; unlinkat(2) touches no memory of ours beyond reading `name`.
-    let status = unsafe { libc::unlinkat(folder.as_raw_fd(), name.as_ptr(), 0) };
-    if status == 0 {
-        return Ok(true);
-    }
-    match io::Error::last_os_error() {
-        e if e.kind() == io::ErrorKind::NotFound => Ok(false),
-        e => Err(io::Error::new(
-            e.kind(),
-            format!("{}: {e}", root.join(relative).display()),
-        )),
-    }
+    folder_inside(root, folder)?.remove(name)
 }
 
 /// The names in the folder `root/relative` and a handle that removes from that very folder (see
@@ -131,7 +117,8 @@ impl FolderInside {
     /// The operating system's, naming the file.
     pub fn remove(&self, name: &OsStr) -> io::Result<bool> {
         let c = c_name(name)?;
-        // SAFETY: as in `remove_inside`: an owned directory descriptor and a NUL-terminated name.
+        // SAFETY: `self.fd` is an open directory descriptor owned by `self`, alive for the call, and `c` a
+        // NUL-terminated string that outlives it; unlinkat(2) touches no memory of ours beyond reading `c`.
         let status = unsafe { libc::unlinkat(self.fd.as_raw_fd(), c.as_ptr(), 0) };
         if status == 0 {
             return Ok(true);
