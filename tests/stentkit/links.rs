@@ -10,8 +10,8 @@
 //! `resume.rs` where a checkpoint is needed, killed after its first one). Comparisons are exact: a refusal
 //! leaves every byte, link and folder as it was.
 
-use crate::outputs::{design, path_str, stentkit, summary, text};
-use crate::resume::{resume, spawn, two_crown_stent, wait_for_checkpoint};
+use crate::outputs::{design, path_str, scratch_folder, stentkit, summary, text};
+use crate::resume::{killed_two_crown_run, resume};
 use std::collections::BTreeMap;
 use std::os::unix::fs::symlink;
 use std::path::{Path, PathBuf};
@@ -19,12 +19,7 @@ use std::process::Output;
 
 /// A fresh scratch folder for test `name`.
 fn scratch(name: &str) -> PathBuf {
-    let dir = Path::new(env!("CARGO_TARGET_TMPDIR"))
-        .join("links-tests")
-        .join(name);
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).expect("scratch folder");
-    dir
+    scratch_folder("links-tests", name)
 }
 
 /// One entry of a folder, seen without following links.
@@ -70,6 +65,24 @@ fn run_bend45(dir: &Path, extra: &[&str]) -> Output {
     stentkit(&args)
 }
 
+/// A fresh scratch folder for test `name` holding a completed bend45 run in `run/`: (scratch, run folder).
+fn finished_bend45(name: &str) -> (PathBuf, PathBuf) {
+    let root = scratch(name);
+    let run = root.join("run");
+    let out = run_bend45(&run, &[]);
+    assert_eq!(out.status.code(), Some(0), "{}", text(&out.stderr));
+    (root, run)
+}
+
+/// `stentkit sweep designs/bend45.yaml --set time.step=0.1,0.05 -o DIR` with `extra` arguments.
+fn sweep_bend45(dir: &Path, extra: &[&str]) -> Output {
+    let file = design("bend45.yaml");
+    let mut args = vec!["sweep", path_str(&file), "--set", "time.step=0.1,0.05"];
+    args.extend_from_slice(&["-o", path_str(dir)]);
+    args.extend_from_slice(extra);
+    stentkit(&args)
+}
+
 /// Asserts exit status 2 with a message containing every one of `words`.
 fn assert_refused(out: &Output, words: &[&str]) {
     let stderr = text(&out.stderr);
@@ -84,10 +97,7 @@ fn assert_refused(out: &Output, words: &[&str]) {
 /// naming both links, and nothing changes, in the run folder or in the user's.
 #[test]
 fn repair_refuses_links_and_changes_nothing() {
-    let root = scratch("repair");
-    let run = root.join("run");
-    let out = run_bend45(&run, &[]);
-    assert_eq!(out.status.code(), Some(0), "{}", text(&out.stderr));
+    let (root, run) = finished_bend45("repair");
     // As a killed run leaves it: the summary still says `running`.
     let summary_path = run.join("summary.json");
     let s = std::fs::read_to_string(&summary_path).expect("summary");
@@ -138,10 +148,7 @@ fn force_refuses_a_folder_holding_links_and_changes_nothing() {
         ("charts", true),
         ("history.csv", false),
     ] {
-        let root = scratch(&format!("force-{}", name.replace('.', "_")));
-        let run = root.join("run");
-        let out = run_bend45(&run, &[]);
-        assert_eq!(out.status.code(), Some(0), "{}", text(&out.stderr));
+        let (root, run) = finished_bend45(&format!("force-{}", name.replace('.', "_")));
         // The user's folder or file: the run's moved there, so its names are the manifest's.
         let users = root.join("users");
         std::fs::create_dir_all(&users).expect("mkdir");
@@ -177,25 +184,13 @@ fn force_refuses_a_folder_holding_links_and_changes_nothing() {
     assert_eq!(summary(&real)["status"], "completed");
 }
 
-/// The two-crown stent killed by SIGKILL after its first checkpoint (at least 50 history rows written): a folder
-/// `--resume` continues. Returns the scratch folder, the design and the run folder.
-fn killed_run(name: &str) -> (PathBuf, PathBuf, PathBuf) {
-    let root = scratch(name);
-    let design = two_crown_stent(&root);
-    let dir = root.join("run");
-    let mut child = spawn(&design, &dir);
-    wait_for_checkpoint(&mut child, &dir, 50);
-    child.kill().expect("SIGKILL");
-    child.wait().expect("reaped");
-    (root, design, dir)
-}
-
 /// `--resume` with `history.csv` a link to a user's copy of it: before, the resumed run cut the user's file
 /// back to the checkpoint's row and wrote its rows into it. Now the resume is refused (exit status 2) naming
 /// the link, and nothing changes.
 #[test]
 fn resume_refuses_a_linked_history_and_changes_nothing() {
-    let (root, design, dir) = killed_run("resume-link");
+    let root = scratch("resume-link");
+    let (design, dir) = killed_two_crown_run(&root);
     let users = root.join("users");
     std::fs::create_dir_all(&users).expect("mkdir");
     let history = dir.join("history.csv");
@@ -218,7 +213,7 @@ fn resume_refuses_a_linked_history_and_changes_nothing() {
 /// back the run resumes and completes.
 #[test]
 fn a_refused_resume_changes_nothing_and_the_run_resumes_later() {
-    let (_root, design, dir) = killed_run("resume-refused");
+    let (design, dir) = killed_two_crown_run(&scratch("resume-refused"));
     let history = dir.join("history.csv");
     let rows = std::fs::read(&history).expect("history");
     let header = rows.iter().position(|&b| b == b'\n').expect("a header") + 1;
@@ -301,10 +296,7 @@ fn mesh_refuses_an_existing_file_without_force() {
 /// the path named, the file unchanged), replaced with it.
 #[test]
 fn export_and_render_refuse_an_existing_file_without_force() {
-    let dir = scratch("export-render");
-    let run = dir.join("run");
-    let out = run_bend45(&run, &[]);
-    assert_eq!(out.status.code(), Some(0), "{}", text(&out.stderr));
+    let (dir, run) = finished_bend45("export-render");
     let stl = dir.join("state.stl");
     let png = dir.join("picture.png");
     let export = |extra: &[&str]| {
@@ -415,15 +407,7 @@ fn tune_and_sweep_refuse_the_users_files() {
         path_str(&users),
     ]);
     assert_refused(&out, &[path_str(&users), "--force"]);
-    let out = stentkit(&[
-        "sweep",
-        path_str(&file),
-        "--set",
-        "time.step=0.1,0.05",
-        "-o",
-        path_str(&dir),
-    ]);
-    assert_refused(&out, &["holds no sweep"]);
+    assert_refused(&sweep_bend45(&dir, &[]), &["holds no sweep"]);
     assert_eq!(std::fs::read(&users).expect("kept"), b"the user's");
 }
 
@@ -434,19 +418,7 @@ fn tune_and_sweep_refuse_the_users_files() {
 fn a_sweeps_script_is_not_written_through_a_link() {
     let root = scratch("sweep-script");
     let dir = root.join("sweep");
-    let file = design("bend45.yaml");
-    let sweep = || {
-        stentkit(&[
-            "sweep",
-            path_str(&file),
-            "--set",
-            "time.step=0.1,0.05",
-            "-o",
-            path_str(&dir),
-            "--slurm",
-            "--dry-run",
-        ])
-    };
+    let sweep = || sweep_bend45(&dir, &["--slurm", "--dry-run"]);
     let out = sweep();
     assert_eq!(out.status.code(), Some(0), "{}", text(&out.stderr));
     let users = root.join("job.sh");

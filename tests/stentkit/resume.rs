@@ -26,7 +26,7 @@ fn scratch(name: &str) -> PathBuf {
 }
 
 /// The two-crown straight stent, written into `dir`.
-pub(crate) fn two_crown_stent(dir: &Path) -> PathBuf {
+fn two_crown_stent(dir: &Path) -> PathBuf {
     let text = replace_line(&design_text("straight_stent.yaml"), "crowns:", "crowns: 2");
     let path = dir.join("two_crowns.yaml");
     std::fs::write(&path, text).expect("design written");
@@ -34,7 +34,7 @@ pub(crate) fn two_crown_stent(dir: &Path) -> PathBuf {
 }
 
 /// Starts `stentkit run DESIGN -o DIR --quiet --checkpoint-every 0.1`.
-pub(crate) fn spawn(design: &Path, dir: &Path) -> Child {
+fn spawn(design: &Path, dir: &Path) -> Child {
     Command::new(env!("CARGO_BIN_EXE_stentkit"))
         .args(["run", path_str(design), "-o", path_str(dir), "--quiet"])
         .args(["--checkpoint-every", "0.1"])
@@ -46,7 +46,7 @@ pub(crate) fn spawn(design: &Path, dir: &Path) -> Child {
 
 /// Waits (at most two minutes) until `dir` holds a checkpoint and `rows` history rows, while `child` runs;
 /// panics if the run ended first.
-pub(crate) fn wait_for_checkpoint(child: &mut Child, dir: &Path, rows: usize) {
+fn wait_for_checkpoint(child: &mut Child, dir: &Path, rows: usize) {
     let started = Instant::now();
     loop {
         let history = std::fs::read_to_string(dir.join("history.csv")).unwrap_or_default();
@@ -63,6 +63,18 @@ pub(crate) fn wait_for_checkpoint(child: &mut Child, dir: &Path, rows: usize) {
         );
         std::thread::sleep(Duration::from_millis(5));
     }
+}
+
+/// The two-crown stent written into `root` and run into `root/run`, killed by SIGKILL after its first checkpoint
+/// with at least 50 history rows: a folder `--resume` continues. Returns the design and the run folder.
+pub(crate) fn killed_two_crown_run(root: &Path) -> (PathBuf, PathBuf) {
+    let design = two_crown_stent(root);
+    let dir = root.join("run");
+    let mut child = spawn(&design, &dir);
+    wait_for_checkpoint(&mut child, &dir, 50);
+    child.kill().expect("SIGKILL");
+    child.wait().expect("reaped");
+    (design, dir)
 }
 
 /// Every message of a recording: (topic, sequence, log time, body).
@@ -198,12 +210,7 @@ fn a_killed_or_interrupted_run_resumes_to_the_uninterrupted_result() {
 #[test]
 fn resuming_the_wrong_run_is_refused_with_status_2() {
     let root = scratch("refused");
-    let design = two_crown_stent(&root);
-    let dir = root.join("run");
-    let mut child = spawn(&design, &dir);
-    wait_for_checkpoint(&mut child, &dir, 50);
-    child.kill().expect("SIGKILL");
-    child.wait().expect("reaped");
+    let (design, dir) = killed_two_crown_run(&root);
 
     // Another design.
     let bend = Path::new(env!("CARGO_MANIFEST_DIR")).join("designs/bend45.yaml");
