@@ -44,6 +44,8 @@ pub struct ExportOptions {
     pub which: Which,
     /// The mesh file (`.stl`, `.obj`, `.3mf`), or `.csv` for the centrelines.
     pub output: PathBuf,
+    /// Replace `output` if it exists (otherwise an existing file is refused).
+    pub force: bool,
     /// The design, instead of the run's `design_file`.
     pub design: Option<PathBuf>,
     /// Vertices around each tube section.
@@ -57,8 +59,8 @@ pub struct ExportOptions {
 /// Exports the state `options.which` of the run in `run_dir` to `options.output`.
 ///
 /// # Errors
-/// [`BadInput`] for a folder that is not a run folder, a design that is not the one that ran, a phase the
-/// model does not have or a time outside what the run reached; the design's errors; a step that fails.
+/// [`BadInput`] for an output that exists (without `force`), a folder that is not a run folder, a design that
+/// is not the one that ran, a phase the model does not have or a time outside what the run reached; the design's errors; a step that fails.
 pub fn run(run_dir: &Path, options: &ExportOptions) -> anyhow::Result<()> {
     let extension = options
         .output
@@ -75,6 +77,7 @@ pub fn run(run_dir: &Path, options: &ExportOptions) -> anyhow::Result<()> {
         ))
         .into());
     }
+    super::refuse_existing([options.output.as_path()], options.force)?;
     let summary_path = run_dir.join("summary.json");
     let summary: serde_json::Value = std::fs::read_to_string(&summary_path)
         .ok()

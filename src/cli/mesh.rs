@@ -43,15 +43,19 @@ pub struct Resolution {
     pub print: Option<PrintSettings>,
 }
 
-/// Writes the shape `state` of the design (with the `--set` overrides `sets`) to `output` (`.stl`, `.obj` or
-/// `.3mf`).
+/// Writes the shape `state` of the design (with the `--set` overrides `sets`) to `output` (`.stl`, `.obj`,
+/// `.3mf` or `.csv`; an existing file only with `--force`).
 pub fn run(
     design: &Path,
-    output: &Path,
+    output: super::Target<'_>,
     state: State,
     resolution: Resolution,
     sets: Vec<SetOverride>,
 ) -> anyhow::Result<()> {
+    let super::Target {
+        path: output,
+        force,
+    } = output;
     let extension = output
         .extension()
         .and_then(|e| e.to_str())
@@ -62,6 +66,7 @@ pub fn run(
             output.display()
         );
     }
+    super::refuse_existing([output], force)?;
     let permanent = load_design_with(design, &DesignOverrides::sets(sets.clone()))?;
     let (model, placed) = match state {
         State::Permanent => (permanent.model, None),

@@ -27,7 +27,7 @@ use std::process::ExitCode;
     about,
     long_about = None,
     after_help = "Exit status: 0 completed, 1 failed (solver, output, folder in use), 2 bad input (design, \
-                  arguments, folder or size refused; nothing ran), 130 interrupted by SIGINT, SIGTERM or SIGHUP."
+                  arguments, folder, existing output or size refused; nothing ran), 130 interrupted by SIGINT, SIGTERM or SIGHUP."
 )]
 pub struct Cli {
     /// What to do.
@@ -122,6 +122,9 @@ pub enum Command {
         /// radius).
         #[arg(short, long)]
         output: PathBuf,
+        /// Replace the output file if it exists (without --force an existing file is refused, exit status 2).
+        #[arg(long)]
+        force: bool,
         /// The design file, when it is no longer where the run found it (summary.json's design_file).
         #[arg(long)]
         design: Option<PathBuf>,
@@ -148,9 +151,12 @@ pub enum Command {
         #[arg(long, value_name = "TOLERANCE")]
         tol: f64,
         /// Write the tuned design here (the design's text with `mesh` and `time` changed and a comment block
-        /// stating the estimated error and the expected saving). An existing file is not replaced.
+        /// stating the estimated error and the expected saving). An existing file is replaced only with --force.
         #[arg(short, long)]
         output: Option<PathBuf>,
+        /// Replace the -o file if it exists (without --force an existing file is refused, exit status 2).
+        #[arg(long, requires = "output")]
+        force: bool,
         /// Degrees to try.
         #[arg(long, value_delimiter = ',', default_value = "4,5,6")]
         degrees: Vec<usize>,
@@ -202,6 +208,9 @@ pub enum Command {
         /// Output file (`.png`).
         #[arg(short, long)]
         output: PathBuf,
+        /// Replace the output file if it exists (without --force an existing file is refused, exit status 2).
+        #[arg(long)]
+        force: bool,
         /// Times to draw, each the nearest snapshot's (default: those of the configuration figures).
         #[arg(long, num_args = 1..)]
         times: Vec<f64>,
@@ -228,6 +237,9 @@ pub enum Command {
         /// radius).
         #[arg(short, long)]
         output: PathBuf,
+        /// Replace the output file if it exists (without --force an existing file is refused, exit status 2).
+        #[arg(long)]
+        force: bool,
         /// Which shape: the permanent one (printed), or the temporary one the programme drives it to (generated
         /// in the programme's placement, not simulated).
         #[arg(long, value_enum, default_value = "permanent")]
@@ -376,6 +388,10 @@ pub enum StudyCommand {
         /// Output folder.
         #[arg(short, long)]
         output: PathBuf,
+        /// Replace the files the study writes if the output folder holds them (without --force they are
+        /// refused, exit status 2; other files in the folder are never touched).
+        #[arg(long)]
+        force: bool,
         /// Degrees p.
         #[arg(long, value_delimiter = ',', default_value = "2,3,4,5,6,7,8")]
         degrees: Vec<usize>,
@@ -410,6 +426,10 @@ pub enum StudyCommand {
         /// Output folder.
         #[arg(short, long)]
         output: PathBuf,
+        /// Replace the files the study writes if the output folder holds them (without --force they are
+        /// refused, exit status 2; other files in the folder are never touched).
+        #[arg(long)]
+        force: bool,
         /// Time at which the error is measured; the runs end there (default: the design's end time).
         #[arg(long)]
         time: Option<f64>,
@@ -444,6 +464,10 @@ pub enum StudyCommand {
         /// Output folder.
         #[arg(short, long)]
         output: PathBuf,
+        /// Replace the files the study writes if the output folder holds them (without --force they are
+        /// refused, exit status 2; other files in the folder are never touched).
+        #[arg(long)]
+        force: bool,
         /// Maps to draw: any of material, bend45, heating, release, coarse.
         #[arg(
             long,
@@ -467,6 +491,48 @@ pub const EXIT_INTERRUPTED: u8 = 130;
 #[derive(Debug, thiserror::Error)]
 #[error("{0}")]
 pub struct BadInput(pub String);
+
+/// A file or folder the user named for a command's output (`-o`), and whether what is there may be replaced
+/// (`--force`).
+#[derive(Debug, Clone, Copy)]
+pub struct Target<'a> {
+    /// The file or folder.
+    pub path: &'a std::path::Path,
+    /// Replace what exists.
+    pub force: bool,
+}
+
+/// Refuses to replace any of `targets` that exists (a file, a folder, a link, even a dangling one) unless
+/// `force`: every command that writes a file the user names (`mesh`, `export`, `render`, `tune -o`, the files a
+/// `study` writes into its `-o` folder) asks this before any work, so that a refusal costs nothing and changes
+/// nothing. Their files are written atomically (a temporary renamed over the target): with `force` a link in a
+/// target's place is replaced, never written through.
+///
+/// # Errors
+/// [`BadInput`] (exit status 2) naming every target that exists.
+pub fn refuse_existing<'a>(
+    targets: impl IntoIterator<Item = &'a std::path::Path>,
+    force: bool,
+) -> Result<(), BadInput> {
+    if force {
+        return Ok(());
+    }
+    let existing: Vec<String> = targets
+        .into_iter()
+        .filter(|p| p.symlink_metadata().is_ok())
+        .map(|p| p.display().to_string())
+        .collect();
+    match existing.as_slice() {
+        [] => Ok(()),
+        [one] => Err(BadInput(format!(
+            "{one}: exists; pass --force to replace it, or choose another name (nothing was written)"
+        ))),
+        many => Err(BadInput(format!(
+            "{}: exist; pass --force to replace them, or choose another folder with -o (nothing was written)",
+            many.join(", ")
+        ))),
+    }
+}
 
 /// A run stopped by a signal (exit status [`EXIT_INTERRUPTED`]).
 #[derive(Debug, thiserror::Error)]
@@ -554,6 +620,7 @@ pub fn main() -> ExitCode {
             time,
             phase,
             output,
+            force,
             design,
             segments,
             rings,
@@ -566,6 +633,7 @@ pub fn main() -> ExitCode {
                     (None, phase) => export::Which::Phase(phase.unwrap_or_default()),
                 },
                 output,
+                force,
                 design,
                 segments,
                 rings,
@@ -576,16 +644,25 @@ pub fn main() -> ExitCode {
             design,
             tol,
             output,
+            force,
             degrees,
             max_points,
             set,
-        } => tune::run(&design, tol, output.as_deref(), degrees, max_points, set),
+        } => tune::run(
+            &design,
+            tol,
+            output.as_deref().map(|path| Target { path, force }),
+            degrees,
+            max_points,
+            set,
+        ),
         Command::Sweep(cli) => sweep(cli),
         Command::Schema => schema(),
         Command::Repair { run_dir } => repair::run(&run_dir),
         Command::Study(StudyCommand::Convergence {
             design,
             output,
+            force,
             degrees,
             points,
             time,
@@ -594,7 +671,10 @@ pub fn main() -> ExitCode {
             time_tolerance,
         }) => study::convergence(
             &design,
-            &output,
+            Target {
+                path: &output,
+                force,
+            },
             degrees,
             points,
             reference,
@@ -604,6 +684,7 @@ pub fn main() -> ExitCode {
         Command::Study(StudyCommand::Time {
             design,
             output,
+            force,
             time,
             steps,
             tolerances,
@@ -612,26 +693,48 @@ pub fn main() -> ExitCode {
             samples,
         }) => study::time(
             &design,
-            &output,
+            Target {
+                path: &output,
+                force,
+            },
             steps,
             tolerances.into_iter().filter_map(|t| t.0).collect(),
             &integrators,
             &reference,
             study::Sampling { time, samples },
         ),
-        Command::Study(StudyCommand::Stability { output, maps }) => {
-            study::stability_maps(&output, &maps)
-        }
+        Command::Study(StudyCommand::Stability {
+            output,
+            force,
+            maps,
+        }) => study::stability_maps(
+            Target {
+                path: &output,
+                force,
+            },
+            &maps,
+        ),
         Command::Render {
             run_dir,
             output,
+            force,
             times,
             view,
             width,
-        } => render::run(&run_dir, &output, &times, &view, width),
+        } => render::run(
+            &run_dir,
+            Target {
+                path: &output,
+                force,
+            },
+            &times,
+            &view,
+            width,
+        ),
         Command::Mesh {
             design,
             output,
+            force,
             state,
             segments,
             samples,
@@ -639,7 +742,10 @@ pub fn main() -> ExitCode {
             print,
         } => mesh::run(
             &design,
-            &output,
+            Target {
+                path: &output,
+                force,
+            },
             state,
             mesh::Resolution {
                 segments,

@@ -9,12 +9,23 @@ use crate::io::snapshots::{SnapshotWriter, VESSEL_FILE};
 use anyhow::Context;
 use std::path::{Path, PathBuf};
 
-/// Draws the snapshots of the run folder `dir` at `times` (empty: the default choice) in `view` into `output`.
+/// Draws the snapshots of the run folder `dir` at `times` (empty: the default choice) in `view` into `output`
+/// (an existing file only with `--force`).
 ///
 /// # Errors
-/// [`BadInput`] for an unknown view, an output that is not `.png`, or a folder without summary or snapshots;
-/// the error of a mesh that cannot be read or a picture that cannot be written.
-pub fn run(dir: &Path, output: &Path, times: &[f64], view: &str, width: u32) -> anyhow::Result<()> {
+/// [`BadInput`] for an unknown view, an output that is not `.png` or exists (without `--force`), or a folder
+/// without summary or snapshots; the error of a mesh that cannot be read or a picture that cannot be written.
+pub fn run(
+    dir: &Path,
+    output: super::Target<'_>,
+    times: &[f64],
+    view: &str,
+    width: u32,
+) -> anyhow::Result<()> {
+    let super::Target {
+        path: output,
+        force,
+    } = output;
     let view = View::parse(view).ok_or_else(|| {
         BadInput(format!(
             "--view `{view}`: expected axonometric, x1-x2, x1-x3 or x2-x3"
@@ -26,6 +37,7 @@ pub fn run(dir: &Path, output: &Path, times: &[f64], view: &str, width: u32) -> 
     if !(16..=2048).contains(&width) {
         return Err(BadInput(format!("--width {width}: expected 16 to 2048 pixels")).into());
     }
+    super::refuse_existing([output], force)?;
     let summary_path = dir.join("summary.json");
     let text = std::fs::read_to_string(&summary_path).map_err(|e| {
         BadInput(format!(

@@ -8,7 +8,9 @@
 //!   the steps it holds and every complete snapshot on disk.
 //!
 //! The folder's lock is taken first, so a folder whose run is still going is refused. Only files the run
-//! folder's manifest lists are touched. Repairing a folder twice changes nothing the second time.
+//! folder's manifest lists are touched, and none through a symbolic link: a folder holding links where
+//! stentkit writes is refused, naming them ([`classify`]), and each file is opened without following one
+//! ([`crate::io::no_follow`]). Repairing a folder twice changes nothing the second time.
 
 use super::{BadInput, short_time};
 use crate::io::mcap_salvage::{Salvage, salvage};
@@ -115,13 +117,16 @@ pub fn run(dir: &Path) -> anyhow::Result<()> {
 /// Cuts `history.csv` back to its last complete row; returns the time of every row (row `k` is step `k`) and
 /// the bytes cut.
 fn repair_history(path: &Path) -> anyhow::Result<(Vec<f64>, usize)> {
-    let text = std::fs::read(path).with_context(|| format!("cannot read {}", path.display()))?;
+    use crate::io::no_follow;
+    use std::io::Read as _;
+    let mut text = Vec::new();
+    no_follow::open(path, std::fs::OpenOptions::new().read(true))
+        .and_then(|mut f| f.read_to_end(&mut text))
+        .with_context(|| format!("cannot read {}", path.display()))?;
     let complete = text.iter().rposition(|&b| b == b'\n').map_or(0, |i| i + 1);
     let cut = text.len() - complete;
     if cut > 0 {
-        let file = std::fs::OpenOptions::new()
-            .write(true)
-            .open(path)
+        let file = no_follow::open(path, std::fs::OpenOptions::new().write(true))
             .and_then(|f| f.set_len(complete as u64).and_then(|()| f.sync_all()));
         file.with_context(|| format!("cannot cut {}", path.display()))?;
     }

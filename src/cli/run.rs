@@ -22,9 +22,10 @@
 //! heartbeat (so the recording's chunks hold every state up to it), and when a signal stops the run, the run
 //! writes `checkpoint.bin` ([`crate::io::checkpoint`]: the simulation's [`crate::solver::Checkpoint`] and where
 //! each output stood), atomically, listed in the manifest; a completed run removes it. `run DESIGN --resume
-//! DIR` takes the folder of a killed or interrupted run ([`RunFolder::open_for_resume`]), refuses another
-//! design (model and output fingerprints), a run that completed or failed and a folder without a checkpoint
-//! (exit status 2), restores the simulation and continues every output from the checkpoint: `history.csv` is
+//! DIR` takes the folder of a killed or interrupted run ([`run_folder::check_resume`]), refuses another
+//! design (model and output fingerprints), a run that completed or failed, a folder without a checkpoint and a
+//! history shorter than the checkpoint's or missing (exit status 2; a refusal changes nothing, the summary
+//! included, so the run can still be resumed once the cause is put right), restores the simulation and continues every output from the checkpoint: `history.csv` is
 //! cut back to the checkpoint's row and continued; the snapshots after it are removed and written again as
 //! their steps come; the recording (salvaged first if the run was killed) is copied up to the checkpoint's
 //! last message into a new file built beside it, which then replaces it, and continues; the charts and the
@@ -576,8 +577,7 @@ fn resume(
         }
         _ => {}
     }
-    let folder =
-        RunFolder::open_for_resume(dir, Path::new(checkpoint::FILE_NAME)).map_err(refused)?;
+    let fit = run_folder::check_resume(dir, Path::new(checkpoint::FILE_NAME)).map_err(refused)?;
     let file = dir.join(checkpoint::FILE_NAME);
     let saved = checkpoint::read(&file).map_err(|e| BadInput(e.to_string()))?;
     if saved.solver.model != model_fingerprint(&design.model) {
@@ -597,6 +597,17 @@ fn resume(
         ))
         .into());
     }
+    let history = dir.join("history.csv");
+    crate::io::history::check_resumable(&history, &saved.outputs.history).map_err(|e| {
+        BadInput(format!(
+            "{}; the run cannot be continued from its checkpoint at step {} without the rows before it \
+             (nothing was changed: put the history back, or run the design again with --force)",
+            e,
+            saved.solver.step
+        ))
+    })?;
+    // Every check passed: only now is anything written (the lock, stale temporaries removed).
+    let folder = fit.open()?;
     if !options.quiet {
         eprintln!(
             "stentkit run: resuming {} from its checkpoint at step {} (t = {} s)",
@@ -730,7 +741,7 @@ fn run_in(
     }
     if result.as_ref().is_ok_and(|s| !s.stopped) && sim.is_finished() {
         // Best effort: a checkpoint left behind is listed, and `--force` removes it.
-        let _ = std::fs::remove_file(&checkpoints.path);
+        let _ = crate::io::no_follow::remove_inside(dir, Path::new(checkpoint::FILE_NAME));
     }
 
     let finish_started = Instant::now();
@@ -931,11 +942,8 @@ fn resume_outputs(
         .collect();
     for listed in manifest.listed() {
         if listed.starts_with(SnapshotWriter::FOLDER) && !kept.contains(listed.as_path()) {
-            let path = dir.join(&listed);
-            if path.exists() {
-                std::fs::remove_file(&path)
-                    .with_context(|| format!("cannot remove {}", path.display()))?;
-            }
+            crate::io::no_follow::remove_inside(dir, &listed)
+                .with_context(|| format!("cannot remove {}", dir.join(&listed).display()))?;
         }
     }
     let snapshots = SnapshotWriter::create(dir, &design.output.snapshots, model)?
@@ -1232,7 +1240,8 @@ fn finish_recording(
                     bytes
                 }
                 Err(salvage_error) => {
-                    let removed = std::fs::remove_file(&mcap_path).is_ok();
+                    let removed = crate::io::no_follow::remove_inside(dir, Path::new("run.mcap"))
+                        .unwrap_or(false);
                     state(
                         "run.mcap",
                         false,

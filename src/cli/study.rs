@@ -1,6 +1,7 @@
 //! `stentkit study`: the arguments of each study turned into its settings, the study run by the library
 //! ([`crate::study`]), its CSV and charts written into the output folder, and its progress and results printed.
 
+use super::Target;
 use crate::io::chart::write_svg;
 use crate::io::design::load_design;
 use crate::material::Integrator;
@@ -11,6 +12,13 @@ use crate::study::stability::{StabilityStudy, stability};
 use crate::study::time::{TimeReference, TimeStudy, time_charts, time_csv, time_study};
 use anyhow::Context;
 use std::path::Path;
+
+/// The files `study convergence` writes into its folder.
+const CONVERGENCE_FILES: [&str; 3] = ["convergence.csv", "error_vs_n.svg", "error_vs_time.svg"];
+/// The files `study time` writes into its folder.
+const TIME_FILES: [&str; 3] = ["time_steps.csv", "error_vs_h.svg", "error_vs_time.svg"];
+/// The summary `study stability` writes after its maps (`<map>.csv`, `<map>.svg`).
+const STABILITY_SUMMARY: &str = "stability.md";
 
 /// When and where a study measures its error: at `time` (default: the design's end time), on `samples` points
 /// per patch.
@@ -23,10 +31,10 @@ pub struct Sampling {
 }
 
 /// `stentkit study convergence`: the `p × n` sweep of `design` against the reference `P,N`, measured at `time`
-/// (default: the design's end time).
+/// (default: the design's end time), written into the folder `output` (its files replaced only with `--force`).
 pub fn convergence(
     design: &Path,
-    output: &Path,
+    output: Target<'_>,
     degrees: Vec<usize>,
     points: Vec<usize>,
     reference: Vec<usize>,
@@ -34,6 +42,11 @@ pub fn convergence(
     time_tolerance: Option<f64>,
 ) -> anyhow::Result<()> {
     let Sampling { time, samples } = sampling;
+    let Target {
+        path: output,
+        force,
+    } = output;
+    refuse_existing(output, CONVERGENCE_FILES, force)?;
     let design = load_design(design)?;
     let model = &design.model;
     let [rp, rn] = reference[..] else {
@@ -49,11 +62,11 @@ pub fn convergence(
     };
     create(output)?;
     let rows = convergence_study(&design, &study, progress)?;
-    let csv = output.join("convergence.csv");
+    let [csv, by_n_svg, by_time_svg] = CONVERGENCE_FILES.map(|f| output.join(f));
     write(&csv, &convergence_csv(&rows, &study, &model.name))?;
     let [by_n, by_time] = convergence_charts(&rows, &study, &model.name);
-    write_svg(&by_n, &output.join("error_vs_n.svg"))?;
-    write_svg(&by_time, &output.join("error_vs_time.svg"))?;
+    write_svg(&by_n, &by_n_svg)?;
+    write_svg(&by_time, &by_time_svg)?;
     println!(
         "{}: {} runs → {} (and error_vs_n.svg, error_vs_time.svg)",
         model.name,
@@ -78,10 +91,11 @@ pub fn parse_integrator(name: &str) -> Result<Integrator, String> {
 }
 
 /// `stentkit study time`: the time-step sweep of `design` per integrator, measured at `time` (default: the
-/// design's end time) against `reference` (`auto`, `design` or a step).
+/// design's end time) against `reference` (`auto`, `design` or a step), written into the folder `output` (its
+/// files replaced only with `--force`).
 pub fn time(
     design: &Path,
-    output: &Path,
+    output: Target<'_>,
     steps: Vec<f64>,
     tolerances: Vec<f64>,
     integrators: &[String],
@@ -89,6 +103,11 @@ pub fn time(
     sampling: Sampling,
 ) -> anyhow::Result<()> {
     let Sampling { time, samples } = sampling;
+    let Target {
+        path: output,
+        force,
+    } = output;
+    refuse_existing(output, TIME_FILES, force)?;
     let design = load_design(design)?;
     let model = &design.model;
     let integrators = integrators
@@ -112,11 +131,11 @@ pub fn time(
     };
     create(output)?;
     let result = time_study(model, &study, progress)?;
-    let csv = output.join("time_steps.csv");
+    let [csv, by_h_svg, by_time_svg] = TIME_FILES.map(|f| output.join(f));
     write(&csv, &time_csv(&result, &study, &model.name))?;
     let [by_h, by_time] = time_charts(&result, &study, &model.name);
-    write_svg(&by_h, &output.join("error_vs_h.svg"))?;
-    write_svg(&by_time, &output.join("error_vs_time.svg"))?;
+    write_svg(&by_h, &by_h_svg)?;
+    write_svg(&by_time, &by_time_svg)?;
     println!(
         "{}: errors at t = {} against {}",
         model.name, study.time, result.reference
@@ -139,14 +158,25 @@ pub fn time(
 }
 
 /// `stentkit study stability`: the maps named in `maps` (any of material, bend45, heating, release, coarse), each
-/// written as `<map>.csv` and `<map>.svg` as soon as it is done, then `stability.md`.
-pub fn stability_maps(output: &Path, maps: &[String]) -> anyhow::Result<()> {
+/// written as `<map>.csv` and `<map>.svg` as soon as it is done, then `stability.md`, into the folder `output`
+/// (its files replaced only with `--force`).
+pub fn stability_maps(output: Target<'_>, maps: &[String]) -> anyhow::Result<()> {
+    let Target {
+        path: output,
+        force,
+    } = output;
     for m in maps {
         anyhow::ensure!(
             ["material", "bend45", "heating", "release", "coarse"].contains(&m.as_str()),
             "unknown map `{m}` (material, bend45, heating, release, coarse)"
         );
     }
+    let files: Vec<String> = maps
+        .iter()
+        .flat_map(|m| [format!("{m}.csv"), format!("{m}.svg")])
+        .chain([STABILITY_SUMMARY.to_string()])
+        .collect();
+    refuse_existing(output, files.iter().map(String::as_str), force)?;
     let mut study = StabilityStudy::default();
     let wanted = |name: &str| maps.iter().any(|m| m == name);
     if !wanted("material") {
@@ -174,9 +204,9 @@ pub fn stability_maps(output: &Path, maps: &[String]) -> anyhow::Result<()> {
         },
         progress,
     )?;
-    write(&output.join("stability.md"), &summary)?;
+    write(&output.join(STABILITY_SUMMARY), &summary)?;
     println!("{summary}");
-    println!("→ {}", output.join("stability.md").display());
+    println!("→ {}", output.join(STABILITY_SUMMARY).display());
     Ok(())
 }
 
@@ -190,7 +220,19 @@ fn create(output: &Path) -> anyhow::Result<()> {
     std::fs::create_dir_all(output).with_context(|| format!("cannot create {}", output.display()))
 }
 
-/// Writes `text` to `file`.
+/// Refuses (exit status 2) the folder `output` when it holds any of the study's `files`, unless `force`; an
+/// empty or new folder, or one holding only other files, is fine.
+fn refuse_existing<'a>(
+    output: &Path,
+    files: impl IntoIterator<Item = &'a str>,
+    force: bool,
+) -> Result<(), super::BadInput> {
+    let paths: Vec<std::path::PathBuf> = files.into_iter().map(|f| output.join(f)).collect();
+    super::refuse_existing(paths.iter().map(std::path::PathBuf::as_path), force)
+}
+
+/// Writes `text` to `file` atomically (a link in its place is replaced, not written through).
 fn write(file: &Path, text: &str) -> anyhow::Result<()> {
-    std::fs::write(file, text).with_context(|| format!("cannot write {}", file.display()))
+    crate::io::stl::write_bytes_atomically(file, text.as_bytes())
+        .with_context(|| format!("cannot write {}", file.display()))
 }

@@ -218,11 +218,11 @@ fn spawn_task(
 ) -> anyhow::Result<Child> {
     use std::os::unix::process::CommandExt as _;
     let log_path = dir.log(&plan.variants[index].id);
-    let log = std::fs::OpenOptions::new()
-        .create(true)
-        .append(true)
-        .open(&log_path)
-        .with_context(|| format!("cannot open {}", log_path.display()))?;
+    let log = crate::io::no_follow::open(
+        &log_path,
+        std::fs::OpenOptions::new().create(true).append(true),
+    )
+    .with_context(|| format!("cannot open {}", log_path.display()))?;
     let mut command = Command::new(exe);
     command
         .arg("sweep")
@@ -270,7 +270,8 @@ fn submit(
     let exe = std::env::current_exe().context("cannot find the stentkit executable")?;
     let text = slurm::sbatch_text(&absolute, &exe, plan, todo, options);
     let script = dir.dir.join("sweep.sbatch");
-    std::fs::write(&script, text).with_context(|| format!("cannot write {}", script.display()))?;
+    crate::io::no_follow::write(&script, text.as_bytes())
+        .with_context(|| format!("cannot write {}", script.display()))?;
     if dry_run {
         println!(
             "wrote {} ({} tasks); submit it with: sbatch {}",
@@ -362,7 +363,8 @@ pub fn task(dir: &Path, index: usize, retry_failed: bool) -> anyhow::Result<()> 
         && !run_dir.join("summary.json").exists()
     {
         // Refused before the run folder had a summary: the state must say so.
-        let _ = std::fs::write(sweep.task_error(&id), super::error_text(e));
+        let _ =
+            crate::io::no_follow::write(&sweep.task_error(&id), super::error_text(e).as_bytes());
     }
     result
 }

@@ -2,7 +2,6 @@
 //! as it finishes, the choice summarised, and the tuned design written with `-o`
 //! ([`crate::io::design::tuned_text`]).
 
-use super::BadInput;
 use crate::io::design::{
     DesignOverrides, SetOverride, TunedChoice, load_design_with, parse_design, tuned_text,
 };
@@ -13,23 +12,18 @@ use std::io::Write as _;
 use std::path::Path;
 
 /// Tunes `design` to `tolerance`, trying `degrees` and at most `max_points` points per patch; writes the tuned
-/// design to `output` when given (never over an existing file). `sets` are `--set` overrides of the design.
+/// design to `output` when given (over an existing file only with `--force`). `sets` are `--set` overrides of
+/// the design.
 pub fn run(
     design_path: &Path,
     tolerance: f64,
-    output: Option<&Path>,
+    output: Option<super::Target<'_>>,
     degrees: Vec<usize>,
     max_points: usize,
     sets: Vec<SetOverride>,
 ) -> anyhow::Result<()> {
-    if let Some(out) = output
-        && out.exists()
-    {
-        return Err(BadInput(format!(
-            "{}: exists; tune does not replace a file (choose another name or remove it)",
-            out.display()
-        ))
-        .into());
+    if let Some(out) = output {
+        super::refuse_existing([out.path], out.force)?;
     }
     let design = load_design_with(design_path, &DesignOverrides::sets(sets))?;
     let settings = TuneSettings {
@@ -128,14 +122,16 @@ fn first_words(text: &str) -> String {
     }
 }
 
-/// Writes the tuned design next to nothing of the user's: a new file, checked to read back as the tuned model.
+/// Writes the tuned design, checked to read back as the tuned model: a new file (with `--force`, written
+/// atomically over what is there).
 fn write_tuned(
     design_path: &Path,
     source: &str,
     tuned: &Tuned,
     tolerance: f64,
-    out: &Path,
+    target: super::Target<'_>,
 ) -> anyhow::Result<()> {
+    let out = target.path;
     let (wall, ..) = tuned.cost;
     let choice = TunedChoice {
         degree: tuned.degree,
@@ -175,13 +171,17 @@ fn write_tuned(
         "the tuned text of {} does not give the tuned model (please report this)",
         design_path.display()
     );
-    // `create_new`: a file that appeared since the check is not replaced either.
-    std::fs::OpenOptions::new()
-        .write(true)
-        .create_new(true)
-        .open(out)
-        .and_then(|mut f| f.write_all(text.as_bytes()))
-        .with_context(|| format!("writing {}", out.display()))?;
+    if target.force {
+        crate::io::stl::write_bytes_atomically(out, text.as_bytes())
+    } else {
+        // `create_new`: a file that appeared since the check is not replaced either.
+        std::fs::OpenOptions::new()
+            .write(true)
+            .create_new(true)
+            .open(out)
+            .and_then(|mut f| f.write_all(text.as_bytes()))
+    }
+    .with_context(|| format!("writing {}", out.display()))?;
     println!("wrote {}", out.display());
     Ok(())
 }

@@ -98,6 +98,53 @@ pub struct HistoryPosition {
     pub last_time: Option<f64>,
 }
 
+/// Whether the history at `path` can be continued from `position` (a checkpoint's), changing nothing: the file
+/// must exist and hold at least the bytes it held at the checkpoint (a killed run may have written more, which
+/// [`HistoryWriter::resume`] cuts off; fewer means rows before the checkpoint are lost).
+///
+/// # Errors
+/// [`std::io::ErrorKind::NotFound`] or [`std::io::ErrorKind::InvalidData`], each naming the file and what it
+/// holds against what the checkpoint needs; another I/O error reading its size.
+pub fn check_resumable(path: &Path, position: &HistoryPosition) -> std::io::Result<()> {
+    let length = match std::fs::symlink_metadata(path) {
+        Ok(meta) => meta.len(),
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => {
+            return Err(std::io::Error::new(
+                e.kind(),
+                format!(
+                    "{} is missing; the checkpoint continues it after its {} bytes ({} rows)",
+                    path.display(),
+                    position.bytes,
+                    position.rows
+                ),
+            ));
+        }
+        Err(e) => {
+            return Err(std::io::Error::new(
+                e.kind(),
+                format!("{}: {e}", path.display()),
+            ));
+        }
+    };
+    shorter_than(path, length, position)
+}
+
+/// The error of a history of `length` bytes at `path` that is shorter than `position` says it was.
+fn shorter_than(path: &Path, length: u64, position: &HistoryPosition) -> std::io::Result<()> {
+    if length < position.bytes {
+        return Err(std::io::Error::new(
+            std::io::ErrorKind::InvalidData,
+            format!(
+                "{} holds {length} bytes, fewer than the {} ({} rows) it held at the checkpoint",
+                path.display(),
+                position.bytes,
+                position.rows
+            ),
+        ));
+    }
+    Ok(())
+}
+
 /// Writes `history.csv` as the simulation reports steps.
 pub struct HistoryWriter {
     /// The materials with a strain limit: `(material index, limit)`, each with a column of its own.
@@ -129,7 +176,7 @@ impl HistoryWriter {
         strain_limits: &[Option<f64>],
     ) -> std::io::Result<Self> {
         let limits = limited_materials(strain_limits);
-        let mut out = BufWriter::new(File::create(path)?);
+        let mut out = BufWriter::new(super::no_follow::create(path)?);
         let mut header = String::from("time");
         if sim.model().solver.path.arc_length().is_some() {
             header.push_str(",load_factor");
@@ -199,21 +246,16 @@ impl HistoryWriter {
         strain_limits: &[Option<f64>],
     ) -> std::io::Result<Self> {
         let limits = limited_materials(strain_limits);
-        let file = std::fs::OpenOptions::new().write(true).open(path)?;
-        let length = file.metadata()?.len();
-        if length < position.bytes {
-            return Err(std::io::Error::new(
-                std::io::ErrorKind::InvalidData,
-                format!(
-                    "{} holds {length} bytes, fewer than the {} it held at the checkpoint",
-                    path.display(),
-                    position.bytes
-                ),
-            ));
-        }
+        check_resumable(path, &position)?;
+        // The handle, opened without following a link, is measured, cut, read and appended to: the path is not
+        // looked up again.
+        let mut file =
+            super::no_follow::open(path, std::fs::OpenOptions::new().read(true).write(true))?;
+        shorter_than(path, file.metadata()?.len(), &position)?;
         file.set_len(position.bytes)?;
-        let peak = run_peak_surface_strain(&std::fs::read_to_string(path)?);
-        let mut file = file;
+        let mut text = String::new();
+        std::io::Read::read_to_string(&mut file, &mut text)?;
+        let peak = run_peak_surface_strain(&text);
         std::io::Seek::seek(&mut file, std::io::SeekFrom::End(0))?;
         Ok(Self {
             exceeded: vec![false; limits.len()],

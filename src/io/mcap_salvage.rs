@@ -76,7 +76,12 @@ pub fn salvage(path: &Path) -> Result<Salvage, SalvageError> {
         path: path.to_path_buf(),
         source,
     };
-    let bytes = std::fs::read(path).map_err(io_err)?;
+    // Opened without following a link (a link in the recording's place points at someone else's file, which a
+    // salvage would cut), then read through the handle.
+    let mut bytes = Vec::new();
+    super::no_follow::open(path, OpenOptions::new().read(true))
+        .and_then(|mut f| io::Read::read_to_end(&mut f, &mut bytes))
+        .map_err(io_err)?;
     // Read whole once: a complete file is either left alone (indexed) or only re-indexed.
     let complete = if bytes.ends_with(MAGIC) {
         messages_in(&bytes)
@@ -122,7 +127,8 @@ fn cut_in_place(path: &Path, bytes: &[u8]) -> Result<Cut, SalvageError> {
         let mut candidate = bytes[..cut].to_vec();
         candidate.extend_from_slice(&ending());
         if let Some(found) = messages_in(&candidate) {
-            let mut file = OpenOptions::new().write(true).open(path).map_err(io_err)?;
+            let mut file =
+                super::no_follow::open(path, OpenOptions::new().write(true)).map_err(io_err)?;
             file.set_len(cut as u64)
                 .and_then(|()| {
                     file.seek(io::SeekFrom::End(0))?;

@@ -13,6 +13,7 @@ pub mod history;
 pub mod mcap;
 pub mod mcap_salvage;
 pub mod mesh_format;
+pub mod no_follow;
 pub mod obj;
 pub mod render;
 pub mod run_charts;

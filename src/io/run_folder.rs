@@ -14,7 +14,13 @@
 //! - A run holds an advisory lock on [`LOCK`] (`flock`, released by the kernel when the process ends, also on
 //!   SIGKILL) for its whole length; the lock file records the holder's pid and start time, which a second run
 //!   into the same folder is refused with.
+//! - Nothing is removed, truncated or rewritten through a symbolic link ([`crate::io::no_follow`]): a run
+//!   folder holding a link in the place of a listed file, of a file every run writes ([`RUN_NAMES`]) or of
+//!   `snapshots/` or `charts/` is refused by [`classify`], naming the links, before anything is changed; and
+//!   every removal, truncation and rewrite below opens its file or folder without following a link. The
+//!   folder itself may be a link (the user chose it).
 
+use super::no_follow;
 use serde::Deserialize;
 use std::collections::BTreeSet;
 use std::fs::{self, File, OpenOptions};
@@ -28,6 +34,20 @@ pub const MANIFEST: &str = ".stentkit-run";
 pub const LOCK: &str = ".stentkit-run.lock";
 /// The space reserve's file name inside a run folder (see [`RunFolder::reserve`]).
 pub const RESERVE: &str = ".stentkit-reserve";
+/// The names every run writes (or may write) in its folder besides the snapshots and charts: none of them may
+/// be a symbolic link ([`classify`]).
+pub const RUN_NAMES: [&str; 10] = [
+    MANIFEST,
+    LOCK,
+    RESERVE,
+    "summary.json",
+    "history.csv",
+    "run.mcap",
+    super::checkpoint::FILE_NAME,
+    super::snapshots::COLLECTION_FILE,
+    super::snapshots::SnapshotWriter::FOLDER,
+    super::run_charts::RunCharts::FOLDER,
+];
 /// The manifest's first line (the format: one path relative to the run folder per following line).
 const MANIFEST_HEADER: &str = "# stentkit run folder: files written by stentkit (`run --force` removes only these), one per line";
 
@@ -80,9 +100,11 @@ pub enum FolderKind {
     Foreign,
 }
 
-/// Looks at `dir` without changing anything.
+/// Looks at `dir` without changing anything. A run folder (or an empty one) holding a symbolic link where
+/// stentkit writes — a listed file, one of [`RUN_NAMES`], a folder of either — is refused, naming the links.
 ///
 /// # Errors
+/// [`RunFolderError::Refused`] for a path that is not a folder or a folder with links;
 /// [`RunFolderError::Io`] when the folder or its manifest cannot be read.
 pub fn classify(dir: &Path) -> Result<FolderKind, RunFolderError> {
     if !dir.exists() {
@@ -95,20 +117,39 @@ pub fn classify(dir: &Path) -> Result<FolderKind, RunFolderError> {
         });
     }
     let manifest = dir.join(MANIFEST);
-    if manifest.exists() {
+    let kind = if manifest.exists() {
         let text = fs::read_to_string(&manifest).map_err(io_error(&manifest))?;
-        return Ok(FolderKind::Run(parse_manifest(&text)));
-    }
-    if let Some(files) = legacy_outputs(dir) {
-        return Ok(FolderKind::Run(files));
-    }
-    let mut entries = fs::read_dir(dir).map_err(io_error(dir))?;
-    let foreign = entries.any(|e| e.is_ok_and(|e| e.file_name() != LOCK));
-    Ok(if foreign {
-        FolderKind::Foreign
+        FolderKind::Run(parse_manifest(&text))
+    } else if let Some(files) = legacy_outputs(dir) {
+        FolderKind::Run(files)
     } else {
+        let mut entries = fs::read_dir(dir).map_err(io_error(dir))?;
+        if entries.any(|e| e.is_ok_and(|e| e.file_name() != LOCK)) {
+            return Ok(FolderKind::Foreign);
+        }
         FolderKind::Empty
-    })
+    };
+    let listed = match &kind {
+        FolderKind::Run(files) => files.iter().map(PathBuf::as_path).collect(),
+        _ => Vec::new(),
+    };
+    let links = super::no_follow::links_inside(dir, RUN_NAMES.iter().map(Path::new).chain(listed));
+    if !links.is_empty() {
+        let named: Vec<String> = links
+            .iter()
+            .map(|(link, target)| format!("{} → {}", link.display(), target.display()))
+            .collect();
+        return Err(RunFolderError::Refused {
+            path: dir.to_path_buf(),
+            reason: format!(
+                "holds symbolic links where stentkit writes ({}); stentkit removes, truncates or rewrites \
+                 nothing through a link: put the files or folders themselves there, or choose another folder \
+                 (nothing was changed)",
+                named.join(", ")
+            ),
+        });
+    }
+    Ok(kind)
 }
 
 /// The relative paths a manifest lists: every line but comments and blanks; absolute paths and paths that
@@ -273,6 +314,68 @@ impl FitFolder {
     }
 }
 
+/// Whether the folder of an earlier run can be continued (`stentkit run --resume`), changing nothing: `dir`
+/// must be a stentkit run folder ([`classify`]: no links where stentkit writes) whose manifest lists
+/// `checkpoint` (a path inside it), and that file must exist. Returns the folder found fit, to be taken with
+/// [`ResumableFolder::open`] once the caller's own checks (the checkpoint's content, the history's length)
+/// pass too: a refusal changes nothing on disk.
+///
+/// # Errors
+/// [`RunFolderError::Refused`] (bad input) for a folder that is not a run folder or holds no checkpoint,
+/// [`RunFolderError::Io`].
+pub fn check_resume(dir: &Path, checkpoint: &Path) -> Result<ResumableFolder, RunFolderError> {
+    let refuse = |reason: String| RunFolderError::Refused {
+        path: dir.to_path_buf(),
+        reason,
+    };
+    let files = match classify(dir)? {
+        FolderKind::Run(files) => files,
+        FolderKind::Empty => {
+            return Err(refuse(
+                "is empty or missing: there is no run to resume; start one without --resume".into(),
+            ));
+        }
+        FolderKind::Foreign => {
+            return Err(refuse(
+                "is not a stentkit run folder (it has no .stentkit-run manifest): there is no run to resume"
+                    .into(),
+            ));
+        }
+    };
+    if !files.contains(checkpoint) || !dir.join(checkpoint).is_file() {
+        return Err(refuse(format!(
+            "holds no checkpoint ({}): the run wrote none (it ran for less than --checkpoint-every, or with a stentkit without checkpoints), so it cannot be resumed; run it again with --force",
+            checkpoint.display()
+        )));
+    }
+    Ok(ResumableFolder {
+        dir: dir.to_path_buf(),
+        files,
+    })
+}
+
+/// The folder of an earlier run that [`check_resume`] found fit to continue, not yet taken: nothing has been
+/// written.
+#[derive(Debug)]
+pub struct ResumableFolder {
+    dir: PathBuf,
+    /// The files its manifest lists.
+    files: BTreeSet<PathBuf>,
+}
+
+impl ResumableFolder {
+    /// Takes the folder (its lock; the manifest keeps its list, and the continued run appends to it) and
+    /// removes the hidden temporaries of listed files (what a killed run leaves); nothing else is removed.
+    ///
+    /// # Errors
+    /// [`RunFolderError::Busy`] when a run holds it, [`RunFolderError::Io`].
+    pub fn open(self) -> Result<RunFolder, RunFolderError> {
+        let folder = RunFolder::take(self.dir, BTreeSet::new())?;
+        remove_stale_temporaries(&folder.dir, &self.files)?;
+        Ok(folder)
+    }
+}
+
 /// Bytes of the files `files` (relative to `dir`) that exist.
 fn files_bytes(dir: &Path, files: &BTreeSet<PathBuf>) -> u64 {
     files
@@ -346,56 +449,16 @@ impl RunFolder {
         check(dir, design_file, force)?.open()
     }
 
-    /// Takes the folder of an earlier run to continue it (`stentkit run --resume`): `dir` must be a stentkit
-    /// run folder whose manifest lists `checkpoint` (a path inside it) and where that file exists. Nothing is
-    /// removed but the hidden temporaries of listed files (what a killed run leaves); the manifest keeps its
-    /// list, and the continued run appends to it.
-    ///
-    /// # Errors
-    /// [`RunFolderError::Refused`] (bad input) for a folder that is not a run folder or holds no checkpoint,
-    /// [`RunFolderError::Busy`] when a run holds it, [`RunFolderError::Io`].
-    pub fn open_for_resume(dir: &Path, checkpoint: &Path) -> Result<Self, RunFolderError> {
-        let refuse = |reason: String| RunFolderError::Refused {
-            path: dir.to_path_buf(),
-            reason,
-        };
-        let files = match classify(dir)? {
-            FolderKind::Run(files) => files,
-            FolderKind::Empty => {
-                return Err(refuse(
-                    "is empty or missing: there is no run to resume; start one without --resume"
-                        .into(),
-                ));
-            }
-            FolderKind::Foreign => {
-                return Err(refuse(
-                    "is not a stentkit run folder (it has no .stentkit-run manifest): there is no run to resume"
-                        .into(),
-                ));
-            }
-        };
-        if !files.contains(checkpoint) || !dir.join(checkpoint).is_file() {
-            return Err(refuse(format!(
-                "holds no checkpoint ({}): the run wrote none (it ran for less than --checkpoint-every, or with a stentkit without checkpoints), so it cannot be resumed; run it again with --force",
-                checkpoint.display()
-            )));
-        }
-        let folder = Self::take(dir.to_path_buf(), BTreeSet::new())?;
-        remove_stale_temporaries(dir, &files)?;
-        Ok(folder)
-    }
-
     fn take(dir: PathBuf, previous: BTreeSet<PathBuf>) -> Result<Self, RunFolderError> {
         let dir = dir.as_path();
         fs::create_dir_all(dir).map_err(io_error(dir))?;
         let lock = lock(dir)?;
         let path = dir.join(MANIFEST);
-        let mut file = OpenOptions::new()
-            .create(true)
-            .append(true)
-            .read(true)
-            .open(&path)
-            .map_err(io_error(&path))?;
+        let mut file = no_follow::open(
+            &path,
+            OpenOptions::new().create(true).append(true).read(true),
+        )
+        .map_err(io_error(&path))?;
         let mut text = String::new();
         file.seek(io::SeekFrom::Start(0))
             .and_then(|_| file.read_to_string(&mut text))
@@ -441,13 +504,16 @@ impl RunFolder {
         let relative = Path::new(RESERVE);
         let path = self.dir.join(relative);
         self.manifest.claim(relative).map_err(io_error(&path))?;
-        let written = File::create(&path)
+        let written = no_follow::create(&path)
             .and_then(|mut f| f.write_all(&vec![0u8; bytes]).and_then(|()| f.sync_data()));
+        let reserve = Reserve {
+            dir: self.dir.clone(),
+        };
         if let Err(e) = written {
-            let _ = fs::remove_file(&path);
+            drop(reserve);
             return Err(io_error(&path)(e));
         }
-        Ok(Reserve { path })
+        Ok(reserve)
     }
 
     /// Removes the files of the earlier run in this folder (only those its manifest lists), stale hidden
@@ -461,10 +527,13 @@ impl RunFolder {
         for relative in &self.previous {
             let path = self.dir.join(relative);
             if path.is_file() {
-                fs::remove_file(&path).map_err(io_error(&path))?;
+                no_follow::remove_inside(&self.dir, relative).map_err(io_error(&path))?;
             }
         }
-        for folder in ["snapshots", "charts"] {
+        for folder in [
+            super::snapshots::SnapshotWriter::FOLDER,
+            super::run_charts::RunCharts::FOLDER,
+        ] {
             // Only if empty: a file of the user's keeps its folder.
             let _ = fs::remove_dir(self.dir.join(folder));
         }
@@ -489,7 +558,8 @@ impl RunFolder {
 /// when dropped.
 #[derive(Debug)]
 pub struct Reserve {
-    path: PathBuf,
+    /// The run folder it is in (as [`RESERVE`]).
+    dir: PathBuf,
 }
 
 impl Reserve {
@@ -500,7 +570,7 @@ impl Reserve {
 impl Drop for Reserve {
     fn drop(&mut self) {
         // Best effort: a reserve that cannot be deleted is listed in the manifest and removed by `--force`.
-        let _ = fs::remove_file(&self.path);
+        let _ = no_follow::remove_inside(&self.dir, Path::new(RESERVE));
     }
 }
 
@@ -519,18 +589,22 @@ pub fn remove_stale_temporaries(
         .collect();
     let mut removed = Vec::new();
     for folder in folders {
-        let Ok(entries) = fs::read_dir(dir.join(&folder)) else {
+        // A folder that is missing (or, raced in since `classify`, a link) holds no temporary of ours.
+        let Ok(opened) = no_follow::folder_inside(dir, &folder) else {
             continue;
         };
-        for entry in entries.flatten() {
-            let name = entry.file_name();
+        let Ok(names) = opened.names() else {
+            continue;
+        };
+        for name in names {
             let Some(target) = name.to_str().and_then(temporary_target) else {
                 continue;
             };
             if owned.contains(&folder.join(target)) {
-                let path = entry.path();
-                fs::remove_file(&path).map_err(io_error(&path))?;
-                removed.push(folder.join(&name));
+                let path = dir.join(&folder).join(&name);
+                if opened.remove(&name).map_err(io_error(&path))? {
+                    removed.push(folder.join(&name));
+                }
             }
         }
     }
@@ -549,13 +623,15 @@ fn temporary_target(name: &str) -> Option<&str> {
 /// Takes the lock of `dir` and writes who holds it.
 fn lock(dir: &Path) -> Result<File, RunFolderError> {
     let path = dir.join(LOCK);
-    let mut file = OpenOptions::new()
-        .create(true)
-        .truncate(false)
-        .read(true)
-        .write(true)
-        .open(&path)
-        .map_err(io_error(&path))?;
+    let mut file = no_follow::open(
+        &path,
+        OpenOptions::new()
+            .create(true)
+            .truncate(false)
+            .read(true)
+            .write(true),
+    )
+    .map_err(io_error(&path))?;
     match file.try_lock() {
         Ok(()) => {}
         Err(fs::TryLockError::WouldBlock) => {

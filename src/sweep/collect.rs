@@ -283,7 +283,7 @@ fn field(text: &str) -> String {
 /// Writes `text` to `path` through a temporary file renamed over it (a reader never sees half a table).
 fn write_replacing(path: &std::path::Path, text: &str) -> Result<(), SweepError> {
     let temporary = path.with_extension("csv.partial");
-    std::fs::write(&temporary, text)
+    crate::io::no_follow::write(&temporary, text.as_bytes())
         .and_then(|()| std::fs::rename(&temporary, path))
         .map_err(|source| SweepError::Io {
             path: path.to_path_buf(),

@@ -143,9 +143,11 @@ pub fn record_job(dir: &SweepDir, job: Job) -> Result<(), SweepError> {
     let mut jobs = read_jobs(dir);
     jobs.push(job);
     let path = dir.dir.join(JOBS_FILE);
-    std::fs::write(
+    crate::io::no_follow::write(
         &path,
-        serde_json::to_string_pretty(&jobs).unwrap_or_default(),
+        serde_json::to_string_pretty(&jobs)
+            .unwrap_or_default()
+            .as_bytes(),
     )
     .map_err(|source| SweepError::Io { path, source })
 }

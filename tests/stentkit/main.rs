@@ -12,6 +12,7 @@ mod designs;
 mod export;
 mod fields;
 mod fuzz;
+mod links;
 mod materials;
 mod mesh;
 mod outputs;

@@ -32,6 +32,17 @@ pub fn test_outputs(name: &str) -> PathBuf {
     dir
 }
 
+/// A fresh, empty folder `<target>/tmp/<group>/<name>` for a test's scratch files (`check_outputs.py` does not
+/// read it).
+pub(crate) fn scratch_folder(group: &str, name: &str) -> PathBuf {
+    let dir = Path::new(env!("CARGO_TARGET_TMPDIR"))
+        .join(group)
+        .join(name);
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).expect("scratch folder");
+    dir
+}
+
 pub(crate) fn stentkit(args: &[&str]) -> Output {
     Command::new(env!("CARGO_BIN_EXE_stentkit"))
         .args(args)

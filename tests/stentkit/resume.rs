@@ -65,6 +65,18 @@ fn wait_for_checkpoint(child: &mut Child, dir: &Path, rows: usize) {
     }
 }
 
+/// The two-crown stent written into `root` and run into `root/run`, killed by SIGKILL after its first checkpoint
+/// with at least 50 history rows: a folder `--resume` continues. Returns the design and the run folder.
+pub(crate) fn killed_two_crown_run(root: &Path) -> (PathBuf, PathBuf) {
+    let design = two_crown_stent(root);
+    let dir = root.join("run");
+    let mut child = spawn(&design, &dir);
+    wait_for_checkpoint(&mut child, &dir, 50);
+    child.kill().expect("SIGKILL");
+    child.wait().expect("reaped");
+    (design, dir)
+}
+
 /// Every message of a recording: (topic, sequence, log time, body).
 fn messages(dir: &Path) -> Vec<(String, u32, u64, Vec<u8>)> {
     let bytes = std::fs::read(dir.join("run.mcap")).expect("run.mcap");
@@ -97,7 +109,7 @@ fn snapshot_files(dir: &Path) -> BTreeMap<String, Vec<u8>> {
 }
 
 /// Resumes `dir` with `design`: the status and the standard error.
-fn resume(design: &Path, dir: &Path) -> (Option<i32>, String) {
+pub(crate) fn resume(design: &Path, dir: &Path) -> (Option<i32>, String) {
     let out = stentkit(&[
         "run",
         path_str(design),
@@ -198,12 +210,7 @@ fn a_killed_or_interrupted_run_resumes_to_the_uninterrupted_result() {
 #[test]
 fn resuming_the_wrong_run_is_refused_with_status_2() {
     let root = scratch("refused");
-    let design = two_crown_stent(&root);
-    let dir = root.join("run");
-    let mut child = spawn(&design, &dir);
-    wait_for_checkpoint(&mut child, &dir, 50);
-    child.kill().expect("SIGKILL");
-    child.wait().expect("reaped");
+    let (design, dir) = killed_two_crown_run(&root);
 
     // Another design.
     let bend = Path::new(env!("CARGO_MANIFEST_DIR")).join("designs/bend45.yaml");

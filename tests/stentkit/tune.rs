@@ -87,9 +87,9 @@ fn a_tuned_arch_stays_within_its_tolerance_of_the_paper_settings() {
     eprintln!("tuned τ = {tau:e}: error against the paper settings {error:.3e}");
     assert!(error <= tolerance, "error {error:.3e} above the tolerance");
 
-    // A second tune to the same file is refused before any run, and the first file is kept.
+    // A second tune to the same file is refused before any run (without --force), and the first file is kept.
     let again = tune(&tuned_path);
     assert_eq!(again.status.code(), Some(2));
-    assert!(String::from_utf8_lossy(&again.stderr).contains("tune does not replace a file"));
+    assert!(String::from_utf8_lossy(&again.stderr).contains("exists; pass --force to replace it"));
     assert_eq!(std::fs::read_to_string(&tuned_path).expect("kept"), text);
 }

@@ -168,7 +168,7 @@ impl McapRecorder {
     ) -> Result<Self, McapError> {
         let model = &design.model;
         let settings = design.output.recording.clone();
-        let file = File::create(path).map_err(|source| McapError::Create {
+        let file = super::no_follow::create(path).map_err(|source| McapError::Create {
             path: path.to_path_buf(),
             source,
         })?;
