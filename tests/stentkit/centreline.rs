@@ -408,3 +408,109 @@ fn a_tapered_stent_follows_the_local_lumen() {
     let err = stentkit::io::design::parse_design(&refused, &path).expect_err("no oversize");
     assert!(err.to_string().contains("stent.taper"), "{err}");
 }
+
+/// A scratch folder for one test (removed first if a previous run left it).
+fn scratch(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("stentkit-{name}-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).expect("scratch folder");
+    dir
+}
+
+/// The aorta design with its centreline file block replaced: `path` and the lines of `file:` given
+/// (`start`, `length`, `smoothing` when `Some`; dropped when `None`).
+fn aorta_design_on(path: &Path, smoothing: Option<&str>, whole: bool) -> String {
+    let design = Path::new(env!("CARGO_MANIFEST_DIR")).join("designs/aorta_stent.yaml");
+    let text = std::fs::read_to_string(design).expect("design");
+    text.lines()
+        .filter_map(|line| {
+            let key = line.trim_start();
+            if key.starts_with("path: data/aorta-centerline.vtp") {
+                Some(format!("      path: {}", path.display()))
+            } else if whole && (key.starts_with("start:") || key.starts_with("length:")) {
+                None
+            } else if key.starts_with("smoothing:") {
+                smoothing.map(|s| format!("      smoothing: {s}"))
+            } else {
+                Some(line.to_string())
+            }
+        })
+        .collect::<Vec<_>>()
+        .join("\n")
+}
+
+/// The value of `smoothing: X` that a too-tight refusal suggests (`set `smoothing: X` or more`).
+fn suggested_smoothing(error: &str) -> String {
+    error
+        .split("set `smoothing: ")
+        .nth(1)
+        .and_then(|rest| rest.split('`').next())
+        .unwrap_or_else(|| panic!("no suggestion in {error}"))
+        .to_string()
+}
+
+/// Issue 31, item 7: a smoothing tighter than the points' scatter. Reproduces the issue's two cases: the
+/// aorta design with `smoothing: 1e-9` (its 40 mm segment of 119 points; before, "singular system … a knot span
+/// holds no data") and 10 000 noisy points (a 45° arc of radius 100 mm sampled every 0.008 mm, each point moved
+/// by up to ±0.02 mm in each coordinate by a seeded generator; `smoothing: 0.001`, below the noise) — before,
+/// 167 s and 791 MB (dense normal equations of up to 10 000 control points, O(n³)) and the same message. Both
+/// are refused at `stent.centreline.file.smoothing`, saying the smoothing is too tight and what to set; the
+/// value suggested is then accepted by the fit (the design may still be refused for the noise's tight bends,
+/// which the stent cannot follow, but not for the smoothing).
+#[test]
+fn a_smoothing_tighter_than_the_points_is_refused_in_words() {
+    let dir = scratch("too-tight");
+    let aorta = Path::new(env!("CARGO_MANIFEST_DIR")).join("designs/data/aorta-centerline.vtp");
+    let mut seed = 0x2545_f491_4f6c_dd1d_u64;
+    let mut noise = || {
+        seed ^= seed << 13;
+        seed ^= seed >> 7;
+        seed ^= seed << 17;
+        (seed >> 11) as f64 / (1u64 << 53) as f64 * 0.04 - 0.02
+    };
+    let mut csv = String::from("x,y,z,radius\n");
+    for k in 0..10_000 {
+        let theta = 45f64.to_radians() * k as f64 / 9_999.0;
+        csv.push_str(&format!(
+            "{:.5},{:.5},{:.5},6\n",
+            100.0 * theta.cos() + noise(),
+            noise(),
+            100.0 * theta.sin() + noise()
+        ));
+    }
+    let noisy = dir.join("noisy.csv");
+    std::fs::write(&noisy, csv).expect("csv");
+    for (name, text) in [
+        ("aorta", aorta_design_on(&aorta, Some("1e-9"), false)),
+        ("noisy", aorta_design_on(&noisy, Some("0.001"), true)),
+    ] {
+        let path = dir.join(format!("{name}.yaml"));
+        let started = std::time::Instant::now();
+        let error = stentkit::io::design::parse_design(&text, &path)
+            .expect_err("too tight")
+            .to_string();
+        eprintln!(
+            "{name}: refused in {:.2} s: {error}",
+            started.elapsed().as_secs_f64()
+        );
+        assert!(
+            error.contains("stent.centreline.file.smoothing")
+                && error.contains("is too tight")
+                && error.contains("set `smoothing: "),
+            "{error}"
+        );
+        let enough = suggested_smoothing(&error);
+        let retried = text.replace(
+            &text
+                .lines()
+                .find(|l| l.trim_start().starts_with("smoothing:"))
+                .expect("a smoothing line")
+                .to_string(),
+            &format!("      smoothing: {enough}"),
+        );
+        if let Err(e) = stentkit::io::design::parse_design(&retried, &path) {
+            assert!(!e.to_string().contains("too tight"), "{enough}: {e}");
+        }
+    }
+    std::fs::remove_dir_all(&dir).ok();
+}

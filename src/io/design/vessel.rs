@@ -23,10 +23,11 @@
 
 use super::dto::{FileCentrelineDto, FileUnitDto, PolylineChoiceDto};
 use super::issue::{Result, issue};
-use crate::geometry::fit::smooth_points;
+use crate::geometry::GeometryError;
+use crate::geometry::fit::{MAX_SMOOTHING_CONTROL_POINTS, smooth_points};
 use crate::geometry::stent::CentrelineSpec;
 use crate::io::centreline::{Polyline, read_centreline};
-use crate::math::{Real, Vec3};
+use crate::math::{Real, Short, Vec3};
 use crate::model::Vessel;
 use std::path::Path;
 
@@ -120,8 +121,32 @@ pub fn vessel_centreline(
     }
     let segment = cut(&line, start, start + length);
     let smoothing = f.smoothing.map_or(1e-3 * length, |s| s.0);
-    let fit = smooth_points(&segment.points, smoothing)
-        .map_err(|e| issue(field("path"), format!("the segment cannot be fitted: {e}")))?;
+    let fit = smooth_points(&segment.points, smoothing).map_err(|e| match e {
+        GeometryError::SmoothingTooTight {
+            points,
+            closest,
+            worst_point,
+            control_points,
+            enough,
+            ..
+        } => {
+            let (at, what) = match f.smoothing {
+                Some(_) => (field("smoothing"), format!("`smoothing: {}`", Short(smoothing))),
+                None => (
+                    path.to_string(),
+                    format!("the default smoothing (length/1000 = {})", Short(smoothing)),
+                ),
+            };
+            issue(
+                at,
+                format!(
+                    "{what} is too tight: the segment's {points} points scatter more than that about any smooth line (the closest spline found, of {control_points} control points, is {closest:.2e} from point {worst_point}; a spline has at most {MAX_SMOOTHING_CONTROL_POINTS} control points, and at most one per point); set `smoothing: {}` or more",
+                    Short(enough)
+                ),
+            )
+        }
+        e => issue(field("path"), format!("the segment cannot be fitted: {e}")),
+    })?;
     let mean_radius = segment.radius.as_ref().map(|r| {
         let mut weighted = 0.0;
         for (w, rr) in segment.points.windows(2).zip(r.windows(2)) {
