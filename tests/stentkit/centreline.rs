@@ -760,6 +760,94 @@ fn a_smoothing_tighter_than_the_points_is_refused_in_words() {
     std::fs::remove_dir_all(&dir).ok();
 }
 
+/// Issue 31, item 8: the lumen of a dense centreline. Reproduces the issue's 100 000-point centreline: a 45° arc
+/// of radius 100 mm (78.5 mm) with a lumen radius of 6 mm as CSV (2.2 MB, under the 4 MiB limit), the aorta
+/// stent on its whole length. Before, the lumen was sampled at twice the points (200 000 rings, a 240 MB
+/// `vessel_lumen.stl`) and the disk estimate (45.7 MB) did not count it. Now the rings are at most
+/// `MAX_LUMEN_RINGS` (1000; 12 segments around, so at most 24 000 triangles), and the disk estimate counts the
+/// lumen to the byte (84 + 50 bytes per triangle) and, as for every run it is made for, covers every byte
+/// written (module docs of `io::estimate`: it has not underestimated a run).
+#[test]
+fn a_dense_centrelines_lumen_is_bounded_and_counted() {
+    let dir = scratch("dense-lumen");
+    let mut csv = String::new();
+    for k in 0..100_000 {
+        let theta = 45f64.to_radians() * k as f64 / 99_999.0;
+        csv.push_str(&format!(
+            "{:.5},0,{:.5},6\n",
+            100.0 * theta.cos(),
+            100.0 * theta.sin()
+        ));
+    }
+    let dense = dir.join("dense.csv");
+    std::fs::write(&dense, csv).expect("csv");
+    let design = dir.join("dense.yaml");
+    std::fs::write(&design, aorta_design_on(&dense, Some("0.01"), true)).expect("design");
+    let loaded = stentkit::io::design::load_design(&design).expect("the design reads");
+    let rings = loaded.model.vessel.as_ref().expect("a vessel").points.len();
+    assert_eq!(rings, stentkit::io::design::vessel::MAX_LUMEN_RINGS);
+    let estimate = stentkit::io::estimate::estimated_disk(&loaded);
+    let run = dir.join("run");
+    let out = crate::outputs::stentkit(&[
+        "run",
+        design.to_str().expect("UTF-8"),
+        "-q",
+        "-o",
+        run.to_str().expect("UTF-8"),
+        "--set",
+        "time.end=0.004",
+        "--set",
+        "output={snapshots: {times: [0.004]}}",
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let lumen = std::fs::metadata(run.join("snapshots/vessel_lumen.stl"))
+        .expect("the lumen")
+        .len();
+    assert_eq!(lumen, 84 + 50 * 2 * 12 * rings as u64);
+    let ran = stentkit::io::design::load_design_with(
+        &design,
+        &stentkit::io::design::DesignOverrides::sets(vec![
+            "time.end=0.004".parse().expect("override"),
+            "output={snapshots: {times: [0.004]}}"
+                .parse()
+                .expect("override"),
+        ]),
+    )
+    .expect("the design reads");
+    let estimate_ran = stentkit::io::estimate::estimated_disk(&ran);
+    assert_eq!(estimate_ran.vessel_lumen, lumen);
+    let files = walk(&run);
+    let written: u64 = files.iter().map(|f| f.1).sum();
+    eprintln!(
+        "lumen {lumen} bytes; run folder {written} bytes, estimated {} (the full design: {})",
+        estimate_ran.total(),
+        estimate.total()
+    );
+    assert!(
+        written <= estimate_ran.total(),
+        "{written} > {estimate_ran:?}: {files:?}"
+    );
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+/// Every file under `dir` with its size.
+fn walk(dir: &Path) -> Vec<(PathBuf, u64)> {
+    let mut files = Vec::new();
+    for entry in std::fs::read_dir(dir).expect("folder").flatten() {
+        let path = entry.path();
+        if path.is_dir() {
+            files.extend(walk(&path));
+        } else if let Ok(m) = entry.metadata() {
+            files.push((path, m.len()));
+        }
+    }
+    files
+}
+
 /// Issue 31, item 16: the header of a CSV centreline. `bom.csv` (tests/data/centrelines) starts with a UTF-8
 /// byte-order mark before the numeric row `0.0,0.0,0.0,6.0`; `letter_o.csv`'s first row is `0.0,0.0,O.0,6.0`
 /// (a letter O). Before, both first rows were taken for a header and the first point silently lost (3 points

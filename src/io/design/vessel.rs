@@ -34,6 +34,14 @@ use std::path::Path;
 /// VMTK's point array of the lumen radius.
 pub const DEFAULT_RADIUS_ARRAY: &str = "MaximumInscribedSphereRadius";
 
+/// Most samples of the vessel kept for the outputs: the rings of its lumen (`snapshots/vessel_lumen.stl`,
+/// `run.mcap`'s `/vessel`, the shaded picture) and the points of its centreline there. The vessel is the
+/// smoothing spline sampled at twice the segment's points, up to 1000: the aorta's 40 mm segment has 238. A
+/// ring every 0.1 mm of a 100 mm segment still shows a spline of up to
+/// [`crate::geometry::fit::MAX_SMOOTHING_CONTROL_POINTS`] control points, and 1000 rings of 12 vertices make
+/// 24 000 triangles, 1.2 MB of STL. (Unbounded, a 100 000-point centreline wrote a 240 MB lumen.)
+pub const MAX_LUMEN_RINGS: usize = 1000;
+
 /// A file centreline as the stent uses it.
 #[derive(Debug, Clone, PartialEq)]
 pub struct VesselCentreline {
@@ -49,8 +57,8 @@ pub struct VesselCentreline {
     pub length: Real,
     /// Points of the segment.
     pub points: usize,
-    /// The vessel for the outputs: the spline sampled at twice the segment's points, the lumen radius
-    /// interpolated there (by normalised arc length along the segment).
+    /// The vessel for the outputs: the spline sampled at twice the segment's points, at most
+    /// [`MAX_LUMEN_RINGS`], the lumen radius interpolated there (by normalised arc length along the segment).
     pub vessel: Vessel,
 }
 
@@ -154,7 +162,7 @@ pub fn vessel_centreline(
         }
         weighted / length
     });
-    let samples = 2 * segment.points.len();
+    let samples = (2 * segment.points.len()).min(MAX_LUMEN_RINGS);
     let u: Vec<Real> = (0..samples)
         .map(|k| k as Real / (samples - 1) as Real)
         .collect();
