@@ -273,6 +273,10 @@ fn designs_on_file_centrelines_are_checked() {
     }
 }
 
+/// The overrides of a brief run (as `the_aorta_stents_run_shows_the_vessel_lumen`'s): to t = 0.004 s, with one
+/// snapshot there besides the initial one.
+const BRIEF_RUN: [&str; 2] = ["time.end=0.004", "output={snapshots: {times: [0.004]}}"];
+
 /// The aorta stent's run folder holds the vessel's lumen beside the device (snapshots/vessel_lumen.stl, a
 /// closed tube of the file's lumen radius; `.ci/run` checks it with trimesh), and the stent's reference shape
 /// sits around the lumen's centreline at the oversized radius. Source: the design's sizing rule, R = the
@@ -787,35 +791,20 @@ fn a_dense_centrelines_lumen_is_bounded_and_counted() {
     let rings = loaded.model.vessel.as_ref().expect("a vessel").points.len();
     assert_eq!(rings, stentkit::io::design::vessel::MAX_LUMEN_RINGS);
     let estimate = stentkit::io::estimate::estimated_disk(&loaded);
-    let run = dir.join("run");
-    let out = crate::outputs::stentkit(&[
-        "run",
-        design.to_str().expect("UTF-8"),
-        "-q",
-        "-o",
-        run.to_str().expect("UTF-8"),
-        "--set",
-        "time.end=0.004",
-        "--set",
-        "output={snapshots: {times: [0.004]}}",
-    ]);
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    let sets: Vec<&str> = BRIEF_RUN.iter().flat_map(|set| ["--set", set]).collect();
+    let run = crate::materials::run(design.to_str().expect("UTF-8"), "dense_lumen", &sets);
     let lumen = std::fs::metadata(run.join("snapshots/vessel_lumen.stl"))
         .expect("the lumen")
         .len();
     assert_eq!(lumen, 84 + 50 * 2 * 12 * rings as u64);
     let ran = stentkit::io::design::load_design_with(
         &design,
-        &stentkit::io::design::DesignOverrides::sets(vec![
-            "time.end=0.004".parse().expect("override"),
-            "output={snapshots: {times: [0.004]}}"
-                .parse()
-                .expect("override"),
-        ]),
+        &stentkit::io::design::DesignOverrides::sets(
+            BRIEF_RUN
+                .iter()
+                .map(|set| set.parse().expect("override"))
+                .collect(),
+        ),
     )
     .expect("the design reads");
     let estimate_ran = stentkit::io::estimate::estimated_disk(&ran);
