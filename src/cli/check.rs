@@ -172,6 +172,7 @@ pub fn describe(design: &Design, file: &str) -> String {
         ("STL", disk.snapshot_stl),
         ("OBJ", disk.snapshot_obj),
         ("fields", disk.snapshot_vtp),
+        ("vessel lumen", disk.vessel_lumen),
     ]
     .into_iter()
     .filter(|&(_, bytes)| bytes > 0)

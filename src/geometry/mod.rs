@@ -98,4 +98,26 @@ pub enum GeometryError {
         /// Curve parameter.
         u: Real,
     },
+    /// No smoothing spline of at most [`fit::MAX_SMOOTHING_CONTROL_POINTS`] control points stays within the
+    /// tolerance of every point ([`fit::smooth_points`]): the tolerance is tighter than the points' scatter.
+    #[error(
+        "a smoothing tolerance of {} is too tight for these {points} points: the closest spline found, with {control_points} control points, is {} from point {worst_point}; set the tolerance to at least {}",
+        crate::math::Short(*tolerance),
+        crate::math::Short(*closest),
+        crate::math::Short(*enough)
+    )]
+    SmoothingTooTight {
+        /// The tolerance asked for [length].
+        tolerance: Real,
+        /// The points to fit.
+        points: usize,
+        /// Largest distance of the closest fit found from a point [length].
+        closest: Real,
+        /// The point (from 0) where that fit is farthest.
+        worst_point: usize,
+        /// Control points of that fit.
+        control_points: usize,
+        /// A tolerance that the same search meets: `closest` rounded up to two significant digits [length].
+        enough: Real,
+    },
 }

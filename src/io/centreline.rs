@@ -18,6 +18,12 @@
 //! A file is refused with its path and what is wrong: not the format its extension says, no polyline, a point
 //! that is not finite, a cell that names a point the file does not have, the radius array missing (when one is
 //! asked for; the arrays it does have are listed) or not positive.
+//!
+//! **Limits.** What reading a file may cost is bounded before it is paid: only a regular file is read (a
+//! device such as `/dev/zero` or `/dev/urandom` never ends, a FIFO blocks until someone writes), of at most
+//! [`MAX_CENTRELINE_BYTES`]; a file holds at most [`MAX_CENTRELINE_POINTS`]; and a compressed array is
+//! inflated no further than its header declares, which must not exceed what the array needs for the points
+//! (or cells) the file declares — a zlib block of a few hundred kilobytes can inflate to gigabytes.
 
 use crate::math::{Real, Vec3};
 use std::path::{Path, PathBuf};
@@ -37,6 +43,21 @@ impl Polyline {
         self.points.windows(2).map(|w| (w[1] - w[0]).norm()).sum()
     }
 }
+
+/// Largest centreline file stentkit reads [bytes]: 4 MiB, the limit of a design file
+/// ([`crate::io::design::guard::MAX_DESIGN_BYTES`]). VMTK's aorta centreline (409 points, zlib-compressed) is
+/// 15 kB; 4 MiB holds about 150 000 points as CSV (5 decimals, 28 bytes a row) and 262 144 in VTK's default
+/// inline base64 `Float32` encoding. The file is read once into memory (parsing adds a few times its size), so
+/// the limit also bounds what reading costs.
+pub const MAX_CENTRELINE_BYTES: u64 = 4 * 1024 * 1024;
+
+/// Most points a centreline file may hold, in all its pieces and polylines: 2¹⁸ (262 144), as many as a
+/// file of [`MAX_CENTRELINE_BYTES`] holds in VTK's default encoding (inline base64 `Float32`, 16 bytes a
+/// point); a CSV of that size holds about 150 000 (5 decimals). VMTK's centrelines have hundreds to a few
+/// thousand points (the aorta's 409). A compressed file could claim any number: this bounds what its arrays
+/// inflate to (6 MiB of `Float64` points) and what smoothing them costs (the fit is linear in the points: a
+/// segment of 2¹⁸ noisy points is refused as too tight in about 4 s, 2²⁰ took 16 s).
+pub const MAX_CENTRELINE_POINTS: usize = 1 << 18;
 
 /// Why a centreline file was refused.
 #[derive(Debug, thiserror::Error)]
@@ -68,9 +89,16 @@ pub fn read_centreline(
     path: &Path,
     radius_array: Option<&str>,
 ) -> Result<Vec<Polyline>, CentrelineError> {
-    let bytes = std::fs::read(path).map_err(|source| CentrelineError::Read {
+    let invalid = |message: String| CentrelineError::Invalid {
         path: path.to_path_buf(),
-        source,
+        message,
+    };
+    let bytes = read_regular_file(path).map_err(|e| match e {
+        Limited::Io(source) => CentrelineError::Read {
+            path: path.to_path_buf(),
+            source,
+        },
+        Limited::Refused(message) => invalid(message),
     })?;
     let extension = path
         .extension()
@@ -85,10 +113,74 @@ pub fn read_centreline(
     };
     result
         .and_then(|polylines| validate(polylines, radius_array))
-        .map_err(|message| CentrelineError::Invalid {
-            path: path.to_path_buf(),
-            message,
-        })
+        .map_err(invalid)
+}
+
+/// Why [`read_regular_file`] read nothing.
+enum Limited {
+    /// The operating system's error.
+    Io(std::io::Error),
+    /// Not a regular file, or larger than [`MAX_CENTRELINE_BYTES`].
+    Refused(String),
+}
+
+/// The bytes of the regular file at `path`, at most [`MAX_CENTRELINE_BYTES`]. Anything else is refused
+/// before it is opened: a device, FIFO, socket or folder (`/dev/zero` is endless, a FIFO blocks). The file is
+/// opened without blocking and checked again once open (it may have been replaced in between), and read no
+/// further than the limit (it may have grown).
+fn read_regular_file(path: &Path) -> Result<Vec<u8>, Limited> {
+    use std::io::Read as _;
+    use std::os::unix::fs::{FileTypeExt as _, OpenOptionsExt as _};
+    let refuse_kind = |kind: std::fs::FileType| {
+        let what = if kind.is_dir() {
+            "a folder"
+        } else if kind.is_char_device() {
+            "a character device"
+        } else if kind.is_block_device() {
+            "a block device"
+        } else if kind.is_fifo() {
+            "a FIFO (named pipe)"
+        } else if kind.is_socket() {
+            "a socket"
+        } else {
+            "not a regular file"
+        };
+        Limited::Refused(format!(
+            "{what}, not a regular file: a centreline is read from a file of at most {} MiB",
+            MAX_CENTRELINE_BYTES >> 20
+        ))
+    };
+    let too_large = |bytes: u64| {
+        Limited::Refused(format!(
+            "the file has {bytes} bytes ({:.1} MiB), more than stentkit's limit of {} MiB ({MAX_CENTRELINE_BYTES} bytes) for a centreline file; a VMTK centreline is tens of kB",
+            bytes as f64 / (1024.0 * 1024.0),
+            MAX_CENTRELINE_BYTES >> 20
+        ))
+    };
+    let metadata = std::fs::metadata(path).map_err(Limited::Io)?;
+    if !metadata.is_file() {
+        return Err(refuse_kind(metadata.file_type()));
+    }
+    if metadata.len() > MAX_CENTRELINE_BYTES {
+        return Err(too_large(metadata.len()));
+    }
+    let file = std::fs::OpenOptions::new()
+        .read(true)
+        .custom_flags(libc::O_NONBLOCK)
+        .open(path)
+        .map_err(Limited::Io)?;
+    let metadata = file.metadata().map_err(Limited::Io)?;
+    if !metadata.is_file() {
+        return Err(refuse_kind(metadata.file_type()));
+    }
+    let mut bytes = Vec::new();
+    file.take(MAX_CENTRELINE_BYTES + 1)
+        .read_to_end(&mut bytes)
+        .map_err(Limited::Io)?;
+    if bytes.len() as u64 > MAX_CENTRELINE_BYTES {
+        return Err(too_large(bytes.len() as u64));
+    }
+    Ok(bytes)
 }
 
 /// Checks what every format must give: at least one polyline of two points or more, finite points, and the
@@ -96,6 +188,12 @@ pub fn read_centreline(
 fn validate(polylines: Vec<Polyline>, radius_array: Option<&str>) -> Result<Vec<Polyline>, String> {
     if polylines.iter().all(|p| p.points.len() < 2) {
         return Err("no polyline of two or more points (a centreline needs `Lines` cells)".into());
+    }
+    let total: usize = polylines.iter().map(|p| p.points.len()).sum();
+    if total > MAX_CENTRELINE_POINTS {
+        return Err(format!(
+            "the polylines hold {total} points, more than stentkit's limit of {MAX_CENTRELINE_POINTS} for a centreline"
+        ));
     }
     for (k, line) in polylines.iter().enumerate() {
         if let Some(i) = line
@@ -120,36 +218,64 @@ fn validate(polylines: Vec<Polyline>, radius_array: Option<&str>) -> Result<Vec<
     Ok(polylines)
 }
 
-/// `x,y,z[,radius]` lines; a first line that is not numbers is a header; `#` starts a comment.
+/// `x,y,z[,radius]` rows, one polyline. A UTF-8 byte-order mark before the first row is skipped (spreadsheet
+/// programs write one); `#` starts a comment. The first row may be a header: a row with no number in it
+/// (`x,y,z,radius`). Any other field that is not a number is an error at its line and column — a first row
+/// `0.0,0.0,O.0,6.0` (a letter O) is a mistyped point, not a header.
 fn read_csv(bytes: &[u8]) -> Result<Vec<Polyline>, String> {
     let text = std::str::from_utf8(bytes).map_err(|_| "not a text file (CSV)".to_string())?;
+    let text = text.strip_prefix('\u{feff}').unwrap_or(text);
     let (mut points, mut radius) = (Vec::new(), Vec::new());
-    let mut columns = None;
+    let (mut columns, mut header) = (None, false);
     for (number, line) in text.lines().enumerate() {
-        let line = line.split('#').next().unwrap_or("").trim();
-        if line.is_empty() {
+        let content = line.split('#').next().unwrap_or("");
+        if content.trim().is_empty() {
             continue;
         }
-        let fields: Result<Vec<Real>, _> =
-            line.split(',').map(|f| f.trim().parse::<Real>()).collect();
-        let Ok(fields) = fields else {
-            if points.is_empty() && columns.is_none() {
-                columns = Some(0); // a header
+        // Each field with the column (from 1, in characters) where its text starts.
+        let mut fields = Vec::new();
+        let mut at = 0;
+        for field in content.split(',') {
+            let lead = field.len() - field.trim_start().len();
+            let column = content[..at + lead].chars().count() + 1;
+            fields.push((field.trim(), column));
+            at += field.len() + 1;
+        }
+        let values: Vec<Option<Real>> = fields.iter().map(|(f, _)| f.parse().ok()).collect();
+        if values.iter().all(Option::is_none) {
+            if points.is_empty() && !header {
+                header = true;
                 continue;
             }
-            return Err(format!("line {}: `{line}` is not numbers", number + 1));
-        };
-        if !(3..=4).contains(&fields.len()) || columns.is_some_and(|c| c != 0 && c != fields.len())
-        {
             return Err(format!(
-                "line {}: expected x,y,z or x,y,z,radius, found {} values",
+                "line {}: `{}` has no number (only the first row may be a header)",
                 number + 1,
+                content.trim()
+            ));
+        }
+        if let Some(k) = values.iter().position(Option::is_none) {
+            let (text, column) = fields[k];
+            return Err(format!(
+                "line {}, column {column}: `{text}` (field {} of {}) is not a number; a header is a row with no number in it",
+                number + 1,
+                k + 1,
                 fields.len()
             ));
         }
-        columns = Some(fields.len());
-        points.push(Vec3::new(fields[0], fields[1], fields[2]));
-        if let Some(&r) = fields.get(3) {
+        let values: Vec<Real> = values.into_iter().flatten().collect();
+        if !(3..=4).contains(&values.len()) || columns.is_some_and(|c| c != values.len()) {
+            return Err(format!(
+                "line {}: expected x,y,z or x,y,z,radius{}, found {} values",
+                number + 1,
+                columns.map_or(String::new(), |c| format!(
+                    " ({c} values as the rows before)"
+                )),
+                values.len()
+            ));
+        }
+        columns = Some(values.len());
+        points.push(Vec3::new(values[0], values[1], values[2]));
+        if let Some(&r) = values.get(3) {
             radius.push(r);
         }
     }
@@ -405,7 +531,10 @@ fn radius_values(
 mod vtp {
     //! VTK XML PolyData (module docs of [`super`]).
 
-    use super::{Polyline, Scalar, attributes, polylines_from_offsets, radius_values, triples};
+    use super::{
+        MAX_CENTRELINE_POINTS, Polyline, Scalar, attributes, polylines_from_offsets, radius_values,
+        triples,
+    };
     use crate::math::Real;
     use base64::Engine as _;
     use quick_xml::events::Event;
@@ -430,6 +559,21 @@ mod vtp {
         }
     }
 
+    /// The most bytes an array may hold, and what they are for (in messages): what the points or cells the
+    /// piece declares need.
+    struct Need {
+        bytes: usize,
+        what: String,
+    }
+
+    impl Need {
+        /// `count` tuples of `components` values of `scalar` for `what`; `None` on overflow.
+        fn of(count: usize, components: usize, scalar: Scalar, what: String) -> Option<Self> {
+            let bytes = count.checked_mul(components)?.checked_mul(scalar.size())?;
+            Some(Self { bytes, what })
+        }
+    }
+
     /// How the file encodes its binary data.
     struct Layout<'a> {
         big: bool,
@@ -445,7 +589,9 @@ mod vtp {
         let head = &bytes[..appended_at.unwrap_or(bytes.len())];
         let mut reader = quick_xml::Reader::from_reader(head);
         let mut buf = Vec::new();
-        let (mut stack, mut arrays, mut pieces) = (Vec::<String>::new(), Vec::new(), Vec::new());
+        let (mut stack, mut arrays) = (Vec::<String>::new(), Vec::new());
+        // Each piece: where its arrays start, and its attributes.
+        let mut pieces: Vec<(usize, Vec<(String, String)>)> = Vec::new();
         let mut root: Option<Vec<(String, String)>> = None;
         let mut current: Option<Array> = None;
         // Elements open inside the current DataArray (VTK writes <InformationKey> there): their text is not data.
@@ -463,7 +609,7 @@ mod vtp {
                     let name = String::from_utf8_lossy(e.name().as_ref()).into_owned();
                     match name.as_str() {
                         "VTKFile" => root = Some(attributes(&e)?),
-                        "Piece" => pieces.push(arrays.len()),
+                        "Piece" => pieces.push((arrays.len(), attributes(&e)?)),
                         "DataArray" => {
                             let array = Array {
                                 section: stack.last().cloned().unwrap_or_default(),
@@ -536,16 +682,45 @@ mod vtp {
             appended,
         };
         let mut polylines = Vec::new();
-        pieces.push(arrays.len());
-        for w in pieces.windows(2) {
-            polylines.extend(piece(&arrays[w[0]..w[1]], &layout, radius_array)?);
+        let mut points = 0usize;
+        for (k, (start, attrs)) in pieces.iter().enumerate() {
+            let end = pieces.get(k + 1).map_or(arrays.len(), |p| p.0);
+            // As VTK's reader: a piece must say its points; no `NumberOfLines` is none.
+            let declared = |name: &str, default: Option<&str>| -> Result<usize, String> {
+                let text = attrs
+                    .iter()
+                    .find(|(n, _)| n == name)
+                    .map(|(_, v)| v.as_str())
+                    .or(default)
+                    .ok_or_else(|| format!("piece {k} has no {name}"))?;
+                text.trim()
+                    .parse()
+                    .map_err(|_| format!("piece {k}: {name}=\"{text}\" is not a count"))
+            };
+            let counts = (
+                declared("NumberOfPoints", None)?,
+                declared("NumberOfLines", Some("0"))?,
+            );
+            points = points.saturating_add(counts.0);
+            if let Some((n, what)) = [(points, "points"), (counts.1, "lines")]
+                .into_iter()
+                .find(|&(n, _)| n > MAX_CENTRELINE_POINTS)
+            {
+                return Err(format!(
+                    "the file declares {n} {what}, more than stentkit's limit of {MAX_CENTRELINE_POINTS} points for a centreline"
+                ));
+            }
+            polylines.extend(piece(&arrays[*start..end], counts, &layout, radius_array)?);
         }
         Ok(polylines)
     }
 
-    /// The polylines of one piece.
+    /// The polylines of one piece of `(points, lines)` as it declares (`NumberOfPoints`, `NumberOfLines`).
+    /// Only the arrays needed are decoded: the points, the radius array asked for, the lines' offsets and
+    /// connectivity; each no further than those counts need ([`Need`]).
     fn piece(
         arrays: &[Array],
+        (count, lines): (usize, usize),
         layout: &Layout<'_>,
         radius_array: Option<&str>,
     ) -> Result<Vec<Polyline>, String> {
@@ -558,39 +733,85 @@ mod vtp {
         let Some(points) = in_section(arrays, "Points").next() else {
             return Ok(Vec::new());
         };
-        let points = triples(&values(points, layout)?, "the Points array")?;
+        let need = |a: &Array, count: usize, components: usize, what: &str| {
+            let scalar = scalar(a)?;
+            Need::of(count, components, scalar, what.to_string()).ok_or_else(|| {
+                format!(
+                    "array `{}`: {count} × {components} values overflow",
+                    a.attr("Name").unwrap_or("(unnamed)")
+                )
+            })
+        };
+        let what = format!("{count} points");
+        let points = triples(
+            &values(points, layout, &need(points, count, 3, &what)?)?,
+            "the Points array",
+        )?;
         let mut point_arrays = Vec::new();
         for a in in_section(arrays, "PointData") {
             let components = a
                 .attr("NumberOfComponents")
                 .and_then(|c| c.parse().ok())
                 .unwrap_or(1);
-            point_arrays.push((
-                a.attr("Name").unwrap_or("").to_string(),
-                components,
-                values(a, layout)?,
-            ));
+            let name = a.attr("Name").unwrap_or("").to_string();
+            // Only the radius asked for is decoded (and only as one value per point): the names of the
+            // others are listed when it is missing.
+            let decoded = if radius_array == Some(name.as_str()) && components == 1 {
+                values(a, layout, &need(a, count, 1, &what)?)?
+            } else {
+                Vec::new()
+            };
+            point_arrays.push((name, components, decoded));
         }
         let radius = radius_values(&point_arrays, radius_array, points.len())?;
         let named = |name: &str| in_section(arrays, "Lines").find(|a| a.attr("Name") == Some(name));
         let (Some(connectivity), Some(offsets)) = (named("connectivity"), named("offsets")) else {
             return Ok(Vec::new());
         };
-        polylines_from_offsets(
-            &points,
-            radius.as_deref(),
-            &values(connectivity, layout)?,
-            &values(offsets, layout)?,
-        )
+        // A leading 0 is allowed (module docs of `polylines_from_offsets`).
+        let offsets = values(
+            offsets,
+            layout,
+            &need(offsets, lines + 1, 1, &format!("{lines} lines"))?,
+        )?;
+        let entries = offsets.iter().fold(0.0, |a: Real, &b| a.max(b));
+        if entries > MAX_CENTRELINE_POINTS as Real {
+            return Err(format!(
+                "the lines' offsets reach {entries}: the lines would hold more than stentkit's limit of {MAX_CENTRELINE_POINTS} points for a centreline"
+            ));
+        }
+        let entries = entries as usize;
+        let connectivity = values(
+            connectivity,
+            layout,
+            &need(
+                connectivity,
+                entries,
+                1,
+                &format!("{entries} point ids (the lines' last offset)"),
+            )?,
+        )?;
+        polylines_from_offsets(&points, radius.as_deref(), &connectivity, &offsets)
     }
 
-    /// The values of an array, whatever its format.
-    fn values(a: &Array, layout: &Layout<'_>) -> Result<Vec<Real>, String> {
+    /// The numeric type of an array.
+    fn scalar(a: &Array) -> Result<Scalar, String> {
+        a.attr("type").and_then(Scalar::parse).ok_or_else(|| {
+            format!(
+                "array `{}`: unknown type {:?}",
+                a.attr("Name").unwrap_or("(unnamed)"),
+                a.attr("type")
+            )
+        })
+    }
+
+    /// The values of an array, whatever its format; binary data no more than `need` bytes.
+    fn values(a: &Array, layout: &Layout<'_>, need: &Need) -> Result<Vec<Real>, String> {
         let name = a.attr("Name").unwrap_or("(unnamed)");
-        let scalar = a
-            .attr("type")
-            .and_then(Scalar::parse)
-            .ok_or_else(|| format!("array `{name}`: unknown type {:?}", a.attr("type")))?;
+        let scalar = scalar(a)?;
+        let unpack = |bytes: &[u8]| {
+            block(bytes, layout, need).map_err(|message| format!("array `{name}`: {message}"))
+        };
         let bytes = match a.attr("format").unwrap_or("ascii") {
             "ascii" => {
                 return a
@@ -603,7 +824,7 @@ mod vtp {
                     })
                     .collect();
             }
-            "binary" => block(&decode_base64(a.text.trim().as_bytes())?, layout)?,
+            "binary" => unpack(&decode_base64(a.text.trim().as_bytes())?)?,
             "appended" => {
                 let (data, base64) = layout.appended.ok_or_else(|| {
                     format!("array `{name}` is appended, but the file has no <AppendedData>")
@@ -618,9 +839,9 @@ mod vtp {
                 if base64 {
                     // Up to the next array (decoding stops at the first block's end anyway).
                     let end = data.iter().position(|&c| c == b'<').unwrap_or(data.len());
-                    block(&decode_base64(&data[..end])?, layout)?
+                    unpack(&decode_base64(&data[..end])?)?
                 } else {
-                    block(data, layout)?
+                    unpack(data)?
                 }
             }
             other => return Err(format!("array `{name}`: unknown format `{other}`")),
@@ -628,33 +849,66 @@ mod vtp {
         Ok(scalar.values(&bytes, layout.big))
     }
 
-    /// The data of one binary block (header and data, module docs of [`super`]).
-    fn block(bytes: &[u8], layout: &Layout<'_>) -> Result<Vec<u8>, String> {
+    /// The data of one binary block (header and data, module docs of [`super`]), refused when its header
+    /// declares more than `need` bytes; a compressed block is inflated no further than its header declares.
+    fn block(bytes: &[u8], layout: &Layout<'_>, need: &Need) -> Result<Vec<u8>, String> {
         let size = layout.header.size();
         let word = |k: usize| -> Result<usize, String> {
-            bytes
-                .get(k * size..(k + 1) * size)
+            k.checked_mul(size)
+                .and_then(|at| bytes.get(at..at.checked_add(size)?))
                 .map(|w| layout.header.values(w, layout.big)[0] as usize)
-                .ok_or_else(|| "a binary array ends inside its header".to_string())
+                .ok_or_else(|| "it ends inside its header".to_string())
+        };
+        let too_much = |declared: Option<usize>| {
+            format!(
+                "its header declares {} bytes, more than the {} bytes its {} need (a damaged or hostile file); nothing was inflated",
+                declared.map_or_else(|| "more than 2⁶⁴".to_string(), |d| d.to_string()),
+                need.bytes,
+                need.what
+            )
         };
         if !layout.compressed {
             let n = word(0)?;
+            if n > need.bytes {
+                return Err(too_much(Some(n)));
+            }
             return bytes
                 .get(size..size + n)
                 .map(<[u8]>::to_vec)
-                .ok_or_else(|| format!("a binary array says {n} bytes but holds fewer"));
+                .ok_or_else(|| format!("it says {n} bytes but holds fewer"));
         }
-        let blocks = word(0)?;
-        let mut at = (3 + blocks) * size;
-        let mut out = Vec::new();
+        // VTK's compressed header: block count, block size, size of the last block (0: a full block), then
+        // each block's compressed size.
+        let (blocks, block_size, last) = (word(0)?, word(1)?, word(2)?);
+        let last = if last == 0 { block_size } else { last };
+        let declared = blocks.checked_sub(1).map_or(Some(0), |full| {
+            full.checked_mul(block_size)?.checked_add(last)
+        });
+        if declared.is_none_or(|d| d > need.bytes) {
+            return Err(too_much(declared));
+        }
+        let mut at = blocks
+            .checked_add(3)
+            .and_then(|w| w.checked_mul(size))
+            .ok_or_else(|| "it ends inside its header".to_string())?;
+        let mut out = Vec::with_capacity(declared.unwrap_or(0));
         for k in 0..blocks {
             let compressed = word(3 + k)?;
-            let chunk = bytes
-                .get(at..at + compressed)
-                .ok_or("a compressed array ends inside a block")?;
-            flate2::read::ZlibDecoder::new(chunk)
+            let chunk = at
+                .checked_add(compressed)
+                .and_then(|end| bytes.get(at..end))
+                .ok_or("it ends inside a compressed block")?;
+            let expected = if k + 1 == blocks { last } else { block_size };
+            let inflated = flate2::read::ZlibDecoder::new(chunk)
+                .take(expected as u64 + 1)
                 .read_to_end(&mut out)
                 .map_err(|e| format!("a compressed block does not inflate: {e}"))?;
+            if inflated > expected {
+                return Err(format!(
+                    "compressed block {} of {blocks} inflates to more than the {expected} bytes its header declares (a damaged or hostile file); inflating stopped there",
+                    k + 1
+                ));
+            }
             at += compressed;
         }
         Ok(out)
@@ -734,7 +988,10 @@ mod vtp {
 mod legacy {
     //! Legacy VTK POLYDATA, ASCII or binary (module docs of [`super`]).
 
-    use super::{Polyline, Scalar, polyline, polylines_from_offsets, radius_values, triples};
+    use super::{
+        MAX_CENTRELINE_POINTS, Polyline, Scalar, polyline, polylines_from_offsets, radius_values,
+        triples,
+    };
     use crate::math::Real;
 
     /// A cursor over the file: words in ASCII sections, raw big-endian values in binary ones.
@@ -782,11 +1039,11 @@ mod legacy {
         /// `count` values of type `scalar`.
         fn values(&mut self, count: usize, scalar: Scalar) -> Result<Vec<Real>, String> {
             if self.binary {
-                let n = count * scalar.size();
-                let bytes = self
-                    .bytes
-                    .get(self.at..self.at + n)
+                let bytes = count
+                    .checked_mul(scalar.size())
+                    .and_then(|n| self.bytes.get(self.at..self.at.checked_add(n)?))
                     .ok_or("the binary data ends early")?;
+                let n = bytes.len();
                 self.at += n;
                 // The line break after the binary block.
                 if self.bytes.get(self.at) == Some(&b'\n') {
@@ -874,6 +1131,11 @@ mod legacy {
                 }
                 "POINTS" => {
                     let n = count(&words, 1, line)?;
+                    if n > MAX_CENTRELINE_POINTS {
+                        return Err(format!(
+                            "`{line}`: {n} points, more than stentkit's limit of {MAX_CENTRELINE_POINTS} for a centreline"
+                        ));
+                    }
                     let scalar = words
                         .get(2)
                         .and_then(|t| Scalar::parse(t))
@@ -902,7 +1164,10 @@ mod legacy {
                         c.at = save;
                     }
                     let n = points.as_ref().map_or(0, Vec::len);
-                    arrays.push((name, components, c.values(n * components, scalar)?));
+                    let values = n
+                        .checked_mul(components)
+                        .ok_or_else(|| format!("`{line}`: too many components"))?;
+                    arrays.push((name, components, c.values(values, scalar)?));
                 }
                 "FIELD" => {
                     let k = count(&words, 2, line)?;
@@ -919,11 +1184,10 @@ mod legacy {
                             .get(3)
                             .and_then(|t| Scalar::parse(t))
                             .ok_or("FIELD: unknown type")?;
-                        arrays.push((
-                            w[0].to_string(),
-                            components,
-                            c.values(components * tuples, scalar)?,
-                        ));
+                        let values = components
+                            .checked_mul(tuples)
+                            .ok_or_else(|| format!("`{head}`: too many values"))?;
+                        arrays.push((w[0].to_string(), components, c.values(values, scalar)?));
                     }
                 }
                 "METADATA" => {
@@ -943,8 +1207,9 @@ mod legacy {
         let mut at = 0;
         while at < cells.len() {
             let n = cells[at] as usize;
-            let ids = cells
-                .get(at + 1..at + 1 + n)
+            let ids = n
+                .checked_add(at + 1)
+                .and_then(|end| cells.get(at + 1..end))
                 .ok_or("LINES: a cell runs past its data")?;
             polylines.push(polyline(&points, radius.as_deref(), ids)?);
             at += 1 + n;

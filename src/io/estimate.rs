@@ -21,7 +21,8 @@
 //! | 45° bend, h = 1e-5 (10⁵ steps) | 65.2 MB (mcap 41.9 MB) | 37.8 MB (mcap 19.3 MB) | 1.73 (mcap 2.17) |
 //!
 //! The snapshots, which dominate the stents' runs, are counted almost exactly: the STL to the byte (caps on
-//! every tube end: a welded end would make it an overestimate), the OBJ 5 % over (coordinates at their longest
+//! every tube end: a welded end would make it an overestimate; the vessel's lumen of a stent on a file
+//! centreline too, at most [`crate::io::design::vessel::MAX_LUMEN_RINGS`] rings), the OBJ 5 % over (coordinates at their longest
 //! usual length). The recording is compressed (zstd level 1), and how much depends on how much the device
 //! moves per step: a centreline point whose coordinates all change costs about 10 bytes compressed (the bend
 //! at 1000 steps), one that barely moves 4–5 (the stents, the bend at 10⁵ steps). The estimate charges the
@@ -49,6 +50,9 @@ pub struct DiskEstimate {
     pub snapshot_obj: u64,
     /// The field files of all snapshots and `run.pvd` [bytes] ([`crate::io::vtk`]).
     pub snapshot_vtp: u64,
+    /// The vessel's lumen, `snapshots/vessel_lumen.stl`, for a stent on a file centreline with a lumen
+    /// radius [bytes] ([`crate::io::snapshots::VESSEL_FILE`]).
+    pub vessel_lumen: u64,
     /// `run.mcap` [bytes].
     pub recording: u64,
     /// `history.csv` [bytes].
@@ -60,9 +64,9 @@ pub struct DiskEstimate {
 }
 
 impl DiskEstimate {
-    /// The snapshots' files: STL, OBJ and the field files [bytes].
+    /// The snapshot folder's files: STL, OBJ, the field files and the vessel's lumen [bytes].
     pub fn snapshots_bytes(&self) -> u64 {
-        self.snapshot_stl + self.snapshot_obj + self.snapshot_vtp
+        self.snapshot_stl + self.snapshot_obj + self.snapshot_vtp + self.vessel_lumen
     }
 
     /// Everything [bytes].
@@ -186,9 +190,34 @@ pub fn estimated_disk(design: &Design) -> DiskEstimate {
     } else {
         0.0
     };
+    // The vessel: its lumen written once with the first snapshot, and recorded once (its centreline and, with
+    // a radius, its lumen at the recording's segments).
+    let (lumen, vessel_message) = match &model.vessel {
+        Some(vessel) => {
+            let rings = vessel.points.len() as Real;
+            let lumen = |segments: usize| -> (Real, Real) {
+                let m = segments as Real;
+                (rings * m + 2.0, 2.0 * m * rings)
+            };
+            let (stl, mesh) = match vessel.radius {
+                Some(_) => {
+                    let (v, t) = lumen(recording.mesh_segments);
+                    (
+                        84.0 + 50.0 * lumen(snapshot.segments).1,
+                        v * point_bytes(model) + 3.0 * t * (digits(v) + 1.0),
+                    )
+                }
+                None => (0.0, 0.0),
+            };
+            let raw = 400.0 + rings * point_bytes(model) + mesh;
+            (stl, raw / MESH_COMPRESSION + MESSAGE_BYTES)
+        }
+        None => (0.0, 0.0),
+    };
     let mcap = if recording.enabled {
         states * (centrelines + state)
             + meshes
+            + vessel_message
             + RECORDING_FIXED_BYTES
             + design.source.len() as Real
     } else {
@@ -226,6 +255,7 @@ pub fn estimated_disk(design: &Design) -> DiskEstimate {
         snapshot_stl: stl as u64,
         snapshot_obj: obj as u64,
         snapshot_vtp: vtp as u64,
+        vessel_lumen: lumen as u64,
         recording: mcap as u64,
         history: history as u64,
         charts: chart_bytes as u64,

@@ -30,7 +30,7 @@ fn history(dir: &Path) -> Vec<HashMap<String, f64>> {
 }
 
 /// Runs `design` (relative to the crate) into a fresh folder named `name`, with extra arguments.
-fn run(design: &str, name: &str, extra: &[&str]) -> std::path::PathBuf {
+pub(crate) fn run(design: &str, name: &str, extra: &[&str]) -> std::path::PathBuf {
     let dir = test_outputs(name);
     let design = Path::new(env!("CARGO_MANIFEST_DIR")).join(design);
     let mut args = vec![

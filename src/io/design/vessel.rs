@@ -23,15 +23,24 @@
 
 use super::dto::{FileCentrelineDto, FileUnitDto, PolylineChoiceDto};
 use super::issue::{Result, issue};
-use crate::geometry::fit::smooth_points;
+use crate::geometry::GeometryError;
+use crate::geometry::fit::{MAX_SMOOTHING_CONTROL_POINTS, smooth_points};
 use crate::geometry::stent::CentrelineSpec;
 use crate::io::centreline::{Polyline, read_centreline};
-use crate::math::{Real, Vec3};
+use crate::math::{Real, Short, Vec3};
 use crate::model::Vessel;
 use std::path::Path;
 
 /// VMTK's point array of the lumen radius.
 pub const DEFAULT_RADIUS_ARRAY: &str = "MaximumInscribedSphereRadius";
+
+/// Most samples of the vessel kept for the outputs: the rings of its lumen (`snapshots/vessel_lumen.stl`,
+/// `run.mcap`'s `/vessel`, the shaded picture) and the points of its centreline there. The vessel is the
+/// smoothing spline sampled at twice the segment's points, up to 1000: the aorta's 40 mm segment has 238. A
+/// ring every 0.1 mm of a 100 mm segment still shows a spline of up to
+/// [`crate::geometry::fit::MAX_SMOOTHING_CONTROL_POINTS`] control points, and 1000 rings of 12 vertices make
+/// 24 000 triangles, 1.2 MB of STL. (Unbounded, a 100 000-point centreline wrote a 240 MB lumen.)
+pub const MAX_LUMEN_RINGS: usize = 1000;
 
 /// A file centreline as the stent uses it.
 #[derive(Debug, Clone, PartialEq)]
@@ -48,8 +57,8 @@ pub struct VesselCentreline {
     pub length: Real,
     /// Points of the segment.
     pub points: usize,
-    /// The vessel for the outputs: the spline sampled at twice the segment's points, the lumen radius
-    /// interpolated there (by normalised arc length along the segment).
+    /// The vessel for the outputs: the spline sampled at twice the segment's points, at most
+    /// [`MAX_LUMEN_RINGS`], the lumen radius interpolated there (by normalised arc length along the segment).
     pub vessel: Vessel,
 }
 
@@ -120,8 +129,32 @@ pub fn vessel_centreline(
     }
     let segment = cut(&line, start, start + length);
     let smoothing = f.smoothing.map_or(1e-3 * length, |s| s.0);
-    let fit = smooth_points(&segment.points, smoothing)
-        .map_err(|e| issue(field("path"), format!("the segment cannot be fitted: {e}")))?;
+    let fit = smooth_points(&segment.points, smoothing).map_err(|e| match e {
+        GeometryError::SmoothingTooTight {
+            points,
+            closest,
+            worst_point,
+            control_points,
+            enough,
+            ..
+        } => {
+            let (at, what) = match f.smoothing {
+                Some(_) => (field("smoothing"), format!("`smoothing: {}`", Short(smoothing))),
+                None => (
+                    path.to_string(),
+                    format!("the default smoothing (length/1000 = {})", Short(smoothing)),
+                ),
+            };
+            issue(
+                at,
+                format!(
+                    "{what} is too tight: the segment's {points} points scatter more than that about any smooth line (the closest spline found, of {control_points} control points, is {closest:.2e} from point {worst_point}; a spline has at most {MAX_SMOOTHING_CONTROL_POINTS} control points, and at most one per point); set `smoothing: {}` or more",
+                    Short(enough)
+                ),
+            )
+        }
+        e => issue(field("path"), format!("the segment cannot be fitted: {e}")),
+    })?;
     let mean_radius = segment.radius.as_ref().map(|r| {
         let mut weighted = 0.0;
         for (w, rr) in segment.points.windows(2).zip(r.windows(2)) {
@@ -129,7 +162,7 @@ pub fn vessel_centreline(
         }
         weighted / length
     });
-    let samples = 2 * segment.points.len();
+    let samples = (2 * segment.points.len()).min(MAX_LUMEN_RINGS);
     let u: Vec<Real> = (0..samples)
         .map(|k| k as Real / (samples - 1) as Real)
         .collect();
