@@ -27,3 +27,4 @@ mod studies;
 mod sweep;
 mod tune;
 mod viscoelastic;
+mod warnings;

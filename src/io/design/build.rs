@@ -339,6 +339,8 @@ pub fn field_path(field: &Field, dto: &DesignDto) -> String {
             SolverField::Path => "solver.path",
             SolverField::ArcLength => "solver.arc_length",
             SolverField::Stabilisation => "solver.stabilisation",
+            SolverField::DissipatedFraction => "solver.stabilisation.dissipated_fraction",
+            SolverField::StabilisationLimit => "solver.stabilisation.limit",
         }
         .into(),
         Field::Probe { index, field } => {
