@@ -209,14 +209,22 @@ fn overloaded_bend(name: &str, extra: &str) -> (Option<i32>, String, serde_json:
     )
 }
 
-/// The summary's `warnings` as strings.
-fn summary_warnings(summary: &serde_json::Value) -> Vec<String> {
-    summary["warnings"]
+/// The warning of summary.json's `warnings` that contains `fragment`, after checking that the run printed it on
+/// stderr too (as `warning: …`).
+#[track_caller]
+pub(crate) fn warning_said(summary: &serde_json::Value, stderr: &str, fragment: &str) -> String {
+    let warnings: Vec<&str> = summary["warnings"]
         .as_array()
         .expect("a list")
         .iter()
-        .map(|w| w.as_str().expect("text").to_string())
-        .collect()
+        .map(|w| w.as_str().expect("text"))
+        .collect();
+    let said = warnings
+        .iter()
+        .find(|w| w.contains(fragment))
+        .unwrap_or_else(|| panic!("no warning with `{fragment}` in {warnings:?}"));
+    assert!(stderr.contains(&format!("warning: {said}")), "{stderr}");
+    said.to_string()
 }
 
 /// Issue 31 item 19: a damping factor given outright (`factor: 1e9`) carried the load — the tip moved 3.6e-4
@@ -243,12 +251,7 @@ fn a_damping_that_carries_the_load_is_warned_about_by_force() {
     let share = s["largest_force_share"].as_f64().expect("the force share");
     assert!(share > 0.9, "the damping carried the load: {share}");
     assert_eq!(s["above_limit"], true);
-    let warnings = summary_warnings(&summary);
-    let said = warnings
-        .iter()
-        .find(|w| w.contains("damping force"))
-        .unwrap_or_else(|| panic!("{warnings:?}"));
-    assert!(stderr.contains(&format!("warning: {said}")), "{stderr}");
+    warning_said(&summary, &stderr, "damping force");
 }
 
 /// Issue 31 item 19: with `dissipated_fraction: 1e6` the run's dissipated ratio ended at 19.4 but the only
@@ -264,16 +267,11 @@ fn the_dissipated_energy_warning_reports_the_final_ratio() {
     );
     assert_eq!(code, Some(0), "{stderr}");
     let ratio = summary["stabilisation"]["ratio"].as_f64().expect("ratio");
-    let warnings = summary_warnings(&summary);
-    let said = warnings
-        .iter()
-        .find(|w| w.contains("dissipated"))
-        .unwrap_or_else(|| panic!("{warnings:?}"));
+    let said = warning_said(&summary, &stderr, "dissipated");
     assert!(
         said.contains(&format!("{ratio:.3e}")),
         "{said} against {ratio}"
     );
-    assert!(stderr.contains(&format!("warning: {said}")), "{stderr}");
     assert!(
         !summary["notices"]
             .as_array()
