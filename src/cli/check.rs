@@ -131,18 +131,36 @@ pub fn describe(design: &Design, file: &str) -> String {
     let _ = writeln!(s, "collocation points  {}", model.num_collocation_points());
     let _ = writeln!(s, "unknowns            {}", model.num_unknowns());
     let plan = design.steps;
+    let bound = error_controlled_bound(design);
     match model.solver.path {
-        crate::model::PathControl::Time => {
-            let _ = writeln!(
-                s,
-                "time steps          {} ({} of h = {} s + {} shortened to land on breakpoints; end {} s)",
-                plan.total(),
-                plan.full,
-                model.time.step,
-                plan.shortened,
-                model.time.end
-            );
-        }
+        crate::model::PathControl::Time => match (model.time.tolerance, bound) {
+            (Some(tolerance), Some(most)) => {
+                let _ = writeln!(
+                    s,
+                    "time steps          error-controlled (tolerance {tolerance:e}): from h = {} s, as many as the time-error estimate needs, between min_step = {:e} s and {}; at most {} (every step at min_step); {} at h; end {} s",
+                    model.time.step,
+                    model.time.min_step,
+                    model
+                        .time
+                        .max_step
+                        .map_or("no max_step".to_string(), |m| format!("max_step = {m} s")),
+                    most.total(),
+                    plan.total(),
+                    model.time.end
+                );
+            }
+            _ => {
+                let _ = writeln!(
+                    s,
+                    "time steps          {} ({} of h = {} s + {} shortened to land on breakpoints; end {} s)",
+                    plan.total(),
+                    plan.full,
+                    model.time.step,
+                    plan.shortened,
+                    model.time.end
+                );
+            }
+        },
         crate::model::PathControl::ArcLength(a) => {
             let _ = writeln!(
                 s,
@@ -157,8 +175,13 @@ pub fn describe(design: &Design, file: &str) -> String {
     let memory = &design.memory;
     let _ = write!(
         s,
-        "memory              about {} (limit {})",
+        "memory              about {}{} (limit {})",
         human_bytes(memory.total()),
+        if bound.is_some() {
+            format!(" at {} steps of h", plan.total())
+        } else {
+            String::new()
+        },
         human_bytes(MEMORY_LIMIT_BYTES)
     );
     if let Some(term) = memory.largest() {
@@ -183,9 +206,27 @@ pub fn describe(design: &Design, file: &str) -> String {
     } else {
         "no recording".to_string()
     };
+    // An error-controlled run's steps are known only as it runs: the estimate at h, and the most it can write.
+    let (basis, most) = match bound {
+        Some(steps) => (
+            format!(" at {} steps of h", plan.total()),
+            format!(
+                "; error-controlled, so at most {} ({} steps at min_step)",
+                human_bytes(
+                    estimated_disk(&Design {
+                        steps,
+                        ..design.clone()
+                    })
+                    .total() as f64
+                ),
+                steps.total()
+            ),
+        ),
+        None => (String::new(), String::new()),
+    };
     let _ = writeln!(
         s,
-        "disk                run folder about {}: {} snapshots {} ({}), {recording}, history.csv {}, charts {}, summary.json {}",
+        "disk                run folder about {}{basis}: {} snapshots {} ({}), {recording}, history.csv {}, charts {}, summary.json {}{most}",
         mb(disk.total()),
         disk.snapshots,
         mb(disk.snapshots_bytes()),
@@ -227,6 +268,22 @@ pub fn describe(design: &Design, file: &str) -> String {
         }
     }
     s
+}
+
+/// The most steps an error-controlled run of `design` can take, `None` for fixed steps (and arc length): every
+/// step at `time.min_step` (error control and step cutting take no shorter one, except to land on a
+/// breakpoint), and one more per landing span for the round-off sliver [`crate::model::Model::planned_steps`]
+/// allows.
+fn error_controlled_bound(design: &Design) -> Option<crate::model::StepPlan> {
+    let model = &design.model;
+    model.time.tolerance?;
+    model.solver.path.arc_length().is_none().then(|| {
+        let mut plan = model.planned_steps_at(model.time.min_step);
+        plan.full = plan
+            .full
+            .saturating_add(model.schedule_breakpoints().len() + 1);
+        plan
+    })
 }
 
 /// One line about a material: the elastic modulus, or the Prony series, the WLF shift and the integrator.

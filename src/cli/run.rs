@@ -191,6 +191,8 @@ struct Outputs {
     totals: crate::solver::RunSummary,
     /// Materials' strain limits exceeded, as said.
     strain_warnings: Vec<String>,
+    /// The design's warnings (the first of summary.json's `warnings`).
+    design_warnings: Vec<String>,
 }
 
 impl Outputs {
@@ -268,15 +270,22 @@ impl Outputs {
                 control.smallest_step = 0.0;
             }
         }
-        if let Some(summary) = &mut s.stabilisation {
+        if let (Some(summary), Some(settings)) =
+            (&mut s.stabilisation, &sim.model().solver.stabilisation)
+        {
             let st = sim.stabilisation();
             summary.damped_steps = st.damped_steps;
             summary.dissipated_energy = st.dissipated;
             summary.peak_strain_energy = st.peak_strain_energy;
             summary.ratio = st.ratio();
             summary.largest_step_ratio = st.largest_step_ratio;
-            summary.above_limit = st.ratio() > summary.limit;
+            summary.largest_force_share = st.largest_force_share;
+            summary.largest_force_share_time = st.largest_force_share_time;
+            summary.steps_above_force_limit = st.steps_above_force_limit;
+            summary.above_limit = st.above_limit(settings);
         }
+        s.warnings.clone_from(&self.design_warnings);
+        s.warnings.extend(sim.stabilisation_warnings());
         s.final_time = sim.time();
         s.snapshots = self.snapshots.snapshots().iter().map(Into::into).collect();
         s.final_state = self
@@ -731,6 +740,16 @@ fn run_in(
     summary.summary.timing.run_s = run_started.elapsed().as_secs_f64();
     outputs.progress.bar.finish_and_clear();
     outputs.progress.notices(&sim);
+    // What the result must be read with: the stabilisation above its limit, and a device that ended heated but
+    // not recovered (a completed run only). Said here and in summary.json's `warnings`, whatever the status.
+    let recovered = result
+        .as_ref()
+        .is_ok_and(|s| !s.stopped && sim.is_finished())
+        .then(|| crate::io::state::recovery_warning(&sim))
+        .flatten();
+    for warning in sim.stabilisation_warnings().iter().chain(&recovered) {
+        eprintln!("warning: {warning}");
+    }
 
     // A run stopped by a signal keeps its last converged step as a checkpoint (before `finish` adds the final
     // snapshot and mesh, which an uninterrupted run does not have); a completed run needs its checkpoint no more.
@@ -774,6 +793,7 @@ fn run_in(
     let mcap_bytes = finished.mcap_bytes;
     let write = summary.write(|s| {
         outputs.fill(s, &sim);
+        s.warnings.extend(recovered.clone());
         s.status = status;
         s.error = error;
         s.failure = failure;
@@ -913,6 +933,7 @@ fn create_outputs(
         beat: Instant::now(),
         totals: crate::solver::RunSummary::default(),
         strain_warnings: Vec::new(),
+        design_warnings: design.warnings.clone(),
     })
 }
 
@@ -966,6 +987,7 @@ fn resume_outputs(
         beat: Instant::now(),
         totals: saved.totals.clone(),
         strain_warnings: Vec::new(),
+        design_warnings: design.warnings.clone(),
     })
 }
 

@@ -2,12 +2,12 @@
 //! output stood at that step ([`OutputsCheckpoint`]), from which `stentkit run --resume` continues a killed or
 //! interrupted run exactly.
 //!
-//! # Format (version 7; version 6 had no snapshot phase, version 5 no stabiliser state, version 4 no load factor per chart sample, version 3 no arc-length state, version 2 had 18 numbers per section law and no
+//! # Format (version 8; version 7's stabiliser state had no force share and no times of its warnings, version 6 had no snapshot phase, version 5 no stabiliser state, version 4 no load factor per chart sample, version 3 no arc-length state, version 2 had 18 numbers per section law and no
 //! per-material recovery, version 1, before error-controlled stepping, no step-control memory)
 //!
 //! ```text
 //! magic     8 bytes   "STKCKPT\0"
-//! version   u32       7
+//! version   u32       8
 //! length    u64       bytes of the payload
 //! payload   …         the fields below, in order
 //! crc32     u32       CRC-32 (IEEE 802.3, as zlib and PNG) of everything before it
@@ -49,7 +49,7 @@ pub const FILE_NAME: &str = "checkpoint.bin";
 const MAGIC: &[u8; 8] = b"STKCKPT\0";
 
 /// The format version this build writes and reads.
-pub const VERSION: u32 = 7;
+pub const VERSION: u32 = 8;
 
 /// Bytes before the payload: magic, version, length.
 const HEADER: usize = 8 + 4 + 8;
@@ -539,7 +539,12 @@ fn encode_solver(e: &mut Encoder, c: &Checkpoint) {
     e.f64(s.peak_strain_energy);
     e.f64(s.largest_step_ratio);
     e.usize(s.damped_steps);
-    e.bool(s.warned);
+    e.option(s.energy_limit_time.as_ref(), |e, t| e.f64(*t));
+    e.f64(s.largest_force_share);
+    e.f64(s.largest_force_share_time);
+    e.usize(s.steps_above_force_limit);
+    e.usize(s.unscaled_stalls);
+    e.f64(s.first_unscaled_time);
 }
 
 fn decode_solver(d: &mut Decoder<'_>) -> Result<Checkpoint, Problem> {
@@ -595,7 +600,12 @@ fn decode_solver(d: &mut Decoder<'_>) -> Result<Checkpoint, Problem> {
             peak_strain_energy: d.f64()?,
             largest_step_ratio: d.f64()?,
             damped_steps: d.usize()?,
-            warned: d.bool()?,
+            energy_limit_time: d.option(|d| d.f64())?,
+            largest_force_share: d.f64()?,
+            largest_force_share_time: d.f64()?,
+            steps_above_force_limit: d.usize()?,
+            unscaled_stalls: d.usize()?,
+            first_unscaled_time: d.f64()?,
         },
     })
 }
@@ -808,7 +818,12 @@ mod tests {
                 peak_strain_energy: 3.5,
                 largest_step_ratio: 0.01,
                 damped_steps: 7,
-                warned: true,
+                energy_limit_time: Some(1.25),
+                largest_force_share: 0.75,
+                largest_force_share_time: 1.5,
+                steps_above_force_limit: 3,
+                unscaled_stalls: 2,
+                first_unscaled_time: 0.5,
             },
         };
         let outputs = OutputsCheckpoint {

@@ -8,7 +8,8 @@
 //! `rejected` (attempts rejected by error control before it).
 //! With automatic stabilisation (`solver.stabilisation`) it adds `stabilisation_factor` (the damping factor `c`
 //! of the step, 0 when undamped), `strain_energy` (at the step's end), `dissipated_energy` (by the damping since
-//! the start) and `dissipated_ratio` (that over the largest strain energy so far;
+//! the start), `dissipated_ratio` (that over the largest strain energy so far) and `damping_force_share` (the
+//! damping force's share of the forces on the device at the step's end, 0 when undamped;
 //! [`crate::solver::simulation::stabilisation`]).
 //! A design with a programme (stents) adds `recovery_ratio_mean` and `recovery_ratio_max`, the mean (weighted
 //! over the full device) and largest `‖η_l‖ / ‖η_temp,l‖` over the driven nodes — 1 at the temporary shape, 0 at
@@ -196,6 +197,7 @@ impl HistoryWriter {
         if sim.model().solver.stabilisation.is_some() {
             header
                 .push_str(",stabilisation_factor,strain_energy,dissipated_energy,dissipated_ratio");
+            header.push_str(",damping_force_share");
         }
         if let Some(programme) = &sim.model().programme {
             header.push_str(",recovery_ratio_mean,recovery_ratio_max");
@@ -345,9 +347,10 @@ impl HistoryWriter {
             let s = report.and_then(|r| r.stabilisation);
             let factor = s.map_or(0.0, |s| s.factor);
             let energy = s.map_or_else(|| sim.strain_energy(), |s| s.strain_energy);
+            let share = s.map_or(0.0, |s| s.force_share);
             let totals = sim.stabilisation();
             line.push_str(&format!(
-                ",{factor:.6e},{energy:.9e},{:.9e},{:.6e}",
+                ",{factor:.6e},{energy:.9e},{:.9e},{:.6e},{share:.6e}",
                 totals.dissipated,
                 totals.ratio()
             ));

@@ -359,7 +359,10 @@ pub struct RunSummaryFile {
     /// The last recorded state.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub final_state: Option<FinalState>,
-    /// Warnings about the design.
+    /// Warnings: about the design (as `check` says them), and about the run's result — a stabilisation above
+    /// its limit by energy or force, a device that ended heated above its Tg but not recovered
+    /// ([`super::state::recovery_warning`]). A run with a warning may still be `completed`: its numbers are
+    /// the simulation's, and these say why they may not be what was wanted.
     pub warnings: Vec<String>,
     /// Notices of the solver (e.g. relaxation frozen below Tg − C2).
     pub notices: Vec<String>,
@@ -406,7 +409,16 @@ pub struct StabilisationSummary {
     pub ratio: Real,
     /// The largest ratio of one step's dissipated energy to the strain energy at its end.
     pub largest_step_ratio: Real,
-    /// Whether `ratio` exceeds `limit`.
+    /// The largest share of the damping force among the forces on the device (loads, reactions and the
+    /// damping) of a damped step: 0 quasi-static, 1 when the damping alone balanced the loads or the motion
+    /// ([`crate::solver::simulation::stabilisation`], *The force*).
+    pub largest_force_share: Real,
+    /// The time of the step with that share [s] (0 when no step was damped).
+    pub largest_force_share_time: Real,
+    /// Damped steps whose force share exceeded `limit`.
+    pub steps_above_force_limit: usize,
+    /// Whether `ratio` exceeds `limit` (or did at some step) or `largest_force_share` does: the run then says so
+    /// in `warnings`.
     pub above_limit: bool,
 }
 
@@ -464,6 +476,9 @@ impl RunSummaryFile {
                 peak_strain_energy: 0.0,
                 ratio: 0.0,
                 largest_step_ratio: 0.0,
+                largest_force_share: 0.0,
+                largest_force_share_time: 0.0,
+                steps_above_force_limit: 0,
                 above_limit: false,
             }),
             final_time: 0.0,

@@ -391,12 +391,16 @@ impl Default for ArcLengthSettings {
 /// `dissipated_fraction` of the strain energy if it moved as Newton's first (undamped) increment says, and
 /// made ten times larger while the damped step still fails. The damping stays on while a step dissipates more
 /// than that fraction, and the dissipated energy is reported per step and for the run, with a warning when
-/// it exceeds `limit` of the largest strain energy the run reached (the result is then not quasi-static).
+/// it exceeds `limit` of the largest strain energy the run reached, or when a damped step's damping force is
+/// more than `limit` of the loads and reactions on the device (the result is then not quasi-static;
+/// [`crate::solver::simulation::stabilisation`]).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct StabilisationSettings {
-    /// Dissipated energy aimed at by the first damped step, as a fraction of the strain energy.
+    /// Dissipated energy aimed at by the first damped step, as a fraction of the strain energy (in (0, 1):
+    /// the builder refuses others).
     pub dissipated_fraction: Real,
-    /// The run's dissipated energy above this fraction of its largest strain energy is warned about.
+    /// The run's dissipated energy above this fraction of its largest strain energy is warned about, and so is a
+    /// damped step whose damping force is more than this share of the forces on the device (in (0, 1)).
     pub limit: Real,
     /// A damping factor `c` \[1/time\] given outright, instead of the energy rule.
     pub factor: Option<Real>,
@@ -597,7 +601,13 @@ impl Model {
     /// landing time than this exact count (measured: the 45° bend at `h = 1e-5` takes 100 001 steps, planned
     /// 100 000); step cuts add steps too.
     pub fn planned_steps(&self) -> StepPlan {
-        let (end, h) = (self.time.end, self.time.step);
+        self.planned_steps_at(self.time.step)
+    }
+
+    /// [`Model::planned_steps`] with every full step of length `h` instead of `time.step`: with `time.min_step`,
+    /// the most steps error-controlled stepping can take (no step is shorter, except to land on a breakpoint).
+    pub fn planned_steps_at(&self, h: Real) -> StepPlan {
+        let end = self.time.end;
         let tolerance = self.time.landing_tolerance();
         let mut plan = StepPlan::default();
         let mut time = 0.0;

@@ -156,7 +156,7 @@ pub fn collect(dir: &SweepDir, times: Option<&[Real]>) -> Result<Collected, Swee
         csv.push(',');
         csv.push_str(&field(&p.path));
     }
-    csv.push_str(&format!(",status,error,wall_time ({time}),steps"));
+    csv.push_str(&format!(",status,error,wall_time ({time}),steps,warnings"));
     for c in &columns {
         csv.push_str(&format!(",{}{}", c.name, c.unit));
     }
@@ -174,13 +174,15 @@ pub fn collect(dir: &SweepDir, times: Option<&[Real]>) -> Result<Collected, Swee
             VariantState::Failed(why) => why.as_str(),
             _ => "",
         };
+        let count = |x: Option<u64>| x.map_or_else(String::new, |s| s.to_string());
         let _ = write!(
             csv,
-            ",{},{},{},{}",
+            ",{},{},{},{},{}",
             row.state.name(),
             field(error),
             number(m.wall_time_s),
-            m.steps.map_or_else(String::new, |s| s.to_string())
+            count(m.steps),
+            count(m.warnings)
         );
         for c in &columns {
             let _ = write!(csv, ",{}", number((c.get)(m)));

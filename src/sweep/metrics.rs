@@ -12,7 +12,9 @@
 //! - **recovery ratio at chosen times** `ρ(t)`, linear between saved steps;
 //! - **time to 50 % / 90 % recovery**: `t − t_r` where `ρ` first falls to 0.5 / 0.1 after the release (empty
 //!   when it never does);
-//! - **final residual shape**: `ρ` (mean and largest) and `u` at the last saved step.
+//! - **final residual shape**: `ρ` (mean and largest) and `u` at the last saved step;
+//! - **warnings**: how many `summary.json` lists (a run can complete with one: stabilisation above its limit,
+//!   a device heated but not recovered), so a table of completed variants does not hide them.
 //!
 //! The peak strain is not reported: runs do not compute strains yet. A design without a programme gets only
 //! the final displacement. A run that stopped early gives the metrics its history reaches.
@@ -28,6 +30,9 @@ pub struct Metrics {
     pub wall_time_s: Option<Real>,
     /// Converged steps.
     pub steps: Option<u64>,
+    /// The warnings in the run's `summary.json` (the design's, and the run's own: stabilisation above its
+    /// limit, a device heated but not recovered).
+    pub warnings: Option<u64>,
     /// `u(t_r)` [length].
     pub programmed_displacement: Option<Real>,
     /// `u(t_r) − u(t_r⁺)` [length].
@@ -177,6 +182,7 @@ pub fn metrics(
     Metrics {
         wall_time_s: summary.and_then(|s| s["wall_time_s"].as_f64()),
         steps: summary.and_then(|s| s["steps"].as_u64()),
+        warnings: summary.and_then(|s| s["warnings"].as_array().map(|w| w.len() as u64)),
         programmed_displacement: programmed,
         snap: programmed.zip(value(&u, after)).map(|(b, a)| b - a),
         fixity,

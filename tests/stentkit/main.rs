@@ -28,3 +28,4 @@ mod studies;
 mod sweep;
 mod tune;
 mod viscoelastic;
+mod warnings;

@@ -199,7 +199,15 @@ pub fn build(dto: &DesignDto, default_name: &str, temporary_shape: bool) -> Resu
     };
     let memory = check_size(dto, &StepCount::planned(&plan, model.time.step, dto))?;
     // A part no condition holds can move as a rigid body: `run` refuses it (the solver's check), `check` warns.
-    for body in crate::solver::diagnose::free_bodies(&model) {
+    // Not of a temporary shape, which is built without its programme (the programme is what takes the nodes
+    // there): `run` solves the permanent design, whose programme holds them (issue 31: `mesh --state temporary`
+    // said the aorta stent would be refused).
+    let free = if temporary_shape {
+        Vec::new()
+    } else {
+        crate::solver::diagnose::free_bodies(&model)
+    };
+    for body in free {
         let names: Vec<String> = body
             .patches
             .iter()
@@ -339,6 +347,8 @@ pub fn field_path(field: &Field, dto: &DesignDto) -> String {
             SolverField::Path => "solver.path",
             SolverField::ArcLength => "solver.arc_length",
             SolverField::Stabilisation => "solver.stabilisation",
+            SolverField::DissipatedFraction => "solver.stabilisation.dissipated_fraction",
+            SolverField::StabilisationLimit => "solver.stabilisation.limit",
         }
         .into(),
         Field::Probe { index, field } => {

@@ -647,11 +647,12 @@ pub struct SolverDto {
 #[derive(Debug, Clone, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct StabilisationDto {
-    /// Dissipated energy the first damped step aims at, as a fraction of the strain energy (default 2e-4).
+    /// Dissipated energy the first damped step aims at, as a fraction of the strain energy (default 2e-4;
+    /// below 1).
     #[serde(default)]
     pub dissipated_fraction: Option<Positive>,
-    /// The run's dissipated energy over its largest strain energy above which a warning is given (default
-    /// 0.05).
+    /// The run's dissipated energy over its largest strain energy, and a damped step's damping force over the
+    /// loads and reactions, above which a warning is given (default 0.05; below 1).
     #[serde(default)]
     pub limit: Option<Positive>,
     /// A damping factor c [1/time] given outright instead of the energy rule.

@@ -80,6 +80,15 @@ pub(super) fn field_path(field: StentField, dto: &DesignDto) -> String {
     };
     match field {
         StentField::Whole => "stent".into(),
+        // A radius sized from the lumen has no `radius` key: the field that sized it is `oversize`.
+        StentField::Parameter(StentParameter::Radius)
+            if dto
+                .stent
+                .as_ref()
+                .is_some_and(|s| s.radius.is_none() && s.oversize.is_some()) =>
+        {
+            "stent.oversize".into()
+        }
         StentField::Parameter(p) => spec_path(p).into(),
         StentField::Degree { bridge } => mesh_key(bridge, |m| m.p, "p"),
         StentField::ControlPoints { bridge } => mesh_key(bridge, |m| m.n, "n"),

@@ -192,6 +192,10 @@ pub enum SolverField {
     ArcLength,
     /// The stabilisation settings.
     Stabilisation,
+    /// The stabilisation's dissipated-energy fraction.
+    DissipatedFraction,
+    /// The stabilisation's limit on its energy and force shares.
+    StabilisationLimit,
 }
 
 /// A part of a probe.

@@ -1040,6 +1040,41 @@ fn check_solver(s: &SolverSettings) -> Result<()> {
             "must be ≥ 1",
         ));
     }
+    if let Some(st) = &s.stabilisation {
+        // Both are shares of the strain energy (and the limit of the damping force's share of the loads too):
+        // a damping that may dissipate all the energy the device stores, or carry all its loads, is not a
+        // stabilisation of a quasi-static run but its load path (issue 31: `dissipated_fraction: 1e6` ended at a
+        // dissipated ratio of 19.4).
+        for (value, field, what) in [
+            (
+                st.dissipated_fraction,
+                SolverField::DissipatedFraction,
+                "the share of the strain energy the first damped step aims to dissipate (Abaqus's default 2e-4)",
+            ),
+            (
+                st.limit,
+                SolverField::StabilisationLimit,
+                "the share of the strain energy, and of the loads, that the damping may take before the run is warned to be not quasi-static (Abaqus's accuracy tolerance 0.05)",
+            ),
+        ] {
+            if !(value > 0.0 && value < 1.0) {
+                return Err(BuildError::new(
+                    Field::Solver(field),
+                    format!(
+                        "{value} must be above 0 and below 1: it is {what}; a damping that takes as much as the device holds carries the run instead of stabilising it"
+                    ),
+                ));
+            }
+        }
+        if let Some(c) = st.factor
+            && !(c > 0.0 && c.is_finite())
+        {
+            return Err(BuildError::new(
+                Field::Solver(SolverField::Stabilisation),
+                format!("the damping factor {c} must be > 0 and finite"),
+            ));
+        }
+    }
     Ok(())
 }
 

@@ -25,7 +25,29 @@
 //! stored energy of an elastic rod; for a viscoelastic one the same measure of the work held in the section's
 //! current forces), and a converged damped step dissipates `D = (c/h) Q` of its actual motion (`x − xₙ`,
 //! `log(Rₙᵀ R)`). The run's ratio is the dissipated total over the largest strain energy it reached — not the
-//! current one, which is zero once a released device is free — and a notice warns when it exceeds `limit`.
+//! current one, which is zero once a released device is free — and the run is warned about once it has gone
+//! above `limit` ([`StabiliserState::warnings`], giving the run's final ratio).
+//!
+//! **The force.** Energy alone misses a damping that carries the load: a device the damping holds still
+//! dissipates little (issue 31: `factor: 1e9` kept the overloaded 45° bend's tip at 3.6e-4 where it moves 87,
+//! and dissipated 1.2 % of the strain energy). So every damped step is also judged by force, at its converged
+//! state: the damping's force and couple densities integrated along the rods (the trapezoidal weights over every
+//! collocation point, ends included: the density is a field along the whole rod, although the equations
+//! impose it at the interior points only; without the ends the overloaded bend's share came out 0.85),
+//! ```text
+//! D = Σ_g w_g (c/h) (A |x − xₙ| + |J Θ| / ℓ),
+//! ```
+//! against what acts on the device from outside, the loads and reactions,
+//! ```text
+//! E = Σ_nodes (|Σ_e σ R N_e| + |Σ_e σ R M_e| / ℓ) + Σ_g w_g (|n̄| + |m̄| / ℓ),
+//! ```
+//! (the rod ends' resultants at a node equal its load at free components and its reaction at prescribed ones; a
+//! joint's cancel), couples turned into forces over the model size `ℓ` (the bounding-box diagonal of the
+//! reference control points, the lever of the largest couple a force can make on it). The step's share is
+//! `D / max(D, E)`: 0 for a quasi-static step, 1 when the damping balances the loads by itself (a load the
+//! structure does not carry) or opposes the motion alone (a free device springing back). Above `limit` — the
+//! same 5 % as the energy's: a damping force of 5 % of the loads is an equilibrium off by as much — the run is
+//! warned about, with the number of such steps and the largest share.
 //!
 //! **Checkpoints.** A damped tangent is never carried past its step (its factorisation is forgotten when the
 //! step converges), so a checkpoint's tangent is always an undamped one; the stabiliser's memory is in
@@ -33,7 +55,8 @@
 
 use super::Simulation;
 use crate::math::{Real, Vec3};
-use crate::solver::assembly::{Damping, point_strains};
+use crate::model::StabilisationSettings;
+use crate::solver::assembly::{Actions, Damping, point_strains};
 use crate::solver::state::State;
 
 /// How many times a damped step that still fails has its factor multiplied by [`ESCALATION`] before it is cut.
@@ -60,8 +83,19 @@ pub struct StabiliserState {
     pub largest_step_ratio: Real,
     /// Steps taken with the damping on.
     pub damped_steps: usize,
-    /// Whether the run's ratio above the limit has been warned about.
-    pub warned: bool,
+    /// When the run's ratio first exceeded the limit \[time\] (`None`: it has not).
+    pub energy_limit_time: Option<Real>,
+    /// The largest share of the damping force among the forces on the device of a damped step (module docs,
+    /// *The force*).
+    pub largest_force_share: Real,
+    /// The time of the step with that share \[time\].
+    pub largest_force_share_time: Real,
+    /// Damped steps whose force share exceeded the limit.
+    pub steps_above_force_limit: usize,
+    /// Stalls whose damping factor the energy rule could not scale (the step was cut instead).
+    pub unscaled_stalls: usize,
+    /// The time the first of them tried to reach \[time\].
+    pub first_unscaled_time: Real,
 }
 
 impl StabiliserState {
@@ -72,6 +106,62 @@ impl StabiliserState {
         } else {
             0.0
         }
+    }
+
+    /// Whether the run went above `settings.limit` by energy (the run's ratio, now or at some step) or by force
+    /// (a damped step's force share): what [`StabiliserState::warnings`] warns about.
+    pub fn above_limit(&self, settings: &StabilisationSettings) -> bool {
+        self.energy_limit_time.is_some() || self.largest_force_share > settings.limit
+    }
+
+    /// What the run must say about its stabilisation so far (summary.json's `warnings` and stderr): the
+    /// dissipated energy above the limit, with the run's ratio now; damped steps whose damping force carried
+    /// more than the limit's share of the loads; stalls the damping could not be scaled for.
+    pub fn warnings(&self, settings: &StabilisationSettings) -> Vec<String> {
+        let mut out = Vec::new();
+        let limit = settings.limit;
+        let advice = if settings.factor.is_some() {
+            "a smaller `solver.stabilisation.factor`, or none (the energy rule then chooses it), a slower programme or a finer mesh may keep it so"
+        } else {
+            "a smaller `solver.stabilisation.dissipated_fraction`, a slower programme or a finer mesh may keep it so"
+        };
+        if let Some(since) = self.energy_limit_time {
+            let ratio = self.ratio();
+            out.push(format!(
+                "the stabilisation dissipated {ratio:.3e} of the largest strain energy over the run ({:.3e} of {:.3e}, in {} damped steps), {}: the result is not quasi-static ({advice})",
+                self.dissipated,
+                self.peak_strain_energy,
+                self.damped_steps,
+                if ratio > limit {
+                    format!("above the limit {limit} since t = {since}")
+                } else {
+                    format!(
+                        "below the limit {limit} in the end (the strain energy grew) but above it from t = {since}"
+                    )
+                }
+            ));
+        }
+        if self.largest_force_share > limit {
+            out.push(format!(
+                "in {} of the {} damped steps the damping force was more than {limit} of the forces on the device from outside (its loads and reactions), up to {:.3e} of them at t = {}: there the damping, not the structure, carried the load, and the result is not quasi-static ({advice})",
+                self.steps_above_force_limit,
+                self.damped_steps,
+                self.largest_force_share,
+                self.largest_force_share_time
+            ));
+        }
+        if self.unscaled_stalls > 0 {
+            out.push(format!(
+                "stabilisation could not scale its damping factor for the step to t = {}{} (no strain energy yet, or no motion in Newton's first increment): the step was cut instead; give `solver.stabilisation.factor` to damp such a step",
+                self.first_unscaled_time,
+                if self.unscaled_stalls > 1 {
+                    format!(" and {} later stalls", self.unscaled_stalls - 1)
+                } else {
+                    String::new()
+                }
+            ));
+        }
+        out
     }
 }
 
@@ -84,6 +174,9 @@ pub struct StepStabilisation {
     pub dissipated: Real,
     /// Strain energy at the step's end \[energy\].
     pub strain_energy: Real,
+    /// The damping force's share of the forces on the device at the step's end (module docs, *The force*); 0
+    /// when the step was undamped.
+    pub force_share: Real,
 }
 
 /// The damping of the attempt in progress as the assembly sees it.
@@ -111,6 +204,50 @@ impl Simulation<'_> {
     /// The stabiliser's memory: the damping factor, if on, and the dissipated and strain energies so far.
     pub fn stabilisation(&self) -> &StabiliserState {
         &self.stabiliser
+    }
+
+    /// What the run must say about its stabilisation so far ([`StabiliserState::warnings`]); none without
+    /// `solver.stabilisation`.
+    pub fn stabilisation_warnings(&self) -> Vec<String> {
+        self.model
+            .solver
+            .stabilisation
+            .map_or_else(Vec::new, |settings| self.stabiliser.warnings(&settings))
+    }
+
+    /// The damping force's share `D / max(D, E)` of the forces on the device in the current state, under the
+    /// damping `d` and the loads at time `t` (module docs, *The force*); 0 when nothing acts.
+    fn damping_force_share(&self, t: Real, d: Damping<'_>) -> Real {
+        let disc = &self.disc;
+        let weights = self.point_weights();
+        let lever = disc.length_scale;
+        let actions = Actions::at(self.model, t, &self.ramps);
+        let (mut damping, mut external) = (0.0, 0.0);
+        for (g, point) in disc.points.iter().enumerate() {
+            let w = weights[g];
+            external += w
+                * (actions.dist_force[point.patch].norm()
+                    + actions.dist_couple[point.patch].norm() / lever);
+            let (area, inertia) = Damping::masses(&disc.shapes[point.shape]);
+            let (dx, theta) = d.motion(disc, &self.state, g);
+            damping +=
+                w * d.rate * (area * dx.norm() + inertia.component_mul(&theta).norm() / lever);
+        }
+        for k in 0..self.model.nodes.len() {
+            let (force, moment) = self
+                .node_end_resultants(k)
+                .iter()
+                .fold((Vec3::zeros(), Vec3::zeros()), |(f, m), (ef, em)| {
+                    (f + ef, m + em)
+                });
+            external += force.norm() + moment.norm() / lever;
+        }
+        let largest = damping.max(external);
+        if largest > 0.0 {
+            damping / largest
+        } else {
+            0.0
+        }
     }
 
     /// `Q` of a motion given per interior collocation point by `motion(g) = (δx, δΘ)` (module docs).
@@ -151,10 +288,10 @@ impl Simulation<'_> {
         })
     }
 
-    /// Called after a step of size `dt` failed and was rolled back: switches the damping on (or raises it) for a
-    /// retry at the same size, and says whether to retry. `false`: stabilisation is off, exhausted for this
-    /// step, or cannot be scaled; the step is then cut.
-    pub(super) fn stabilise_retry(&mut self, dt: Real) -> bool {
+    /// Called after a step of size `dt` to `target` failed and was rolled back: switches the damping on (or
+    /// raises it) for a retry at the same size, and says whether to retry. `false`: stabilisation is off,
+    /// exhausted for this step, or cannot be scaled; the step is then cut.
+    pub(super) fn stabilise_retry(&mut self, dt: Real, target: Real) -> bool {
         let Some(settings) = self.model.solver.stabilisation else {
             return false;
         };
@@ -178,10 +315,11 @@ impl Simulation<'_> {
                     settings.dissipated_fraction * energy * dt / motion
                 });
                 if !(c.is_finite() && c > 0.0) {
-                    let notice = "stabilisation could not scale its damping factor (no strain energy yet, or no motion in Newton's first increment): the step is cut instead; give `solver.stabilisation.factor` to damp such a step".to_string();
-                    if !self.notices.contains(&notice) {
-                        self.notices.push(notice);
+                    let s = &mut self.stabiliser;
+                    if s.unscaled_stalls == 0 {
+                        s.first_unscaled_time = target;
                     }
+                    s.unscaled_stalls += 1;
                     return false;
                 }
                 self.stabiliser.factor = Some(c);
@@ -192,9 +330,9 @@ impl Simulation<'_> {
         }
     }
 
-    /// After a converged step: its damping's dissipated energy and the strain energy (for runs with
-    /// stabilisation), the damping switched off when the step dissipated no more than the fraction aimed at, a
-    /// damped tangent forgotten, and the run's ratio warned about once above the limit.
+    /// After a converged step to `t`: its damping's dissipated energy and force share and the strain energy (for
+    /// runs with stabilisation), the damping switched off when the step dissipated no more than the fraction
+    /// aimed at, a damped tangent forgotten, and when the run went above the limit remembered.
     pub(super) fn account_stabilisation(&mut self, t: Real) -> Option<StepStabilisation> {
         let settings = self.model.solver.stabilisation?;
         let energy = self.strain_energy();
@@ -207,12 +345,20 @@ impl Simulation<'_> {
         let dissipated = view(&damping).map_or(0.0, |d| {
             d.rate * self.motion_measure(|g| d.motion(&self.disc, &self.state, g))
         });
+        let force_share = view(&damping).map_or(0.0, |d| self.damping_force_share(t, d));
         let s = &mut self.stabiliser;
         s.escalations = 0;
         s.peak_strain_energy = s.peak_strain_energy.max(energy);
         if damping.is_some() {
             s.damped_steps += 1;
             s.dissipated += dissipated;
+            if force_share > s.largest_force_share {
+                s.largest_force_share = force_share;
+                s.largest_force_share_time = t;
+            }
+            if force_share > settings.limit {
+                s.steps_above_force_limit += 1;
+            }
             if energy > 0.0 {
                 s.largest_step_ratio = s.largest_step_ratio.max(dissipated / energy);
             }
@@ -228,18 +374,14 @@ impl Simulation<'_> {
             self.forget_factorisation();
         }
         let s = &mut self.stabiliser;
-        if !s.warned && s.ratio() > settings.limit {
-            s.warned = true;
-            let ratio = s.ratio();
-            self.notices.push(format!(
-                "at t = {t} the stabilisation has dissipated {ratio:.3e} of the largest strain energy, above the limit {}: the result is not quasi-static there (a smaller `solver.stabilisation.dissipated_fraction`, a slower programme or a finer mesh may keep it so)",
-                settings.limit
-            ));
+        if s.energy_limit_time.is_none() && s.ratio() > settings.limit {
+            s.energy_limit_time = Some(t);
         }
         Some(StepStabilisation {
             factor,
             dissipated,
             strain_energy: energy,
+            force_share,
         })
     }
 }

@@ -275,7 +275,7 @@ impl Simulation<'_> {
                     self.roll_back(start, &captured, Abandon::Failed);
                     observer.step_failed(target, dt, &newton);
                     // Stabilisation: the same step again with the damping switched on or raised.
-                    if self.stabilise_retry(dt) {
+                    if self.stabilise_retry(dt, target) {
                         continue;
                     }
                     if is_smallest_step(dt, min_step, target) {

@@ -36,7 +36,7 @@ pub struct NewtonRun {
     pub wall: Real,
     /// Why the run stopped early.
     pub failure: Option<String>,
-    /// The solver's notices (e.g. the WLF freeze).
+    /// The solver's notices (e.g. the WLF freeze) and the stabilisation's warnings.
     pub notices: Vec<String>,
     /// `(path parameter, load factor)` of every converged increment (arc-length runs; empty for time steps).
     pub load_path: Vec<(Real, Real)>,
@@ -108,6 +108,7 @@ pub fn newton_run(model: &Model) -> Result<NewtonRun, SolverError> {
     let mut run = watch.0;
     run.wall = started.elapsed().as_secs_f64();
     run.notices = sim.notices().to_vec();
+    run.notices.extend(sim.stabilisation_warnings());
     run.stabilisation = model.solver.stabilisation.map(|_| *sim.stabilisation());
     run.final_probe = model
         .probes
@@ -298,7 +299,7 @@ pub fn solver_summary(
                 st.ratio(),
                 if st.ratio() > crate::model::StabilisationSettings::default().limit {
                     " (above the limit 0.05: not quasi-static)"
-                } else if st.warned {
+                } else if st.energy_limit_time.is_some() {
                     " (above the limit 0.05 for a while: see the notice)"
                 } else {
                     ""
