@@ -25,5 +25,6 @@ mod stabilisation;
 mod stent;
 mod studies;
 mod sweep;
+mod sweep_hostile;
 mod tune;
 mod viscoelastic;
