@@ -1,6 +1,7 @@
 //! Refusing a run that the disk cannot hold: the run's estimated output ([`estimated_disk`]: snapshots,
 //! recording, history, charts, summary) and the finishing reserve against the free space of the run folder's
-//! file system, before anything is removed or written.
+//! file system, before anything is removed or written; and a sweep likewise, its variants' estimates summed
+//! ([`crate::sweep::disk`]).
 
 use super::BadInput;
 use crate::io::design::Design;
@@ -9,6 +10,9 @@ use crate::io::design::size::human_bytes;
 use crate::io::estimate::{DiskEstimate, estimated_disk};
 use crate::io::run_folder::FitFolder;
 use crate::math::Real;
+use crate::sweep::Plan;
+use crate::sweep::disk::SweepEstimate;
+use std::path::Path;
 
 /// Room a run keeps free for finishing \[bytes\]: the summary (a few kB) and the charts (tens of kB each), written
 /// after a disk that filled up during the run ([`crate::io::run_folder::RunFolder::reserve`]).
@@ -25,11 +29,7 @@ pub fn check_space(design: &Design, folder: &FitFolder) -> anyhow::Result<()> {
     let dir = folder.dir();
     let estimate = estimated_disk(design);
     let needed = estimate.total() + FINISHING_RESERVE as u64;
-    let Some(Ok(free)) = dir
-        .ancestors()
-        .find(|a| a.exists())
-        .map(fs4::available_space)
-    else {
+    let Some(free) = free_space(dir) else {
         return Ok(());
     };
     let free = free + folder.previous_bytes();
@@ -37,23 +37,91 @@ pub fn check_space(design: &Design, folder: &FitFolder) -> anyhow::Result<()> {
         return Ok(());
     }
     let (field, advice) = largest_part(&estimate);
-    let position = Locator::new(&design.source)
+    Err(BadInput(format!(
+        "{}{}: {field}: this run would write about {} ({}) into {}, whose file system has {} free: {advice}, or choose a folder on a larger disk with -o",
+        design.path.display(),
+        position(&design.source, field),
+        human_bytes(needed as Real),
+        parts(&estimate),
+        dir.display(),
+        human_bytes(free as Real),
+    ))
+    .into())
+}
+
+/// Refuses (with [`BadInput`]) a sweep into `dir` whose estimated output ([`SweepEstimate`]: what the runs of its
+/// variants still to run write, and their design files) plus [`FINISHING_RESERVE`] for each of the
+/// `concurrent` runs at once exceeds the free space of the folder's file system (of its nearest existing
+/// ancestor). A file system whose free space cannot be read is not checked. Returns the free space, if known.
+///
+/// # Errors
+/// [`BadInput`] naming the design file, the field that sizes the largest part of the largest variant, the
+/// total, that variant's estimate by part, and the free space.
+pub fn check_sweep_space(
+    plan: &Plan,
+    dir: &Path,
+    estimate: &SweepEstimate,
+    concurrent: usize,
+) -> anyhow::Result<Option<u64>> {
+    let needed = sweep_bytes(estimate, concurrent);
+    let free = free_space(dir);
+    let (Some(free_bytes), Some((index, largest))) = (free, estimate.largest) else {
+        return Ok(free);
+    };
+    if needed <= free_bytes {
+        return Ok(free);
+    }
+    let (field, advice) = largest_part(&largest);
+    let source = std::fs::read_to_string(&plan.design).unwrap_or_default();
+    Err(BadInput(format!(
+        "{}{}: {field}: this sweep would write about {} ({} variants to run; the largest, {} [{}], about {}: {}) into {}, whose file system has {} free: {advice}, sweep fewer variants, or choose a folder on a larger disk with -o",
+        plan.design.display(),
+        position(&source, field),
+        human_bytes(needed as Real),
+        estimate.variants,
+        plan.variants.get(index).map_or("?", |v| v.id.as_str()),
+        plan.label(index),
+        human_bytes(largest.total() as Real),
+        parts(&largest),
+        dir.display(),
+        human_bytes(free_bytes as Real),
+    ))
+    .into())
+}
+
+/// What a sweep needs free: its estimate and [`FINISHING_RESERVE`] for each of the `concurrent` runs [bytes].
+pub fn sweep_bytes(estimate: &SweepEstimate, concurrent: usize) -> u64 {
+    estimate.total + (concurrent.min(estimate.variants) * FINISHING_RESERVE) as u64
+}
+
+/// Free bytes of the file system of `dir` (of its nearest existing ancestor, if it does not exist yet: the
+/// current folder for a relative `runs/x` whose `runs` does not exist), or `None` when they cannot be read.
+fn free_space(dir: &Path) -> Option<u64> {
+    std::path::absolute(dir)
+        .ok()?
+        .ancestors()
+        .find(|a| a.exists())
+        .and_then(|a| fs4::available_space(a).ok())
+}
+
+/// `:line:column` of `field` in the design text `source`, or nothing when the text does not set it.
+fn position(source: &str, field: &str) -> String {
+    Locator::new(source)
         .get(field)
         .map(|p| format!(":{}:{}", p.line, p.column))
-        .unwrap_or_default();
-    Err(BadInput(format!(
-        "{}{position}: {field}: this run would write about {} ({} snapshots {}, run.mcap {}, history.csv {}, charts and summary {}) into {}, whose file system has {} free: {advice}, or choose a folder on a larger disk with -o",
-        design.path.display(),
-        human_bytes(needed as Real),
+        .unwrap_or_default()
+}
+
+/// `8 snapshots 42.0 MB, run.mcap 19.0 MB, history.csv 203 kB, charts and summary 3.0 MB`.
+fn parts(estimate: &DiskEstimate) -> String {
+    format!(
+        "{} snapshots {}, run.mcap {}, history.csv {}, charts and summary {}",
         estimate.snapshots,
         human_bytes(estimate.snapshots_bytes() as Real),
         human_bytes(estimate.recording as Real),
         human_bytes(estimate.history as Real),
         human_bytes((estimate.charts + estimate.summary) as Real),
-        dir.display(),
-        human_bytes(free as Real),
-    ))
-    .into())
+    )
 }
 
 /// The field that sizes the largest part of `estimate`, and what to do with it.

@@ -39,7 +39,7 @@ pub const RUN: Messages = Messages {
 
 /// A sweep's messages (`cli::sweep`).
 pub const SWEEP: Messages = Messages {
-    first: "no new variant starts; the running ones finish their files and stop (the same command continues the sweep)",
+    first: "no new variant is prepared or started; the running ones finish their files and stop (the same command continues the sweep)",
     second: "still waiting for the running variants (a third signal quits the sweep; they finish on their own)",
 };
 

@@ -5,13 +5,16 @@
 //! Local workers are `stentkit sweep task DIR INDEX` child processes, each in its own process group with
 //! `RAYON_NUM_THREADS` set to the threads per run, their output appended to the variant's `log.txt`. On SIGINT,
 //! SIGTERM or SIGHUP no new variant starts and each running one gets one SIGTERM (it finishes its files and
-//! writes a checkpoint); the sweep waits for them, collects, and exits with status 130. A rerun continues.
+//! writes a checkpoint); the sweep waits for them, collects, and exits with status 130. A signal while the
+//! designs are read for the disk estimate ends the sweep with nothing written, one while the variants are
+//! prepared ends it after the variant in hand (status 130 both). A rerun continues.
 
 use super::{BadInput, Interrupted, signals};
+use crate::io::design::size::human_bytes;
 use crate::math::Real;
 use crate::sweep::collect::{Collected, collect};
 use crate::sweep::slurm::{self, Job, SlurmOptions};
-use crate::sweep::{Parameter, Plan, SweepDir, VariantState};
+use crate::sweep::{Parameter, Plan, Prepared, SweepDir, VariantState, disk};
 use anyhow::Context as _;
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use std::path::{Path, PathBuf};
@@ -41,11 +44,14 @@ pub struct SweepOptions {
     pub dry_run: bool,
 }
 
-/// Plans the sweep, writes its folder and runs (or submits) the variants that need it.
+/// Plans the sweep, checks the folder and the disk, writes its folder and runs (or submits) the variants that
+/// need it. Nothing is written before the plan, the folder, the values headed for a batch script and the disk
+/// estimate are accepted; a signal before then leaves nothing, a signal while the variants are prepared stops
+/// there (the same command continues: [`SweepDir::prepare`]).
 ///
 /// # Errors
-/// [`BadInput`] for arguments or a folder refused, [`Interrupted`] when stopped by a signal, an error when
-/// variants failed (after the table is written) or Slurm refused the job.
+/// [`BadInput`] for arguments, a folder or a disk refused, [`Interrupted`] when stopped by a signal, an error
+/// when variants failed (after the table is written) or Slurm refused the job.
 pub fn run(design: &Path, options: SweepOptions) -> anyhow::Result<()> {
     signals::install_with(signals::SWEEP);
     let parameters = options
@@ -58,15 +64,55 @@ pub fn run(design: &Path, options: SweepOptions) -> anyhow::Result<()> {
     let dir = SweepDir {
         dir: options.output.clone(),
     };
-    dir.prepare(&plan).map_err(|e| match e {
-        crate::sweep::SweepError::Io { .. } => anyhow::Error::from(e),
-        e => BadInput(e.to_string()).into(),
-    })?;
+    if let Some(slurm_options) = &options.slurm {
+        let exe = std::env::current_exe().context("cannot find the stentkit executable")?;
+        let absolute = std::path::absolute(&dir.dir)
+            .with_context(|| format!("cannot resolve {}", dir.dir.display()))?;
+        slurm::check_script_values(&absolute, &exe, &plan, slurm_options)
+            .map_err(|e| BadInput(e.to_string()))?;
+    }
+    dir.check(&plan).map_err(refused)?;
+    let to_run: Vec<usize> = (0..plan.variants.len())
+        .filter(|&i| dir.state(&plan.variants[i].id).to_run(options.retry_failed))
+        .collect();
+    let Some(estimate) = disk::estimate(&plan, &to_run, &signals::stop_requested) else {
+        return Err(Interrupted(format!(
+            "{} while the variants' designs were read: nothing was written",
+            signals::first().unwrap_or("signal")
+        ))
+        .into());
+    };
+    let concurrent = match &options.slurm {
+        Some(s) => s.max_parallel.unwrap_or(to_run.len()),
+        None => workers(&options),
+    };
+    let free = super::disk::check_sweep_space(&plan, &dir.dir, &estimate, concurrent)?;
+    eprintln!(
+        "disk: about {} for {} variants to run{}",
+        human_bytes(super::disk::sweep_bytes(&estimate, concurrent) as Real),
+        estimate.variants,
+        free.map_or_else(String::new, |f| format!(
+            ", {} free",
+            human_bytes(f as Real)
+        ))
+    );
+    if let Prepared::Stopped { prepared } = dir
+        .prepare(&plan, &estimate.resolved, &signals::stop_requested)
+        .map_err(refused)?
+    {
+        return Err(Interrupted(format!(
+            "{}: the preparation stopped with {prepared} of {} variants written (and {}); the same command continues it",
+            signals::first().unwrap_or("signal"),
+            plan.variants.len(),
+            dir.plan_file().display()
+        ))
+        .into());
+    }
     let states: Vec<VariantState> = plan.variants.iter().map(|v| dir.state(&v.id)).collect();
     let mut todo: Vec<usize> = (0..plan.variants.len())
         .filter(|&i| states[i].to_run(options.retry_failed))
         .collect();
-    let refused = states
+    let failed_earlier = states
         .iter()
         .filter(|s| matches!(s, VariantState::Failed(_)))
         .count();
@@ -80,8 +126,8 @@ pub fn run(design: &Path, options: SweepOptions) -> anyhow::Result<()> {
             .filter(|s| **s == VariantState::Completed)
             .count(),
         todo.len(),
-        if refused > 0 && !options.retry_failed {
-            format!(" ({refused} refused or failed: --retry-failed reruns the failed runs)")
+        if failed_earlier > 0 && !options.retry_failed {
+            format!(" ({failed_earlier} refused or failed: --retry-failed reruns the failed runs)")
         } else {
             String::new()
         }
@@ -126,6 +172,21 @@ struct Worker {
     signalled: bool,
 }
 
+/// A sweep error as the command's: a refused folder or plan is bad input (exit status 2), an I/O error is not.
+fn refused(e: crate::sweep::SweepError) -> anyhow::Error {
+    match e {
+        crate::sweep::SweepError::Io { .. } => anyhow::Error::from(e),
+        e => BadInput(e.to_string()).into(),
+    }
+}
+
+/// Local workers: `--jobs`, or the cores over the threads per run (at least one).
+fn workers(options: &SweepOptions) -> usize {
+    let threads = options.threads_per_run.max(1);
+    let cores = std::thread::available_parallelism().map_or(1, usize::from);
+    options.jobs.unwrap_or(cores / threads).max(1)
+}
+
 /// Runs the variants `todo` with the options' workers; returns whether a signal stopped the sweep.
 fn run_locally(
     dir: &SweepDir,
@@ -134,8 +195,7 @@ fn run_locally(
     options: &SweepOptions,
 ) -> anyhow::Result<bool> {
     let threads = options.threads_per_run.max(1);
-    let cores = std::thread::available_parallelism().map_or(1, usize::from);
-    let jobs = options.jobs.unwrap_or(cores / threads).max(1);
+    let jobs = workers(options);
     if todo.is_empty() {
         return Ok(false);
     }
@@ -268,7 +328,8 @@ fn submit(
     }
     let absolute = slurm::absolute(&dir.dir)?;
     let exe = std::env::current_exe().context("cannot find the stentkit executable")?;
-    let text = slurm::sbatch_text(&absolute, &exe, plan, todo, options);
+    let text = slurm::sbatch_text(&absolute, &exe, plan, todo, options)
+        .map_err(|e| BadInput(e.to_string()))?;
     let script = dir.dir.join("sweep.sbatch");
     crate::io::no_follow::write(&script, text.as_bytes())
         .with_context(|| format!("cannot write {}", script.display()))?;
@@ -377,10 +438,7 @@ pub fn collect_command(dir: &Path, at: Option<Vec<Real>>) -> anyhow::Result<()> 
     let sweep = SweepDir {
         dir: dir.to_path_buf(),
     };
-    let collected = collect(&sweep, at.as_deref()).map_err(|e| match e {
-        crate::sweep::SweepError::Io { .. } => anyhow::Error::from(e),
-        e => BadInput(e.to_string()).into(),
-    })?;
+    let collected = collect(&sweep, at.as_deref()).map_err(refused)?;
     report(&collected);
     Ok(())
 }

@@ -7,6 +7,11 @@
 //! step). The variants are the cartesian product of the values, the first parameter varying slowest, or with
 //! `--zip` the k-th values of every parameter together (the lists must be equally long).
 //!
+//! A path may be swept once: a second `--set` of the same path, or a later `--set` of a map that holds an
+//! earlier swept path (`mesh.n=…` then `mesh={…}`), would run other values than the variant's row says
+//! ([`Plan::new`] refuses both). A later `--set` inside an earlier one (`mesh={p: 6}` then `mesh.n=…`) changes
+//! only what it names.
+//!
 //! **Folder.** `DIR/sweep.json` (the plan: the design file, the parameters, the variants with their
 //! overrides), and per variant `DIR/variants/vNNN/`: `design.yaml` (the resolved design, [`crate::io::design::set`]),
 //! `run/` (its run folder), `log.txt` (what its run printed) or `error.txt` (why its design was refused: a
@@ -14,18 +19,28 @@
 //! sweep: a rerun skips completed variants, continues interrupted or killed ones from their checkpoint, starts
 //! those never started, and reruns failed ones only when asked (`--retry-failed`, which replaces only the files
 //! that failed run wrote). A rerun must describe the same sweep: a different plan or a variant whose resolved
-//! design changed (the design file was edited) is refused.
+//! design changed (the design file was edited) is refused, and so is a `sweep.json` that no longer describes
+//! its sweep (edited by hand: [`SweepDir::read_plan`]).
+//!
+//! **Preparation** ([`SweepDir::prepare`]) writes `sweep.json` first, then the variants' designs, every file
+//! through a temporary renamed into place: a preparation stopped by a signal (between two variants) or killed
+//! outright leaves a folder the same command continues — it checks the designs already written and writes the
+//! rest — and never half a file.
 //!
 //! **State** of a variant ([`VariantState`]) is read from its files: `summary.json`'s status, or `error.txt`
 //! (its design was refused), or `task_error.txt` (its run was refused before it wrote a summary), or nothing
 //! yet.
 
 pub mod collect;
+pub mod disk;
 pub mod metrics;
 pub mod slurm;
 
-use crate::io::design::{DesignError, DesignOverrides, SetOverride, load_design_with};
+use crate::io::design::set::{PathStep, parse_path, path_text};
+use crate::io::design::{Design, DesignError, DesignOverrides, SetOverride, load_design_with};
 use serde::{Deserialize, Serialize};
+use std::collections::HashMap;
+use std::io::Write as _;
 use std::path::{Path, PathBuf};
 
 /// The plan file in a sweep folder.
@@ -62,6 +77,9 @@ pub enum SweepError {
         /// Why it cannot be used.
         reason: String,
     },
+    /// A value that would reach the batch script cannot be written into it safely (a control character).
+    #[error("{0}")]
+    Script(String),
     /// A file could not be read or written.
     #[error("{path}: {source}")]
     Io {
@@ -115,6 +133,11 @@ impl Parameter {
             path: path.trim().to_string(),
             values,
         })
+    }
+
+    /// The parameter as a `--set` argument (`mesh.n=20,22`), for messages.
+    pub fn argument(&self) -> String {
+        format!("{}={}", self.path, self.values.join(","))
     }
 }
 
@@ -187,7 +210,8 @@ impl Plan {
     ///
     /// # Errors
     /// [`SweepError::Plan`] for no parameters, `--zip` lists of different lengths or more than
-    /// [`MAX_VARIANTS`] variants.
+    /// [`MAX_VARIANTS`] variants; [`SweepError::Parameter`] for a path swept twice or replaced by a later
+    /// parameter (module docs).
     pub fn new(design: &Path, parameters: Vec<Parameter>, zip: bool) -> Result<Self, SweepError> {
         if parameters.is_empty() {
             return Err(SweepError::Plan(
@@ -195,6 +219,7 @@ impl Plan {
                     .into(),
             ));
         }
+        check_paths(&parameters)?;
         let rows: Vec<Vec<String>> = if zip {
             let n = parameters[0].values.len();
             if let Some(p) = parameters.iter().find(|p| p.values.len() != n) {
@@ -240,6 +265,57 @@ impl Plan {
         })
     }
 
+    /// Why this plan, read from a file, is not the one its own parameters make (a variant lost a value, an id
+    /// was changed, a variant added or removed: `sweep.json` edited by hand), naming the field; `None` when it is.
+    fn mismatch(&self) -> Option<String> {
+        let expected = match Self::new(&self.design, self.parameters.clone(), self.zip) {
+            Ok(plan) => plan,
+            Err(e) => return Some(format!("parameters: {e}")),
+        };
+        if self.variants.len() != expected.variants.len() {
+            return Some(format!(
+                "variants: {} variants, where its parameters make {}",
+                self.variants.len(),
+                expected.variants.len()
+            ));
+        }
+        let paths = || {
+            self.parameters
+                .iter()
+                .map(|p| p.path.as_str())
+                .collect::<Vec<_>>()
+                .join(", ")
+        };
+        self.variants
+            .iter()
+            .zip(&expected.variants)
+            .enumerate()
+            .find_map(|(k, (v, e))| {
+                if v.id != e.id {
+                    Some(format!(
+                        "variants[{k}].id: `{}`, expected `{}`",
+                        v.id.escape_debug(),
+                        e.id
+                    ))
+                } else if v.values.len() != self.parameters.len() {
+                    Some(format!(
+                        "variants[{k}].values: {} value{} for {} parameters ({})",
+                        v.values.len(),
+                        if v.values.len() == 1 { "" } else { "s" },
+                        self.parameters.len(),
+                        paths()
+                    ))
+                } else if v.values != e.values {
+                    Some(format!(
+                        "variants[{k}].values: {:?}, where its parameters give {:?}",
+                        v.values, e.values
+                    ))
+                } else {
+                    None
+                }
+            })
+    }
+
     /// The `--set` overrides of variant `index`, in the parameters' order.
     pub fn overrides(&self, index: usize) -> Vec<String> {
         self.variants.get(index).map_or_else(Vec::new, |v| {
@@ -263,6 +339,45 @@ impl Plan {
             .collect::<Vec<_>>()
             .join(", ")
     }
+}
+
+/// Refuses a path swept twice, or swept and then replaced by a later parameter that sets a map holding it
+/// (module docs); paths are compared as parsed, so `patches[00].n` is `patches[0].n`.
+fn check_paths(parameters: &[Parameter]) -> Result<(), SweepError> {
+    let steps = parameters
+        .iter()
+        .map(|p| {
+            parse_path(&p.path).map_err(|message| SweepError::Parameter {
+                argument: p.argument(),
+                message,
+            })
+        })
+        .collect::<Result<Vec<Vec<PathStep>>, _>>()?;
+    for (j, later) in parameters.iter().enumerate() {
+        for (i, earlier) in parameters[..j].iter().enumerate() {
+            let message = if steps[i] == steps[j] {
+                format!(
+                    "`{}` is already swept by --set {}: give all its values in one --set",
+                    path_text(&steps[j]),
+                    earlier.argument()
+                )
+            } else if steps[i].starts_with(&steps[j]) {
+                format!(
+                    "it replaces `{}`, swept by the earlier --set {}: give the --set of the whole `{}` first",
+                    path_text(&steps[i]),
+                    earlier.argument(),
+                    path_text(&steps[j])
+                )
+            } else {
+                continue;
+            };
+            return Err(SweepError::Parameter {
+                argument: later.argument(),
+                message,
+            });
+        }
+    }
+    Ok(())
 }
 
 /// The last key of a field path (`material.wlf.Tg` → `Tg`).
@@ -314,36 +429,39 @@ impl SweepDir {
         self.variant(id).join("task_error.txt")
     }
 
-    /// Reads the plan.
+    /// Reads the plan, and checks that it is the plan its own parameters make.
     ///
     /// # Errors
-    /// [`SweepError::Folder`] when DIR holds no sweep or an unreadable plan.
+    /// [`SweepError::Folder`] when DIR holds no sweep or an unreadable plan, or a plan that no longer describes
+    /// its sweep (naming the field: `sweep.json: variants[3].values: 1 value for 2 parameters …`).
     pub fn read_plan(&self) -> Result<Plan, SweepError> {
         let path = self.plan_file();
-        let text = std::fs::read_to_string(&path).map_err(|e| SweepError::Folder {
-            dir: self.dir.clone(),
-            reason: format!("no sweep here ({PLAN_FILE}: {e})"),
-        })?;
-        serde_json::from_str(&text).map_err(|e| SweepError::Folder {
-            dir: self.dir.clone(),
-            reason: format!("{PLAN_FILE} is not a sweep plan: {e}"),
-        })
-    }
-
-    /// Writes `plan` and each variant's resolved design (or the reason it was refused) into a new folder, or
-    /// checks that an existing folder holds the same plan and the same resolved designs (module docs).
-    ///
-    /// # Errors
-    /// [`SweepError::Folder`] for a folder holding another sweep or a changed design (or a folder that is not
-    /// empty and holds no sweep); [`SweepError::Io`] when a file cannot be written.
-    pub fn prepare(&self, plan: &Plan) -> Result<(), SweepError> {
         let folder = |reason: String| SweepError::Folder {
             dir: self.dir.clone(),
             reason,
         };
-        let io = |path: &Path| {
-            let path = path.to_path_buf();
-            move |source| SweepError::Io { path, source }
+        let text = std::fs::read_to_string(&path)
+            .map_err(|e| folder(format!("no sweep here ({PLAN_FILE}: {e})")))?;
+        let plan: Plan = serde_json::from_str(&text)
+            .map_err(|e| folder(format!("{PLAN_FILE} is not a sweep plan: {e}")))?;
+        match plan.mismatch() {
+            None => Ok(plan),
+            Some(why) => Err(folder(format!(
+                "{PLAN_FILE}: {why}: the file no longer describes the sweep written here (was it edited?); restore it, or start a new sweep folder"
+            ))),
+        }
+    }
+
+    /// Whether `plan` may be prepared here, changing nothing: a new or empty folder, or one that holds the same
+    /// plan (a sweep to continue).
+    ///
+    /// # Errors
+    /// [`SweepError::Folder`] for a folder holding another sweep, or a folder that is not empty and holds no
+    /// sweep.
+    pub fn check(&self, plan: &Plan) -> Result<(), SweepError> {
+        let folder = |reason: String| SweepError::Folder {
+            dir: self.dir.clone(),
+            reason,
         };
         if self.plan_file().exists() {
             let existing = self.read_plan()?;
@@ -354,44 +472,97 @@ impl SweepDir {
                     existing
                         .parameters
                         .iter()
-                        .map(|p| format!("{}={}", p.path, p.values.join(",")))
+                        .map(Parameter::argument)
                         .collect::<Vec<_>>()
                         .join(" ")
                 )));
             }
-        } else if self.dir.read_dir().is_ok_and(|mut d| d.next().is_some()) {
-            return Err(folder(
+            return Ok(());
+        }
+        // A preparation killed while it wrote the plan leaves only the plan's temporary: as good as empty.
+        let temporary = temporary(&self.plan_file());
+        let mut entries = match self.dir.read_dir() {
+            Ok(d) => d.flatten().map(|e| e.path()).filter(|p| *p != temporary),
+            Err(_) => return Ok(()),
+        };
+        match entries.next() {
+            None => Ok(()),
+            Some(_) if self.dir.join("variants").is_dir() => Err(folder(format!(
+                "holds variants/ but no {PLAN_FILE}: a sweep whose preparation was killed by a stentkit that wrote the plan last; nothing in it is removed: delete the folder yourself and run the sweep again, or choose a new folder"
+            ))),
+            Some(_) => Err(folder(
                 "is not empty and holds no sweep: choose a new folder (nothing in it is removed)"
                     .into(),
-            ));
+            )),
         }
+    }
+
+    /// Writes `plan` into the folder ([`SweepDir::check`] must accept it) and then each variant's resolved
+    /// design, or the reason it was refused, checking those an earlier preparation wrote. The plan comes
+    /// first and every file is written through a temporary renamed into place, so a preparation killed at any
+    /// moment leaves a folder this continues (module docs). `known` holds resolutions already made
+    /// ([`disk::SweepEstimate::resolved`]); `stop` is asked before each variant, and when it says so the
+    /// preparation ends there.
+    ///
+    /// # Errors
+    /// [`SweepError::Folder`] for a folder [`SweepDir::check`] refuses or a variant whose design changed;
+    /// [`SweepError::Io`] when a file cannot be written.
+    pub fn prepare(
+        &self,
+        plan: &Plan,
+        known: &Resolutions,
+        stop: &dyn Fn() -> bool,
+    ) -> Result<Prepared, SweepError> {
+        self.check(plan)?;
+        let io = |path: &Path| {
+            let path = path.to_path_buf();
+            move |source| SweepError::Io { path, source }
+        };
         std::fs::create_dir_all(&self.dir).map_err(io(&self.dir))?;
+        if !self.plan_file().exists() {
+            let text = serde_json::to_string_pretty(plan).unwrap_or_default();
+            write_atomically(&self.plan_file(), &text, true).map_err(io(&self.plan_file()))?;
+        }
         for (index, v) in plan.variants.iter().enumerate() {
+            if stop() {
+                return Ok(Prepared::Stopped { prepared: index });
+            }
             let dir = self.variant(&v.id);
             std::fs::create_dir_all(&dir).map_err(io(&dir))?;
-            let resolved = resolve(plan, index);
+            let resolved = known
+                .get(&index)
+                .cloned()
+                .unwrap_or_else(|| resolve(plan, index));
             let (path, text) = match &resolved {
                 Ok(text) => (self.design(&v.id), text),
                 Err(error) => (self.error(&v.id), error),
             };
             match std::fs::read_to_string(&path) {
                 Ok(existing) if existing == *text => {}
-                Ok(_) => {
-                    return Err(folder(format!(
-                        "variant {} ({}) resolves to another design than the one it was written with ({}): was the design file edited? Start a new sweep folder",
-                        v.id,
-                        plan.label(index),
-                        path.display()
-                    )));
+                // Empty: written but not yet flushed when the machine stopped (the text is never empty).
+                Ok(existing) if existing.is_empty() => {
+                    write_atomically(&path, text, false).map_err(io(&path))?;
                 }
-                Err(_) => write_new(&path, text).map_err(io(&path))?,
+                Err(e) if e.kind() == std::io::ErrorKind::NotFound => {
+                    write_atomically(&path, text, false).map_err(io(&path))?;
+                }
+                Err(e) if e.kind() != std::io::ErrorKind::InvalidData => {
+                    return Err(io(&path)(e));
+                }
+                _ => {
+                    return Err(SweepError::Folder {
+                        dir: self.dir.clone(),
+                        reason: format!(
+                            "variant {} ({}) resolves to another design than the one it was written with ({}): was the design file edited? Start a new sweep folder",
+                            v.id,
+                            plan.label(index),
+                            path.display()
+                        ),
+                    });
+                }
             }
         }
-        let text = serde_json::to_string_pretty(plan).unwrap_or_default();
-        if !self.plan_file().exists() {
-            write_new(&self.plan_file(), &text).map_err(io(&self.plan_file()))?;
-        }
-        Ok(())
+        Ok(Prepared::All)
     }
 
     /// The state of variant `id` from its files.
@@ -423,18 +594,50 @@ impl SweepDir {
     }
 }
 
-/// Writes `text` to a file that must not exist yet (nothing the user wrote is replaced).
-fn write_new(path: &Path, text: &str) -> std::io::Result<()> {
-    use std::io::Write as _;
-    let mut file = std::fs::OpenOptions::new()
-        .write(true)
-        .create_new(true)
-        .open(path)?;
-    file.write_all(text.as_bytes())
+/// Resolutions of variants made before the preparation, by index: the resolved design text, or why the
+/// design was refused ([`resolve`]).
+pub type Resolutions = HashMap<usize, Result<String, String>>;
+
+/// How far [`SweepDir::prepare`] got.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Prepared {
+    /// Every variant's design is written.
+    All,
+    /// Stopped when asked, with the variants before `prepared` written.
+    Stopped {
+        /// Variants written (those with a smaller index).
+        prepared: usize,
+    },
+}
+
+/// `path` with `.partial` appended: where [`write_atomically`] writes first.
+fn temporary(path: &Path) -> PathBuf {
+    let mut name = path.as_os_str().to_owned();
+    name.push(".partial");
+    PathBuf::from(name)
+}
+
+/// Writes `text` to `path` through a temporary renamed over it (a reader, or a rerun after SIGKILL, never sees
+/// half a file; a stale temporary of a killed writer is replaced), flushed to the disk first when `sync`.
+/// `path` itself is one this sweep writes and checks before it writes: nothing the user wrote is replaced.
+fn write_atomically(path: &Path, text: &str, sync: bool) -> std::io::Result<()> {
+    let partial = temporary(path);
+    let mut file = std::fs::File::create(&partial)?;
+    file.write_all(text.as_bytes())?;
+    if sync {
+        file.sync_all()?;
+    }
+    drop(file);
+    std::fs::rename(&partial, path)
 }
 
 /// The resolved design text of variant `index`, or the design error its overrides give.
 pub fn resolve(plan: &Plan, index: usize) -> Result<String, String> {
+    resolve_design(plan, index).map(|d| d.source)
+}
+
+/// The resolved design of variant `index`, or the design error its overrides give (as text).
+pub fn resolve_design(plan: &Plan, index: usize) -> Result<Design, String> {
     let sets: Result<Vec<SetOverride>, _> = plan
         .overrides(index)
         .iter()
@@ -442,7 +645,6 @@ pub fn resolve(plan: &Plan, index: usize) -> Result<String, String> {
         .collect();
     let sets = sets.map_err(|e| e.to_string())?;
     load_design_with(&plan.design, &DesignOverrides::sets(sets))
-        .map(|d| d.source)
         .map_err(|e: DesignError| e.to_string())
 }
 

@@ -8,6 +8,14 @@
 //! after `KillWait`; a run killed outright continues from its last periodic checkpoint). Its output is appended
 //! to the variant's `log.txt`. A resubmission (`stentkit sweep … --slurm` again) submits only the variants
 //! that are neither completed nor queued or running in a job of this sweep.
+//!
+//! **What reaches the script.** The partition, the time limit, the job name (from the design file's name), the
+//! sweep folder's path and the binary's path are written into it; a control character in any of them (a line
+//! break would start a shell command) is refused ([`check_script_values`]). The rest is quoted for who reads
+//! it: `#SBATCH` values in double quotes with `\`, `"`, `'` and `#` escaped by a backslash (how sbatch splits
+//! those lines: `_get_argument` in Slurm's `src/sbatch/opt.c`), `%` doubled in the output file name (Slurm's
+//! file name patterns, where a backslash would turn the `%a` of the variant off: a folder with one is refused),
+//! and the command line in single quotes for bash.
 
 use super::{Plan, SweepDir, SweepError};
 use serde::{Deserialize, Serialize};
@@ -59,40 +67,127 @@ fn quoted(text: &str) -> String {
     format!("'{}'", text.replace('\'', r"'\''"))
 }
 
+/// `text` as one argument of an `#SBATCH` line: in double quotes, with `\`, `"`, `'` and `#` escaped by a
+/// backslash (sbatch's `_get_argument` takes a backslash to escape the next character, in quotes or not, and
+/// older versions end the line at a `#` even in quotes).
+fn sbatch_quoted(text: &str) -> String {
+    let mut out = String::from("\"");
+    for c in text.chars() {
+        if matches!(c, '\\' | '"' | '\'' | '#') {
+            out.push('\\');
+        }
+        out.push(c);
+    }
+    out.push('"');
+    out
+}
+
+/// The job's name: `stentkit-` and the design file's name without its extension.
+fn job_name(plan: &Plan) -> String {
+    let stem = plan
+        .design
+        .file_stem()
+        .map_or_else(|| "design".into(), |s| s.to_string_lossy().into_owned());
+    format!("stentkit-{stem}")
+}
+
+/// Refuses (naming it) a value that would reach the batch script of the sweep in `dir`, run by `exe`, and
+/// that the script cannot hold: a control character in the partition, the time limit, the job name, the
+/// folder's or the binary's path, or a backslash in the folder's path (Slurm would then not replace the `%a`
+/// in the output file name, and every task would write one file).
+///
+/// # Errors
+/// [`SweepError::Script`] naming the value, shown with escapes.
+pub fn check_script_values(
+    dir: &Path,
+    exe: &Path,
+    plan: &Plan,
+    options: &SlurmOptions,
+) -> Result<(), SweepError> {
+    let folder = dir.to_string_lossy();
+    // What, where it comes from (what to change), the value.
+    let values = [
+        ("--partition", "", options.partition.clone()),
+        ("--time", "", options.time.clone()),
+        (
+            "the job name",
+            " (from the design file's name: rename the file)",
+            Some(job_name(plan)),
+        ),
+        ("the sweep folder's path", "", Some(folder.to_string())),
+        (
+            "the stentkit binary's path",
+            " (move the binary)",
+            Some(exe.to_string_lossy().into_owned()),
+        ),
+    ];
+    for (what, origin, value) in values {
+        let Some(value) = value else {
+            continue;
+        };
+        if let Some(c) = value.chars().find(|c| c.is_control()) {
+            return Err(SweepError::Script(format!(
+                "{what} `{}`{origin}: holds a control character (U+{:04X}), which the batch script cannot hold (a line break would start a shell command): remove it",
+                value.escape_debug(),
+                u32::from(c),
+            )));
+        }
+    }
+    for (what, path) in [
+        ("the sweep folder's path", dir),
+        ("the stentkit binary's path", exe),
+    ] {
+        if path.to_str().is_none() {
+            return Err(SweepError::Script(format!(
+                "{what} `{}` is not UTF-8 text, which the batch script cannot name: choose another",
+                path.display()
+            )));
+        }
+    }
+    if folder.contains('\\') {
+        return Err(SweepError::Script(format!(
+            "the sweep folder's path `{folder}` holds a backslash, which makes Slurm write every task's output to one file (no `%a` in its name): choose a folder without one"
+        )));
+    }
+    Ok(())
+}
+
 /// The batch script of the tasks `indices` of the sweep in `dir` (an absolute path), run by `exe`.
+///
+/// # Errors
+/// [`SweepError::Script`] for a value the script cannot hold ([`check_script_values`]).
 pub fn sbatch_text(
     dir: &Path,
     exe: &Path,
     plan: &Plan,
     indices: &[usize],
     options: &SlurmOptions,
-) -> String {
-    let name = plan
-        .design
-        .file_stem()
-        .map_or_else(|| "design".into(), |s| s.to_string_lossy().into_owned());
+) -> Result<String, SweepError> {
+    check_script_values(dir, exe, plan, options)?;
     let mut array = array_ranges(indices);
     if let Some(m) = options.max_parallel {
         array.push_str(&format!("%{m}"));
     }
+    // `%3a`: the task id padded to three digits, the variant's folder `v%3a`; a `%` of the folder's path is
+    // `%%` in a Slurm file name.
+    let output = format!(
+        "{}/variants/v%3a/log.txt",
+        dir.to_string_lossy().replace('%', "%%")
+    );
     let mut lines = vec![
         "#!/bin/bash".to_string(),
-        format!("#SBATCH --job-name=stentkit-{name}"),
+        format!("#SBATCH --job-name={}", sbatch_quoted(&job_name(plan))),
         format!("#SBATCH --array={array}"),
         "#SBATCH --ntasks=1".into(),
         format!("#SBATCH --cpus-per-task={}", options.cpus_per_task.max(1)),
-        // `%3a`: the task id padded to three digits, the variant's folder `v%3a`.
-        format!(
-            "#SBATCH --output={}",
-            dir.join("variants/v%3a/log.txt").display()
-        ),
+        format!("#SBATCH --output={}", sbatch_quoted(&output)),
         "#SBATCH --open-mode=append".into(),
     ];
     if let Some(p) = &options.partition {
-        lines.push(format!("#SBATCH --partition={p}"));
+        lines.push(format!("#SBATCH --partition={}", sbatch_quoted(p)));
     }
     if let Some(t) = &options.time {
-        lines.push(format!("#SBATCH --time={t}"));
+        lines.push(format!("#SBATCH --time={}", sbatch_quoted(t)));
     }
     lines.extend([
         String::new(),
@@ -115,7 +210,7 @@ pub fn sbatch_text(
             }
         ),
     ]);
-    lines.join("\n") + "\n"
+    Ok(lines.join("\n") + "\n")
 }
 
 /// One submitted job array.
@@ -260,12 +355,141 @@ mod tests {
             &plan,
             &[0, 2],
             &options,
-        );
+        )
+        .expect("a script");
         assert!(text.contains("#SBATCH --array=0,2%4\n"), "{text}");
-        assert!(text.contains("#SBATCH --partition=debug\n#SBATCH --time=00:10:00\n"));
-        assert!(text.contains("#SBATCH --output=/s w/dir/variants/v%3a/log.txt\n"));
+        assert!(text.contains("#SBATCH --partition=\"debug\"\n#SBATCH --time=\"00:10:00\"\n"));
+        assert!(text.contains("#SBATCH --output=\"/s w/dir/variants/v%3a/log.txt\"\n"));
         assert!(
             text.ends_with("exec '/bin/stentkit' sweep task '/s w/dir' \"$SLURM_ARRAY_TASK_ID\"\n")
         );
+    }
+
+    /// The arguments sbatch takes from the text after `#SBATCH`: Slurm's `_get_argument` (src/sbatch/opt.c,
+    /// versions 18 to 24) transcribed — whitespace separates arguments, a backslash takes the next character
+    /// as it is (in quotes too), `"` or `'` quote up to the same character, an unquoted `#` ends the line.
+    fn sbatch_arguments(text: &str) -> Vec<String> {
+        let (mut arguments, mut current, mut chars) = (Vec::new(), None::<String>, text.chars());
+        let mut quote = None;
+        while let Some(c) = chars.next() {
+            match (c, quote) {
+                ('\\', _) => {
+                    if let Some(next) = chars.next() {
+                        current.get_or_insert_with(String::new).push(next);
+                    }
+                }
+                (c, Some(q)) if c == q => quote = None,
+                (c, Some(_)) => current.get_or_insert_with(String::new).push(c),
+                ('"' | '\'', None) => {
+                    quote = Some(c);
+                    current.get_or_insert_with(String::new);
+                }
+                ('#', None) => break,
+                (c, None) if c.is_whitespace() => arguments.extend(current.take()),
+                (c, None) => current.get_or_insert_with(String::new).push(c),
+            }
+        }
+        assert!(quote.is_none(), "unmatched quote in {text}");
+        arguments.extend(current);
+        arguments
+    }
+
+    // Item 15 of issue 31: values with spaces, quotes, `#`, `%` and backslashes reach sbatch and bash as
+    // they were given. Each `#SBATCH` line is split as sbatch splits it (the transcription above) and must
+    // give exactly the one intended argument, with `%` doubled in the output file name (Slurm's `%%`); the
+    // command line is run by bash, with the binary a link to `echo` whose name holds a space and quotes, and
+    // must print the folder and the task id unchanged. Control characters are refused, naming the value.
+    #[test]
+    fn the_script_passes_odd_values_through_sbatch_and_bash_unchanged() {
+        let scratch = std::env::temp_dir().join(format!("stentkit-sbatch-{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&scratch);
+        let bin = scratch.join("my bin");
+        std::fs::create_dir_all(&bin).expect("folder");
+        let exe = bin.join("it's \"stentkit\" #1");
+        std::os::unix::fs::symlink("/bin/echo", &exe).expect("a link to echo");
+        let plan = Plan::new(
+            Path::new("designs/my \"odd\" design #2.yaml"),
+            vec![super::super::Parameter::parse("a=1,2").expect("a")],
+            false,
+        )
+        .expect("plan");
+        let options = SlurmOptions {
+            partition: Some("a b#\"c'd\\e".into()),
+            time: Some("1-00:00:00".into()),
+            cpus_per_task: 1,
+            max_parallel: None,
+            retry_failed: false,
+        };
+        let dir = Path::new("/s w/50%/it's \"x\" $HOME #1");
+        let text = sbatch_text(dir, &exe, &plan, &[0, 1], &options).expect("a script");
+        let argument = |option: &str| {
+            let line = text
+                .lines()
+                .find(|l| l.starts_with(&format!("#SBATCH {option}=")))
+                .unwrap_or_else(|| panic!("no {option} in {text}"));
+            let arguments = sbatch_arguments(&line["#SBATCH ".len()..]);
+            assert_eq!(arguments.len(), 1, "{line}: {arguments:?}");
+            arguments[0].clone()
+        };
+        assert_eq!(argument("--partition"), "--partition=a b#\"c'd\\e");
+        assert_eq!(argument("--time"), "--time=1-00:00:00");
+        assert_eq!(
+            argument("--job-name"),
+            "--job-name=stentkit-my \"odd\" design #2"
+        );
+        assert_eq!(
+            argument("--output"),
+            "--output=/s w/50%%/it's \"x\" $HOME #1/variants/v%3a/log.txt"
+        );
+        let script = scratch.join("sweep.sbatch");
+        std::fs::write(&script, &text).expect("script");
+        let out = Command::new("bash")
+            .arg(&script)
+            .env("SLURM_ARRAY_TASK_ID", "7")
+            .output()
+            .expect("bash runs");
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        assert_eq!(
+            String::from_utf8_lossy(&out.stdout),
+            "sweep task /s w/50%/it's \"x\" $HOME #1 7\n"
+        );
+        let _ = std::fs::remove_dir_all(&scratch);
+        for (options, dir, expected) in [
+            (
+                SlurmOptions {
+                    partition: Some("debug\ntouch X".into()),
+                    ..options.clone()
+                },
+                Path::new("/s"),
+                "--partition `debug\\ntouch X`: holds a control character (U+000A)",
+            ),
+            (
+                SlurmOptions {
+                    time: Some("1:00\u{7f}".into()),
+                    ..options.clone()
+                },
+                Path::new("/s"),
+                "--time `1:00\\u{7f}`: holds a control character (U+007F)",
+            ),
+            (
+                options.clone(),
+                Path::new("/s\r/x"),
+                "the sweep folder's path `/s\\r/x`: holds a control character (U+000D)",
+            ),
+            (
+                options.clone(),
+                Path::new("/s\\x"),
+                "the sweep folder's path `/s\\x` holds a backslash",
+            ),
+        ] {
+            let error = sbatch_text(dir, &exe, &plan, &[0], &options)
+                .expect_err("refused")
+                .to_string();
+            assert!(error.contains(expected), "{error}");
+        }
     }
 }

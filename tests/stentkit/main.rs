@@ -26,6 +26,7 @@ mod stabilisation;
 mod stent;
 mod studies;
 mod sweep;
+mod sweep_hostile;
 mod tune;
 mod viscoelastic;
 mod warnings;

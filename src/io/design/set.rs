@@ -79,8 +79,11 @@ impl fmt::Display for SetOverride {
     }
 }
 
-/// Parses `a.b[2].c` (module docs).
-fn parse_path(text: &str) -> Result<Vec<PathStep>, String> {
+/// Parses a field path `a.b[2].c` (module docs).
+///
+/// # Errors
+/// A message for an empty path or key, or a malformed index.
+pub fn parse_path(text: &str) -> Result<Vec<PathStep>, String> {
     if text.is_empty() {
         return Err("the field path is empty".into());
     }
