@@ -79,12 +79,10 @@ pub fn run(run_dir: &Path, options: &ExportOptions) -> anyhow::Result<()> {
     }
     super::refuse_existing([options.output.as_path()], options.force)?;
     let summary_path = run_dir.join("summary.json");
-    let summary: serde_json::Value = std::fs::read_to_string(&summary_path)
-        .ok()
-        .and_then(|text| serde_json::from_str(&text).ok())
-        .ok_or_else(|| {
+    let summary: serde_json::Value =
+        crate::io::summary::read_json(&summary_path).map_err(|why| {
             BadInput(format!(
-                "{}: not a run folder (no readable summary.json)",
+                "{}: not a run folder (summary.json: {why})",
                 run_dir.display()
             ))
         })?;

@@ -6,7 +6,6 @@ use super::{BadInput, short_time};
 use crate::io::configurations::{View, chosen_indices};
 use crate::io::render::{render_snapshots, write_png};
 use crate::io::snapshots::{SnapshotWriter, VESSEL_FILE};
-use anyhow::Context;
 use std::path::{Path, PathBuf};
 
 /// Draws the snapshots of the run folder `dir` at `times` (empty: the default choice) in `view` into `output`
@@ -39,14 +38,13 @@ pub fn run(
     }
     super::refuse_existing([output], force)?;
     let summary_path = dir.join("summary.json");
-    let text = std::fs::read_to_string(&summary_path).map_err(|e| {
-        BadInput(format!(
-            "{}: {e} (not a run folder?)",
-            summary_path.display()
-        ))
-    })?;
-    let summary: serde_json::Value = serde_json::from_str(&text)
-        .with_context(|| format!("{}: not JSON", summary_path.display()))?;
+    let summary: serde_json::Value =
+        crate::io::summary::read_json(&summary_path).map_err(|why| {
+            BadInput(format!(
+                "{}: {why} (not a run folder?)",
+                summary_path.display()
+            ))
+        })?;
     // Every snapshot with an STL, in time order (the first is the initial state).
     let snapshots: Vec<(f64, PathBuf)> = summary["snapshots"]
         .as_array()

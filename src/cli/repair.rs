@@ -82,10 +82,8 @@ pub fn run(dir: &Path) -> anyhow::Result<()> {
     }
     let summary_path = dir.join("summary.json");
     if summary_path.exists() {
-        let text = std::fs::read_to_string(&summary_path)
-            .with_context(|| format!("cannot read {}", summary_path.display()))?;
-        let mut summary: Value = serde_json::from_str(&text)
-            .with_context(|| format!("{}: not a stentkit summary", summary_path.display()))?;
+        let mut summary: Value = crate::io::summary::read_json(&summary_path)
+            .map_err(|why| anyhow::anyhow!("{}: {why}", summary_path.display()))?;
         if summary["status"] == "running" {
             mark_killed(&mut summary, &rows, dir, &listed, mcap_bytes);
             let mut text = serde_json::to_string_pretty(&summary)?;

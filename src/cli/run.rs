@@ -630,8 +630,7 @@ fn resume(
 
 /// The `status` of the run folder's `summary.json`, if it can be read.
 fn previous_status(dir: &Path) -> Option<String> {
-    let text = std::fs::read_to_string(dir.join("summary.json")).ok()?;
-    let value: serde_json::Value = serde_json::from_str(&text).ok()?;
+    let value: serde_json::Value = crate::io::summary::read_json(&dir.join("summary.json")).ok()?;
     value.get("status")?.as_str().map(str::to_string)
 }
 

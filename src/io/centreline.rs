@@ -25,6 +25,7 @@
 //! inflated no further than its header declares, which must not exceed what the array needs for the points
 //! (or cells) the file declares — a zlib block of a few hundred kilobytes can inflate to gigabytes.
 
+use crate::io::input::{InputError, read_regular_file};
 use crate::math::{Real, Vec3};
 use std::path::{Path, PathBuf};
 
@@ -93,12 +94,20 @@ pub fn read_centreline(
         path: path.to_path_buf(),
         message,
     };
-    let bytes = read_regular_file(path).map_err(|e| match e {
-        Limited::Io(source) => CentrelineError::Read {
+    let bytes = read_regular_file(path, MAX_CENTRELINE_BYTES).map_err(|e| match e {
+        InputError::Io(source) => CentrelineError::Read {
             path: path.to_path_buf(),
             source,
         },
-        Limited::Refused(message) => invalid(message),
+        InputError::NotRegular(what) => invalid(format!(
+            "{what}, not a regular file: a centreline is read from a file of at most {} MiB",
+            MAX_CENTRELINE_BYTES >> 20
+        )),
+        InputError::TooLarge(bytes) => invalid(format!(
+            "the file has {bytes} bytes ({:.1} MiB), more than stentkit's limit of {} MiB ({MAX_CENTRELINE_BYTES} bytes) for a centreline file; a VMTK centreline is tens of kB",
+            bytes as f64 / (1024.0 * 1024.0),
+            MAX_CENTRELINE_BYTES >> 20
+        )),
     })?;
     let extension = path
         .extension()
@@ -114,73 +123,6 @@ pub fn read_centreline(
     result
         .and_then(|polylines| validate(polylines, radius_array))
         .map_err(invalid)
-}
-
-/// Why [`read_regular_file`] read nothing.
-enum Limited {
-    /// The operating system's error.
-    Io(std::io::Error),
-    /// Not a regular file, or larger than [`MAX_CENTRELINE_BYTES`].
-    Refused(String),
-}
-
-/// The bytes of the regular file at `path`, at most [`MAX_CENTRELINE_BYTES`]. Anything else is refused
-/// before it is opened: a device, FIFO, socket or folder (`/dev/zero` is endless, a FIFO blocks). The file is
-/// opened without blocking and checked again once open (it may have been replaced in between), and read no
-/// further than the limit (it may have grown).
-fn read_regular_file(path: &Path) -> Result<Vec<u8>, Limited> {
-    use std::io::Read as _;
-    use std::os::unix::fs::{FileTypeExt as _, OpenOptionsExt as _};
-    let refuse_kind = |kind: std::fs::FileType| {
-        let what = if kind.is_dir() {
-            "a folder"
-        } else if kind.is_char_device() {
-            "a character device"
-        } else if kind.is_block_device() {
-            "a block device"
-        } else if kind.is_fifo() {
-            "a FIFO (named pipe)"
-        } else if kind.is_socket() {
-            "a socket"
-        } else {
-            "not a regular file"
-        };
-        Limited::Refused(format!(
-            "{what}, not a regular file: a centreline is read from a file of at most {} MiB",
-            MAX_CENTRELINE_BYTES >> 20
-        ))
-    };
-    let too_large = |bytes: u64| {
-        Limited::Refused(format!(
-            "the file has {bytes} bytes ({:.1} MiB), more than stentkit's limit of {} MiB ({MAX_CENTRELINE_BYTES} bytes) for a centreline file; a VMTK centreline is tens of kB",
-            bytes as f64 / (1024.0 * 1024.0),
-            MAX_CENTRELINE_BYTES >> 20
-        ))
-    };
-    let metadata = std::fs::metadata(path).map_err(Limited::Io)?;
-    if !metadata.is_file() {
-        return Err(refuse_kind(metadata.file_type()));
-    }
-    if metadata.len() > MAX_CENTRELINE_BYTES {
-        return Err(too_large(metadata.len()));
-    }
-    let file = std::fs::OpenOptions::new()
-        .read(true)
-        .custom_flags(libc::O_NONBLOCK)
-        .open(path)
-        .map_err(Limited::Io)?;
-    let metadata = file.metadata().map_err(Limited::Io)?;
-    if !metadata.is_file() {
-        return Err(refuse_kind(metadata.file_type()));
-    }
-    let mut bytes = Vec::new();
-    file.take(MAX_CENTRELINE_BYTES + 1)
-        .read_to_end(&mut bytes)
-        .map_err(Limited::Io)?;
-    if bytes.len() as u64 > MAX_CENTRELINE_BYTES {
-        return Err(too_large(bytes.len() as u64));
-    }
-    Ok(bytes)
 }
 
 /// Checks what every format must give: at least one polyline of two points or more, finite points, and the

@@ -10,6 +10,7 @@ pub mod design;
 pub mod estimate;
 pub mod formats;
 pub mod history;
+pub mod input;
 pub mod mcap;
 pub mod mcap_salvage;
 pub mod mesh_format;

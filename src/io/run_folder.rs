@@ -199,8 +199,7 @@ struct LegacyFiles {
 /// The files of a run folder written before the manifest existed, as its `summary.json` lists them; `None`
 /// when there is no such summary.
 fn legacy_outputs(dir: &Path) -> Option<BTreeSet<PathBuf>> {
-    let text = fs::read_to_string(dir.join("summary.json")).ok()?;
-    let summary: LegacySummary = serde_json::from_str(&text).ok()?;
+    let summary: LegacySummary = crate::io::summary::read_json(&dir.join("summary.json")).ok()?;
     if summary.stentkit_version.is_empty() {
         return None;
     }

@@ -570,9 +570,9 @@ impl SweepDir {
         if let Ok(error) = std::fs::read_to_string(self.error(id)) {
             return VariantState::Failed(error.trim().to_string());
         }
-        let summary = std::fs::read_to_string(self.run(id).join("summary.json"))
-            .ok()
-            .and_then(|t| serde_json::from_str::<serde_json::Value>(&t).ok());
+        let summary =
+            crate::io::summary::read_json::<serde_json::Value>(&self.run(id).join("summary.json"))
+                .ok();
         let Some(summary) = summary else {
             return match std::fs::read_to_string(self.task_error(id)) {
                 Ok(why) => VariantState::Failed(why.trim().to_string()),

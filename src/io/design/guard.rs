@@ -51,10 +51,10 @@ pub struct Refusal {
 }
 
 /// The refusal of a design of `bytes` bytes (more than [`MAX_DESIGN_BYTES`]), reported at its start.
-pub fn too_large(bytes: Option<u64>) -> Refusal {
-    let size = bytes.map_or_else(
-        || "more than 4 MiB".to_string(),
-        |b| format!("{b} bytes ({:.1} MiB)", b as f64 / (1024.0 * 1024.0)),
+pub fn too_large(bytes: u64) -> Refusal {
+    let size = format!(
+        "{bytes} bytes ({:.1} MiB)",
+        bytes as f64 / (1024.0 * 1024.0)
     );
     Refusal {
         position: Position { line: 1, column: 1 },
@@ -73,7 +73,7 @@ pub fn too_large(bytes: Option<u64>) -> Refusal {
 /// beyond the limit, or at the first alias.
 pub fn check_text(text: &str) -> Result<(), Refusal> {
     if text.len() > MAX_DESIGN_BYTES {
-        return Err(too_large(Some(text.len() as u64)));
+        return Err(too_large(text.len() as u64));
     }
     scan(text, MAX_NESTING_DEPTH).map(|_| ())
 }

@@ -228,22 +228,19 @@ pub fn load_design(path: &Path) -> Result<Design, DesignError> {
 
 /// [`load_design`] with `overrides` applied before the model is built (e.g. `run --tol`).
 pub fn load_design_with(path: &Path, overrides: &DesignOverrides) -> Result<Design, DesignError> {
-    use std::io::Read as _;
+    use crate::io::input::{InputError, read_regular_file};
     let read_error = |source| DesignError::Read {
         file: path.to_path_buf(),
         source,
     };
-    let mut bytes = Vec::new();
-    std::fs::File::open(path)
-        .and_then(|f| {
-            f.take(guard::MAX_DESIGN_BYTES as u64 + 1)
-                .read_to_end(&mut bytes)
-        })
-        .map_err(read_error)?;
-    if bytes.len() > guard::MAX_DESIGN_BYTES {
-        let size = std::fs::metadata(path).ok().map(|m| m.len());
-        return Err(refused(path, guard::too_large(size)));
-    }
+    let bytes = read_regular_file(path, guard::MAX_DESIGN_BYTES as u64).map_err(|e| match e {
+        InputError::Io(source) => read_error(source),
+        InputError::NotRegular(what) => read_error(std::io::Error::new(
+            std::io::ErrorKind::InvalidInput,
+            format!("{what}, not a regular file"),
+        )),
+        InputError::TooLarge(size) => refused(path, guard::too_large(size)),
+    })?;
     let text = String::from_utf8(bytes)
         .map_err(|e| read_error(std::io::Error::new(std::io::ErrorKind::InvalidData, e)))?;
     parse_design_with(&text, path, overrides)
