@@ -590,6 +590,7 @@ fn read_within(path: &Path, seconds: u64) -> Result<usize, String> {
 /// system's error; a regular file of 4 MiB + 1 byte (sparse) is one byte over the limit. Each is refused at
 /// once naming the file and why (20 s is the deadline of a hang, not a timing). End to end, `stentkit check`
 /// on the aorta design pointed at the FIFO exits with status 2 (bad input) naming the field and the file.
+/// The design file itself is read the same way (`check` on the FIFO, on `/dev/zero`).
 #[test]
 fn only_regular_files_within_the_size_limit_are_read() {
     let dir = scratch("not-regular");
@@ -638,21 +639,7 @@ fn only_regular_files_within_the_size_limit_are_read() {
         text.replace("data/aorta-centerline.vtp", fifo.to_str().expect("UTF-8")),
     )
     .expect("design");
-    let mut child = std::process::Command::new(env!("CARGO_BIN_EXE_stentkit"))
-        .args(["check", on_fifo.to_str().expect("UTF-8")])
-        .stdout(std::process::Stdio::piped())
-        .stderr(std::process::Stdio::piped())
-        .spawn()
-        .expect("stentkit runs");
-    let started = std::time::Instant::now();
-    while child.try_wait().expect("status").is_none() {
-        if started.elapsed().as_secs() > 20 {
-            child.kill().ok();
-            panic!("stentkit check on a FIFO centreline did not end in 20 s");
-        }
-        std::thread::sleep(std::time::Duration::from_millis(50));
-    }
-    let out = child.wait_with_output().expect("output");
+    let out = check_within(&on_fifo, 20);
     let stderr = String::from_utf8_lossy(&out.stderr);
     assert_eq!(out.status.code(), Some(2), "{stderr}");
     assert!(
@@ -663,7 +650,47 @@ fn only_regular_files_within_the_size_limit_are_read() {
             )),
         "{stderr}"
     );
+    // The design file itself read from the same paths: before io::input it was read with no kind check, so
+    // `check FIFO` hung and `check /dev/zero` said "the design is 0 bytes … more than the limit".
+    for (path, what) in [
+        (Path::new("/dev/zero"), "a character device"),
+        (fifo.as_path(), "a FIFO (named pipe)"),
+    ] {
+        let out = check_within(path, 20);
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(2), "{stderr}");
+        assert!(
+            stderr.contains(&format!(
+                "{}: cannot read the design: {what}, not a regular file",
+                path.display()
+            )),
+            "{stderr}"
+        );
+    }
     std::fs::remove_dir_all(&dir).ok();
+}
+
+/// `stentkit check DESIGN`, killed (and the test failed) if it has not ended within `seconds`: the deadline of
+/// a hang, not a timing.
+fn check_within(design: &Path, seconds: u64) -> std::process::Output {
+    let mut child = std::process::Command::new(env!("CARGO_BIN_EXE_stentkit"))
+        .args(["check", design.to_str().expect("UTF-8")])
+        .stdout(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .expect("stentkit runs");
+    let started = std::time::Instant::now();
+    while child.try_wait().expect("status").is_none() {
+        if started.elapsed().as_secs() > seconds {
+            child.kill().ok();
+            panic!(
+                "stentkit check {} did not end in {seconds} s",
+                design.display()
+            );
+        }
+        std::thread::sleep(std::time::Duration::from_millis(50));
+    }
+    child.wait_with_output().expect("output")
 }
 
 /// The aorta design with its centreline file block replaced: `path` and the lines of `file:` given
