@@ -205,10 +205,10 @@ pub enum Command {
         #[arg(short, long)]
         output: PathBuf,
         /// Times to draw, each the nearest snapshot's (default: those of the configuration figures).
-        #[arg(long, num_args = 1..)]
+        #[arg(long, num_args = 1.., value_parser = arguments::non_negative(), allow_negative_numbers = true)]
         times: Vec<f64>,
         /// View: `axonometric`, `x1-x2`, `x1-x3` or `x2-x3`.
-        #[arg(long, default_value = "axonometric")]
+        #[arg(long, default_value = "axonometric", value_parser = arguments::parsed_by(render::view_name))]
         view: String,
         /// Width of each panel in pixels.
         #[arg(long, default_value_t = crate::io::render::PANEL_WIDTH)]
