@@ -68,15 +68,8 @@ pub fn run(run_dir: &Path, options: &ExportOptions) -> anyhow::Result<()> {
         .and_then(|e| e.to_str())
         .map(str::to_ascii_lowercase)
         .unwrap_or_default();
+    // (The extension was checked with the arguments: `arguments::device_file`.)
     let format = formats::format(&extension);
-    if format.is_none() && extension != "csv" {
-        return Err(BadInput(format!(
-            "{}: the output must end in one of: {}, csv",
-            options.output.display(),
-            formats::extensions()
-        ))
-        .into());
-    }
     super::refuse_existing([options.output.as_path()], options.force)?;
     let summary_path = run_dir.join("summary.json");
     let summary: serde_json::Value =
@@ -117,6 +110,16 @@ pub fn run(run_dir: &Path, options: &ExportOptions) -> anyhow::Result<()> {
         ))
         .into());
     }
+    // Before the simulation: what drawing the state would cost.
+    super::drawing::check_drawing(
+        model,
+        &super::drawing::Drawing {
+            sampling: super::drawing::Sampling::PerPatch(options.rings),
+            segments: options.segments,
+            print: options.print,
+            centrelines: extension == "csv",
+        },
+    )?;
     let snap = model.time.landing_tolerance();
     let target = match &options.which {
         Which::Time(t) => *t,
@@ -171,7 +174,7 @@ pub fn run(run_dir: &Path, options: &ExportOptions) -> anyhow::Result<()> {
             model,
             &current_device_shapes(&sim, options.rings),
             settings,
-        ),
+        )?,
     };
     let time = sim.time();
     let state = SnapshotState { model, step, time };

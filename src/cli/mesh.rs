@@ -13,6 +13,8 @@
 //! With `--print`, either shape is written as one printable solid ([`crate::post::print`]) instead of one
 //! tube per rod.
 
+use super::BadInput;
+use super::drawing::{Drawing, Sampling, check_drawing};
 use crate::geometry::fit::best_fit_rigid;
 use crate::io::design::{DesignOverrides, SetOverride, load_design_with};
 use crate::io::{obj, stl, threemf};
@@ -60,14 +62,17 @@ pub fn run(
         .extension()
         .and_then(|e| e.to_str())
         .map(str::to_ascii_lowercase);
-    if !matches!(extension.as_deref(), Some("stl" | "obj" | "3mf" | "csv")) {
-        bail!(
-            "{}: the output must end in .stl, .obj, .3mf or .csv",
-            output.display()
-        );
-    }
     super::refuse_existing([output], force)?;
     let permanent = load_design_with(design, &DesignOverrides::sets(sets.clone()))?;
+    check_drawing(
+        &permanent.model,
+        &Drawing {
+            sampling: Sampling::PerPoint(resolution.samples),
+            segments: resolution.segments,
+            print: resolution.print,
+            centrelines: extension.as_deref() == Some("csv"),
+        },
+    )?;
     let (model, placed) = match state {
         State::Permanent => (permanent.model, None),
         State::Temporary => {
@@ -98,7 +103,7 @@ pub fn run(
     let mut mesh = match resolution.print {
         None => reference_device_mesh(&model, resolution.segments, resolution.samples)?,
         // The solid stands upright whatever the placement: a rigid motion first would change nothing.
-        Some(settings) => print_solid_mesh(&model, &shapes()?, &settings),
+        Some(settings) => print_solid_mesh(&model, &shapes()?, &settings)?,
     };
     if let (Some((r, t, _)), false) = (placed, solid) {
         for v in &mut mesh.vertices {
@@ -153,11 +158,14 @@ pub(super) fn print_solid_mesh(
     model: &Model,
     shapes: &[crate::solver::shape::PatchShape],
     settings: &PrintSettings,
-) -> crate::geometry::mesh::TriangleMesh {
+) -> anyhow::Result<crate::geometry::mesh::TriangleMesh> {
     eprintln!("making the print solid (about 20 s for the paper's stents)");
-    let solid = print_solid(model, shapes, settings);
+    let solid = print_solid(model, shapes, settings).map_err(|e| BadInput(e.to_string()))?;
     println!("{}", solid.describe(model.units.length()));
-    solid.mesh
+    if solid.mesh.triangles.is_empty() {
+        bail!("the print solid is empty (please report this)");
+    }
+    Ok(solid.mesh)
 }
 
 /// Writes the full device's wires in the shape `shapes` as centrelines to `output` (CSV: `rod,point,x,y,z,

@@ -2,8 +2,10 @@
 //! shape as a closed tube surface), `run` (simulate and write the run folder), `study` (accuracy against cost)
 //! and `schema` (the JSON Schema of the design format). The only module that uses `anyhow` and prints.
 
+pub mod arguments;
 pub mod check;
 pub mod disk;
+pub mod drawing;
 pub mod export;
 pub mod mesh;
 pub mod render;
@@ -48,7 +50,7 @@ pub enum Command {
         /// Override a field of the design: `PATH=VALUE`, the field path as error messages write it and a YAML
         /// value (`--set stent.crowns=8 --set material.wlf.Tg=65 --set mesh.n=30`); repeatable, applied in order
         /// and checked as if written in the file.
-        #[arg(long = "set", value_name = "PATH=VALUE")]
+        #[arg(long = "set", value_name = "PATH=VALUE", value_parser = arguments::set_override())]
         set: Vec<SetOverride>,
     },
     /// Simulate a design and write the run folder: history.csv, summary.json, snapshots/ (STL and OBJ of the
@@ -88,17 +90,17 @@ pub enum Command {
         resume: Option<PathBuf>,
         /// Wall time between checkpoints, in seconds (0: after every step). A checkpoint costs a write of the
         /// state (a few MB for a large stent) and closes the recording's chunk.
-        #[arg(long, value_name = "SECONDS", default_value_t = 60.0)]
+        #[arg(long, value_name = "SECONDS", default_value_t = 60.0, value_parser = arguments::non_negative(), allow_negative_numbers = true)]
         checkpoint_every: f64,
         /// Error-controlled time steps at this time-error tolerance (replaces the design's `time.tolerance`; a
         /// design's `step` becomes the first step): the estimated error of each step, normalised as Newton's
         /// increments (translations over the patch length, rotations in radians), stays below it.
-        #[arg(long, value_name = "TOLERANCE")]
+        #[arg(long, value_name = "TOLERANCE", value_parser = arguments::positive(), allow_negative_numbers = true)]
         tol: Option<f64>,
         /// Override a field of the design: `PATH=VALUE`, the field path as error messages write it and a YAML
         /// value (`--set stent.crowns=8 --set material.wlf.Tg=65 --set mesh.n=30`); repeatable, applied in order
         /// and checked as if written in the file.
-        #[arg(long = "set", value_name = "PATH=VALUE")]
+        #[arg(long = "set", value_name = "PATH=VALUE", value_parser = arguments::set_override())]
         set: Vec<SetOverride>,
     },
     /// Write the full device's tube mesh in any state of a finished run: at a time, or at an event of its
@@ -113,14 +115,14 @@ pub enum Command {
         /// The run folder.
         run_dir: PathBuf,
         /// The first step at or after this time.
-        #[arg(long, conflicts_with = "phase", required_unless_present = "phase")]
+        #[arg(long, conflicts_with = "phase", required_unless_present = "phase", value_parser = arguments::non_negative(), allow_negative_numbers = true)]
         time: Option<f64>,
         /// An event of the cycle: initial, programmed, fixed, released, final.
         #[arg(long)]
         phase: Option<String>,
         /// Output file, `.stl`, `.obj` or `.3mf`; or `.csv` for the wires' centrelines (rod, point, x, y, z,
         /// radius).
-        #[arg(short, long)]
+        #[arg(short, long, value_parser = arguments::device_file())]
         output: PathBuf,
         /// Replace the output file if it exists (without --force an existing file is refused, exit status 2).
         #[arg(long)]
@@ -129,10 +131,10 @@ pub enum Command {
         #[arg(long)]
         design: Option<PathBuf>,
         /// Segments around each tube.
-        #[arg(long, default_value_t = 16)]
+        #[arg(long, default_value_t = drawing::DEFAULT_SEGMENTS, value_parser = arguments::at_least::<3>(), allow_negative_numbers = true)]
         segments: usize,
         /// Rings along each patch, about.
-        #[arg(long, default_value_t = 41)]
+        #[arg(long, default_value_t = drawing::DEFAULT_RINGS, value_parser = arguments::at_least::<2>(), allow_negative_numbers = true)]
         rings: usize,
         #[command(flatten)]
         print: PrintArgs,
@@ -148,7 +150,7 @@ pub enum Command {
         design: PathBuf,
         /// Tolerance on the results: displacements over the largest one, Δr over its largest, recovery ratios
         /// absolute.
-        #[arg(long, value_name = "TOLERANCE")]
+        #[arg(long, value_name = "TOLERANCE", value_parser = arguments::positive(), allow_negative_numbers = true)]
         tol: f64,
         /// Write the tuned design here (the design's text with `mesh` and `time` changed and a comment block
         /// stating the estimated error and the expected saving). An existing file is replaced only with --force.
@@ -158,15 +160,15 @@ pub enum Command {
         #[arg(long, requires = "output")]
         force: bool,
         /// Degrees to try.
-        #[arg(long, value_delimiter = ',', default_value = "4,5,6")]
+        #[arg(long, value_delimiter = ',', default_value = "4,5,6", value_parser = arguments::at_least::<2>(), allow_negative_numbers = true)]
         degrees: Vec<usize>,
         /// Most control points per patch tried.
-        #[arg(long, default_value_t = 200)]
+        #[arg(long, default_value_t = 200, value_parser = arguments::at_least::<3>(), allow_negative_numbers = true)]
         max_points: usize,
         /// Override a field of the design: `PATH=VALUE`, the field path as error messages write it and a YAML
         /// value (`--set stent.crowns=8 --set material.wlf.Tg=65 --set mesh.n=30`); repeatable, applied in order
         /// and checked as if written in the file.
-        #[arg(long = "set", value_name = "PATH=VALUE")]
+        #[arg(long = "set", value_name = "PATH=VALUE", value_parser = arguments::set_override())]
         set: Vec<SetOverride>,
     },
     /// Run a family of variants of a design: the cartesian product (or with --zip the pairs) of the values of
@@ -212,10 +214,10 @@ pub enum Command {
         #[arg(long)]
         force: bool,
         /// Times to draw, each the nearest snapshot's (default: those of the configuration figures).
-        #[arg(long, num_args = 1..)]
+        #[arg(long, num_args = 1.., value_parser = arguments::non_negative(), allow_negative_numbers = true)]
         times: Vec<f64>,
         /// View: `axonometric`, `x1-x2`, `x1-x3` or `x2-x3`.
-        #[arg(long, default_value = "axonometric")]
+        #[arg(long, default_value = "axonometric", value_parser = arguments::parsed_by(render::view_name))]
         view: String,
         /// Width of each panel in pixels.
         #[arg(long, default_value_t = crate::io::render::PANEL_WIDTH)]
@@ -235,7 +237,7 @@ pub enum Command {
         design: PathBuf,
         /// Output file, `.stl`, `.obj` or `.3mf`; or `.csv` for the wires' centrelines (rod, point, x, y, z,
         /// radius).
-        #[arg(short, long)]
+        #[arg(short, long, value_parser = arguments::device_file())]
         output: PathBuf,
         /// Replace the output file if it exists (without --force an existing file is refused, exit status 2).
         #[arg(long)]
@@ -245,15 +247,15 @@ pub enum Command {
         #[arg(long, value_enum, default_value = "permanent")]
         state: mesh::State,
         /// Segments around each tube.
-        #[arg(long, default_value_t = 16)]
+        #[arg(long, default_value_t = drawing::DEFAULT_SEGMENTS, value_parser = arguments::at_least::<3>(), allow_negative_numbers = true)]
         segments: usize,
         /// Samples along each patch per control point.
-        #[arg(long, default_value_t = 4)]
+        #[arg(long, default_value_t = drawing::DEFAULT_SAMPLES, value_parser = arguments::at_least::<1>(), allow_negative_numbers = true)]
         samples: usize,
         /// Override a field of the design: `PATH=VALUE`, the field path as error messages write it and a YAML
         /// value (`--set stent.crowns=8 --set material.wlf.Tg=65 --set mesh.n=30`); repeatable, applied in order
         /// and checked as if written in the file.
-        #[arg(long = "set", value_name = "PATH=VALUE")]
+        #[arg(long = "set", value_name = "PATH=VALUE", value_parser = arguments::set_override())]
         set: Vec<SetOverride>,
         #[command(flatten)]
         print: PrintArgs,
@@ -269,11 +271,11 @@ pub struct PrintArgs {
     pub print: bool,
     /// Grid spacing of the print solid, in the design's length unit (default: a third of the thinnest wire's
     /// radius).
-    #[arg(long, requires = "print")]
+    #[arg(long, requires = "print", value_parser = arguments::positive(), allow_negative_numbers = true)]
     pub grid: Option<f64>,
     /// How far the print solid's simplification may move the surface, in the design's length unit (default: a
     /// fiftieth of the thinnest wire's radius).
-    #[arg(long, requires = "print")]
+    #[arg(long, requires = "print", value_parser = arguments::non_negative(), allow_negative_numbers = true)]
     pub deviation: Option<f64>,
 }
 
@@ -393,27 +395,28 @@ pub enum StudyCommand {
         #[arg(long)]
         force: bool,
         /// Degrees p.
-        #[arg(long, value_delimiter = ',', default_value = "2,3,4,5,6,7,8")]
+        #[arg(long, value_delimiter = ',', default_value = "2,3,4,5,6,7,8", value_parser = arguments::at_least::<2>(), allow_negative_numbers = true)]
         degrees: Vec<usize>,
         /// Control points n per patch.
         #[arg(
             long,
             value_delimiter = ',',
-            default_value = "8,10,12,16,20,24,32,40,48,64"
+            default_value = "8,10,12,16,20,24,32,40,48,64",
+            value_parser = arguments::at_least::<3>(), allow_negative_numbers = true
         )]
         points: Vec<usize>,
         /// Time at which the error is measured (default: the design's end time).
-        #[arg(long)]
+        #[arg(long, value_parser = arguments::positive(), allow_negative_numbers = true)]
         time: Option<f64>,
         /// Reference degree and points, `P,N`.
-        #[arg(long, value_delimiter = ',', default_value = "8,150", num_args = 1)]
-        reference: Vec<usize>,
+        #[arg(long, default_value = "8,150", value_parser = arguments::parsed_by(study::degree_and_points))]
+        reference: (usize, usize),
         /// Sampling points per patch.
-        #[arg(long, default_value_t = 9)]
+        #[arg(long, default_value_t = 9, value_parser = arguments::at_least::<2>(), allow_negative_numbers = true)]
         samples: usize,
         /// Also run every p × n with error-controlled steps at this time-error tolerance (work–precision
         /// curves beside the fixed steps); `none` for none.
-        #[arg(long, default_value = "1e-4", value_parser = tolerance_or_none)]
+        #[arg(long, default_value = "1e-4", value_parser = arguments::positive_or_none(), allow_negative_numbers = true)]
         time_tolerance: MaybeTolerance,
     },
     /// Time-step sweep per integrator: displacement error at time T against a self-converged run, and wall
@@ -431,28 +434,29 @@ pub enum StudyCommand {
         #[arg(long)]
         force: bool,
         /// Time at which the error is measured; the runs end there (default: the design's end time).
-        #[arg(long)]
+        #[arg(long, value_parser = arguments::positive(), allow_negative_numbers = true)]
         time: Option<f64>,
         /// Nominal time steps h.
-        #[arg(long, value_delimiter = ',', default_value = "0.04,0.02,0.01,0.005")]
+        #[arg(long, value_delimiter = ',', default_value = "0.04,0.02,0.01,0.005", value_parser = arguments::positive(), allow_negative_numbers = true)]
         steps: Vec<f64>,
         /// Time-error tolerances of error-controlled runs (trapezoidal update) beside the fixed steps; `none`
         /// for none.
-        #[arg(long, value_delimiter = ',', default_value = "1e-2,1e-3,1e-4,1e-5", value_parser = tolerance_or_none)]
+        #[arg(long, value_delimiter = ',', default_value = "1e-2,1e-3,1e-4,1e-5", value_parser = arguments::positive_or_none(), allow_negative_numbers = true)]
         tolerances: Vec<MaybeTolerance>,
         /// Integrators to compare.
         #[arg(
             long,
             value_delimiter = ',',
-            default_value = "trapezoidal,backward-euler,exponential"
+            default_value = "trapezoidal,backward-euler,exponential",
+            value_parser = arguments::parsed_by(study::parse_integrator)
         )]
-        integrators: Vec<String>,
+        integrators: Vec<crate::material::Integrator>,
         /// Reference run: `auto` (exponential integrator, smallest h halved), `design` (the design's own step
         /// and integrator) or a step (exponential integrator with that step).
-        #[arg(long, default_value = "auto")]
-        reference: String,
+        #[arg(long, default_value = "auto", value_parser = arguments::parsed_by(study::parse_reference))]
+        reference: crate::study::time::TimeReference,
         /// Sampling points per patch.
-        #[arg(long, default_value_t = 9)]
+        #[arg(long, default_value_t = 9, value_parser = arguments::at_least::<2>(), allow_negative_numbers = true)]
         samples: usize,
     },
     /// Stability map: where each integrator rings (h/τ on one Maxwell branch, held and cooled) and where
@@ -472,7 +476,8 @@ pub enum StudyCommand {
         #[arg(
             long,
             value_delimiter = ',',
-            default_value = "material,bend45,heating,release,coarse"
+            default_value = "material,bend45,heating,release,coarse",
+            value_parser = arguments::one_of(study::MAPS)
         )]
         maps: Vec<String>,
     },
@@ -561,7 +566,8 @@ pub fn exit_code(error: &anyhow::Error) -> u8 {
 }
 
 /// An error's message followed by its causes, each said once: a cause whose text the message already holds
-/// (an error that prints its source and also returns it, as many libraries' errors do) is not repeated.
+/// (an error that prints its source and also returns it, as many libraries' errors do) is not repeated; its
+/// numbers written out in full are written short ([`crate::math::quote::shortened_numbers`]).
 pub fn error_text(error: &anyhow::Error) -> String {
     let mut text = String::new();
     for cause in error.chain() {
@@ -574,7 +580,7 @@ pub fn error_text(error: &anyhow::Error) -> String {
         }
         text.push_str(&s);
     }
-    text
+    crate::math::quote::shortened_numbers(&text).into_owned()
 }
 
 /// A time for messages: at most 9 decimals, trailing zeros dropped (`0.1`, not `0.10000000000000005`).
@@ -699,8 +705,8 @@ pub fn main() -> ExitCode {
             },
             steps,
             tolerances.into_iter().filter_map(|t| t.0).collect(),
-            &integrators,
-            &reference,
+            integrators,
+            reference,
             study::Sampling { time, samples },
         ),
         Command::Study(StudyCommand::Stability {
@@ -768,17 +774,6 @@ pub fn main() -> ExitCode {
 /// optional argument).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct MaybeTolerance(pub Option<f64>);
-
-/// A tolerance, or `none`.
-fn tolerance_or_none(text: &str) -> Result<MaybeTolerance, String> {
-    match text {
-        "none" => Ok(MaybeTolerance(None)),
-        t => t
-            .parse()
-            .map(|v| MaybeTolerance(Some(v)))
-            .map_err(|e| format!("`{t}` is not a number or `none`: {e}")),
-    }
-}
 
 /// `stentkit sweep …`.
 fn sweep(cli: SweepCli) -> anyhow::Result<()> {

@@ -8,6 +8,13 @@ use crate::io::render::{render_snapshots, write_png};
 use crate::io::snapshots::{SnapshotWriter, VESSEL_FILE};
 use std::path::{Path, PathBuf};
 
+/// `text` when it names a view ([`View::parse`]; `--view` is checked with it as it is read).
+pub fn view_name(text: &str) -> Result<String, String> {
+    View::parse(text)
+        .map(|_| text.to_string())
+        .ok_or_else(|| "must be axonometric, x1-x2, x1-x3 or x2-x3".to_string())
+}
+
 /// Draws the snapshots of the run folder `dir` at `times` (empty: the default choice) in `view` into `output`
 /// (an existing file only with `--force`).
 ///

@@ -495,7 +495,8 @@ pub struct RunOptions {
     pub verbose: bool,
     /// Continue the run in this folder from its checkpoint instead of starting one.
     pub resume: Option<PathBuf>,
-    /// Wall time between checkpoints \[s\] (0: after every step).
+    /// Wall time between checkpoints \[s\] (0: after every step; finite and ≥ 0, as `--checkpoint-every` is
+    /// checked).
     pub checkpoint_every: Real,
     /// Error-controlled stepping at this time-error tolerance, replacing the design's (`--tol`).
     pub time_tolerance: Option<Real>,
@@ -511,11 +512,7 @@ pub struct RunOptions {
 pub fn run(design_path: &Path, options: RunOptions) -> anyhow::Result<()> {
     let started = Instant::now();
     signals::install();
-    if let Some(tol) = options.time_tolerance
-        && !(tol > 0.0 && tol.is_finite())
-    {
-        return Err(BadInput(format!("--tol {tol}: give a tolerance > 0")).into());
-    }
+    // `--tol` and `--checkpoint-every` were checked with the arguments (`super::arguments`).
     let overrides = DesignOverrides {
         time_tolerance: options.time_tolerance,
         sets: options.sets.clone(),
@@ -529,13 +526,6 @@ pub fn run(design_path: &Path, options: RunOptions) -> anyhow::Result<()> {
         return Err(Interrupted(format!(
             "{} while reading the design: nothing was written",
             signals::first().unwrap_or("signal")
-        ))
-        .into());
-    }
-    if !(options.checkpoint_every.is_finite() && options.checkpoint_every >= 0.0) {
-        return Err(BadInput(format!(
-            "--checkpoint-every {}: give a number of seconds ≥ 0",
-            options.checkpoint_every
         ))
         .into());
     }

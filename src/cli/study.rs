@@ -2,14 +2,18 @@
 //! ([`crate::study`]), its CSV and charts written into the output folder, and its progress and results printed.
 
 use super::Target;
+use super::BadInput;
+use super::arguments::{count, rounded_up, short};
 use crate::io::chart::write_svg;
-use crate::io::design::load_design;
+use crate::io::design::size::{StepCount, over_limit};
+use crate::io::design::{Design, load_design};
 use crate::material::Integrator;
 use crate::study::convergence::{
     ConvergenceStudy, convergence_charts, convergence_csv, convergence_study,
 };
 use crate::study::stability::{StabilityStudy, stability};
 use crate::study::time::{TimeReference, TimeStudy, time_charts, time_csv, time_study};
+use crate::study::variant::TimeVariant;
 use anyhow::Context;
 use std::path::Path;
 
@@ -37,7 +41,7 @@ pub fn convergence(
     output: Target<'_>,
     degrees: Vec<usize>,
     points: Vec<usize>,
-    reference: Vec<usize>,
+    reference: (usize, usize),
     sampling: Sampling,
     time_tolerance: Option<f64>,
 ) -> anyhow::Result<()> {
@@ -49,14 +53,19 @@ pub fn convergence(
     refuse_existing(output, CONVERGENCE_FILES, force)?;
     let design = load_design(design)?;
     let model = &design.model;
-    let [rp, rn] = reference[..] else {
-        anyhow::bail!("--reference takes two numbers, P,N");
-    };
+    if let Some(t) = time {
+        check_steps(
+            &design,
+            &format!("--time {}", short(t)),
+            &ending(t, None),
+            1.0,
+        )?;
+    }
     let study = ConvergenceStudy {
         degrees,
         points,
         time: time.unwrap_or(model.time.end),
-        reference: (rp, rn),
+        reference,
         samples,
         time_tolerance,
     };
@@ -85,9 +94,69 @@ pub fn parse_integrator(name: &str) -> Result<Integrator, String> {
     ]
     .into_iter()
     .find(|i| i.name() == name)
-    .ok_or_else(|| {
-        format!("unknown integrator `{name}` (trapezoidal, backward-euler or exponential)")
-    })
+    .ok_or_else(|| "must be one of trapezoidal, backward-euler, exponential".to_string())
+}
+
+/// Parses `study time --reference`: `auto`, `design` or a time step > 0.
+pub fn parse_reference(text: &str) -> Result<TimeReference, String> {
+    match text {
+        "auto" => Ok(TimeReference::Auto),
+        "design" => Ok(TimeReference::Design),
+        h => match h.parse::<f64>() {
+            Ok(h) if h > 0.0 && h.is_finite() => Ok(TimeReference::Step(h)),
+            _ => Err("must be auto, design or a time step > 0".to_string()),
+        },
+    }
+}
+
+/// Parses `study convergence --reference P,N`: a degree ≥ 2 and more control points than that.
+pub fn degree_and_points(text: &str) -> Result<(usize, usize), String> {
+    text.split_once(',')
+        .and_then(|(p, n)| Some((p.trim().parse().ok()?, n.trim().parse().ok()?)))
+        .filter(|&(p, n)| p >= 2 && n > p)
+        .ok_or_else(|| "must be two whole numbers P,N with P ≥ 2 and N > P".to_string())
+}
+
+/// The maps `study stability --maps` draws.
+pub const MAPS: &[&str] = &["material", "bend45", "heating", "release", "coarse"];
+
+/// Refuses (exit status 2, naming `argument`) a study run of `design` changed by `variant` whose time steps
+/// would need more memory than a design may ([`crate::io::design::size::MemoryEstimate::with_steps`]: the
+/// guard designs get, for the run's steps landing on every breakpoint), or that the variant itself refuses
+/// (a step beyond the end). The argument's value is `scale` times the run's step.
+fn check_steps(
+    design: &Design,
+    argument: &str,
+    variant: &TimeVariant,
+    scale: f64,
+) -> anyhow::Result<()> {
+    let model = variant
+        .of(&design.model)
+        .map_err(|e| BadInput(format!("{argument}: {e}")))?;
+    let plan = model.planned_steps();
+    // In floating point: an absurd count saturates the plan's integers.
+    let steps = plan.full as f64 + plan.shortened as f64;
+    let counted = StepCount {
+        steps,
+        field: argument.to_string(),
+        what: format!(
+            "{} time steps of h = {} s to t = {} s",
+            count(steps),
+            short(model.time.step),
+            short(model.time.end)
+        ),
+    };
+    let estimate = design.memory.with_steps(&counted);
+    if let Some(refusal) = over_limit(&estimate) {
+        let most = estimate.steps_within_limit();
+        return Err(BadInput(format!(
+            "{argument}: the run {refusal}: give a step of at least {} s, or an earlier --time (at most {} steps fit)",
+            rounded_up(scale * model.time.end / most.max(1.0)),
+            count(most.floor())
+        ))
+        .into());
+    }
+    Ok(())
 }
 
 /// `stentkit study time`: the time-step sweep of `design` per integrator, measured at `time` (default: the
@@ -98,8 +167,8 @@ pub fn time(
     output: Target<'_>,
     steps: Vec<f64>,
     tolerances: Vec<f64>,
-    integrators: &[String],
-    reference: &str,
+    integrators: Vec<Integrator>,
+    reference: TimeReference,
     sampling: Sampling,
 ) -> anyhow::Result<()> {
     let Sampling { time, samples } = sampling;
@@ -110,22 +179,43 @@ pub fn time(
     refuse_existing(output, TIME_FILES, force)?;
     let design = load_design(design)?;
     let model = &design.model;
-    let integrators = integrators
-        .iter()
-        .map(|name| parse_integrator(name).map_err(anyhow::Error::msg))
-        .collect::<anyhow::Result<Vec<_>>>()?;
-    let reference = match reference {
-        "auto" => TimeReference::Auto,
-        "design" => TimeReference::Design,
-        h => TimeReference::Step(h.parse().with_context(|| {
-            format!("--reference takes auto, design or a time step, not `{h}`")
-        })?),
+    let end = time.unwrap_or(model.time.end);
+    // Every run's steps, before any runs: the reference's (the smallest step halved by default) first.
+    let smallest = steps.iter().copied().fold(f64::INFINITY, f64::min);
+    // A step suggested for --steps must also hold for the reference run when that halves it.
+    let scale = if reference == TimeReference::Auto {
+        2.0
+    } else {
+        1.0
     };
+    let mut checks: Vec<(String, TimeVariant, f64)> = steps
+        .iter()
+        .map(|&h| (format!("--steps {}", short(h)), ending(end, Some(h)), scale))
+        .collect();
+    checks.push(match reference {
+        TimeReference::Auto => (
+            format!(
+                "--steps {} (the reference run's step is half of it)",
+                short(smallest)
+            ),
+            ending(end, Some(smallest / 2.0)),
+            2.0,
+        ),
+        TimeReference::Step(h) => (
+            format!("--reference {}", short(h)),
+            ending(end, Some(h)),
+            1.0,
+        ),
+        TimeReference::Design => (format!("--time {}", short(end)), ending(end, None), 1.0),
+    });
+    for (argument, variant, scale) in &checks {
+        check_steps(&design, argument, variant, *scale)?;
+    }
     let study = TimeStudy {
         integrators,
         steps,
         tolerances,
-        time: time.unwrap_or(model.time.end),
+        time: end,
         reference,
         samples,
     };
@@ -177,6 +267,8 @@ pub fn stability_maps(output: Target<'_>, maps: &[String]) -> anyhow::Result<()>
         .chain([STABILITY_SUMMARY.to_string()])
         .collect();
     refuse_existing(output, files.iter().map(String::as_str), force)?;
+/// written as `<map>.csv` and `<map>.svg` as soon as it is done, then `stability.md`.
+pub fn stability_maps(output: &Path, maps: &[String]) -> anyhow::Result<()> {
     let mut study = StabilityStudy::default();
     let wanted = |name: &str| maps.iter().any(|m| m == name);
     if !wanted("material") {
@@ -208,6 +300,15 @@ pub fn stability_maps(output: Target<'_>, maps: &[String]) -> anyhow::Result<()>
     println!("{summary}");
     println!("→ {}", output.join(STABILITY_SUMMARY).display());
     Ok(())
+}
+
+/// The variant of a design's run that ends at `end` (with fixed steps `step`, when given).
+fn ending(end: f64, step: Option<f64>) -> TimeVariant {
+    TimeVariant {
+        end: Some(end),
+        step,
+        ..TimeVariant::default()
+    }
 }
 
 /// Prints a study's progress line (indented, on stderr: stdout holds the results).

@@ -42,6 +42,18 @@ impl std::fmt::Display for Short {
     }
 }
 
+impl Short {
+    /// `x` rounded to `digits` significant digits, for a message (`0.1`, not `0.09999999999999999`, for a
+    /// third of 0.3).
+    pub fn rounded(x: Real, digits: usize) -> Short {
+        Short(
+            format!("{:.*e}", digits.saturating_sub(1), x)
+                .parse()
+                .unwrap_or(x),
+        )
+    }
+}
+
 /// Errors raised by the math layer when data (not the programmer) is wrong.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum MathError {

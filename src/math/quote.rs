@@ -14,6 +14,11 @@ pub const QUOTED_CHARS: usize = 40;
 /// (`conditions[12].displacement[2]`); a longer one holds a user's key.
 pub const MAX_FIELD_CHARS: usize = 200;
 
+/// Most digits a number keeps in a message: 20, those of the largest `u64`. A longer run is a floating-point
+/// number written out in full (Rust's `{}` writes `1e308` with 309 digits, and `{:.3}` adds three more), which
+/// [`shortened_numbers`] rewrites in its short form ([`super::Short`]).
+pub const MAX_NUMBER_DIGITS: usize = 20;
+
 /// Longest message shown whole [characters]; a longer one (after its quoted values are shortened) is cut.
 /// stentkit's longest messages (an unknown field with the list of allowed ones) have about 300.
 pub const MAX_MESSAGE_CHARS: usize = 1000;
@@ -51,11 +56,12 @@ fn length_note(text: &str, limit: usize) -> String {
 /// `value` in backticks for a message: control characters escaped, and cut after [`QUOTED_CHARS`]
 /// characters with `…` and its full length, `` `aaaa…` (52428800 characters) ``.
 pub fn quoted(value: &str) -> String {
-    format!(
-        "`{}`{}",
-        cut(value, QUOTED_CHARS),
-        length_note(value, QUOTED_CHARS)
-    )
+    quoted_up_to(value, QUOTED_CHARS)
+}
+
+/// [`quoted`] with `limit` characters shown instead of [`QUOTED_CHARS`] (a file's path is shown whole).
+pub fn quoted_up_to(value: &str, limit: usize) -> String {
+    format!("`{}`{}", cut(value, limit), length_note(value, limit))
 }
 
 /// `text` (a field path, say) shortened like a quoted value but without backticks, when longer than `limit`
@@ -67,9 +73,61 @@ pub fn shortened(text: &str, limit: usize) -> Cow<'_, str> {
     }
 }
 
-/// A message from elsewhere with every value quoted in backticks or double quotes shortened as by [`quoted`],
-/// then cut at [`MAX_MESSAGE_CHARS`] if still longer. Linear in the message's length.
+/// `message` with every number of more than [`MAX_NUMBER_DIGITS`] digits (a floating-point number written out
+/// in full) in its short form: `1e308`, not 309 digits. Linear in the message's length.
+pub fn shortened_numbers(message: &str) -> Cow<'_, str> {
+    let bytes = message.as_bytes();
+    let mut out = String::new();
+    let (mut copied, mut i) = (0, 0);
+    while i < bytes.len() {
+        let starts = bytes[i].is_ascii_digit()
+            && (i == 0 || !(bytes[i - 1].is_ascii_digit() || bytes[i - 1] == b'.'));
+        if !starts {
+            i += 1;
+            continue;
+        }
+        let mut end = i;
+        while end < bytes.len() && bytes[end].is_ascii_digit() {
+            end += 1;
+        }
+        let mut digits = end - i;
+        if end + 1 < bytes.len() && bytes[end] == b'.' && bytes[end + 1].is_ascii_digit() {
+            let fraction = end + 1;
+            end = fraction;
+            while end < bytes.len() && bytes[end].is_ascii_digit() {
+                end += 1;
+            }
+            digits += end - fraction;
+        }
+        if digits > MAX_NUMBER_DIGITS
+            && let Ok(x) = message[i..end].parse::<f64>()
+        {
+            out.push_str(&message[copied..i]);
+            out.push_str(&super::Short(x).to_string());
+            copied = end;
+        }
+        i = end;
+    }
+    if copied == 0 {
+        Cow::Borrowed(message)
+    } else {
+        out.push_str(&message[copied..]);
+        Cow::Owned(out)
+    }
+}
+
+/// A message from elsewhere with its long numbers written short ([`shortened_numbers`]) and every value quoted
+/// in backticks or double quotes shortened as by [`quoted`], then cut at [`MAX_MESSAGE_CHARS`] if still longer.
+/// Linear in the message's length.
 pub fn shortened_message(message: &str) -> Cow<'_, str> {
+    match shortened_numbers(message) {
+        Cow::Borrowed(message) => shortened_quotes(message),
+        Cow::Owned(message) => Cow::Owned(shortened_quotes(&message).into_owned()),
+    }
+}
+
+/// [`shortened_message`] but for the numbers.
+fn shortened_quotes(message: &str) -> Cow<'_, str> {
     let mut out = String::new();
     let mut copied = 0;
     let mut rest = message.char_indices();
@@ -136,6 +194,28 @@ mod tests {
         let exactly = "é".repeat(QUOTED_CHARS);
         assert_eq!(quoted(&exactly), format!("`{exactly}`"));
         assert_eq!(shortened("patches[0].name", 200), "patches[0].name");
+    }
+
+    #[test]
+    fn numbers_written_out_in_full_are_written_short() {
+        // Rust's `{}` of 1e308 is a 1 and 308 zeros; `{:.3}` adds `.000`. Up to 20 digits (a u64) stay.
+        let full = format!("{}", 1e308);
+        assert_eq!(full.len(), 309);
+        assert_eq!(
+            shortened_numbers(&format!(
+                "Δr = -{full} must be smaller; |angle| = {:.3}°",
+                1e308
+            )),
+            "Δr = -1e308 must be smaller; |angle| = 1e308°"
+        );
+        let kept = "18446744073709551615 and 3.14159 and 1e308 and 2026-11-26";
+        assert_eq!(shortened_numbers(kept), kept);
+        assert_eq!(
+            shortened_message(&format!(
+                "invalid type: floating point `{full}`, expected usize"
+            )),
+            "invalid type: floating point `1e308`, expected usize"
+        );
     }
 
     #[test]

@@ -46,6 +46,35 @@ pub enum ReferenceMeshError {
     },
 }
 
+/// Memory per sample of a patch's shape [bytes]: its point and section frame (a `Vec3` and a `Rot3`).
+pub const BYTES_PER_SHAPE_SAMPLE: Real = 96.0;
+
+/// Memory per point of the full device's rods [bytes] (a `Vec3`), for the print solid and the centrelines.
+pub const BYTES_PER_ROD_POINT: Real = 24.0;
+
+/// Memory per row of a centreline file [bytes]: `rod,point,x,y,z,radius` with the coordinates at full
+/// precision is at most about 100 characters.
+pub const BYTES_PER_CENTRELINE_ROW: Real = 100.0;
+
+/// Peak memory of the full device's tube mesh per triangle [bytes]: the mesh, its closedness check and the
+/// file's bytes. Measured (peak resident memory of `stentkit mesh` on the straight stent over its triangles):
+/// 151 at its defaults (0.26 million triangles, with the program's own few MB), 163 at 10 samples per control
+/// point and 64 segments (2.6 million; STL, OBJ and 3MF alike) and 161 at 40 and 64 (10.5 million).
+pub const BYTES_PER_TUBE_TRIANGLE: Real = 165.0;
+
+/// Each patch of `model` as `(copies, length)`: how many rods of the full device it makes (itself and its
+/// mirror images, [`patch_copies`]) and the length of its control polygon, which bounds the curve's length
+/// from above (knot insertion cuts the polygon's corners towards the curve).
+pub fn patch_sizes(model: &Model) -> Vec<(usize, Real)> {
+    (0..model.patches.len())
+        .map(|k| {
+            let points = model.patches[k].curve.points();
+            let length = points.windows(2).map(|w| (w[1] - w[0]).norm()).sum();
+            (patch_copies(model, k).len(), length)
+        })
+        .collect()
+}
+
 /// Indices of about `target` of `n` samples, evenly spaced (every k-th, `k = round((n − 1)/(target − 1))`),
 /// the first and the last always included; all of them when `n ≤ target`.
 pub fn decimation(n: usize, target: usize) -> Vec<usize> {

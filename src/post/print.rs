@@ -22,16 +22,73 @@
 
 use crate::geometry::mesh::TriangleMesh;
 use crate::geometry::simplify::{SimplifyReport, simplify};
-use crate::geometry::solid::{Capsule, offset_to_volume, union_surface};
-use crate::math::{Mat3, Real, Rot3, Vec3};
+use crate::geometry::solid::{
+    Capsule, ContourSize, WireSize, estimated_contour, offset_to_volume, union_surface,
+};
+use crate::math::{Mat3, Real, Rot3, Short, Vec3};
 use crate::model::Model;
-use crate::post::device::device_rods;
+use crate::post::device::{device_rods, patch_sizes};
 use crate::solver::shape::PatchShape;
 
 /// The grid spacing of a print solid, as a fraction of the thinnest wire's radius.
 pub const DEFAULT_SPACING_PER_RADIUS: Real = 1.0 / 3.0;
 /// The simplification tolerance of a print solid, as a fraction of the thinnest wire's radius.
 pub const DEFAULT_TOLERANCE_PER_RADIUS: Real = 0.02;
+
+/// The coarsest grid spacing of a print solid, as a fraction of the thinnest wire's radius: 1. Every point
+/// of space lies within `√3 h / 2 < r` of a grid point, so a wire of radius `r ≥ h` holds grid points all along
+/// and is contoured; on a coarser grid a wire can fall between the grid points and vanish (`--grid 1e9` made
+/// an empty solid).
+pub const MAX_SPACING_PER_RADIUS: Real = 1.0;
+
+/// The largest simplification tolerance of a print solid, as a fraction of the thinnest wire's radius: 1/4
+/// (12.5 times the default). A wire's section then stays a polygon of at least five sides (a side's sagitta
+/// `r (1 − cos π/m)` is at most r/4 for m ≥ 5); a tolerance of the order of the radius lets the collapses
+/// flatten a wire, and one beyond the gaps between the wires lets them join wires
+/// ([`crate::geometry::simplify`] is meant for tolerances far below both). Measured on the straight stent
+/// (r = 0.3 mm, processor time): the default r/50 gives 152 836 triangles in 22.9 s, r/10 17 306 in 24.9 s,
+/// r/4 5370 in 25.6 s, r/2 2450 and r 1454 in 27 s; `--deviation 1e9` had not finished after 15 minutes.
+pub const MAX_TOLERANCE_PER_RADIUS: Real = 0.25;
+
+/// Peak memory of a print solid per triangle of its contour [bytes]: the contour's vertices, normals and
+/// edge-to-vertex map, the simplification's quadrics, edges and queue, and the output. With
+/// [`BYTES_PER_BAND_POINT`] fitted to the peak resident memory of `stentkit mesh --print` on the straight
+/// stent, 224, 535 and 960 MB at h = r/2, r/3 and r/4 (0.89, 2.02 and 3.60 million triangles): the estimate
+/// gives 238, 545 and 982 MB; and at r/6 (8.12 million), 2.29 GB measured, 2.28 GB estimated.
+pub const BYTES_PER_CONTOUR_TRIANGLE: Real = 235.0;
+
+/// Peak memory of a print solid per grid point sampled [bytes]: an entry of the sampled field (a point, its
+/// distance and capsule: 40 bytes) in a hash map filled to at most 7/8, whose table doubles as it grows.
+pub const BYTES_PER_BAND_POINT: Real = 80.0;
+
+/// Memory per capsule united [bytes]: its ends and radius (56 bytes) and its point in the device's rods.
+pub const BYTES_PER_CAPSULE: Real = 80.0;
+
+/// Processor time of a print solid of [`REFERENCE_TRIANGLES`] contour triangles [s]: contouring,
+/// simplifying and placing it; it grows as the triangles to the power [`TIME_GROWTH`] (the larger maps miss
+/// the caches more often). Fitted (least squares on the logarithms) to the user + system time of `stentkit mesh
+/// --print` on the straight stent on this machine (2 cores shared with other work): 8.7 s for 0.89 million
+/// triangles at h = r/2, 22.9 s for 2.02 million at r/3 (its default), 178 s for 8.12 million at r/6; the fit
+/// gives 8.2, 25.4 and 172.8 s (within 11 %).
+pub const REFERENCE_SECONDS: Real = 25.0;
+
+/// The contour triangles [`REFERENCE_SECONDS`] is the time of.
+pub const REFERENCE_TRIANGLES: Real = 2.0e6;
+
+/// How a print solid's time grows with its contour's triangles (see [`REFERENCE_SECONDS`]).
+pub const TIME_GROWTH: Real = 1.38;
+
+/// Processor time per grid point a print solid visits [s] (a capsule's distance there, and its entry in the
+/// sampled field when within the band). Measured: the straight stent's print solid at 100 samples per control
+/// point (204 000 capsules, about 1500 points visited each) took 6.2 s longer than at the default 4 (8160).
+pub const SECONDS_PER_GRID_VISIT: Real = 21e-9;
+
+/// The longest a print solid may be estimated to take [s]: 10 minutes, 26 times the straight stent's
+/// default solid (23 s). On the paper's 0.3 mm wires it stops the grid at about 0.032 mm (r/9.5, about 20
+/// million contour triangles and 6 GB, below stentkit's 8 GB memory limit) and the samples at about 8800 per
+/// control point (the polyline's segments then 1/1500 of the grid's spacing; `--samples 1000000` would take
+/// about 18 hours and 270 GB).
+pub const TIME_LIMIT_SECONDS: Real = 600.0;
 
 /// How finely a print solid is made (lengths in the model's unit).
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
@@ -40,6 +97,127 @@ pub struct PrintSettings {
     pub spacing: Option<Real>,
     /// Simplification tolerance; `None`: [`DEFAULT_TOLERANCE_PER_RADIUS`] of the thinnest wire's radius.
     pub tolerance: Option<Real>,
+}
+
+/// Why print settings are refused (lengths in the model's unit).
+#[derive(Debug, Clone, Copy, PartialEq, thiserror::Error)]
+pub enum PrintSettingsError {
+    /// The grid spacing is not positive and finite, or coarser than [`MAX_SPACING_PER_RADIUS`] allows.
+    #[error(
+        "the grid spacing must be > 0 and at most the thinnest wire's radius, {} (a coarser grid can miss a wire \
+         altogether); the default is a third of it, {}",
+        Short::rounded(*radius * MAX_SPACING_PER_RADIUS, 4),
+        Short::rounded(*radius * DEFAULT_SPACING_PER_RADIUS, 4)
+    )]
+    Spacing {
+        /// The spacing given.
+        spacing: Real,
+        /// The thinnest wire's radius.
+        radius: Real,
+    },
+    /// The simplification tolerance is negative, not finite, or larger than [`MAX_TOLERANCE_PER_RADIUS`]
+    /// allows.
+    #[error(
+        "the simplification's deviation must be ≥ 0 and at most a quarter of the thinnest wire's radius, {} \
+         (a larger one can flatten a wire); the default is a fiftieth of it, {}",
+        Short::rounded(*radius * MAX_TOLERANCE_PER_RADIUS, 4),
+        Short::rounded(*radius * DEFAULT_TOLERANCE_PER_RADIUS, 4)
+    )]
+    Tolerance {
+        /// The tolerance given.
+        tolerance: Real,
+        /// The thinnest wire's radius.
+        radius: Real,
+    },
+}
+
+impl PrintSettings {
+    /// The grid spacing and simplification tolerance for wires whose thinnest radius is `thinnest`: the
+    /// defaults where none is given, else the given ones when within [`MAX_SPACING_PER_RADIUS`] and
+    /// [`MAX_TOLERANCE_PER_RADIUS`].
+    ///
+    /// # Errors
+    /// [`PrintSettingsError`] for a spacing or tolerance out of range.
+    pub fn resolved(&self, thinnest: Real) -> Result<(Real, Real), PrintSettingsError> {
+        let spacing = self
+            .spacing
+            .unwrap_or(DEFAULT_SPACING_PER_RADIUS * thinnest);
+        if !(spacing > 0.0 && spacing.is_finite() && spacing <= MAX_SPACING_PER_RADIUS * thinnest) {
+            return Err(PrintSettingsError::Spacing {
+                spacing,
+                radius: thinnest,
+            });
+        }
+        let tolerance = self
+            .tolerance
+            .unwrap_or(DEFAULT_TOLERANCE_PER_RADIUS * thinnest);
+        if !(tolerance >= 0.0
+            && tolerance.is_finite()
+            && tolerance <= MAX_TOLERANCE_PER_RADIUS * thinnest)
+        {
+            return Err(PrintSettingsError::Tolerance {
+                tolerance,
+                radius: thinnest,
+            });
+        }
+        Ok((spacing, tolerance))
+    }
+}
+
+/// The memory and time a print solid needs, estimated before any of it is made ([`estimated_print`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PrintEstimate {
+    /// The contour's size.
+    pub contour: ContourSize,
+    /// Capsules united.
+    pub capsules: Real,
+    /// Peak memory [bytes].
+    pub bytes: Real,
+    /// Processor time on the machine the constants were measured on [s].
+    pub seconds: Real,
+}
+
+/// The memory and time of the print solid of `wires` (every rod of the full device) contoured at grid spacing
+/// `spacing` ([`estimated_contour`], with [`BYTES_PER_CONTOUR_TRIANGLE`], [`BYTES_PER_BAND_POINT`] and
+/// [`BYTES_PER_CAPSULE`] for the memory, [`REFERENCE_SECONDS`] and [`SECONDS_PER_GRID_VISIT`] for the time).
+pub fn estimated_print(wires: impl IntoIterator<Item = WireSize>, spacing: Real) -> PrintEstimate {
+    let wires: Vec<WireSize> = wires.into_iter().collect();
+    let contour = estimated_contour(wires.iter().copied(), spacing);
+    let capsules = wires.iter().map(|w| w.capsules).sum::<Real>();
+    PrintEstimate {
+        contour,
+        capsules,
+        bytes: contour.triangles * BYTES_PER_CONTOUR_TRIANGLE
+            + contour.band_points * BYTES_PER_BAND_POINT
+            + capsules * BYTES_PER_CAPSULE,
+        seconds: REFERENCE_SECONDS * (contour.triangles / REFERENCE_TRIANGLES).powf(TIME_GROWTH)
+            + contour.visits * SECONDS_PER_GRID_VISIT,
+    }
+}
+
+/// [`estimated_print`] for the full device of `model` with `samples[k]` samples (capsule ends) along patch
+/// `k`: every rod its patch's length ([`patch_sizes`]: an upper bound) and radius.
+pub fn estimated_device_print(model: &Model, samples: &[Real], spacing: Real) -> PrintEstimate {
+    let wires = patch_sizes(model)
+        .into_iter()
+        .zip(samples)
+        .enumerate()
+        .flat_map(|(k, ((copies, length), &kept))| {
+            let wire = WireSize {
+                length,
+                radius: model.wire_radius(k),
+                capsules: kept - 1.0,
+            };
+            std::iter::repeat_n(wire, copies)
+        });
+    estimated_print(wires, spacing)
+}
+
+/// The radius of the thinnest wire of `model` (∞ for a model without patches).
+pub fn thinnest_wire(model: &Model) -> Real {
+    (0..model.patches.len())
+        .map(|k| model.wire_radius(k))
+        .fold(Real::INFINITY, Real::min)
 }
 
 /// A print solid and how it was made.
@@ -92,24 +270,22 @@ pub fn device_capsules(model: &Model, shapes: &[PatchShape]) -> Vec<Capsule> {
 }
 
 /// The full device of `model` in the shape `shapes` as one solid (see the module documentation).
-pub fn print_solid(model: &Model, shapes: &[PatchShape], settings: &PrintSettings) -> PrintSolid {
+///
+/// # Errors
+/// [`PrintSettingsError`] for settings out of range ([`PrintSettings::resolved`]).
+pub fn print_solid(
+    model: &Model,
+    shapes: &[PatchShape],
+    settings: &PrintSettings,
+) -> Result<PrintSolid, PrintSettingsError> {
+    let (spacing, tolerance) = settings.resolved(thinnest_wire(model))?;
     let capsules = device_capsules(model, shapes);
-    let thinnest = capsules
-        .iter()
-        .map(|c| c.radius)
-        .fold(Real::INFINITY, Real::min);
-    let spacing = settings
-        .spacing
-        .unwrap_or(DEFAULT_SPACING_PER_RADIUS * thinnest);
-    let tolerance = settings
-        .tolerance
-        .unwrap_or(DEFAULT_TOLERANCE_PER_RADIUS * thinnest);
     let contoured = union_surface(&capsules, spacing);
     let (mut mesh, simplified) = simplify(&contoured.mesh, tolerance);
     let volume = contoured.volume_second_order();
     let offset = offset_to_volume(&mut mesh, volume);
     stand_upright(&mut mesh);
-    PrintSolid {
+    Ok(PrintSolid {
         mesh,
         spacing,
         tolerance,
@@ -118,7 +294,7 @@ pub fn print_solid(model: &Model, shapes: &[PatchShape], settings: &PrintSetting
         contour_volume: contoured.mesh.volume(),
         volume,
         offset,
-    }
+    })
 }
 
 /// Turns `mesh` so that its axis points along +z, then moves it onto z = 0, centred on the z axis (see the

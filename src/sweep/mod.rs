@@ -147,10 +147,15 @@ fn range_values(start: f64, stop: f64, step: f64) -> Result<Vec<String>, String>
     if step == 0.0 || (stop - start) * step < 0.0 {
         return Err(format!("STEP {step} does not lead from {start} to {stop}"));
     }
-    let count = ((stop - start) / step + 1e-9).floor() as usize + 1;
-    if count > MAX_VARIANTS {
-        return Err(format!("{count} values: at most {MAX_VARIANTS}"));
+    // Counted in floating point: a tiny step's count overflows an integer (and wrapped to none).
+    let counted = ((stop - start) / step + 1e-9).floor() + 1.0;
+    if !(counted <= MAX_VARIANTS as f64) {
+        return Err(format!(
+            "about {} values: at most {MAX_VARIANTS}",
+            crate::math::Short::rounded(counted, 3)
+        ));
     }
+    let count = counted as usize;
     Ok((0..count)
         .map(|k| {
             let x = start + k as f64 * step;

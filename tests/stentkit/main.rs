@@ -4,6 +4,7 @@
 mod common;
 
 mod arc_length;
+mod arguments;
 mod centreline;
 mod checkpoint;
 mod cli;

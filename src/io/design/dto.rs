@@ -4,6 +4,7 @@
 //! size must be), so serde_yaml reports the offending value with its line and column. Checks that need
 //! several fields at once are in [`super::build`].
 
+use crate::math::Short;
 use schemars::{JsonSchema, Schema, SchemaGenerator, json_schema};
 use serde::Deserialize;
 use serde::de::{self, Deserializer, SeqAccess, Visitor};
@@ -100,7 +101,7 @@ impl<'de> Deserialize<'de> for Positive {
         if x > 0.0 {
             Ok(Positive(x))
         } else {
-            Err(de::Error::custom(format!("{x} must be > 0")))
+            Err(de::Error::custom(format!("{} must be > 0", Short(x))))
         }
     }
 }
@@ -115,7 +116,7 @@ impl<'de> Deserialize<'de> for NonNegative {
         if x >= 0.0 {
             Ok(NonNegative(x))
         } else {
-            Err(de::Error::custom(format!("{x} must be ≥ 0")))
+            Err(de::Error::custom(format!("{} must be ≥ 0", Short(x))))
         }
     }
 }
@@ -1070,14 +1071,64 @@ pub struct FileCentrelineDto {
     pub reference: Option<Vector>,
 }
 
-/// Which polyline of a centreline file.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, JsonSchema)]
+/// Which polyline of a centreline file: an index or `longest` (read by [`PolylineChoiceVisitor`], which says
+/// what is allowed when neither fits; an untagged enum would only say that no variant matched).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, JsonSchema)]
 #[serde(untagged)]
 pub enum PolylineChoiceDto {
     /// Its index, from 0.
     Index(usize),
     /// `longest`.
     Keyword(PolylineKeywordDto),
+}
+
+impl<'de> Deserialize<'de> for PolylineChoiceDto {
+    fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        d.deserialize_any(PolylineChoiceVisitor)
+    }
+}
+
+struct PolylineChoiceVisitor;
+
+impl PolylineChoiceVisitor {
+    /// The refusal of `value` (already written for a message).
+    fn refused<E: de::Error>(value: &str) -> E {
+        E::custom(format!(
+            "{value} is not a polyline of the file: give its index (0, 1, …) or `longest`"
+        ))
+    }
+}
+
+impl<'de> Visitor<'de> for PolylineChoiceVisitor {
+    type Value = PolylineChoiceDto;
+
+    fn expecting(&self, f: &mut fmt::Formatter) -> fmt::Result {
+        f.write_str("a polyline index (0, 1, …) or `longest`")
+    }
+
+    fn visit_u64<E: de::Error>(self, v: u64) -> Result<PolylineChoiceDto, E> {
+        usize::try_from(v)
+            .map(PolylineChoiceDto::Index)
+            .map_err(|_| Self::refused(&v.to_string()))
+    }
+
+    fn visit_i64<E: de::Error>(self, v: i64) -> Result<PolylineChoiceDto, E> {
+        match u64::try_from(v) {
+            Ok(v) => self.visit_u64(v),
+            Err(_) => Err(Self::refused(&v.to_string())),
+        }
+    }
+
+    fn visit_f64<E: de::Error>(self, v: f64) -> Result<PolylineChoiceDto, E> {
+        Err(Self::refused(&Short(v).to_string()))
+    }
+
+    fn visit_str<E: de::Error>(self, v: &str) -> Result<PolylineChoiceDto, E> {
+        match v {
+            "longest" => Ok(PolylineChoiceDto::Keyword(PolylineKeywordDto::Longest)),
+            _ => Err(Self::refused(&crate::math::quote::quoted(v))),
+        }
+    }
 }
 
 /// `longest`.

@@ -206,9 +206,19 @@ impl fmt::Display for DesignError {
                 field,
                 message,
             } => {
-                write!(f, "{}: --set {argument}: ", file.display())?;
-                if !field.is_empty() {
-                    write!(f, "{field}: ")?;
+                // The argument and its path are the user's: shortened as values in messages are.
+                write!(
+                    f,
+                    "{}: --set {}: ",
+                    file.display(),
+                    quote::shortened(argument, quote::QUOTED_CHARS)
+                )?;
+                // A long path that is the argument's own was just shown (shortened) with it.
+                let own = argument.starts_with(field.as_str())
+                    && argument[field.len()..].starts_with('=');
+                let shown = own && field.chars().nth(quote::QUOTED_CHARS).is_some();
+                if !(field.is_empty() || shown) {
+                    write!(f, "{}: ", quote::shortened(field, quote::MAX_FIELD_CHARS))?;
                 }
                 write!(f, "{message}")
             }

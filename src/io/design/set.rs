@@ -10,6 +10,7 @@
 //! naming the file and the overrides — is what a run records ([`resolved_text`]); the file's comments are not
 //! kept in it.
 
+use crate::math::quote::{QUOTED_CHARS, quoted, shortened, shortened_message};
 use serde_yaml::{Mapping, Value};
 use std::fmt;
 use std::str::FromStr;
@@ -34,9 +35,10 @@ pub struct SetOverride {
     pub value: Value,
 }
 
-/// Why a `--set` argument was refused before the design was read.
+/// Why a `--set` argument was refused before the design was read (the argument shown shortened, as values
+/// in messages are: [`crate::math::quote`]).
 #[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
-#[error("--set {argument}: {message}")]
+#[error("--set {}: {message}", shortened(argument, QUOTED_CHARS))]
 pub struct SetSyntaxError {
     /// The argument as given.
     pub argument: String,
@@ -56,8 +58,12 @@ impl FromStr for SetOverride {
             fail("expected PATH=VALUE (e.g. `stent.crowns=8`, `material.wlf.Tg=65`)".into())
         })?;
         let path = parse_path(path.trim()).map_err(fail)?;
-        let value: Value =
-            serde_yaml::from_str(value).map_err(|e| fail(format!("the value is not YAML: {e}")))?;
+        let value: Value = serde_yaml::from_str(value).map_err(|e| {
+            fail(format!(
+                "the value is not YAML: {}",
+                shortened_message(&e.to_string())
+            ))
+        })?;
         Ok(Self {
             argument: argument.to_string(),
             path,
@@ -91,7 +97,7 @@ pub fn parse_path(text: &str) -> Result<Vec<PathStep>, String> {
     for part in text.split('.') {
         let (key, mut rest) = part.split_at(part.find('[').unwrap_or(part.len()));
         if key.is_empty() && (steps.is_empty() || rest.is_empty()) {
-            return Err(format!("`{text}` has an empty key"));
+            return Err(format!("{} has an empty key", quoted(text)));
         }
         if !key.is_empty() {
             steps.push(PathStep::Key(key.to_string()));
@@ -100,9 +106,15 @@ pub fn parse_path(text: &str) -> Result<Vec<PathStep>, String> {
             let close = rest
                 .find(']')
                 .filter(|_| rest.starts_with('['))
-                .ok_or_else(|| format!("`{text}`: expected `[index]` after `{key}`"))?;
+                .ok_or_else(|| {
+                    format!("{}: expected `[index]` after {}", quoted(text), quoted(key))
+                })?;
             let index = rest[1..close].trim().parse().map_err(|_| {
-                format!("`{text}`: `{}` is not an index (0, 1, …)", &rest[1..close])
+                format!(
+                    "{}: {} is not an index (0, 1, …)",
+                    quoted(text),
+                    quoted(&rest[1..close])
+                )
             })?;
             steps.push(PathStep::Index(index));
             rest = &rest[close + 1..];
@@ -157,8 +169,13 @@ pub fn apply(root: &mut Value, set: &SetOverride) -> Result<Applied, String> {
                 let what = kind_of(node);
                 let map = node.as_mapping_mut().ok_or_else(|| {
                     format!(
-                        "`{}` is {what}, not a map: it has no field `{key}`",
-                        if here.is_empty() { "the design" } else { &here },
+                        "{} is {what}, not a map: it has no field {}",
+                        if here.is_empty() {
+                            "the design".to_string()
+                        } else {
+                            quoted(&here)
+                        },
+                        quoted(key)
                     )
                 })?;
                 // A missing key is inserted empty; the next step makes it a map (and records it as created).
@@ -166,12 +183,16 @@ pub fn apply(root: &mut Value, set: &SetOverride) -> Result<Applied, String> {
             }
             PathStep::Index(index) => {
                 let seq = node.as_sequence_mut().ok_or_else(|| {
-                    format!("`{here}` is not a list: `[{index}]` does not apply to it")
+                    format!(
+                        "{} is not a list: `[{index}]` does not apply to it",
+                        quoted(&here)
+                    )
                 })?;
                 let len = seq.len();
                 seq.get_mut(*index).ok_or_else(|| {
                     format!(
-                        "`{here}` has {len} entries: there is no `[{index}]` (entries count from 0)"
+                        "{} has {len} entries: there is no `[{index}]` (entries count from 0)",
+                        quoted(&here)
                     )
                 })?
             }

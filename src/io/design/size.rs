@@ -47,6 +47,10 @@ pub struct MemoryTerm {
 pub struct MemoryEstimate {
     /// The contributions.
     pub terms: Vec<MemoryTerm>,
+    /// Bytes kept per time step (the design's probes decide it).
+    pub bytes_per_step: Real,
+    /// Which of `terms` is the time steps' (none in an empty estimate).
+    steps_term: Option<usize>,
 }
 
 impl MemoryEstimate {
@@ -58,6 +62,30 @@ impl MemoryEstimate {
     /// The largest contribution.
     pub fn largest(&self) -> Option<&MemoryTerm> {
         self.terms.iter().max_by(|a, b| a.bytes.total_cmp(&b.bytes))
+    }
+
+    /// The estimate for a run of the same design that takes the time steps `steps` instead of those it was
+    /// made for (a study's variant of the time stepping): the time steps' term replaced, the rest kept.
+    pub fn with_steps(&self, steps: &StepCount) -> MemoryEstimate {
+        let mut changed = self.clone();
+        if let Some(term) = self.steps_term.and_then(|k| changed.terms.get_mut(k)) {
+            *term = MemoryTerm {
+                field: steps.field.clone(),
+                what: steps.what.clone(),
+                bytes: steps.steps * self.bytes_per_step,
+            };
+        }
+        changed
+    }
+
+    /// The most time steps that keep this estimate within [`MEMORY_LIMIT_BYTES`], the other terms as they are
+    /// (zero when they alone exceed it).
+    pub fn steps_within_limit(&self) -> Real {
+        let steps = self
+            .steps_term
+            .and_then(|k| self.terms.get(k))
+            .map_or(0.0, |t| t.bytes);
+        ((MEMORY_LIMIT_BYTES - (self.total() - steps)) / self.bytes_per_step).max(0.0)
     }
 }
 
@@ -230,6 +258,7 @@ pub fn estimated_memory(dto: &DesignDto, steps: &StepCount) -> MemoryEstimate {
     }
     let patch_terms = terms.len();
     let probes = dto.output.as_ref().map_or(0, |o| o.probes.len());
+    let steps_term = terms.len();
     terms.push((
         steps.field.clone(),
         steps.what.clone(),
@@ -271,6 +300,8 @@ pub fn estimated_memory(dto: &DesignDto, steps: &StepCount) -> MemoryEstimate {
             .into_iter()
             .map(|(field, what, bytes, _)| MemoryTerm { field, what, bytes })
             .collect(),
+        bytes_per_step: bytes_per_step(probes),
+        steps_term: Some(steps_term),
     }
 }
 
@@ -293,23 +324,31 @@ pub fn human_bytes(bytes: Real) -> String {
     }
 }
 
+/// Whether `estimate` is above [`MEMORY_LIMIT_BYTES`] (or not a number): then what it would need, in words
+/// (`would need about 2 TB of memory (patch `beam` (…): 2 TB), more than stentkit's limit of 8.0 GB`).
+pub fn over_limit(estimate: &MemoryEstimate) -> Option<String> {
+    let total = estimate.total();
+    if !(total.is_nan() || total > MEMORY_LIMIT_BYTES) {
+        return None;
+    }
+    let term = estimate.largest()?;
+    Some(format!(
+        "would need about {} of memory ({}: {}), more than stentkit's limit of {}",
+        human_bytes(total),
+        term.what,
+        human_bytes(term.bytes),
+        human_bytes(MEMORY_LIMIT_BYTES)
+    ))
+}
+
 /// The [`estimated_memory`] for `steps`; refused when above [`MEMORY_LIMIT_BYTES`], naming the field of the
 /// largest contribution.
 pub(super) fn check_size(dto: &DesignDto, steps: &StepCount) -> Result<MemoryEstimate> {
     let estimate = estimated_memory(dto, steps);
-    let total = estimate.total();
-    if (total.is_nan() || total > MEMORY_LIMIT_BYTES)
-        && let Some(term) = estimate.largest()
-    {
+    if let (Some(too_much), Some(term)) = (over_limit(&estimate), estimate.largest()) {
         return Err(issue(
             &term.field,
-            format!(
-                "this design would need about {} of memory ({}: {}), more than stentkit's limit of {}: reduce it",
-                human_bytes(total),
-                term.what,
-                human_bytes(term.bytes),
-                human_bytes(MEMORY_LIMIT_BYTES)
-            ),
+            format!("this design {too_much}: reduce it"),
         ));
     }
     Ok(estimate)

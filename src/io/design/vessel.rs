@@ -114,16 +114,24 @@ pub fn vessel_centreline(
     let total = line.length();
     let start = f.start.map_or(0.0, |s| s.0);
     let length = f.length.map_or(total - start, |l| l.0);
-    if !(start + length <= total * (1.0 + 1e-12)) || !(length > 0.0) {
+    if !(start < total) {
         return Err(issue(
-            field(if f.length.is_some() {
-                "length"
-            } else {
-                "start"
-            }),
+            field("start"),
             format!(
-                "the segment from {start} to {} is longer than the polyline ({total} in the design's length unit)",
-                start + length
+                "the segment starts at {}, not before the end of the polyline, which is {} long in the design's length unit",
+                Short(start),
+                Short(total)
+            ),
+        ));
+    }
+    if !(start + length <= total * (1.0 + 1e-12)) {
+        return Err(issue(
+            field("length"),
+            format!(
+                "the segment from {} to {} is longer than the polyline ({} in the design's length unit)",
+                Short(start),
+                Short(start + length),
+                Short(total)
             ),
         ));
     }
