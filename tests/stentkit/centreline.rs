@@ -639,7 +639,7 @@ fn only_regular_files_within_the_size_limit_are_read() {
         text.replace("data/aorta-centerline.vtp", fifo.to_str().expect("UTF-8")),
     )
     .expect("design");
-    let out = check_within(&on_fifo, 20);
+    let out = check_within(&on_fifo);
     let stderr = String::from_utf8_lossy(&out.stderr);
     assert_eq!(out.status.code(), Some(2), "{stderr}");
     assert!(
@@ -656,7 +656,7 @@ fn only_regular_files_within_the_size_limit_are_read() {
         (Path::new("/dev/zero"), "a character device"),
         (fifo.as_path(), "a FIFO (named pipe)"),
     ] {
-        let out = check_within(path, 20);
+        let out = check_within(path);
         let stderr = String::from_utf8_lossy(&out.stderr);
         assert_eq!(out.status.code(), Some(2), "{stderr}");
         assert!(
@@ -670,27 +670,12 @@ fn only_regular_files_within_the_size_limit_are_read() {
     std::fs::remove_dir_all(&dir).ok();
 }
 
-/// `stentkit check DESIGN`, killed (and the test failed) if it has not ended within `seconds`: the deadline of
-/// a hang, not a timing.
-fn check_within(design: &Path, seconds: u64) -> std::process::Output {
-    let mut child = std::process::Command::new(env!("CARGO_BIN_EXE_stentkit"))
-        .args(["check", design.to_str().expect("UTF-8")])
-        .stdout(std::process::Stdio::piped())
-        .stderr(std::process::Stdio::piped())
-        .spawn()
-        .expect("stentkit runs");
-    let started = std::time::Instant::now();
-    while child.try_wait().expect("status").is_none() {
-        if started.elapsed().as_secs() > seconds {
-            child.kill().ok();
-            panic!(
-                "stentkit check {} did not end in {seconds} s",
-                design.display()
-            );
-        }
-        std::thread::sleep(std::time::Duration::from_millis(50));
-    }
-    child.wait_with_output().expect("output")
+/// `stentkit check DESIGN`, failed if it has not ended within 20 s (the deadline of a hang, not a timing).
+fn check_within(design: &Path) -> std::process::Output {
+    crate::outputs::stentkit_within(
+        &["check", design.to_str().expect("UTF-8")],
+        std::time::Duration::from_secs(20),
+    )
 }
 
 /// The aorta design with its centreline file block replaced: `path` and the lines of `file:` given

@@ -50,6 +50,43 @@ pub(crate) fn stentkit(args: &[&str]) -> Output {
         .expect("stentkit runs")
 }
 
+/// Runs `stentkit` with `args`, failing the test if it has not ended within `limit` (the deadline of a hang,
+/// not a timing: it is killed and its stderr so far shown).
+pub(crate) fn stentkit_within(args: &[&str], limit: std::time::Duration) -> Output {
+    let child = Command::new(env!("CARGO_BIN_EXE_stentkit"))
+        .args(args)
+        .stdout(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .expect("stentkit starts");
+    let what: String = format!("stentkit {}", args.join(" "))
+        .chars()
+        .take(200)
+        .collect();
+    wait_at_most(child, limit, &what)
+}
+
+/// Waits for `child` at most `limit`; kills it and fails the test when it takes longer.
+pub(crate) fn wait_at_most(
+    mut child: std::process::Child,
+    limit: std::time::Duration,
+    what: &str,
+) -> Output {
+    let start = std::time::Instant::now();
+    while child.try_wait().expect("try_wait").is_none() {
+        if start.elapsed() > limit {
+            let _ = child.kill();
+            let out = child.wait_with_output().expect("killed");
+            panic!(
+                "{what} took more than {limit:?}; stderr so far:\n{}",
+                text(&out.stderr)
+            );
+        }
+        std::thread::sleep(std::time::Duration::from_millis(20));
+    }
+    child.wait_with_output().expect("output")
+}
+
 pub(crate) fn text(bytes: &[u8]) -> String {
     String::from_utf8_lossy(bytes).into_owned()
 }

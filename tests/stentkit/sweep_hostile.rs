@@ -8,7 +8,7 @@
 //! step (1301 snapshots of 5 MB each), so that 5000 variants need tens of terabytes, more than any disk these
 //! tests run on.
 
-use crate::outputs::{design, path_str, stentkit, test_outputs, text};
+use crate::outputs::{design, path_str, stentkit, test_outputs, text, wait_at_most};
 use std::path::{Path, PathBuf};
 use std::process::{Child, Command, Output, Stdio};
 use std::time::{Duration, Instant};
@@ -43,23 +43,6 @@ fn spawn(args: &[String]) -> Child {
         .stderr(Stdio::piped())
         .spawn()
         .expect("stentkit starts")
-}
-
-/// Waits for `child` at most `limit`; kills it and fails the test when it takes longer.
-fn wait_at_most(mut child: Child, limit: Duration, what: &str) -> Output {
-    let start = Instant::now();
-    while child.try_wait().expect("try_wait").is_none() {
-        if start.elapsed() > limit {
-            let _ = child.kill();
-            let out = child.wait_with_output().expect("killed");
-            panic!(
-                "{what} took more than {limit:?}; stderr so far:\n{}",
-                text(&out.stderr)
-            );
-        }
-        std::thread::sleep(Duration::from_millis(20));
-    }
-    child.wait_with_output().expect("output")
 }
 
 /// Polls `done` every 2 ms for at most a minute.

@@ -107,7 +107,11 @@ impl StepCount {
         Self {
             steps,
             field: "time.step".to_string(),
-            what: format!("{steps:.3e} time steps"),
+            what: if steps.is_finite() {
+                format!("{steps:.3e} time steps")
+            } else {
+                "more than 1e308 time steps".to_string()
+            },
         }
     }
 
@@ -305,9 +309,11 @@ pub fn estimated_memory(dto: &DesignDto, steps: &StepCount) -> MemoryEstimate {
     }
 }
 
-/// `1.2 GB`-style size.
+/// `1.2 GB`-style size (`more than 1e308 bytes` when the count overflowed).
 pub fn human_bytes(bytes: Real) -> String {
-    if bytes >= 1e15 {
+    if bytes == Real::INFINITY {
+        "more than 1e308 bytes".to_string()
+    } else if bytes >= 1e15 {
         format!("{bytes:.1e} bytes")
     } else if bytes >= 1e12 {
         format!("{:.0} TB", bytes / 1e12)
@@ -333,8 +339,12 @@ pub fn over_limit(estimate: &MemoryEstimate) -> Option<String> {
     }
     let term = estimate.largest()?;
     Some(format!(
-        "would need about {} of memory ({}: {}), more than stentkit's limit of {}",
-        human_bytes(total),
+        "would need {} of memory ({}: {}), more than stentkit's limit of {}",
+        if total.is_finite() {
+            format!("about {}", human_bytes(total))
+        } else {
+            human_bytes(total)
+        },
         term.what,
         human_bytes(term.bytes),
         human_bytes(MEMORY_LIMIT_BYTES)
