@@ -72,13 +72,12 @@ pub fn run(run_dir: &Path, options: &ExportOptions) -> anyhow::Result<()> {
     let format = formats::format(&extension);
     super::refuse_existing([options.output.as_path()], options.force)?;
     let summary_path = run_dir.join("summary.json");
-    let summary: serde_json::Value =
-        crate::io::summary::read_json(&summary_path).map_err(|why| {
-            BadInput(format!(
-                "{}: not a run folder (summary.json: {why})",
-                run_dir.display()
-            ))
-        })?;
+    let summary: serde_json::Value = crate::io::input::read_json(&summary_path).map_err(|why| {
+        BadInput(format!(
+            "{}: not a run folder (summary.json: {why})",
+            run_dir.display()
+        ))
+    })?;
     let design_path = match &options.design {
         Some(path) => path.clone(),
         None => PathBuf::from(summary["design_file"].as_str().unwrap_or_default()),

@@ -45,13 +45,12 @@ pub fn run(
     }
     super::refuse_existing([output], force)?;
     let summary_path = dir.join("summary.json");
-    let summary: serde_json::Value =
-        crate::io::summary::read_json(&summary_path).map_err(|why| {
-            BadInput(format!(
-                "{}: {why} (not a run folder?)",
-                summary_path.display()
-            ))
-        })?;
+    let summary: serde_json::Value = crate::io::input::read_json(&summary_path).map_err(|why| {
+        BadInput(format!(
+            "{}: {why} (not a run folder?)",
+            summary_path.display()
+        ))
+    })?;
     // Every snapshot with an STL, in time order (the first is the initial state).
     let snapshots: Vec<(f64, PathBuf)> = summary["snapshots"]
         .as_array()

@@ -82,7 +82,7 @@ pub fn run(dir: &Path) -> anyhow::Result<()> {
     }
     let summary_path = dir.join("summary.json");
     if summary_path.exists() {
-        let mut summary: Value = crate::io::summary::read_json(&summary_path)
+        let mut summary: Value = crate::io::input::read_json(&summary_path)
             .map_err(|why| anyhow::anyhow!("{}: {why}", summary_path.display()))?;
         if summary["status"] == "running" {
             mark_killed(&mut summary, &rows, dir, &listed, mcap_bytes);

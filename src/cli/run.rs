@@ -620,7 +620,7 @@ fn resume(
 
 /// The `status` of the run folder's `summary.json`, if it can be read.
 fn previous_status(dir: &Path) -> Option<String> {
-    let value: serde_json::Value = crate::io::summary::read_json(&dir.join("summary.json")).ok()?;
+    let value: serde_json::Value = crate::io::input::read_json(&dir.join("summary.json")).ok()?;
     value.get("status")?.as_str().map(str::to_string)
 }
 

@@ -43,7 +43,7 @@ use crate::solver::{Checkpoint, RunSummary, SolverTiming};
 use std::path::{Path, PathBuf};
 
 /// The checkpoint's file name inside a run folder.
-pub const FILE_NAME: &str = "checkpoint.bin";
+pub const FILE_NAME: &str = crate::io::run_folder::CHECKPOINT_FILE;
 
 /// The format's first eight bytes.
 const MAGIC: &[u8; 8] = b"STKCKPT\0";

@@ -34,7 +34,7 @@ pub struct RunCharts {
 
 impl RunCharts {
     /// Folder of the charts inside the run folder.
-    pub const FOLDER: &'static str = "charts";
+    pub const FOLDER: &'static str = super::run_folder::CHARTS_FOLDER;
 
     /// An empty collection for a run of `model`.
     pub fn new(model: &Model) -> Self {

@@ -34,6 +34,15 @@ pub const MANIFEST: &str = ".stentkit-run";
 pub const LOCK: &str = ".stentkit-run.lock";
 /// The space reserve's file name inside a run folder (see [`RunFolder::reserve`]).
 pub const RESERVE: &str = ".stentkit-reserve";
+/// The checkpoint's file name ([`crate::io::checkpoint`]). The run folder's layout is named here, below the
+/// writers that fill it, so that the folder's rules need none of them.
+pub const CHECKPOINT_FILE: &str = "checkpoint.bin";
+/// The ParaView collection of the run's field files ([`crate::io::snapshots`]).
+pub const COLLECTION_FILE: &str = "run.pvd";
+/// The folder of the snapshots ([`crate::io::snapshots::SnapshotWriter`]).
+pub const SNAPSHOTS_FOLDER: &str = "snapshots";
+/// The folder of the charts ([`crate::io::run_charts::RunCharts`]).
+pub const CHARTS_FOLDER: &str = "charts";
 /// The names every run writes (or may write) in its folder besides the snapshots and charts: none of them may
 /// be a symbolic link ([`classify`]).
 pub const RUN_NAMES: [&str; 10] = [
@@ -43,10 +52,10 @@ pub const RUN_NAMES: [&str; 10] = [
     "summary.json",
     "history.csv",
     "run.mcap",
-    super::checkpoint::FILE_NAME,
-    super::snapshots::COLLECTION_FILE,
-    super::snapshots::SnapshotWriter::FOLDER,
-    super::run_charts::RunCharts::FOLDER,
+    CHECKPOINT_FILE,
+    COLLECTION_FILE,
+    SNAPSHOTS_FOLDER,
+    CHARTS_FOLDER,
 ];
 /// The manifest's first line (the format: one path relative to the run folder per following line).
 const MANIFEST_HEADER: &str = "# stentkit run folder: files written by stentkit (`run --force` removes only these), one per line";
@@ -199,7 +208,7 @@ struct LegacyFiles {
 /// The files of a run folder written before the manifest existed, as its `summary.json` lists them; `None`
 /// when there is no such summary.
 fn legacy_outputs(dir: &Path) -> Option<BTreeSet<PathBuf>> {
-    let summary: LegacySummary = crate::io::summary::read_json(&dir.join("summary.json")).ok()?;
+    let summary: LegacySummary = crate::io::input::read_json(&dir.join("summary.json")).ok()?;
     if summary.stentkit_version.is_empty() {
         return None;
     }
@@ -529,10 +538,7 @@ impl RunFolder {
                 no_follow::remove_inside(&self.dir, relative).map_err(io_error(&path))?;
             }
         }
-        for folder in [
-            super::snapshots::SnapshotWriter::FOLDER,
-            super::run_charts::RunCharts::FOLDER,
-        ] {
+        for folder in [SNAPSHOTS_FOLDER, CHARTS_FOLDER] {
             // Only if empty: a file of the user's keeps its folder.
             let _ = fs::remove_dir(self.dir.join(folder));
         }

@@ -173,7 +173,7 @@ pub struct Snapshot {
 }
 
 /// The ParaView collection of a run's field files, in the run folder ([`vtk::collection`]).
-pub const COLLECTION_FILE: &str = "run.pvd";
+pub const COLLECTION_FILE: &str = super::run_folder::COLLECTION_FILE;
 
 /// The file of the vessel's lumen in the snapshot folder (a stent on a centreline read from a file).
 pub const VESSEL_FILE: &str = "vessel_lumen.stl";
@@ -268,7 +268,7 @@ pub struct SnapshotWriter {
 
 impl SnapshotWriter {
     /// Folder of the snapshots inside the run folder.
-    pub const FOLDER: &'static str = "snapshots";
+    pub const FOLDER: &'static str = super::run_folder::SNAPSHOTS_FOLDER;
 
     /// Creates `run_dir/snapshots`.
     ///

@@ -12,30 +12,6 @@ use serde::Serialize;
 use std::collections::BTreeMap;
 use std::path::Path;
 
-/// Largest `summary.json` stentkit reads back [bytes]: 16 MiB. A summary is a few kB (the straight stent's,
-/// with its snapshots and timing, 5 kB; a failure report adds the residuals of one step); the limit only keeps
-/// a file put in its place (a device, a FIFO, a huge file) from costing more than that.
-pub const MAX_SUMMARY_BYTES: u64 = 16 * 1024 * 1024;
-
-/// The JSON of the run summary at `path`, read as a regular file of at most [`MAX_SUMMARY_BYTES`]
-/// ([`crate::io::input`]).
-///
-/// # Errors
-/// A message (without the path) saying why it cannot be read: missing, not a regular file, too large, not
-/// UTF-8 or not JSON.
-pub fn read_json<T: serde::de::DeserializeOwned>(path: &Path) -> Result<T, String> {
-    use crate::io::input::{InputError, read_regular_file};
-    let bytes = read_regular_file(path, MAX_SUMMARY_BYTES).map_err(|e| match e {
-        InputError::Io(e) => e.to_string(),
-        InputError::NotRegular(what) => format!("{what}, not a regular file"),
-        InputError::TooLarge(bytes) => format!(
-            "{bytes} bytes, more than the {} MiB a summary may have",
-            MAX_SUMMARY_BYTES >> 20
-        ),
-    })?;
-    serde_json::from_slice(&bytes).map_err(|e| format!("not a stentkit summary: {e}"))
-}
-
 /// How the run ended, or that it has not ended yet.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
 #[serde(rename_all = "snake_case")]

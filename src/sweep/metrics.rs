@@ -200,7 +200,7 @@ pub fn run_metrics(model: &Model, run: &Path, times: &[Real]) -> Metrics {
     let history = std::fs::read_to_string(run.join("history.csv"))
         .map(|t| History::parse(&t))
         .unwrap_or_default();
-    let summary = crate::io::summary::read_json(&run.join("summary.json")).ok();
+    let summary = crate::io::input::read_json(&run.join("summary.json")).ok();
     metrics(Release::of(model), &history, summary.as_ref(), times)
 }
 

@@ -576,7 +576,7 @@ impl SweepDir {
             return VariantState::Failed(error.trim().to_string());
         }
         let summary =
-            crate::io::summary::read_json::<serde_json::Value>(&self.run(id).join("summary.json"))
+            crate::io::input::read_json::<serde_json::Value>(&self.run(id).join("summary.json"))
                 .ok();
         let Some(summary) = summary else {
             return match std::fs::read_to_string(self.task_error(id)) {
