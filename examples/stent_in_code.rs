@@ -23,7 +23,7 @@ use stentkit::solver::Simulation;
 fn final_delta_r(model: &Model) -> Result<Real, Box<dyn std::error::Error>> {
     let mut sim = Simulation::new(model)?;
     sim.run(&mut [])?;
-    let recovery = stentkit::io::state::recovery(&sim).ok_or("the model has no programme")?;
+    let recovery = stentkit::post::recovery::recovery(&sim).ok_or("the model has no programme")?;
     Ok(recovery
         .delta_r
         .ok_or("the programme is not a radial contraction")?)

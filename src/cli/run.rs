@@ -734,7 +734,7 @@ fn run_in(
     let recovered = result
         .as_ref()
         .is_ok_and(|s| !s.stopped && sim.is_finished())
-        .then(|| crate::io::state::recovery_warning(&sim))
+        .then(|| crate::post::recovery::recovery_warning(&sim))
         .flatten();
     for warning in sim.stabilisation_warnings().iter().chain(&recovered) {
         eprintln!("warning: {warning}");

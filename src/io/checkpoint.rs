@@ -31,10 +31,11 @@
 use super::history::HistoryPosition;
 use super::mcap::RecordingPosition;
 use super::snapshots::Snapshot;
-use super::state::{Recovery, StateSample};
+use super::state::StateSample;
 use crate::material::LAW_NUMBERS;
 use crate::math::{Mat3, Real, Vec3};
 use crate::model::cycle::Phase;
+use crate::post::recovery::Recovery;
 use crate::solver::assembly::{Actions, ReleaseRamp};
 use crate::solver::simulation::adaptive::StepControl;
 use crate::solver::simulation::{ArcState, StabiliserState, TangentOrigin};

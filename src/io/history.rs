@@ -355,7 +355,7 @@ impl HistoryWriter {
                 totals.ratio()
             ));
         }
-        if let Some(r) = super::state::recovery(sim) {
+        if let Some(r) = crate::post::recovery::recovery(sim) {
             line.push_str(&format!(",{:.9e},{:.9e}", r.ratio_mean, r.ratio_max));
             if let Some(delta_r) = r.delta_r {
                 line.push_str(&format!(",{delta_r:.9e}"));
@@ -366,7 +366,7 @@ impl HistoryWriter {
         }
         line.push_str(&format!(
             ",{:.9e}",
-            super::state::max_node_displacement(sim)
+            crate::post::recovery::max_node_displacement(sim)
         ));
         match sim.peak_surface_strain() {
             Some(peak) => {

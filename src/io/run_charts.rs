@@ -153,7 +153,7 @@ impl RunCharts {
         }
 
         if self.samples.iter().any(|s| s.recovery.is_some()) {
-            let recovery = |f: &dyn Fn(&super::state::Recovery) -> Real| {
+            let recovery = |f: &dyn Fn(&crate::post::recovery::Recovery) -> Real| {
                 self.samples
                     .iter()
                     .filter_map(|s| s.recovery.as_ref().map(|r| (s.time, f(r))))

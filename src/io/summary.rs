@@ -361,7 +361,7 @@ pub struct RunSummaryFile {
     pub final_state: Option<FinalState>,
     /// Warnings: about the design (as `check` says them), and about the run's result — a stabilisation above
     /// its limit by energy or force, a device that ended heated above its Tg but not recovered
-    /// ([`super::state::recovery_warning`]). A run with a warning may still be `completed`: its numbers are
+    /// ([`crate::post::recovery::recovery_warning`]). A run with a warning may still be `completed`: its numbers are
     /// the simulation's, and these say why they may not be what was wanted.
     pub warnings: Vec<String>,
     /// Notices of the solver (e.g. relaxation frozen below Tg − C2).

@@ -5,7 +5,8 @@
 //! [`device`] samples every patch (the deformed state through [`crate::solver::shape`], or the reference
 //! geometry with rotation-minimising frames), decimates the samples to a drawing budget, and turns a
 //! symmetry-reduced model back into the full device (DESIGN §5: exports always show the full device): mirror
-//! copies of every patch, centrelines and closed tube meshes. [`path`] reads an arc-length path's limit loads.
+//! copies of every patch, centrelines and closed tube meshes. [`path`] reads an arc-length path's limit loads; [`recovery`]
+//! measures how far a programmed device has recovered.
 //!
 //! Layer: above `solver` (it reads a [`crate::solver::Simulation`]'s state), below `io` (which writes what it
 //! returns). Pure: no files, no printing, no serde.
@@ -13,4 +14,5 @@
 pub mod device;
 pub mod path;
 pub mod print;
+pub mod recovery;
 pub mod vessel;

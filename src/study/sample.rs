@@ -3,9 +3,9 @@
 //! measures, optionally the grid — at every record time ([`watched_run`]); with the run's wall time and the
 //! solver's totals.
 
-use crate::io::state::{Recovery, recovery};
 use crate::math::{Real, Vec3};
 use crate::model::{Model, ProbeLocation};
+use crate::post::recovery::{Recovery, recovery};
 use crate::solver::{Observer, RunSummary, Simulation, SolverError, StepReport};
 use std::ops::ControlFlow;
 use std::time::Instant;

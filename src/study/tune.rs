@@ -651,7 +651,7 @@ mod tests {
     // short of a comparison time cannot pass.
     #[test]
     fn the_difference_normalises_each_quantity_as_documented() {
-        use crate::io::state::Recovery;
+        use crate::post::recovery::Recovery;
         let watched = |time: Real, u: Real, delta_r: Real, ratio: Real| Watched {
             time,
             displacements: vec![Vec3::new(u, 0.0, 0.0)],

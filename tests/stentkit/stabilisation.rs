@@ -81,7 +81,7 @@ fn a_hot_release_runs_through_with_stabilisation_and_says_it_is_not_quasi_static
     );
     let model = design.model;
     let (sim, recorder) = solve(&model);
-    let recovery = stentkit::io::state::recovery(&sim).expect("a programme");
+    let recovery = stentkit::post::recovery::recovery(&sim).expect("a programme");
     let s = *sim.stabilisation();
     println!(
         "hot release: {} steps, {} damped, dissipated {:.3e} of the peak strain energy {:.4}, final recovery ratio {:.3e}",
