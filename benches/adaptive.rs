@@ -24,7 +24,7 @@
 //! Runs shorter than 5 s are repeated three times and the shortest wall time is reported.
 //!
 //! `cargo bench --bench adaptive` runs all four (about 6 minutes on two cores); `cargo bench --bench adaptive
-//! -- curved` (or `straight`, `arch`, `cantilever`) one. The tables in the README come from it.
+//! -- curved` (or `straight`, `arch`, `cantilever`) one. The tables in docs/speed.md come from it.
 
 use std::path::Path;
 use stentkit::io::design::load_design;

@@ -10,7 +10,7 @@
 //! onto the permanent ones. It prints a Markdown table. No default is changed by it.
 //!
 //! The runs use the tuned discretisation (`designs/tuned/curved_stent.yaml`: p = 5, n = 44, τ = 3e-2), whose
-//! ratios are within 6.7e-4 of the paper-settings run (README, work–precision table): ten times smaller than
+//! ratios are within 6.7e-4 of the paper-settings run (docs/speed.md, work–precision table): ten times smaller than
 //! the smallest effect reported here.
 //!
 //! ```sh

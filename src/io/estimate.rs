@@ -419,7 +419,7 @@ mod tests {
         );
     }
 
-    // Reference: README, the curved stent's recording is 31.9 MB (this version, 8 snapshots); from above, not
+    // Reference: docs/run-folder.md, the curved stent's recording is 31.9 MB (this version, 8 snapshots); from above, not
     // beyond 1.5 times.
     #[test]
     fn the_curved_stents_recording_is_estimated_from_above() {

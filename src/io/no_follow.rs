@@ -1,7 +1,7 @@
 //! Changing files without following symbolic links: every file stentkit removes, truncates or rewrites in a
 //! folder of its own (a run folder, a sweep folder) goes through this module.
 //!
-//! The rule (README, "When things go wrong", **Links and existing files**): nothing stentkit removes, truncates
+//! The rule (docs/when-things-go-wrong.md, **Links and existing files**): nothing stentkit removes, truncates
 //! or rewrites is reached through a symbolic link. A link named `history.csv` may point at a user's file, and a
 //! `snapshots/` that is a link may be a user's folder: opening such a path for writing, or removing a file
 //! below it, would change the user's data instead of stentkit's. So

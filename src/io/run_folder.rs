@@ -1,7 +1,7 @@
 //! The run folder as a place on disk: which folders a run may write into, the manifest of the files stentkit
 //! wrote there, the lock that keeps two runs out of one folder, and what `--force` may remove.
 //!
-//! Rules (README, "When things go wrong"):
+//! Rules (docs/when-things-go-wrong.md):
 //!
 //! - A run writes only into an empty or missing folder, or into a **stentkit run folder**: one holding the
 //!   manifest [`MANIFEST`] (or, for folders written before the manifest existed, a `summary.json` whose

@@ -607,7 +607,11 @@ fn only_regular_files_within_the_size_limit_are_read() {
         .and_then(|f| f.set_len(4 * 1024 * 1024 + 1))
         .expect("a sparse file");
     let limit = stentkit::io::centreline::MAX_CENTRELINE_BYTES;
-    assert_eq!(limit, 4 * 1024 * 1024, "the limit the README states");
+    assert_eq!(
+        limit,
+        4 * 1024 * 1024,
+        "the limit docs/when-things-go-wrong.md states"
+    );
     for (path, fragment) in [
         (
             Path::new("/dev/zero"),

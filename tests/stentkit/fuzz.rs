@@ -11,7 +11,7 @@
 //! unlocated error.
 //!
 //! Cases: [`CASES`] from a fixed seed (about 10 s in release); `PROPTEST_CASES` and `PROPTEST_RNG_SEED` override
-//! them for longer runs (a 20 000-case run was made while writing it, see the README).
+//! them for longer runs (a 20 000-case run was made while writing it, see docs/when-things-go-wrong.md).
 
 use proptest::prelude::*;
 use proptest::test_runner::{Config, RngSeed};

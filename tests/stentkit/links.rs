@@ -5,7 +5,7 @@
 //! history is back; and every command that writes a file the user names refuses to replace it without
 //! `--force` (exit status 2, the path named).
 //!
-//! Source: the rule in README "When things go wrong" (**Links and existing files**); each test reproduces one of
+//! Source: the rule in docs/when-things-go-wrong.md (**Links and existing files**); each test reproduces one of
 //! the reports on the smallest designs (bend45: 10 steps, half a second; the two-crown stent of
 //! `resume.rs` where a checkpoint is needed, killed after its first one). Comparisons are exact: a refusal
 //! leaves every byte, link and folder as it was.

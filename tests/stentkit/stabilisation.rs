@@ -111,7 +111,7 @@ fn a_hot_release_runs_through_with_stabilisation_and_says_it_is_not_quasi_static
 
 /// Issue 18 item 3: the p = 5, n = 14 two-crown stent of the stability map, whose release Newton alone cannot
 /// pass (measured: no convergence at t = 1.75280 s, release ramp 0.01 s), completes with stabilisation. (Its
-/// state after the release is not the converged model's: see the README's stability section — the coarse
+/// state after the release is not the converged model's: see docs/speed.md, the stability study — the coarse
 /// model's own release path folds, as the coarse bend's and roll-up's load paths do.)
 #[test]
 fn the_coarse_stent_whose_release_folds_completes_with_stabilisation() {

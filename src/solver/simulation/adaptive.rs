@@ -58,7 +58,7 @@ pub const MIN_FACTOR: Real = 0.2;
 /// steps that follow add to it before the material relaxes it away, so the estimate is held to half the
 /// tolerance. Measured global errors over the tolerance: creep after a jump 0.50 / 0.43 / 0.47 at 1e-3 / 1e-4 /
 /// 1e-5 (1.07 when held to all of the tolerance); pure bending 0.26 / 0.20 / 0.31; the four paper cases at
-/// 1e-1 … 1e-4 at most 0.30 (README, `cargo bench --bench adaptive`).
+/// 1e-1 … 1e-4 at most 0.30 (docs/speed.md, `cargo bench --bench adaptive`).
 pub const LOCAL_FRACTION: Real = 0.5;
 
 /// The estimate over its share of the tolerance ([`LOCAL_FRACTION`]): a step is accepted when this is at most
