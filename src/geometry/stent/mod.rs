@@ -68,17 +68,28 @@
 //! the symmetry's validity and the sector a cut keeps (`sector.rs`), the crowns' angular layout, nodes and wires
 //! (`crowns.rs`), the bridges and the crowns' clearance (`bridges.rs`) and the named node sets (`sets.rs`).
 //! Every patch is a [`StentCurve`] (`curve.rs`); the temporary placement of the nodes is in `temporary.rs`.
+//!
+//! # Families
+//!
+//! [`StentSpec`] is the ring family (`family: ring`, the default). Every family implements [`StentFamily`]
+//! (`family.rs`), which the model and the design language ask, and generates a [`StentGeometry`]; the closed
+//! diamond cells of [`DiamondSpec`] (`diamond.rs`, `family: diamond`) are the second. A new family is one module
+//! implementing the trait on the axis, sector and curve of this folder.
 
 mod axis;
 mod bridges;
 mod checks;
 mod crowns;
 mod curve;
+mod diamond;
+mod family;
 mod sector;
 mod sets;
 mod temporary;
 
 pub use curve::StentCurve;
+pub use diamond::{DiamondSpec, diamond_counts};
+pub use family::{FamilyCounts, StentFamily, ring_counts};
 
 use super::GeometryError;
 use crate::math::{Real, Vec3};
@@ -298,13 +309,16 @@ pub enum PatchRole {
     },
 }
 
-/// Whether a node is a crest (`x = +h_c`, facing the next crown) or a trough.
+/// Whether a node is a crest (`x = +h_c`, facing the next crown), a trough, or both at once: a junction where a
+/// crest of one crown is a trough of the next (the closed cells of [`DiamondSpec`]).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum NodeKind {
     /// `x = +h_c`.
     Crest,
     /// `x = −h_c`.
     Trough,
+    /// A crest of crown `crown` that is a trough of crown `crown + 1`.
+    Junction,
 }
 
 /// Which end of a generated patch.
@@ -357,9 +371,9 @@ pub struct GeneratedNode {
     pub position: Vec3,
     /// The patch ends joined here.
     pub ends: Vec<(usize, WireEnd)>,
-    /// Crown index, 0-based.
+    /// Crown index, 0-based (of a junction: the crown whose crest it is).
     pub crown: usize,
-    /// Node index within the crown, 0-based (even: crest).
+    /// Node index within the crown, 0-based (even: crest); of a diamond stent's node, its angle in half waves.
     pub index: usize,
     /// Crest or trough.
     pub kind: NodeKind,
