@@ -624,6 +624,41 @@ mod tests {
         assert_eq!(half.patches.len(), 18 + 7);
     }
 
+    // The counts the ring family reports without generating (what the memory estimate charges) are what it
+    // generates: a cut model's patches and nodes weighted by the copies each stands for (half as many for a
+    // bridge or node on a plane), for bridges at every crest and at every third one (two per pair, at 0° and
+    // 180° from the crown's first crest, which keeps the quarter symmetry).
+    #[test]
+    fn reported_counts_are_the_generated_ones() {
+        for (symmetry, cut) in [
+            (Symmetry::None, false),
+            (Symmetry::Half, true),
+            (Symmetry::Quarter, true),
+        ] {
+            for (every, first) in [(1, 0), (3, 0)] {
+                let mut spec = straight(symmetry, cut);
+                spec.bridges = Some(BridgeSpec {
+                    shape: BridgeShape::Straight,
+                    every,
+                    first,
+                });
+                let counts = StentFamily::counts(&spec);
+                let g = spec.generate().unwrap();
+                let sectors = counts.sectors;
+                let weight = |in_plane: bool| if in_plane { sectors / 2 } else { sectors };
+                let patches: usize = g.patches.iter().map(|p| weight(p.in_plane.is_some())).sum();
+                let nodes: usize = g.nodes.iter().map(|n| n.multiplicity).sum();
+                let label = format!("{symmetry:?}, every {every}");
+                assert_eq!(
+                    patches as Real,
+                    counts.crown_wires + counts.bridges,
+                    "{label}"
+                );
+                assert_eq!(nodes as Real, counts.nodes, "{label}");
+            }
+        }
+    }
+
     // Crests of crown k face troughs of crown k + 1, and the bridge ends are those nodes to round-off.
     #[test]
     fn bridges_end_at_crown_nodes() {
