@@ -1,6 +1,6 @@
 //! The registry of stent families: the `family` key of a `stent:` block (`ring`, the default, or `diamond`)
-//! selects the module that translates the block ([`FamilyBlock`]: the ring family's in [`super::stent`], the
-//! diamond cells' in [`super::diamond`]). A new family is its block's module and one line here.
+//! selects the module that translates the block (a `stent::FamilyBlock`: the ring family's in [`super::stent`],
+//! the diamond cells' in `diamond.rs`). A new family is its block's module and one line here.
 
 use super::dto::{StentDto, StentFamilyDto};
 use super::issue::Result;

@@ -4,7 +4,7 @@
 //! a [`StentMesh`] and a [`ProgrammeSpec`] with the checks of the blocks' form, and names the design field of a
 //! stent [`StentField`].
 //!
-//! Every stent family translates its own block behind [`FamilyBlock`]; [`super::family`] is the registry that
+//! Every stent family translates its own block behind `FamilyBlock`; [`super::family`] is the registry that
 //! the block's `family` key selects from. This file holds the ring family's block and what the families share
 //! (centreline, symmetry, meshes, materials, programme).
 //!
