@@ -25,7 +25,7 @@ pub fn straight_stent(crowns: usize, (p, n): (usize, usize), step: f64) -> Model
     );
     b.units(Units::MmNMpa);
     b.stent(
-        StentSpec {
+        std::sync::Arc::new(StentSpec {
             crown: CrownSpec {
                 radius: 20.0,
                 amplitude: 5.0,
@@ -47,7 +47,7 @@ pub fn straight_stent(crowns: usize, (p, n): (usize, usize), step: f64) -> Model
             symmetry: Symmetry::Quarter,
             cut: true,
             crown_radii: None,
-        },
+        }),
         StentMesh {
             crown: (p, n),
             bridge: (p, n),

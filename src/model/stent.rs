@@ -1,7 +1,8 @@
 //! A generated stent in the model: its patches fitted at the crown and bridge discretisations (half a section
 //! for patches lying in a symmetry plane), its nodes with their symmetry conditions, node sets and symmetry
 //! planes, and the [`Programme`] that drives a node set to the temporary shape. The geometry itself is
-//! [`crate::geometry::stent`]; [`super::builder::ModelBuilder::stent`] and
+//! [`crate::geometry::stent`], of any family: this module asks only the [`StentFamily`] interface (the rings of
+//! a `StentSpec`, the diamond cells of a `DiamondSpec`); [`super::builder::ModelBuilder::stent`] and
 //! [`super::builder::ModelBuilder::programme`] put both into a model.
 
 use super::builder::checks::{FIT_WARNING_FRACTION, check_discretisation};
@@ -14,11 +15,12 @@ use crate::geometry::fit::{FitSettings, best_fit_rigid, fit_curve};
 use crate::geometry::frame::basis_from_unit_axis;
 use crate::geometry::primitives;
 use crate::geometry::stent::{
-    GeneratedPatch, PatchRole, StentGeometry, StentParameter, StentSpec, TemporarySpec, WireEnd,
+    GeneratedPatch, PatchRole, StentFamily, StentGeometry, StentParameter, TemporarySpec, WireEnd,
 };
 use crate::material::{Section, SectionProperties};
 use crate::math::quote::quoted;
 use crate::math::{Real, Vec3};
+use std::sync::Arc;
 
 /// Degree and control points of the stent's wires.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -88,8 +90,8 @@ pub struct ProgrammeSpec {
 /// The generated stent, ready to be merged into the model (its patches and nodes come first).
 #[derive(Debug, Clone)]
 pub struct GeneratedStent {
-    /// The specification it was generated from.
-    pub spec: StentSpec,
+    /// The family and specification it was generated from.
+    pub family: Arc<dyn StentFamily>,
     /// The analytic device.
     pub geometry: StentGeometry,
     /// Fitted patches, in the order of `geometry.patches` (moved into the model by the builder).
@@ -109,7 +111,7 @@ fn geometry_error(e: GeometryError) -> BuildError {
 }
 
 /// Where a programme's temporary shape puts the device: the placement and how much every crown's radius
-/// shrinks ([`StentSpec::generate_temporary`]).
+/// shrinks ([`StentFamily::generate_temporary`]).
 pub type Placement = (TemporarySpec, Real);
 
 impl ProgrammeSpec {
@@ -133,7 +135,7 @@ impl ProgrammeSpec {
 /// appended to `sections`; `poisson` gives its shear factor), of the materials `materials` gives per role
 /// (already checked against the number of crowns), nodes with their symmetry conditions.
 pub fn generate(
-    spec: &StentSpec,
+    family: &Arc<dyn StentFamily>,
     mesh: &StentMesh,
     materials: &StentMaterials,
     sections: &mut Vec<Section>,
@@ -141,10 +143,10 @@ pub fn generate(
     placement: Option<&Placement>,
     warnings: &mut Vec<String>,
 ) -> Result<GeneratedStent> {
-    wire_fits(spec, sections[0].diameter())?;
+    wire_fits(family.as_ref(), sections[0].diameter())?;
     let geometry = match placement {
-        None => spec.generate(),
-        Some((temporary, shrink)) => spec.generate_temporary(temporary, *shrink),
+        None => family.generate(),
+        Some((temporary, shrink)) => family.generate_temporary(temporary, *shrink),
     }
     .map_err(geometry_error)?;
     for (bridge, (p, n)) in [(false, mesh.crown), (true, mesh.bridge)] {
@@ -260,7 +262,7 @@ pub fn generate(
         })
         .collect();
     Ok(GeneratedStent {
-        spec: spec.clone(),
+        family: family.clone(),
         geometry,
         patches,
         nodes,
@@ -329,7 +331,7 @@ impl Fold {
 /// rod model does not describe (issue 31: a lumen radius of 1e-9 in a centreline file sized a stent of radius
 /// 1.1e-9 with a 0.4 mm wire, and `check` said "warnings none"). The paper's stents have a wire of 0.6 mm on a
 /// radius of 20 mm; the aorta stent 0.4 mm on 6.3 mm, and compacted to 2 mm.
-fn wire_fits(spec: &StentSpec, diameter: Real) -> Result<()> {
+fn wire_fits(spec: &dyn StentFamily, diameter: Real) -> Result<()> {
     let (smallest, _) = spec.radius_range();
     if diameter <= smallest {
         return Ok(());
@@ -342,7 +344,7 @@ fn wire_fits(spec: &StentSpec, diameter: Real) -> Result<()> {
             "the wire (diameter {}) is thicker than the stent's radius {}{}: its tube would fill the stent's lumen; give a radius larger than the wire (a radius sized from a centreline file's lumen radius: check that radius and the file's `unit`)",
             shown(diameter),
             shown(smallest),
-            if spec.crowns > 1 && spec.radius_range().1 > smallest {
+            if spec.crowns() > 1 && spec.radius_range().1 > smallest {
                 " (its smallest crown)"
             } else {
                 ""
@@ -489,7 +491,7 @@ pub fn programme(
     }
     let geometry = &stent.geometry;
     // Δr must stay below the smallest crown radius.
-    let radius = stent.spec.radius_range().0;
+    let radius = stent.family.radius_range().0;
     let (kind, targets): (ProgrammeKind, Vec<Vec3>) = match &spec.target {
         &ProgrammeTarget::RadialContraction { delta_r } => {
             if !(delta_r > 0.0 && delta_r.is_finite()) {
@@ -513,7 +515,7 @@ pub fn programme(
         }
         ProgrammeTarget::TargetShape { temporary, align } => {
             let positions = stent
-                .spec
+                .family
                 .temporary_node_positions(geometry, temporary)
                 .map_err(geometry_error)?;
             let positions = if *align {

@@ -10,6 +10,7 @@ mod checkpoint;
 mod cli;
 mod design_errors;
 mod designs;
+mod diamond;
 mod export;
 mod fields;
 mod fuzz;

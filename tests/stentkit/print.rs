@@ -10,7 +10,7 @@ use stentkit::io::stl::read_stl;
 
 /// The one closed surface of a print STL: closed and oriented after the STL round trip, one connected
 /// piece, standing on z = 0, not crossing itself; and its volume.
-fn one_closed_body(path: &std::path::Path) -> f64 {
+pub(crate) fn one_closed_body(path: &std::path::Path) -> f64 {
     let mesh = read_stl(path).expect("a binary STL");
     mesh.check_closed()
         .expect("closed, 2-manifold and oriented after the f32 round trip");
@@ -116,7 +116,7 @@ fn crossing_pairs(mesh: &stentkit::geometry::mesh::TriangleMesh, cell: f64) -> u
 }
 
 /// The volume a `--print` command reported (`… volume 3.430483e2 mm³ …` on its `wrote` line).
-fn reported_volume(stdout: &str) -> f64 {
+pub(crate) fn reported_volume(stdout: &str) -> f64 {
     let line = stdout
         .lines()
         .find(|l| l.starts_with("wrote"))

@@ -111,18 +111,7 @@ impl StentSpec {
 
     /// The crowns fit inside the bend of an arc centreline: `R` below the bend radius.
     pub(super) fn check_bend_radius(&self, axis: &Axis) -> Result<(), GeometryError> {
-        let largest = self.radius_range().1;
-        if let Axis::Arc { radius, .. } = axis
-            && largest >= *radius
-        {
-            return Err(invalid(
-                StentParameter::Radius,
-                format!(
-                    "the crown radius {largest} must be smaller than the centreline's bend radius {radius}"
-                ),
-            ));
-        }
-        Ok(())
+        check_bend_radius(self.radius_range().1, axis)
     }
 
     /// Bridges join each crest to the facing trough of the next crown, which needs `m α ≡ π (mod 2π)` (module
@@ -143,4 +132,19 @@ impl StentSpec {
         }
         Ok(())
     }
+}
+
+/// A device of largest radius `largest` fits inside the bend of an arc centreline: `R` below the bend radius.
+pub(super) fn check_bend_radius(largest: Real, axis: &Axis) -> Result<(), GeometryError> {
+    if let Axis::Arc { radius, .. } = axis
+        && largest >= *radius
+    {
+        return Err(invalid(
+            StentParameter::Radius,
+            format!(
+                "the crown radius {largest} must be smaller than the centreline's bend radius {radius}"
+            ),
+        ));
+    }
+    Ok(())
 }

@@ -5,7 +5,7 @@ use super::CrownSpec;
 use super::axis::Axis;
 use crate::geometry::analytic::ParametricCurve;
 use crate::math::{Mat3, Real, Vec3};
-use std::f64::consts::TAU;
+use std::f64::consts::{PI, TAU};
 use std::sync::Arc;
 
 /// The local shape of a bridge across the axis.
@@ -32,6 +32,13 @@ pub(super) enum CurveKind {
         to: Real,
         angle: Real,
         offset: Offset,
+    },
+    /// A strut of a diamond cell from the node at `(station, angle)` `from` to the node at `to`, the angle
+    /// turning by `turn` (signed, `±π/m`) (module documentation of [`super::diamond`]).
+    Strut {
+        from: (Real, Real),
+        to: (Real, Real),
+        turn: Real,
     },
 }
 
@@ -60,7 +67,7 @@ impl StentCurve {
     ) -> Self {
         let station_frame = match kind {
             CurveKind::Crown { station, .. } => Some(axis.frame(station)),
-            CurveKind::Bridge { .. } => None,
+            CurveKind::Bridge { .. } | CurveKind::Strut { .. } => None,
         };
         Self {
             axis: axis.clone(),
@@ -144,6 +151,30 @@ impl StentCurve {
                 let (sa, ca) = a.sin_cos();
                 let p = Vec3::new(x, r * ca, r * sa);
                 let dp = Vec3::new(dx, dr * ca - r * sa * da, dr * sa + r * ca * da);
+                (p, dp, sigma, dsigma)
+            }
+            CurveKind::Strut {
+                from: (s0, a0),
+                to: (s1, a1),
+                turn,
+            } => {
+                // The station follows the half wave w = (1 − cos πu)/2 between the nodes' stations, as a crown
+                // wire's axial coordinate does between its trough and crest; both ends are exactly the nodes'
+                // (w is exactly 0 and 1 there, and `(1 − w) s0 + w s1` then exactly s0 and s1).
+                let (sw, cw) = (PI * t).sin_cos();
+                let w = 0.5 * (1.0 - cw);
+                let sigma = (1.0 - w) * s0 + w * s1;
+                let dsigma = (s1 - s0) * 0.5 * PI * sw;
+                // The angle is counted from the nearer end, so that both ends are exactly the nodes' angles (a
+                // strut across ϑ = 0 ends at 2π counted from one end and at 0 counted from the other).
+                let a = if t <= 0.5 {
+                    a0 + t * turn
+                } else {
+                    a1 - (1.0 - t) * turn
+                };
+                let (sa, ca) = a.sin_cos();
+                let p = Vec3::new(0.0, big_r * ca, big_r * sa);
+                let dp = Vec3::new(0.0, -big_r * sa, big_r * ca) * turn;
                 (p, dp, sigma, dsigma)
             }
         }

@@ -68,17 +68,28 @@
 //! the symmetry's validity and the sector a cut keeps (`sector.rs`), the crowns' angular layout, nodes and wires
 //! (`crowns.rs`), the bridges and the crowns' clearance (`bridges.rs`) and the named node sets (`sets.rs`).
 //! Every patch is a [`StentCurve`] (`curve.rs`); the temporary placement of the nodes is in `temporary.rs`.
+//!
+//! # Families
+//!
+//! [`StentSpec`] is the ring family (`family: ring`, the default). Every family implements [`StentFamily`]
+//! (`family.rs`), which the model and the design language ask, and generates a [`StentGeometry`]; the closed
+//! diamond cells of [`DiamondSpec`] (`diamond.rs`, `family: diamond`) are the second. A new family is one module
+//! implementing the trait on the axis, sector and curve of this folder.
 
 mod axis;
 mod bridges;
 mod checks;
 mod crowns;
 mod curve;
+mod diamond;
+mod family;
 mod sector;
 mod sets;
 mod temporary;
 
 pub use curve::StentCurve;
+pub use diamond::{DiamondSpec, diamond_counts};
+pub use family::{FamilyCounts, StentFamily, ring_counts};
 
 use super::GeometryError;
 use crate::math::{Real, Vec3};
@@ -298,13 +309,16 @@ pub enum PatchRole {
     },
 }
 
-/// Whether a node is a crest (`x = +h_c`, facing the next crown) or a trough.
+/// Whether a node is a crest (`x = +h_c`, facing the next crown), a trough, or both at once: a junction where a
+/// crest of one crown is a trough of the next (the closed cells of [`DiamondSpec`]).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum NodeKind {
     /// `x = +h_c`.
     Crest,
     /// `x = −h_c`.
     Trough,
+    /// A crest of crown `crown` that is a trough of crown `crown + 1`.
+    Junction,
 }
 
 /// Which end of a generated patch.
@@ -357,9 +371,9 @@ pub struct GeneratedNode {
     pub position: Vec3,
     /// The patch ends joined here.
     pub ends: Vec<(usize, WireEnd)>,
-    /// Crown index, 0-based.
+    /// Crown index, 0-based (of a junction: the crown whose crest it is).
     pub crown: usize,
-    /// Node index within the crown, 0-based (even: crest).
+    /// Node index within the crown, 0-based (even: crest); of a diamond stent's node, its angle in half waves.
     pub index: usize,
     /// Crest or trough.
     pub kind: NodeKind,
@@ -608,6 +622,41 @@ mod tests {
         );
         let half = straight(Symmetry::Half, true).generate().unwrap();
         assert_eq!(half.patches.len(), 18 + 7);
+    }
+
+    // The counts the ring family reports without generating (what the memory estimate charges) are what it
+    // generates: a cut model's patches and nodes weighted by the copies each stands for (half as many for a
+    // bridge or node on a plane), for bridges at every crest and at every third one (two per pair, at 0° and
+    // 180° from the crown's first crest, which keeps the quarter symmetry).
+    #[test]
+    fn reported_counts_are_the_generated_ones() {
+        for (symmetry, cut) in [
+            (Symmetry::None, false),
+            (Symmetry::Half, true),
+            (Symmetry::Quarter, true),
+        ] {
+            for (every, first) in [(1, 0), (3, 0)] {
+                let mut spec = straight(symmetry, cut);
+                spec.bridges = Some(BridgeSpec {
+                    shape: BridgeShape::Straight,
+                    every,
+                    first,
+                });
+                let counts = StentFamily::counts(&spec);
+                let g = spec.generate().unwrap();
+                let sectors = counts.sectors;
+                let weight = |in_plane: bool| if in_plane { sectors / 2 } else { sectors };
+                let patches: usize = g.patches.iter().map(|p| weight(p.in_plane.is_some())).sum();
+                let nodes: usize = g.nodes.iter().map(|n| n.multiplicity).sum();
+                let label = format!("{symmetry:?}, every {every}");
+                assert_eq!(
+                    patches as Real,
+                    counts.crown_wires + counts.bridges,
+                    "{label}"
+                );
+                assert_eq!(nodes as Real, counts.nodes, "{label}");
+            }
+        }
     }
 
     // Crests of crown k face troughs of crown k + 1, and the bridge ends are those nodes to round-off.

@@ -24,10 +24,12 @@ pub(super) struct Sector {
 impl Sector {
     /// The sector of `spec`.
     pub(super) fn new(spec: &StentSpec) -> Self {
-        Self {
-            symmetry: spec.symmetry,
-            cut: spec.cut,
-        }
+        Self::of(spec.symmetry, spec.cut)
+    }
+
+    /// The sector a device of `symmetry` keeps, cut (`cut`) or whole.
+    pub(super) fn of(symmetry: Symmetry, cut: bool) -> Self {
+        Self { symmetry, cut }
     }
 
     /// The angle is kept in the model.
@@ -113,55 +115,11 @@ impl StentSpec {
                 ),
             ));
         }
-        match (self.symmetry, axis) {
-            (Symmetry::None, _) => Ok(()),
-            (Symmetry::Quarter, Axis::Straight { .. }) => {
-                if !self.crown.peaks.is_multiple_of(2) {
-                    return Err(invalid(
-                        StentParameter::Symmetry,
-                        format!(
-                            "quarter symmetry needs an even number of peaks (a crest or trough on the plane ϑ = 90°), got {}",
-                            self.crown.peaks
-                        ),
-                    ));
-                }
-                Ok(())
-            }
-            (Symmetry::Quarter, _) => Err(invalid(
-                StentParameter::Symmetry,
-                "quarter symmetry needs a straight centreline; use half symmetry for a planar bent one",
-            )),
-            (Symmetry::Half, Axis::Straight { .. }) => Ok(()),
-            (Symmetry::Half, Axis::Arc { axis: a, frame, .. }) => {
-                if frame.column(1).dot(a).abs() > PLANARITY_TOLERANCE {
-                    return Err(invalid(
-                        StentParameter::Symmetry,
-                        "half symmetry needs the reference direction (ϑ = 0) in the plane of the arc",
-                    ));
-                }
-                Ok(())
-            }
-            (Symmetry::Half, Axis::Curve { centreline }) => {
-                let length = centreline.length();
-                let (c0, r0) = axis.frame(0.0);
-                let normal = r0.column(2).into_owned();
-                let samples = 64;
-                for k in 0..=samples {
-                    let (c, r) = axis.frame(length * k as Real / samples as Real);
-                    if (c - c0).dot(&normal).abs() > PLANARITY_TOLERANCE * length
-                        || (r.column(2) - normal).norm() > PLANARITY_TOLERANCE
-                    {
-                        return Err(invalid(
-                            StentParameter::Symmetry,
-                            "half symmetry needs a planar centreline with the reference direction (ϑ = 0) in its plane",
-                        ));
-                    }
-                }
-                Ok(())
-            }
-        }
+        check_axis_symmetry(self.symmetry, self.crown.peaks, axis)
     }
+}
 
+impl StentSpec {
     /// The bridges of pair `k` at crest angles `angles` must map onto themselves under every mirror of the
     /// device's symmetry.
     pub(super) fn check_bridge_symmetry(
@@ -190,5 +148,62 @@ impl StentSpec {
             }
         }
         Ok(())
+    }
+}
+
+/// The centreline can carry the symmetry of a device with `peaks` crests per crown, with a node on every cut
+/// plane: straight with an even number of peaks for quarter symmetry, planar with `ϑ = 0` in its plane for half
+/// symmetry.
+pub(super) fn check_axis_symmetry(
+    symmetry: Symmetry,
+    peaks: usize,
+    axis: &Axis,
+) -> Result<(), GeometryError> {
+    match (symmetry, axis) {
+        (Symmetry::None, _) => Ok(()),
+        (Symmetry::Quarter, Axis::Straight { .. }) => {
+            if !peaks.is_multiple_of(2) {
+                return Err(invalid(
+                    StentParameter::Symmetry,
+                    format!(
+                        "quarter symmetry needs an even number of peaks (a crest or trough on the plane ϑ = 90°), got {}",
+                        peaks
+                    ),
+                ));
+            }
+            Ok(())
+        }
+        (Symmetry::Quarter, _) => Err(invalid(
+            StentParameter::Symmetry,
+            "quarter symmetry needs a straight centreline; use half symmetry for a planar bent one",
+        )),
+        (Symmetry::Half, Axis::Straight { .. }) => Ok(()),
+        (Symmetry::Half, Axis::Arc { axis: a, frame, .. }) => {
+            if frame.column(1).dot(a).abs() > PLANARITY_TOLERANCE {
+                return Err(invalid(
+                    StentParameter::Symmetry,
+                    "half symmetry needs the reference direction (ϑ = 0) in the plane of the arc",
+                ));
+            }
+            Ok(())
+        }
+        (Symmetry::Half, Axis::Curve { centreline }) => {
+            let length = centreline.length();
+            let (c0, r0) = axis.frame(0.0);
+            let normal = r0.column(2).into_owned();
+            let samples = 64;
+            for k in 0..=samples {
+                let (c, r) = axis.frame(length * k as Real / samples as Real);
+                if (c - c0).dot(&normal).abs() > PLANARITY_TOLERANCE * length
+                    || (r.column(2) - normal).norm() > PLANARITY_TOLERANCE
+                {
+                    return Err(invalid(
+                        StentParameter::Symmetry,
+                        "half symmetry needs a planar centreline with the reference direction (ϑ = 0) in its plane",
+                    ));
+                }
+            }
+            Ok(())
+        }
     }
 }

@@ -9,56 +9,55 @@ use super::{
 use crate::geometry::GeometryError;
 use crate::math::{Real, Vec3};
 
-impl StentSpec {
-    /// The axis of a temporary placement: the permanent one, its tangent line at the middle station between the
-    /// first and last crown (`straighten`), or a given centreline long enough for the crowns' `stations`.
-    fn temporary_axis(
-        &self,
-        permanent: Axis,
-        stations: &[Real],
-        temporary: &TemporarySpec,
-    ) -> Result<Axis, GeometryError> {
-        if let Some(radius) = temporary.radius
-            && !(radius.is_finite() && radius > 0.0)
-        {
-            return Err(invalid(
-                StentParameter::TemporaryRadius,
-                format!("must be > 0, got {radius}"),
-            ));
-        }
-        Ok(match &temporary.centreline {
-            TemporaryCentreline::Same => permanent,
-            TemporaryCentreline::Straightened => {
-                let mid = 0.5 * (stations[0] + stations[stations.len() - 1]);
-                let (c, r) = permanent.frame(mid);
-                Axis::Straight {
-                    origin: c - r.column(0) * mid,
-                    frame: r,
-                }
-            }
-            TemporaryCentreline::Given(spec) => {
-                let axis = Axis::new(spec).map_err(|e| match e {
-                    GeometryError::InvalidStent { reason, .. } => {
-                        invalid(StentParameter::TemporaryCentreline, reason)
-                    }
-                    e => e,
-                })?;
-                if let Some(l) = axis.length() {
-                    let last = stations[stations.len() - 1];
-                    if last > l * (1.0 + PLANARITY_TOLERANCE) {
-                        return Err(invalid(
-                            StentParameter::TemporaryCentreline,
-                            format!(
-                                "the last crown sits at arc length {last}, beyond the temporary centreline's length {l}"
-                            ),
-                        ));
-                    }
-                }
-                axis
-            }
-        })
+/// The axis of a temporary placement: the permanent one, its tangent line at the middle station between the
+/// first and last crown (`straighten`), or a given centreline long enough for the crowns' `stations`.
+pub(super) fn temporary_axis(
+    permanent: Axis,
+    stations: &[Real],
+    temporary: &TemporarySpec,
+) -> Result<Axis, GeometryError> {
+    if let Some(radius) = temporary.radius
+        && !(radius.is_finite() && radius > 0.0)
+    {
+        return Err(invalid(
+            StentParameter::TemporaryRadius,
+            format!("must be > 0, got {radius}"),
+        ));
     }
+    Ok(match &temporary.centreline {
+        TemporaryCentreline::Same => permanent,
+        TemporaryCentreline::Straightened => {
+            let mid = 0.5 * (stations[0] + stations[stations.len() - 1]);
+            let (c, r) = permanent.frame(mid);
+            Axis::Straight {
+                origin: c - r.column(0) * mid,
+                frame: r,
+            }
+        }
+        TemporaryCentreline::Given(spec) => {
+            let axis = Axis::new(spec).map_err(|e| match e {
+                GeometryError::InvalidStent { reason, .. } => {
+                    invalid(StentParameter::TemporaryCentreline, reason)
+                }
+                e => e,
+            })?;
+            if let Some(l) = axis.length() {
+                let last = stations[stations.len() - 1];
+                if last > l * (1.0 + PLANARITY_TOLERANCE) {
+                    return Err(invalid(
+                        StentParameter::TemporaryCentreline,
+                        format!(
+                            "the last crown sits at arc length {last}, beyond the temporary centreline's length {l}"
+                        ),
+                    ));
+                }
+            }
+            axis
+        }
+    })
+}
 
+impl StentSpec {
     /// Positions of the nodes of `geometry` (generated from `self`) in a temporary placement: the same crowns at
     /// the same stations and angles on another centreline and/or radius (paper Eq. `target_disp`: `P_temp`).
     pub fn temporary_node_positions(
@@ -66,8 +65,7 @@ impl StentSpec {
         geometry: &StentGeometry,
         temporary: &TemporarySpec,
     ) -> Result<Vec<Vec3>, GeometryError> {
-        let axis =
-            self.temporary_axis(Axis::new(&self.centreline)?, &geometry.stations, temporary)?;
+        let axis = temporary_axis(Axis::new(&self.centreline)?, &geometry.stations, temporary)?;
         let h = self.crown.amplitude;
         Ok(geometry
             .nodes
@@ -99,7 +97,7 @@ impl StentSpec {
         self.check_numbers()?;
         let permanent = Axis::new(&self.centreline)?;
         let stations = self.stations(&permanent)?;
-        let axis = self.temporary_axis(permanent, &stations, temporary)?;
+        let axis = temporary_axis(permanent, &stations, temporary)?;
         let radii: Vec<Real> = (0..self.crowns)
             .map(|k| temporary.radius.unwrap_or(self.radius_of(k) - shrink))
             .collect();

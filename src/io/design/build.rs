@@ -88,12 +88,12 @@ pub fn build(dto: &DesignDto, default_name: &str, temporary_shape: bool) -> Resu
     };
     let mut notes = Vec::new();
     if let Some(s) = &dto.stent {
-        let (spec, said, vessel) = stent::spec(s, metres_per_unit)?;
+        let (device, said, vessel) = super::family::device(s, metres_per_unit)?;
         notes.extend(said);
         if let Some(v) = vessel {
             builder.vessel(v);
         }
-        builder.stent(spec, stent::mesh(s, dto.mesh.as_ref())?);
+        builder.stent(device, stent::mesh(s, dto.mesh.as_ref())?);
         if let Some(m) = &s.materials {
             builder.stent_materials(stent::materials(m, &material_names)?);
         }

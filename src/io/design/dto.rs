@@ -825,7 +825,11 @@ pub struct ProbeDto {
 #[derive(Debug, Clone, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct StentDto {
-    /// Number of crowns.
+    /// The device family: `ring` (crowns joined by bridges, the default) or `diamond` (closed diamond cells:
+    /// neighbouring rings meet crest to trough, no bridges).
+    #[serde(default)]
+    pub family: StentFamilyDto,
+    /// Number of crowns (the rings of a diamond stent).
     pub crowns: usize,
     /// Crown radius `R` [length]; or give `oversize` to size the stent from a file centreline's lumen radius.
     #[serde(default)]
@@ -1151,6 +1155,17 @@ pub enum FileUnitDto {
     /// Metres.
     #[serde(rename = "m")]
     M,
+}
+
+/// Stent family keyword.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Deserialize, JsonSchema)]
+#[serde(rename_all = "snake_case")]
+pub enum StentFamilyDto {
+    /// Sinusoidal crowns joined by bridges ([`crate::geometry::stent::StentSpec`]).
+    #[default]
+    Ring,
+    /// Closed diamond cells: rings that meet crest to trough ([`crate::geometry::stent::DiamondSpec`]).
+    Diamond,
 }
 
 /// Symmetry keyword.

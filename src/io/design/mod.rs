@@ -9,7 +9,9 @@
 //! with the discretisation `stentkit tune` chose.
 
 pub mod build;
+mod diamond;
 pub mod dto;
+pub mod family;
 pub mod guard;
 pub mod issue;
 pub mod locate;

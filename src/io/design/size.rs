@@ -216,24 +216,17 @@ pub fn estimated_memory(dto: &DesignDto, steps: &StepCount) -> MemoryEstimate {
         ));
     }
     if let Some(s) = &dto.stent {
-        let sector = match s.symmetry {
-            _ if s.full_model => 1.0,
-            None | Some(SymmetryDto::None) => 1.0,
-            Some(SymmetryDto::Half) => 2.0,
-            Some(SymmetryDto::Quarter) => 4.0,
-        };
+        // The family's own counts of the full device, shared among the modelled sectors.
+        let counts = super::family::counts(s);
+        let sector = counts.sectors as Real;
         let (crowns, peaks) = (s.crowns as Real, s.peaks as Real);
-        let every = s
-            .bridges
-            .as_ref()
-            .map_or(0.0, |b| 1.0 / b.every.unwrap_or(1).max(1) as Real);
         let pick = |own: Option<&MeshDto>| {
             let p = own.and_then(|m| m.p).or(mesh.and_then(|m| m.p));
             let n = own.and_then(|m| m.n).or(mesh.and_then(|m| m.n));
             p.zip(n)
         };
-        let crown_patches = crowns * 2.0 * peaks / sector;
-        let bridge_patches = (crowns - 1.0).max(0.0) * peaks * every / sector;
+        let crown_patches = counts.crown_wires / sector;
+        let bridge_patches = counts.bridges / sector;
         patches += crown_patches + bridge_patches;
         for (count, pn, what) in [
             (crown_patches, pick(s.crown_mesh.as_ref()), "crown wires"),

@@ -4,8 +4,13 @@
 //! a [`StentMesh`] and a [`ProgrammeSpec`] with the checks of the blocks' form, and names the design field of a
 //! stent [`StentField`].
 //!
+//! Every stent family translates its own block behind `FamilyBlock`; [`super::family`] is the registry that
+//! the block's `family` key selects from. This file holds the ring family's block and what the families share
+//! (centreline, symmetry, meshes, materials, programme).
+//!
 //! ```yaml
 //! stent:
+//!   family: ring          # the default; `diamond`: closed diamond cells (its block in `diamond.rs`)
 //!   crowns: 6
 //!   radius: 20            # crown radius R [length]
 //!   amplitude: 5          # h_c: the crown is 2 h_c high
@@ -28,12 +33,70 @@ use super::dto::*;
 use super::issue::{Result, issue, mesh_key_path};
 use super::vessel::{VesselCentreline, tightest_bend, vessel_centreline};
 use crate::geometry::stent::{
-    BridgeDirection, BridgeShape, BridgeSpec, CentrelineSpec, CrownSpec, StentParameter, StentSpec,
-    Symmetry, TemporaryCentreline, TemporarySpec,
+    BridgeDirection, BridgeShape, BridgeSpec, CentrelineSpec, CrownSpec, FamilyCounts, StentFamily,
+    StentParameter, StentSpec, Symmetry, TemporaryCentreline, TemporarySpec, ring_counts,
 };
 use crate::math::{Real, Vec3};
 use crate::model::builder::StentField;
 use crate::model::stent::{ProgrammeSpec, ProgrammeTarget, StentMaterials, StentMesh};
+use std::sync::Arc;
+
+/// A generated device of a `stent:` block: its family's specification, what `check` says about it, and the
+/// vessel of a file centreline.
+pub type Device = (
+    Arc<dyn StentFamily>,
+    Vec<String>,
+    Option<crate::model::Vessel>,
+);
+
+/// How a family's `stent:` block becomes its device, with the checks of the block's form: one implementation
+/// per family, registered in [`super::family`] under the block's `family` key.
+pub(super) trait FamilyBlock {
+    /// The device of the block (lengths in units of `metres_per_unit` metres).
+    fn device(&self, dto: &StentDto, metres_per_unit: Real) -> Result<Device>;
+
+    /// The device's size from the block alone (the memory estimate's, before anything is generated).
+    fn counts(&self, dto: &StentDto) -> FamilyCounts;
+}
+
+/// The symmetry a block asks for.
+pub(super) fn symmetry(dto: &StentDto) -> Symmetry {
+    match dto.symmetry {
+        None | Some(SymmetryDto::None) => Symmetry::None,
+        Some(SymmetryDto::Half) => Symmetry::Half,
+        Some(SymmetryDto::Quarter) => Symmetry::Quarter,
+    }
+}
+
+/// The copies of the modelled part that make the full device: the symmetry's sectors, 1 for a full model.
+pub(super) fn sectors(dto: &StentDto) -> usize {
+    if dto.full_model {
+        1
+    } else {
+        symmetry(dto).sectors()
+    }
+}
+
+/// The ring family (`family: ring`, the default): crowns joined by bridges.
+pub(super) struct Ring;
+
+impl FamilyBlock for Ring {
+    fn device(&self, dto: &StentDto, metres_per_unit: Real) -> Result<Device> {
+        let (spec, notes, vessel) = ring_spec(dto, metres_per_unit)?;
+        Ok((Arc::new(spec), notes, vessel))
+    }
+
+    fn counts(&self, dto: &StentDto) -> FamilyCounts {
+        ring_counts(
+            dto.crowns,
+            dto.peaks,
+            dto.bridges
+                .as_ref()
+                .map(|b| (b.every.unwrap_or(1), b.first.unwrap_or(1).saturating_sub(1))),
+            sectors(dto),
+        )
+    }
+}
 
 /// The field of a stent parameter.
 fn spec_path(parameter: StentParameter) -> &'static str {
@@ -124,7 +187,7 @@ pub(super) fn materials(m: &StentMaterialsDto, names: &[String]) -> Result<Stent
 }
 
 /// A centreline of the design; a `file` one is read, cut and fitted ([`super::vessel`]) and returned with it.
-fn centreline(
+pub(super) fn centreline(
     c: &CentrelineDto,
     path: &str,
     metres_per_unit: Real,
@@ -223,9 +286,9 @@ fn bridges(b: &BridgesDto) -> Result<BridgeSpec> {
     })
 }
 
-/// The specification of a `stent:` block (lengths in units of `metres_per_unit` metres), with what `check`
-/// says about a file centreline.
-pub fn spec(
+/// The specification of a ring family's `stent:` block (lengths in units of `metres_per_unit` metres), with
+/// what `check` says about a file centreline.
+fn ring_spec(
     dto: &StentDto,
     metres_per_unit: Real,
 ) -> Result<(StentSpec, Vec<String>, Option<crate::model::Vessel>)> {
@@ -288,11 +351,7 @@ pub fn spec(
             }),
         bridges: dto.bridges.as_ref().map(bridges).transpose()?,
         centreline: axis,
-        symmetry: match dto.symmetry {
-            None | Some(SymmetryDto::None) => Symmetry::None,
-            Some(SymmetryDto::Half) => Symmetry::Half,
-            Some(SymmetryDto::Quarter) => Symmetry::Quarter,
-        },
+        symmetry: symmetry(dto),
         cut: !dto.full_model,
         crown_radii: None,
     };
@@ -325,11 +384,17 @@ pub fn spec(
         ));
         spec.crown_radii = Some(radii);
     }
-    let largest = spec.radius_range().1;
-    if let Some((bend, u)) = tightest_bend(&spec.centreline)
+    check_centreline_bend(&spec.centreline, spec.radius_range().1)?;
+    Ok((spec, notes, vessel.map(|v| v.vessel)))
+}
+
+/// A point-list or file centreline must not bend tighter than the stent's largest radius `largest`, or the
+/// crowns would fold onto themselves.
+pub(super) fn check_centreline_bend(centreline: &CentrelineSpec, largest: Real) -> Result<()> {
+    if let Some((bend, u)) = tightest_bend(centreline)
         && bend < largest
     {
-        let (field, advice) = match spec.centreline {
+        let (field, advice) = match centreline {
             CentrelineSpec::Points { .. } => (
                 "stent.centreline.points",
                 "spread the points or lower their bend",
@@ -349,7 +414,7 @@ pub fn spec(
             ),
         ));
     }
-    Ok((spec, notes, vessel.map(|v| v.vessel)))
+    Ok(())
 }
 
 /// The lumen radius of the vessel at arc length `s` along its sampled centreline (linear between samples,

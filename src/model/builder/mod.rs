@@ -37,12 +37,13 @@ use super::stent::{self as stent_model, ProgrammeSpec, StentMesh};
 use super::*;
 use crate::geometry::analytic::ParametricCurve;
 use crate::geometry::fit::{FitSettings, fit_curve};
-use crate::geometry::stent::StentSpec;
+use crate::geometry::stent::StentFamily;
 use crate::geometry::{GeometryError, Parameter, primitives};
 use crate::material::{ConstitutiveLaw, MaterialLaw, Section, Wlf};
 use crate::math::quote::quoted;
 use crate::math::{Mat3, Real, Vec3};
 use std::collections::{BTreeMap, HashMap};
+use std::sync::Arc;
 
 /// Default smallest step, as a fraction of the nominal step: ten halvings.
 pub const DEFAULT_MIN_STEP_FRACTION: Real = 1.0 / 1024.0;
@@ -415,7 +416,7 @@ pub struct ModelBuilder {
     materials: Vec<MaterialLaw>,
     material_names: Vec<String>,
     sections: Vec<Section>,
-    stent: Option<(StentSpec, StentMesh)>,
+    stent: Option<(Arc<dyn StentFamily>, StentMesh)>,
     stent_materials: stent_model::StentMaterials,
     programme: Option<ProgrammeSpec>,
     /// Generate the stent in its programme's temporary placement, without the programme.
@@ -513,10 +514,12 @@ impl ModelBuilder {
         self
     }
 
-    /// Generates a stent whose patches and nodes come first in the model, with its node sets (`all_joints`,
-    /// `crown_<k>`, …), symmetry planes and the symmetry conditions of its cut nodes ([`stent_model`]).
-    pub fn stent(&mut self, spec: StentSpec, mesh: StentMesh) -> &mut Self {
-        self.stent = Some((spec, mesh));
+    /// Generates a stent of any family (the rings of a [`crate::geometry::stent::StentSpec`], the diamond
+    /// cells of a [`crate::geometry::stent::DiamondSpec`], …) whose patches and nodes come first in the model,
+    /// with its node sets (`all_joints`, `crown_<k>`, …), symmetry planes and the symmetry conditions of its cut
+    /// nodes ([`stent_model`]).
+    pub fn stent(&mut self, family: Arc<dyn StentFamily>, mesh: StentMesh) -> &mut Self {
+        self.stent = Some((family, mesh));
         self
     }
 
@@ -649,8 +652,8 @@ impl ModelBuilder {
             }
         };
         let mut stent = match &self.stent {
-            Some((spec, mesh)) => Some(stent_model::generate(
-                spec,
+            Some((family, mesh)) => Some(stent_model::generate(
+                family,
                 mesh,
                 &self.stent_materials,
                 &mut sections,
@@ -811,16 +814,16 @@ impl ModelBuilder {
                 format!("material {m} does not exist ({count} materials)"),
             ));
         }
-        if let Some((spec, _)) = &self.stent
+        if let Some((family, _)) = &self.stent
             && crowns.len() > 1
-            && crowns.len() != spec.crowns
+            && crowns.len() != family.crowns()
         {
             return Err(BuildError::new(
                 field(),
                 format!(
                     "{} crown materials for {} crowns: give one for every crown, or one for all",
                     crowns.len(),
-                    spec.crowns
+                    family.crowns()
                 ),
             ));
         }
