@@ -33,6 +33,7 @@ use crate::model::Model;
 use crate::solver::SolverError;
 use crate::solver::assembly::{Actions, ReleaseRamp};
 use crate::solver::state::State;
+use crate::solver::terms::Constraint;
 
 /// Everything a simulation needs to continue exactly from where it was ([`Simulation::checkpoint`]); plain
 /// data (numbers, vectors, strings), so that any format can store it.
