@@ -6,6 +6,7 @@
 //! cuts the step when Newton fails (restoring the last converged state), and reports every converged step to an
 //! [`Observer`] — the engine reports, observers record.
 
+pub mod actions;
 pub mod assembly;
 pub mod block;
 pub mod diagnose;

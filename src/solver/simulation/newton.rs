@@ -306,8 +306,12 @@ impl Simulation<'_> {
             },
             e => e,
         })?;
-        self.tangent
-            .factorised(&self.state, &self.materials.laws, self.gauge_active);
+        self.tangent.factorised(
+            &self.state,
+            &self.materials.laws,
+            self.gauge_active,
+            &self.terms,
+        );
         SolverTiming::add(&mut self.timing.factorisation, start);
         Ok(())
     }

@@ -15,8 +15,7 @@ use super::{InteriorLoad, PointTerm, PointView};
 use crate::material::SectionShape;
 use crate::math::so3::{log, right_jacobian_inverse};
 use crate::math::{Mat3, Real, Rot3, Vec3};
-use crate::solver::assembly::point_position;
-use crate::solver::discretisation::Discretisation;
+use crate::solver::discretisation::{Discretisation, point_position};
 use crate::solver::state::State;
 
 /// The damping of one attempt of a step (module docs).

@@ -8,7 +8,7 @@
 
 use super::{InteriorLoad, PointTerm, PointView};
 #[cfg(doc)]
-use crate::solver::assembly::Actions;
+use crate::solver::actions::Actions;
 
 /// The distributed loads of the model (stateless: the values of the instant are in [`Actions`]).
 #[derive(Debug, Clone, Copy, Default)]

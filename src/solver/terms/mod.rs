@@ -24,10 +24,15 @@
 //! - *Contributions add up in the order of the list*: the first value given for a quantity is taken as it is,
 //!   later ones are added to it, and a quantity no term gives is zero and adds nothing. Only what a term gives is
 //!   added, so a list of terms that act nowhere changes no bit of the assembly.
-//! - *Its state*: a term is a value built for one assembly from what the simulation keeps (the resolved loads,
-//!   the last converged state, a factor); what it keeps between steps is a [`TermState`], which the simulation
-//!   rolls back with a step that is abandoned, commits with one that converged, and writes to and reads from its
-//!   checkpoints.
+//! - *Its state*: what a term keeps between steps (an anchor, a slip, a history) changes only when a step
+//!   converges ([`PointTerm::commit`], called with the converged state after the materials' commit); during
+//!   the attempts of a step the term is read-only (`&self`), so an attempt that fails, is rejected or is
+//!   interrupted leaves the term as the last converged step left it — the roll-back of a term is to do
+//!   nothing, and no snapshot is needed for it. A checkpoint keeps each term's numbers
+//!   ([`PointTerm::save`], [`PointTerm::restore`]; the simulation's `Checkpoint::terms`, in the order of the
+//!   list), so a restored run continues bit for bit. A stateless term (today's three) keeps the defaults. The
+//!   damping of stabilisation is the one term built per attempt from the simulation's own memory (the last
+//!   converged state and `c/h`), which drops it when the attempt ends either way.
 //!
 //! **[`Constraint`]** — equations held by Lagrange multipliers. A constraint of `m` rows adds `m` unknowns
 //! (its multipliers `λ_j`, stored after the rod's unknowns in [`State::multipliers`]) and `m` equations, linear
@@ -55,8 +60,8 @@ pub(crate) mod spring;
 #[cfg(test)]
 mod tests;
 
-use super::assembly::{Actions, point_position};
-use super::discretisation::{CollocationPoint, Discretisation};
+use super::actions::Actions;
+use super::discretisation::{CollocationPoint, Discretisation, point_position};
 use super::state::State;
 use crate::material::SectionShape;
 use crate::math::{Mat3, Real, Vec3};
@@ -72,6 +77,22 @@ pub trait PointTerm: Sync {
     /// Adds this term's concentrated load on a node through one of its patch ends (and, when `at.tangent`, its
     /// derivatives). The default adds nothing.
     fn end(&self, _at: &PointView<'_>, _load: &mut EndLoad) {}
+
+    /// A step converged at `state`: the term updates what it keeps between steps (module docs). The default
+    /// keeps nothing.
+    fn commit(&mut self, _disc: &Discretisation, _state: &State) {}
+
+    /// Appends what a checkpoint keeps of the term's state (the default: nothing).
+    fn save(&self, _out: &mut Vec<Real>) {}
+
+    /// Takes the state a checkpoint kept ([`PointTerm::save`]).
+    ///
+    /// # Errors
+    /// The number of values expected, when `values` cannot be this term's state (a damaged checkpoint, or one
+    /// of a simulation with other terms).
+    fn restore(&mut self, values: &[Real]) -> Result<(), usize> {
+        if values.is_empty() { Ok(()) } else { Err(0) }
+    }
 }
 
 /// Equations held by Lagrange multipliers, linear in node positions (module docs).
@@ -96,24 +117,6 @@ pub trait Constraint: Sync {
 
     /// The scale that makes the equations' residuals dimensionless \[length\].
     fn scale(&self) -> Real;
-}
-
-/// What a term keeps between steps, as the simulation keeps it (module docs).
-pub trait TermState {
-    /// An attempt of a step was abandoned: back to what the last converged step left.
-    fn roll_back(&mut self);
-
-    /// The step converged.
-    fn commit(&mut self);
-
-    /// The numbers a checkpoint keeps of this state (nothing, for a state that lives within a step).
-    fn save(&self, out: &mut Vec<Real>);
-
-    /// Takes the state a checkpoint kept ([`TermState::save`]).
-    ///
-    /// # Errors
-    /// The expected number of values, when `values` has another length (a damaged checkpoint).
-    fn restore(&mut self, values: &[Real]) -> Result<(), usize>;
 }
 
 /// The terms of one assembly, in the order they add up.

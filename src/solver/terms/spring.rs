@@ -13,7 +13,7 @@
 use super::{EndLoad, InteriorLoad, PointTerm, PointView};
 use crate::math::so3::{log, right_jacobian_inverse};
 use crate::math::{Real, Rot3, Vec3};
-use crate::solver::assembly::point_position;
+use crate::solver::discretisation::point_position;
 
 /// Springs to ground along the rods and at their ends (module docs).
 #[derive(Debug, Clone, Copy, PartialEq)]

@@ -294,3 +294,125 @@ fn a_bar_on_a_spring_foundation_stretches_as_the_closed_form() {
     );
     assert!(u.y.abs() < 1e-12 && u.z.abs() < 1e-12, "u = {u:?}");
 }
+
+/// A stateful test term: a foundation anchored where the rod was at the last converged step (a tissue that
+/// remodels around the device), force density `−k (c − a)` at the interior points, the anchors `a` moved to
+/// the converged positions at every commit.
+struct RelaxingSpring {
+    /// Stiffness `k` \[force/length²\].
+    stiffness: Real,
+    /// Anchor of every collocation point \[length\] (ends unused).
+    anchors: Vec<Vec3>,
+}
+
+impl RelaxingSpring {
+    /// Anchored at the reference positions.
+    fn new(disc: &Discretisation, stiffness: Real) -> Self {
+        let anchors = (0..disc.points.len())
+            .map(|g| crate::solver::assembly::point_position(disc, &disc.control0, g))
+            .collect();
+        Self { stiffness, anchors }
+    }
+}
+
+impl PointTerm for RelaxingSpring {
+    fn name(&self) -> &'static str {
+        "relaxing spring"
+    }
+
+    fn interior(&self, at: &PointView<'_>, load: &mut InteriorLoad) {
+        load.add_force(-(at.position() - self.anchors[at.g]) * self.stiffness);
+        if at.tangent {
+            load.add_force_position(-at.rotation_t * self.stiffness);
+        }
+    }
+
+    fn commit(&mut self, disc: &Discretisation, state: &State) {
+        for (g, a) in self.anchors.iter_mut().enumerate() {
+            *a = crate::solver::assembly::point_position(disc, &state.control, g);
+        }
+    }
+
+    fn save(&self, out: &mut Vec<Real>) {
+        out.extend(self.anchors.iter().flat_map(|a| a.iter().copied()));
+    }
+
+    fn restore(&mut self, values: &[Real]) -> Result<(), usize> {
+        if values.len() != 3 * self.anchors.len() {
+            return Err(3 * self.anchors.len());
+        }
+        for (a, v) in self.anchors.iter_mut().zip(values.chunks_exact(3)) {
+            *a = Vec3::new(v[0], v[1], v[2]);
+        }
+        Ok(())
+    }
+}
+
+/// Source: the checkpoint contract ([`Simulation::restore`]: a restored simulation continues bit for bit) for a
+/// term with a state of its own. A bar pulled by a force ramped over four steps, on a foundation that follows it
+/// (`RelaxingSpring`, stiffness `k = EA/L²`, so it carries a share of the load comparable to the bar's):
+/// checkpointed after two steps, the run continued in a fresh simulation from the checkpoint ends with the same
+/// bits as the run that went on; the same checkpoint with the term's state set back to the reference anchors
+/// ends elsewhere, so the term's state is what the checkpoint carries (and the comparison can fail).
+#[test]
+fn a_terms_state_is_committed_and_carried_by_checkpoints() {
+    let material = ElasticLaw::try_new(2.0e5, 0.3).expect("E > 0, ν = 0.3");
+    let section = CircularSection::try_new(0.1).expect("d > 0").into();
+    let mut b = ModelBuilder::new("relaxing", material, section);
+    b.patch(
+        "bar",
+        PatchShape::Line {
+            from: Vec3::zeros(),
+            to: Vec3::new(1.0, 0.0, 0.0),
+        },
+        4,
+        12,
+    );
+    b.condition(ConditionSpec::clamp("bar.start"));
+    let ramp = TimeFunction::try_table(vec![(0.0, 0.0), (1.0, 10.0)]).expect("a ramp");
+    b.condition(
+        ConditionSpec::at("bar.end")
+            .with_force(0, ramp.clone())
+            .with_force(1, ramp),
+    );
+    b.time(TimeSpec::new(1.0, 0.25));
+    let model = b.build().expect("valid model").model;
+    let disc = Discretisation::new(&model).expect("discretisation");
+    let stiffness = 2.0e5 * std::f64::consts::PI * 0.01 / 4.0;
+    let simulation = || {
+        let mut sim = Simulation::new(&model).expect("simulation");
+        sim.add_term(Box::new(RelaxingSpring::new(&disc, stiffness)));
+        sim
+    };
+    let mut first = simulation();
+    for _ in 0..2 {
+        first.step().expect("converges");
+    }
+    let checkpoint = first.checkpoint();
+    assert_eq!(checkpoint.terms.len(), 2, "distributed load and the spring");
+    assert!(checkpoint.terms[0].is_empty());
+    let anchors = &checkpoint.terms[1];
+    let reference: Vec<Real> = RelaxingSpring::new(&disc, stiffness)
+        .anchors
+        .iter()
+        .flat_map(|a| a.iter().copied())
+        .collect();
+    assert_ne!(anchors, &reference, "two commits moved the anchors");
+    while first.step().expect("converges").is_some() {}
+    let mut second = simulation();
+    second.restore(&checkpoint).expect("restores");
+    while second.step().expect("converges").is_some() {}
+    assert_eq!(first.state(), second.state(), "continued bit for bit");
+    let mut forgotten = checkpoint.clone();
+    forgotten.terms[1] = reference;
+    let mut third = simulation();
+    third.restore(&forgotten).expect("restores");
+    while third.step().expect("converges").is_some() {}
+    assert_ne!(first.state().control, third.state().control);
+    let mut damaged = checkpoint;
+    damaged.terms[1].pop();
+    assert!(matches!(
+        simulation().restore(&damaged),
+        Err(crate::solver::CheckpointError::Term { expected, .. }) if expected == 3 * disc.points.len()
+    ));
+}
