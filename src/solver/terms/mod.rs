@@ -48,10 +48,14 @@
 //!
 //! The terms of today: [`distributed::DistributedLoad`] (the model's distributed loads), the viscous
 //! regularisation [`damping::Damping`] of automatic stabilisation, and the gauge constraints
-//! ([`super::gauge::Gauge`]) of a released device. A new term is one module here (a type implementing
-//! [`PointTerm`], tested by the central-difference test of every term in `tests`) plus one line that puts it in
-//! the simulation's list ([`super::Simulation`]'s `terms`); `spring` (test-only: a spring to ground) is the
-//! example.
+//! ([`super::gauge::Gauge`]) of a released device.
+//!
+//! **A new term** is one module here (a type implementing [`PointTerm`]; its `pub mod` line above) plus one
+//! registration line: in `registered_terms` of `simulation/mod.rs` for a term every simulation of a model has,
+//! or a call of [`super::Simulation::add_term`] for one the model does not describe. Adding it to the list of
+//! the generic central-difference test in `tests` checks its tangent. `spring` (test-only: a spring to ground)
+//! is the example: the module, and `sim.add_term(Box::new(SpringToGround { … }))` in the test of a bar on a
+//! foundation against its closed form.
 
 pub mod damping;
 pub mod distributed;
