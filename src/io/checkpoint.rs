@@ -2,12 +2,12 @@
 //! output stood at that step ([`OutputsCheckpoint`]), from which `stentkit run --resume` continues a killed or
 //! interrupted run exactly.
 //!
-//! # Format (version 8; version 7's stabiliser state had no force share and no times of its warnings, version 6 had no snapshot phase, version 5 no stabiliser state, version 4 no load factor per chart sample, version 3 no arc-length state, version 2 had 18 numbers per section law and no
+//! # Format (version 9; version 8 had no point terms' states, version 7's stabiliser state had no force share and no times of its warnings, version 6 had no snapshot phase, version 5 no stabiliser state, version 4 no load factor per chart sample, version 3 no arc-length state, version 2 had 18 numbers per section law and no
 //! per-material recovery, version 1, before error-controlled stepping, no step-control memory)
 //!
 //! ```text
 //! magic     8 bytes   "STKCKPT\0"
-//! version   u32       8
+//! version   u32       9
 //! length    u64       bytes of the payload
 //! payload   …         the fields below, in order
 //! crc32     u32       CRC-32 (IEEE 802.3, as zlib and PNG) of everything before it
@@ -17,7 +17,7 @@
 //! back exactly; a `usize` is a `u64`; a vector or string is its length (`u64`) then its items; an option is a
 //! byte 0/1 then the value. The payload is the model fingerprint of the outputs' settings, the solver's
 //! checkpoint (time, step, step control, state, materials, ramps, gauge, tangent origin, notices, timing, arc-length
-//! state, stabiliser) and the outputs'
+//! state, stabiliser, point terms' states) and the outputs'
 //! positions, in the order [`write()`] writes them.
 //!
 //! Why this format: a checkpoint must restore every number bit for bit (a text format would need round-trip
@@ -50,7 +50,7 @@ pub const FILE_NAME: &str = crate::io::run_folder::CHECKPOINT_FILE;
 const MAGIC: &[u8; 8] = b"STKCKPT\0";
 
 /// The format version this build writes and reads.
-pub const VERSION: u32 = 8;
+pub const VERSION: u32 = 9;
 
 /// Bytes before the payload: magic, version, length.
 const HEADER: usize = 8 + 4 + 8;
@@ -520,6 +520,7 @@ fn encode_solver(e: &mut Encoder, c: &Checkpoint) {
         });
         encode_actions(e, &t.actions);
         e.bool(t.gauge_active);
+        e.list(&t.terms, |e, v| e.f64s(v));
     });
     encode_timing(e, &c.timing);
     e.option(c.arc.as_ref(), |e, a| {
@@ -546,6 +547,7 @@ fn encode_solver(e: &mut Encoder, c: &Checkpoint) {
     e.usize(s.steps_above_force_limit);
     e.usize(s.unscaled_stalls);
     e.f64(s.first_unscaled_time);
+    e.list(&c.terms, |e, t| e.f64s(t));
 }
 
 fn decode_solver(d: &mut Decoder<'_>) -> Result<Checkpoint, Problem> {
@@ -581,6 +583,7 @@ fn decode_solver(d: &mut Decoder<'_>) -> Result<Checkpoint, Problem> {
                 })?,
                 actions: decode_actions(d)?,
                 gauge_active: d.bool()?,
+                terms: d.list(8, |d| d.f64s())?,
             })
         })?,
         timing: decode_timing(d)?,
@@ -608,6 +611,7 @@ fn decode_solver(d: &mut Decoder<'_>) -> Result<Checkpoint, Problem> {
             unscaled_stalls: d.usize()?,
             first_unscaled_time: d.f64()?,
         },
+        terms: d.list(8, |d| d.f64s())?,
     })
 }
 
@@ -799,6 +803,7 @@ mod tests {
                     dist_couple: vec![Vec3::zeros()],
                 },
                 gauge_active: false,
+                terms: vec![vec![0.5, -2.0], Vec::new()],
             }),
             timing: SolverTiming {
                 residual: (3, 0.5),
@@ -826,6 +831,7 @@ mod tests {
                 unscaled_stalls: 2,
                 first_unscaled_time: 0.5,
             },
+            terms: vec![Vec::new(), vec![1.5, -0.0, f64::MIN_POSITIVE]],
         };
         let outputs = OutputsCheckpoint {
             settings: 42,

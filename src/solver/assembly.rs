@@ -28,13 +28,15 @@
 //! rows by `E A`, moment rows by `E I / L`, per unit length by one more `1/L`, translations by `L`), used by
 //! Newton's normalised norms.
 
+pub use super::actions::{Actions, ReleaseRamp};
+pub use super::discretisation::point_position;
 use super::discretisation::{CollocationPoint, Discretisation};
-use super::gauge::Gauge;
 use super::state::State;
+use super::terms::{EndLoad, InteriorLoad, PointView, Terms};
 use crate::material::{ConstitutiveLaw, SectionLaw, SectionStrains};
-use crate::math::so3::{hat, log, right_jacobian_inverse};
+use crate::math::so3::{hat, log};
 use crate::math::{Mat3, Real, Rot3, Vec3};
-use crate::model::{Component, Model};
+use crate::model::Model;
 use rayon::prelude::*;
 
 /// Receives the tangent's entries in a fixed order: first to record the sparsity pattern, then to fill values.
@@ -79,110 +81,6 @@ impl Sink<'_> {
     }
 }
 
-/// A released component's reaction, ramped to the load after release (see
-/// [`crate::model::TimeSettings::release_ramp`]).
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct ReleaseRamp {
-    /// The reaction component that held the node at the release, in the node's local basis [force or moment].
-    pub reaction: Real,
-    /// Release time \[time\].
-    pub start: Real,
-    /// Ramp duration \[time\].
-    pub duration: Real,
-}
-
-impl ReleaseRamp {
-    /// The part of the reaction still applied at time `t`.
-    pub fn value(&self, t: Real) -> Real {
-        let f = if self.duration > 0.0 {
-            1.0 - (t - self.start) / self.duration
-        } else {
-            0.0
-        };
-        self.reaction * f.clamp(0.0, 1.0)
-    }
-}
-
-/// The loads and prescribed values at one instant, resolved from the model's schedules.
-#[derive(Debug, Clone, PartialEq)]
-pub struct Actions {
-    /// Per node: concentrated force and moment (spatial) on its free components.
-    pub node_force: Vec<Vec3>,
-    /// Per node: concentrated moment (spatial).
-    pub node_moment: Vec<Vec3>,
-    /// Per node and local component: the prescribed value, or `None` when the component is free.
-    pub prescribed: Vec<[Option<Real>; 6]>,
-    /// Per patch: distributed force per unit length (spatial).
-    pub dist_force: Vec<Vec3>,
-    /// Per patch: distributed couple per unit length (spatial).
-    pub dist_couple: Vec<Vec3>,
-}
-
-impl Actions {
-    /// Evaluates every schedule of the model at time `t`; `ramps[k][i]` is the release ramp of node `k`'s
-    /// component `i` once it has been released (empty: none).
-    pub fn at(model: &Model, t: Real, ramps: &[[Option<ReleaseRamp>; 6]]) -> Self {
-        let mut node_force = Vec::with_capacity(model.nodes.len());
-        let mut node_moment = Vec::with_capacity(model.nodes.len());
-        let mut prescribed = Vec::with_capacity(model.nodes.len());
-        for (k, node) in model.nodes.iter().enumerate() {
-            let mut local = [0.0; 6];
-            let mut fixed = [None; 6];
-            for (i, c) in node.conditions.components.iter().enumerate() {
-                match c {
-                    Component::Load(f) => local[i] = f.value(t),
-                    Component::Prescribed {
-                        value,
-                        release,
-                        load_after_release,
-                    } => {
-                        if release.is_none_or(|r| t < r) {
-                            fixed[i] = Some(value.value(t));
-                        } else {
-                            let ramp = ramps.get(k).and_then(|r| r[i]).map_or(0.0, |r| r.value(t));
-                            local[i] = load_after_release.value(t) + ramp;
-                        }
-                    }
-                }
-            }
-            let b = &node.conditions.basis;
-            node_force.push(b * Vec3::new(local[0], local[1], local[2]));
-            node_moment.push(b * Vec3::new(local[3], local[4], local[5]));
-            prescribed.push(fixed);
-        }
-        let mut dist_force = vec![Vec3::zeros(); model.patches.len()];
-        let mut dist_couple = vec![Vec3::zeros(); model.patches.len()];
-        for load in &model.distributed_loads {
-            dist_force[load.patch] += Vec3::from_fn(|i, _| load.force[i].value(t));
-            dist_couple[load.patch] += Vec3::from_fn(|i, _| load.couple[i].value(t));
-        }
-        Self {
-            node_force,
-            node_moment,
-            prescribed,
-            dist_force,
-            dist_couple,
-        }
-    }
-
-    /// Every load and prescribed value multiplied by `factor` (arc-length continuation's load factor: the
-    /// residual is affine in it).
-    pub fn scaled(&self, factor: Real) -> Self {
-        let scale = |v: &[Vec3]| v.iter().map(|x| x * factor).collect();
-        Self {
-            node_force: scale(&self.node_force),
-            node_moment: scale(&self.node_moment),
-            prescribed: self
-                .prescribed
-                .iter()
-                .map(|c| c.map(|v| v.map(|v| v * factor)))
-                .collect(),
-            dist_force: scale(&self.dist_force),
-            dist_couple: scale(&self.dist_couple),
-        }
-    }
-}
-
 /// The constitutive data of one time step: the section law of every collocation point (from its patch's
 /// material, [`crate::material::ConstitutiveLaw::section_law`]).
 #[derive(Debug, Clone, Copy)]
@@ -200,34 +98,20 @@ impl StepMaterial<'_> {
     }
 }
 
-/// Viscous regularisation of the equilibrium equations ([`crate::model::StabilisationSettings`], issue 18):
-/// at every interior collocation point a force density `−c A (x − xₙ)/h` (spatial) and a couple density
-/// `−c J Θ/h` (material, `Θ = log(Rₙᵀ R)`) oppose the motion since the last converged state `xₙ, Rₙ`, with
-/// the section's area `A` and its second moments `J = diag(I₂ + I₃, I₂, I₃)` as the mass of a unit density
-/// (Abaqus's automatic stabilisation scales its damping by such an artificial mass matrix).
-#[derive(Debug, Clone, Copy)]
-pub struct Damping<'a> {
-    /// The last converged state.
-    pub previous: &'a State,
-    /// `c / h`, the damping factor over the step \[1/time²\] (per unit density).
-    pub rate: Real,
-}
-
-impl Damping<'_> {
-    /// The unit-density translational mass `A` and rotational mass `diag(I₂ + I₃, I₂, I₃)` of a section shape.
-    pub fn masses(shape: &crate::material::SectionShape) -> (Real, Vec3) {
-        let (i2, i3) = (shape.moment.y, shape.moment.z);
-        (shape.force.x, Vec3::new(i2 + i3, i2, i3))
-    }
-
-    /// The motion of collocation point `g` since the last converged state: `(x − xₙ, Θ)` with `Θ = log(Rₙᵀ R)`
-    /// (material).
-    pub fn motion(&self, disc: &Discretisation, state: &State, g: usize) -> (Vec3, Vec3) {
-        let dx = point_position(disc, &state.control, g)
-            - point_position(disc, &self.previous.control, g);
-        let relative = self.previous.rotation[g].transpose() * state.rotation[g];
-        (dx, log(&Rot3::from_matrix_unchecked(relative)))
-    }
+/// Everything one assembly reads: the discrete problem, the iterate, the section laws of the step, the loads of
+/// the instant and the terms beyond the rod ([`super::terms`]).
+#[derive(Clone, Copy)]
+pub struct Assembly<'a> {
+    /// The discrete problem.
+    pub disc: &'a Discretisation,
+    /// The iterate.
+    pub state: &'a State,
+    /// The section law of every collocation point.
+    pub material: StepMaterial<'a>,
+    /// The loads and prescribed values of the instant.
+    pub actions: &'a Actions,
+    /// The point terms and constraints, in the order they add up.
+    pub terms: Terms<'a>,
 }
 
 /// One end of a node, as the node equations see it.
@@ -352,23 +236,13 @@ impl Assembler {
         }
     }
 
-    /// Assembles the residual into `lin` and the tangent into `sink` (entries in the pattern's order).
-    /// With active gauge constraints ([`Gauge`]) the system has one more unknown (a multiplier, in
-    /// `state.multipliers`) and equation per constraint, after the rod's.
-    #[allow(clippy::too_many_arguments)]
-    pub fn assemble(
-        &self,
-        disc: &Discretisation,
-        state: &State,
-        material: StepMaterial<'_>,
-        actions: &Actions,
-        damping: Option<Damping<'_>>,
-        gauge: Option<&Gauge>,
-        lin: &mut Linearisation,
-        sink: &mut Sink<'_>,
-    ) {
+    /// Assembles the residual into `lin` and the tangent into `sink` (entries in the pattern's order), with the
+    /// point terms and constraints of `at.terms` ([`super::terms`]). With constraints the system has one more
+    /// unknown (a multiplier, in `state.multipliers`) and equation per constraint equation, after the rod's.
+    pub fn assemble(&self, at: &Assembly<'_>, lin: &mut Linearisation, sink: &mut Sink<'_>) {
+        let disc = at.disc;
         let n = disc.num_unknowns();
-        let m = gauge.map_or(0, Gauge::len);
+        let m = at.terms.multipliers();
         lin.residual.resize(n + m, 0.0);
         lin.row_scale.resize(n + m, 1.0);
         // Interior points: independent (each owns its six rows and a known slice of the tangent's entries), so
@@ -394,11 +268,7 @@ impl Assembler {
                 .into_par_iter()
                 .for_each(|(g, residual, scale, values)| {
                     let mut sink = Sink::Values { values, next: 0 };
-                    let point = &disc.points[g];
-                    self.interior(
-                        disc, state, material, actions, damping, g, point, residual, scale,
-                        &mut sink,
-                    );
+                    self.interior(at, g, residual, scale, &mut sink);
                     if let Sink::Values { values, next } = sink {
                         debug_assert_eq!(
                             next,
@@ -408,68 +278,57 @@ impl Assembler {
                     }
                 });
         } else {
-            for (g, point) in disc.points.iter().enumerate() {
+            for g in 0..disc.points.len() {
                 if !disc.is_end(g) {
                     let rows = 6 * g..6 * g + 6;
                     let (residual, scale) =
                         (&mut lin.residual[rows.clone()], &mut lin.row_scale[rows]);
-                    self.interior(
-                        disc, state, material, actions, damping, g, point, residual, scale, sink,
-                    );
+                    self.interior(at, g, residual, scale, sink);
                 }
             }
         }
         // Node rows.
         for (k, node) in self.nodes.iter().enumerate() {
-            self.node(disc, state, material, actions, k, node, lin, sink);
+            self.node(at, k, node, lin, sink);
         }
-        if let Some(gauge) = gauge {
-            self.gauge(disc, state, actions, gauge, lin, sink);
-        }
+        self.constraints(at, lin, sink);
     }
 
-    /// The gauge constraints' rows (`C_j`, rows `n + j`) and their multipliers' columns in the free
-    /// translational rows of the constrained nodes (always emitted, zero where a component is prescribed, so
-    /// the pattern does not depend on the conditions).
-    fn gauge(
-        &self,
-        disc: &Discretisation,
-        state: &State,
-        actions: &Actions,
-        gauge: &Gauge,
-        lin: &mut Linearisation,
-        sink: &mut Sink<'_>,
-    ) {
+    /// The constraints' rows (`C_j`, rows `n + j`) and their multipliers' columns in the free translational rows
+    /// of the constrained nodes (always emitted, zero where a component is prescribed, so the pattern does not
+    /// depend on the conditions); module docs of [`super::terms`].
+    fn constraints(&self, at: &Assembly<'_>, lin: &mut Linearisation, sink: &mut Sink<'_>) {
+        let (disc, state) = (at.disc, at.state);
         let n = disc.num_unknowns();
-        for (j, row) in gauge.rows.iter().enumerate() {
-            let lambda = state.multipliers.get(j).copied().unwrap_or(0.0);
-            let mut c = 0.0;
-            for &(k, a) in &row.terms {
-                let node = &self.nodes[k];
-                let first = &node.ends[0];
-                let g1 = first.point;
-                let position = point_position(disc, &state.control, g1);
-                let frozen = gauge
-                    .frozen
-                    .iter()
-                    .find(|(l, _)| *l == k)
-                    .map_or(position, |(_, x)| *x);
-                c += a.dot(&(position - frozen));
-                let local = node.basis.transpose() * a;
-                let col = 6 * (disc.points[g1].first + first.end_basis);
-                for i in 0..3 {
-                    let free = actions.prescribed[k][i].is_none();
-                    if free {
-                        lin.residual[6 * g1 + i] -= lambda * local[i];
+        let mut row = n;
+        for constraint in at.terms.constraints {
+            for j in 0..constraint.len() {
+                let lambda = state.multipliers.get(row - n).copied().unwrap_or(0.0);
+                let mut c = 0.0;
+                for &(k, a) in constraint.row(j) {
+                    let node = &self.nodes[k];
+                    let first = &node.ends[0];
+                    let g1 = first.point;
+                    let position = point_position(disc, &state.control, g1);
+                    let origin = constraint.origin(k).unwrap_or(position);
+                    c += a.dot(&(position - origin));
+                    let local = node.basis.transpose() * a;
+                    let col = 6 * (disc.points[g1].first + first.end_basis);
+                    for i in 0..3 {
+                        let free = at.actions.prescribed[k][i].is_none();
+                        if free {
+                            lin.residual[6 * g1 + i] -= lambda * local[i];
+                        }
+                        sink.push(6 * g1 + i, row, if free { -local[i] } else { 0.0 });
                     }
-                    sink.push(6 * g1 + i, n + j, if free { -local[i] } else { 0.0 });
+                    for i in 0..3 {
+                        sink.push(row, col + i, a[i]);
+                    }
                 }
-                for i in 0..3 {
-                    sink.push(n + j, col + i, a[i]);
-                }
+                lin.residual[row] = c;
+                lin.row_scale[row] = constraint.scale();
+                row += 1;
             }
-            lin.residual[n + j] = c;
-            lin.row_scale[n + j] = gauge.scale;
         }
     }
 
@@ -498,21 +357,20 @@ impl Assembler {
             .collect()
     }
 
-    #[allow(non_snake_case, clippy::too_many_arguments)]
+    /// The balance laws `F`, `T` at interior collocation point `g` (module docs) with the point terms' loads,
+    /// their row scales and, unless the sink discards them, their tangent blocks.
+    #[allow(non_snake_case)]
     fn interior(
         &self,
-        disc: &Discretisation,
-        state: &State,
-        material: StepMaterial<'_>,
-        actions: &Actions,
-        damping: Option<Damping<'_>>,
+        at: &Assembly<'_>,
         g: usize,
-        point: &CollocationPoint,
         residual: &mut [Real],
         row_scale: &mut [Real],
         sink: &mut Sink<'_>,
     ) {
-        let law = material.law(g);
+        let (disc, state) = (at.disc, at.state);
+        let point = &disc.points[g];
+        let law = at.material.law(g);
         let (CN, CM) = law.stiffness_matrices();
         let k = kinematics(point, state, g);
         let stress = law.stress(&strains(point, state, g, &k));
@@ -527,22 +385,29 @@ impl Assembler {
         let R = &state.rotation[g];
         let Rt = R.transpose();
         let shape = &disc.shapes[point.shape];
-        // Viscous regularisation ([`Damping`]): a spatial force density that joins the distributed load (whose
-        // rotation derivative `hat(n̄)` the tangent has) and a material couple density, `(c A/h, Θ, c J/h)`.
-        let mut force_density = actions.dist_force[point.patch];
-        let mut viscous = None;
-        if let Some(d) = damping {
-            let (area, inertia) = Damping::masses(shape);
-            let (dx, theta) = d.motion(disc, state, g);
-            force_density -= dx * (d.rate * area);
-            viscous = Some((d.rate * area, theta, inertia * d.rate));
+        let tangent = !matches!(sink, Sink::Discard);
+        let view = PointView {
+            disc,
+            state,
+            actions: at.actions,
+            g,
+            point,
+            shape,
+            rotation_t: Rt,
+            tangent,
+        };
+        let mut load = InteriorLoad::default();
+        for term in at.terms.point {
+            term.interior(&view, &mut load);
         }
-        let viscous_couple =
-            viscous.map_or(Vec3::zeros(), |(_, theta, c)| -c.component_mul(&theta));
-        let nbar = Rt * force_density;
-        let mbar = Rt * actions.dist_couple[point.patch];
+        let nbar = Rt * load.force.unwrap_or_else(Vec3::zeros);
+        let mbar = Rt * load.couple.unwrap_or_else(Vec3::zeros);
         let F = K.cross(&N) + N_s + nbar;
-        let T = K.cross(&M) + M_s + k.gamma.cross(&N) + mbar + viscous_couple;
+        let T = K.cross(&M)
+            + M_s
+            + k.gamma.cross(&N)
+            + mbar
+            + load.material_couple.unwrap_or_else(Vec3::zeros);
         let row = 6 * g;
         residual[..3].copy_from_slice(F.as_slice());
         residual[3..6].copy_from_slice(T.as_slice());
@@ -552,7 +417,7 @@ impl Assembler {
         let moment_scale = modulus_scale * shape.moment.y / (length * length);
         row_scale[..3].fill(force_scale);
         row_scale[3..6].fill(moment_scale);
-        if matches!(sink, Sink::Discard) {
+        if !tangent {
             return;
         }
         let (Kt, Gt, Nt, Mt) = (hat(&K), hat(&k.gamma), hat(&N), hat(&M));
@@ -563,12 +428,12 @@ impl Assembler {
         let f_eta_ss = CN * Rt;
         let ng = -Nt + Gt * CN;
         let mut t_th = -Mt * Kt + Kt * CM * Kt + CM * hat(&K_s) + ng * Gt + hat(&mbar);
-        let mut f_eta = Mat3::zeros();
-        if let Some((c_area, theta, c_inertia)) = viscous {
-            // δ(−c A Δx/h) in the material frame is −(c A/h) Rᵀ δη; the couple's `δΘ = T(Θ)⁻¹ δθ` is the right
-            // trivialisation of `log(Rₙᵀ R exp(δθ̃))`.
-            f_eta = -Rt * c_area;
-            t_th -= Mat3::from_diagonal(&c_inertia) * right_jacobian_inverse(&theta);
+        let f_eta = load.force_position.unwrap_or_else(Mat3::zeros);
+        if let Some(block) = load.force_rotation {
+            f_th += block;
+        }
+        if let Some(block) = load.couple_rotation {
+            t_th += block;
         }
         let mut t_th_s = -Mt + Kt * CM + CM * Kt;
         if let Some((CN_s, CM_s)) = law.stiffness_slope_matrices() {
@@ -583,9 +448,13 @@ impl Assembler {
         let t_eta_s = ng * Rt;
         for (a, b) in point.basis.iter().enumerate() {
             let col = 6 * (point.first + a);
+            let t_eta = match load.couple_position {
+                Some(t_eta) => t_eta * b[0] + t_eta_s * b[1],
+                None => t_eta_s * b[1],
+            };
             sink.block(row, col, &(f_eta * b[0] + f_eta_s * b[1] + f_eta_ss * b[2]));
             sink.block(row, col + 3, &(f_th * b[0] + f_th_s * b[1]));
-            sink.block(row + 3, col, &(t_eta_s * b[1]));
+            sink.block(row + 3, col, &t_eta);
             sink.block(
                 row + 3,
                 col + 3,
@@ -594,18 +463,39 @@ impl Assembler {
         }
     }
 
-    #[allow(non_snake_case, clippy::too_many_arguments)]
+    /// The rows of node `k` (module docs): equilibrium or kinematic conditions in the rows of its first end,
+    /// continuity in the rows of the others.
     fn node(
         &self,
-        disc: &Discretisation,
-        state: &State,
-        material: StepMaterial<'_>,
-        actions: &Actions,
+        at: &Assembly<'_>,
         k: usize,
         node: &NodeRows,
         lin: &mut Linearisation,
         sink: &mut Sink<'_>,
     ) {
+        let tangent = !matches!(sink, Sink::Discard);
+        let ends = self.node_equilibrium(at, k, node, lin, tangent);
+        self.continuity_residual(at, node, lin);
+        if !tangent {
+            return;
+        }
+        self.node_equilibrium_tangent(at, k, node, &ends, sink);
+        self.continuity_tangent(at, node, sink);
+    }
+
+    /// The residual and row scales of the rows of node `k`'s first end: equilibrium `Bᵀ(Σ σ_e R_e N_e − f̄ − f)`,
+    /// `Bᵀ(Σ σ_e R_e M_e − m̄ − m)` with the point terms' loads `f`, `m` on the ends, or the kinematic condition of
+    /// a prescribed component. Returns per end what the tangent needs.
+    #[allow(non_snake_case)]
+    fn node_equilibrium(
+        &self,
+        at: &Assembly<'_>,
+        k: usize,
+        node: &NodeRows,
+        lin: &mut Linearisation,
+        tangent: bool,
+    ) -> Vec<EndTerms> {
+        let (disc, state) = (at.disc, at.state);
         let B = &node.basis;
         let Bt = B.transpose();
         let first = &node.ends[0];
@@ -617,21 +507,13 @@ impl Assembler {
         let modulus_scale = self.modulus_scale[p1.patch];
         let force_scale = modulus_scale * shape1.force.x;
         let moment_scale = modulus_scale * shape1.moment.y / length;
-        // Equilibrium residual (spatial) and, per end and support control point, its 6×6 blocks in the local basis.
-        let mut force = -actions.node_force[k];
-        let mut moment = -actions.node_moment[k];
-        struct EndTerms {
-            /// ∂(σ R N)/∂δη,s and ∂(σ R N)/∂δΘ (spatial).
-            n_eta_s: Mat3,
-            n_th: Mat3,
-            /// ∂(σ R M)/∂δΘ and ∂(σ R M)/∂δΘ,s.
-            m_th: Mat3,
-            m_th_s: Mat3,
-        }
+        // Equilibrium residual (spatial) and, per end, its derivatives (spatial).
+        let mut force = -at.actions.node_force[k];
+        let mut moment = -at.actions.node_moment[k];
         let mut terms = Vec::with_capacity(node.ends.len());
         for e in &node.ends {
             let point = &disc.points[e.point];
-            let law = material.law(e.point);
+            let law = at.material.law(e.point);
             let (CN, CM) = law.stiffness_matrices();
             let kin = kinematics(point, state, e.point);
             let stress = law.stress(&strains(point, state, e.point, &kin));
@@ -640,12 +522,35 @@ impl Assembler {
             let R = &state.rotation[e.point];
             force += R * N * e.sign;
             moment += R * M * e.sign;
+            let mut load = EndLoad::default();
+            if !at.terms.point.is_empty() {
+                let view = PointView {
+                    disc,
+                    state,
+                    actions: at.actions,
+                    g: e.point,
+                    point,
+                    shape: &disc.shapes[point.shape],
+                    rotation_t: R.transpose(),
+                    tangent,
+                };
+                for term in at.terms.point {
+                    term.end(&view, &mut load);
+                }
+                if let Some(f) = load.force {
+                    force -= f;
+                }
+                if let Some(m) = load.moment {
+                    moment -= m;
+                }
+            }
             let sR = R * e.sign;
             terms.push(EndTerms {
                 n_eta_s: sR * CN * R.transpose(),
                 n_th: sR * (-hat(&N) + CN * hat(&kin.gamma)),
                 m_th: sR * (-hat(&M) + CM * hat(&K)),
                 m_th_s: sR * CM,
+                load,
             });
         }
         let mut r = [0.0; 6];
@@ -660,13 +565,9 @@ impl Assembler {
             moment_scale,
         ];
         // Kinematic rows for prescribed components.
-        let prescribed = &actions.prescribed[k];
+        let prescribed = &at.actions.prescribed[k];
         let c1 = point_position(disc, &state.control, g1);
-        let R1 = &state.rotation[g1];
-        let phi = log(&Rot3::from_matrix_unchecked(
-            R1 * node.rotation0.transpose(),
-        ));
-        let jl_inv = crate::math::so3::right_jacobian_inverse(&(-phi));
+        let phi = node.rotation_vector(state);
         for i in 0..6 {
             if let Some(value) = prescribed[i] {
                 let axis = B.column(i % 3).into_owned();
@@ -681,7 +582,86 @@ impl Assembler {
         }
         lin.residual[row1..row1 + 6].copy_from_slice(&r);
         lin.row_scale[row1..row1 + 6].copy_from_slice(&scale);
-        // Continuity rows of the other ends.
+        terms
+    }
+
+    /// The tangent of the rows of node `k`'s first end: equilibrium blocks per end and support control point,
+    /// with the rows of prescribed components replaced by their kinematic conditions.
+    #[allow(non_snake_case)]
+    fn node_equilibrium_tangent(
+        &self,
+        at: &Assembly<'_>,
+        k: usize,
+        node: &NodeRows,
+        ends: &[EndTerms],
+        sink: &mut Sink<'_>,
+    ) {
+        let (disc, state) = (at.disc, at.state);
+        let B = &node.basis;
+        let Bt = B.transpose();
+        let first = &node.ends[0];
+        let row1 = 6 * first.point;
+        let prescribed = &at.actions.prescribed[k];
+        let R1 = &state.rotation[first.point];
+        let jl_inv = crate::math::so3::right_jacobian_inverse(&(-node.rotation_vector(state)));
+        let kin_rows: [Option<nalgebra::RowVector3<Real>>; 6] = std::array::from_fn(|i| {
+            prescribed[i].map(|_| {
+                let axis = B.column(i % 3).transpose();
+                if i < 3 { axis } else { axis * jl_inv * R1 }
+            })
+        });
+        let zero_row = nalgebra::RowVector3::zeros();
+        for (ei, (e, t)) in node.ends.iter().zip(ends).enumerate() {
+            let point = &disc.points[e.point];
+            for (a, b) in point.basis.iter().enumerate() {
+                let col = 6 * (point.first + a);
+                let mut fe = Bt * t.n_eta_s * b[1];
+                let mut ft = Bt * t.n_th * b[0];
+                let mut me = Mat3::zeros();
+                let mut mt = Bt * (t.m_th * b[0] + t.m_th_s * b[1]);
+                // The point terms' loads on the node, `−Bᵀ ∂(f, m)/∂(c, δΘ)` times the basis value.
+                let load = &t.load;
+                if let Some(block) = load.force_position {
+                    fe -= Bt * (block * b[0]);
+                }
+                if let Some(block) = load.force_rotation {
+                    ft -= Bt * (block * b[0]);
+                }
+                if let Some(block) = load.moment_position {
+                    me -= Bt * (block * b[0]);
+                }
+                if let Some(block) = load.moment_rotation {
+                    mt -= Bt * (block * b[0]);
+                }
+                for (i, kr) in kin_rows.iter().enumerate() {
+                    let Some(kr) = kr else { continue };
+                    let on_end = ei == 0 && a == first.end_basis;
+                    let row = if on_end { *kr } else { zero_row };
+                    if i < 3 {
+                        fe.set_row(i, &row);
+                        ft.set_row(i, &zero_row);
+                    } else {
+                        me.set_row(i - 3, &zero_row);
+                        mt.set_row(i - 3, &row);
+                    }
+                }
+                sink.block(row1, col, &fe);
+                sink.block(row1, col + 3, &ft);
+                sink.block(row1 + 3, col, &me);
+                sink.block(row1 + 3, col + 3, &mt);
+            }
+        }
+    }
+
+    /// The residual and row scales of the continuity rows of node `node`'s other ends: `c_e − c_1` and the
+    /// rotation mismatch `log(R_e (R_1 Q_e)ᵀ)`.
+    #[allow(non_snake_case)]
+    fn continuity_residual(&self, at: &Assembly<'_>, node: &NodeRows, lin: &mut Linearisation) {
+        let (disc, state) = (at.disc, at.state);
+        let g1 = node.ends[0].point;
+        let length = self.patch_length[disc.points[g1].patch];
+        let c1 = point_position(disc, &state.control, g1);
+        let R1 = &state.rotation[g1];
         for e in &node.ends[1..] {
             let row = 6 * e.point;
             let ce = point_position(disc, &state.control, e.point);
@@ -694,63 +674,18 @@ impl Assembler {
             lin.row_scale[row..row + 3].fill(length);
             lin.row_scale[row + 3..row + 6].fill(1.0);
         }
-        if matches!(sink, Sink::Discard) {
-            return;
-        }
-        // Tangent of the rows of end 1: equilibrium blocks, with prescribed rows replaced.
-        let kin_rows: [Option<nalgebra::RowVector3<Real>>; 6] = std::array::from_fn(|i| {
-            prescribed[i].map(|_| {
-                let axis = B.column(i % 3).transpose();
-                if i < 3 { axis } else { axis * jl_inv * R1 }
-            })
-        });
-        for (ei, (e, t)) in node.ends.iter().zip(&terms).enumerate() {
-            let point = &disc.points[e.point];
-            for (a, b) in point.basis.iter().enumerate() {
-                let col = 6 * (point.first + a);
-                let mut fe = Bt * t.n_eta_s * b[1];
-                let mut ft = Bt * t.n_th * b[0];
-                let mut me = Mat3::zeros();
-                let mut mt = Bt * (t.m_th * b[0] + t.m_th_s * b[1]);
-                for (i, kr) in kin_rows.iter().enumerate() {
-                    let Some(kr) = kr else { continue };
-                    let on_end = ei == 0 && a == first.end_basis;
-                    let (row_eta, row_th) = if i < 3 {
-                        (
-                            if on_end {
-                                *kr
-                            } else {
-                                nalgebra::RowVector3::zeros()
-                            },
-                            nalgebra::RowVector3::zeros(),
-                        )
-                    } else {
-                        (
-                            nalgebra::RowVector3::zeros(),
-                            if on_end {
-                                *kr
-                            } else {
-                                nalgebra::RowVector3::zeros()
-                            },
-                        )
-                    };
-                    if i < 3 {
-                        fe.set_row(i, &row_eta);
-                        ft.set_row(i, &row_th);
-                    } else {
-                        me.set_row(i - 3, &row_eta);
-                        mt.set_row(i - 3, &row_th);
-                    }
-                }
-                sink.block(row1, col, &fe);
-                sink.block(row1, col + 3, &ft);
-                sink.block(row1 + 3, col, &me);
-                sink.block(row1 + 3, col + 3, &mt);
-            }
-        }
-        // Continuity rows at the end control points: δη_e − δη_1, and for the rotation mismatch
-        // r = log(E), E = R_e (R_1 Q_e)ᵀ, under spatial increments φ = R δΘ: E ← exp(φ̃_e) E exp(−φ̃_1), so
-        // δr = J_l⁻¹(r) (R_e δΘ_e − E R_1 δΘ_1) (= R_e δΘ_e − R_1 δΘ_1 once continuity holds, r = 0).
+    }
+
+    /// The tangent of the continuity rows at the end control points: `δη_e − δη_1`, and for the rotation
+    /// mismatch `r = log(E)`, `E = R_e (R_1 Q_e)ᵀ`, under spatial increments `φ = R δΘ`: `E ← exp(φ̃_e) E
+    /// exp(−φ̃_1)`, so `δr = J_l⁻¹(r) (R_e δΘ_e − E R_1 δΘ_1)` (`= R_e δΘ_e − R_1 δΘ_1` once continuity holds,
+    /// `r = 0`).
+    #[allow(non_snake_case)]
+    fn continuity_tangent(&self, at: &Assembly<'_>, node: &NodeRows, sink: &mut Sink<'_>) {
+        let (disc, state) = (at.disc, at.state);
+        let first = &node.ends[0];
+        let p1 = &disc.points[first.point];
+        let R1 = &state.rotation[first.point];
         for e in &node.ends[1..] {
             let row = 6 * e.point;
             let ce = 6 * (disc.points[e.point].first + e.end_basis);
@@ -770,6 +705,28 @@ impl Assembler {
             sink.block(row + 3, c1col, &zero);
             sink.block(row + 3, c1col + 3, &(-jl_inv * E * R1));
         }
+    }
+}
+
+/// Per end of a node, the derivatives of its equilibrium terms (spatial) and the point terms' load on it.
+struct EndTerms {
+    /// ∂(σ R N)/∂δη,s and ∂(σ R N)/∂δΘ.
+    n_eta_s: Mat3,
+    n_th: Mat3,
+    /// ∂(σ R M)/∂δΘ and ∂(σ R M)/∂δΘ,s.
+    m_th: Mat3,
+    m_th_s: Mat3,
+    /// The point terms' concentrated load through this end.
+    load: EndLoad,
+}
+
+impl NodeRows {
+    /// The rotation of the node's first end from its reference, `φ` with `R_1 = exp(φ̃) R_1⁰` (spatial).
+    fn rotation_vector(&self, state: &State) -> Vec3 {
+        let r1 = &state.rotation[self.ends[0].point];
+        log(&Rot3::from_matrix_unchecked(
+            r1 * self.rotation0.transpose(),
+        ))
     }
 }
 
@@ -813,17 +770,6 @@ fn strains(point: &CollocationPoint, state: &State, g: usize, k: &Kinematics) ->
         force_ds: k.gamma_s - point.gamma0_s,
         moment_ds: state.kappa_s[g] - point.kappa0_s,
     }
-}
-
-/// The position `c = Σ N_j p_j` at collocation point `g`.
-pub fn point_position(disc: &Discretisation, control: &[Vec3], g: usize) -> Vec3 {
-    let point = &disc.points[g];
-    point
-        .basis
-        .iter()
-        .enumerate()
-        .map(|(a, b)| control[point.first + a] * b[0])
-        .sum()
 }
 
 /// Parts of each knot span in [`curve_length`]'s quadrature: 5-point Gauss–Legendre is exact for polynomials of

@@ -194,3 +194,14 @@ impl Discretisation {
         g == r.offset || g == r.offset + r.n - 1
     }
 }
+
+/// The position `c = Σ N_j p_j` at collocation point `g`.
+pub fn point_position(disc: &Discretisation, control: &[Vec3], g: usize) -> Vec3 {
+    let point = &disc.points[g];
+    point
+        .basis
+        .iter()
+        .enumerate()
+        .map(|(a, b)| control[point.first + a] * b[0])
+        .sum()
+}

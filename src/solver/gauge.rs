@@ -16,9 +16,13 @@
 //! The multipliers enter the free force components of the driven nodes' equilibrium rows as `−λ a_l`; for a
 //! self-equilibrated device their converged values are zero (sum the equilibrium rows: `λ Σ w_l = 0`), so the
 //! constraints fix the placement without changing the deformation.
+//!
+//! The gauge is a [`Constraint`] ([`crate::solver::terms`]): the assembly writes its rows and the multipliers'
+//! forces; the simulation builds it at the release and keeps its frozen positions (in its checkpoints too).
 
 use crate::math::{Real, Vec3};
 use crate::model::Model;
+use crate::solver::terms::Constraint;
 
 /// One constraint: per driven node, the coefficient vector `a_l` on its displacement.
 #[derive(Debug, Clone, PartialEq)]
@@ -128,14 +132,29 @@ impl Gauge {
             scale: length_scale,
         })
     }
+}
 
-    /// Number of constraints (extra unknowns).
-    pub fn len(&self) -> usize {
+impl Constraint for Gauge {
+    fn name(&self) -> &'static str {
+        "gauge"
+    }
+
+    fn len(&self) -> usize {
         self.rows.len()
     }
 
-    /// True when there is nothing to constrain.
-    pub fn is_empty(&self) -> bool {
-        self.rows.is_empty()
+    fn row(&self, j: usize) -> &[(usize, Vec3)] {
+        &self.rows[j].terms
+    }
+
+    fn origin(&self, node: usize) -> Option<Vec3> {
+        self.frozen
+            .iter()
+            .find(|(l, _)| *l == node)
+            .map(|(_, x)| *x)
+    }
+
+    fn scale(&self) -> Real {
+        self.scale
     }
 }

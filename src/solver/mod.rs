@@ -2,10 +2,11 @@
 //!
 //! [`Simulation`] owns the discrete problem ([`discretisation`]), the evolving [`state::State`], the assembly of
 //! residual and tangent ([`assembly`]) and the linear solves ([`linear`]: the block-bordered solver of [`block`]
-//! or the sparse LU of [`sparse`]). It steps through time with Newton's method on normalised per-field norms,
+//! or the sparse LU of [`sparse`]), with the loads, dampers and constraints beyond the rod as [`terms`]. It steps through time with Newton's method on normalised per-field norms,
 //! cuts the step when Newton fails (restoring the last converged state), and reports every converged step to an
 //! [`Observer`] — the engine reports, observers record.
 
+pub mod actions;
 pub mod assembly;
 pub mod block;
 pub mod diagnose;
@@ -16,6 +17,7 @@ pub mod shape;
 pub mod simulation;
 pub mod sparse;
 pub mod state;
+pub mod terms;
 
 pub use simulation::{
     Checkpoint, CheckpointError, NewtonReport, Observer, Observers, PeakSurfaceStrain, PointFields,

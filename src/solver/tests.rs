@@ -1,9 +1,12 @@
 //! Unit tests of the solver internals: the consistent tangent against central differences of the residual,
 //! and Newton's quadratic convergence.
 
-use super::assembly::{Actions, Assembler, Damping, Linearisation, Sink, StepMaterial};
+use super::assembly::{Actions, Assembler, Assembly, Linearisation, Sink, StepMaterial};
 use super::discretisation::Discretisation;
 use super::state::State;
+use super::terms::damping::Damping;
+use super::terms::distributed::DistributedLoad;
+use super::terms::{PointTerm, Terms};
 use crate::material::{CircularSection, ConstitutiveLaw, ElasticLaw, SectionLaw};
 use crate::math::{Real, Vec3};
 use crate::model::builder::{
@@ -14,7 +17,7 @@ use crate::model::{Model, TimeFunction};
 /// A curved, loaded, two-patch test structure: a 60° arc (NURBS, so the rational basis is exercised) clamped at
 /// its start and joined at an angle to a straight patch whose free end carries a force and a couple; a
 /// distributed load acts on the arc. Elastic, ν = 0.3.
-fn test_model() -> Model {
+pub(super) fn test_model() -> Model {
     let material = ElasticLaw::try_new(2.0e5, 0.3).expect("E > 0, ν = 0.3");
     let section = CircularSection::try_new(0.1).expect("d > 0").into();
     let mut b = ModelBuilder::new("tangent_test", material, section);
@@ -68,35 +71,16 @@ fn test_model() -> Model {
     model
 }
 
-fn dense_tangent(
-    disc: &Discretisation,
-    asm: &Assembler,
-    state: &State,
-    material: StepMaterial<'_>,
-    actions: &Actions,
-    damping: Option<Damping<'_>>,
-) -> Vec<Vec<Real>> {
-    let n = disc.num_unknowns();
+/// The tangent of `at` as a dense matrix (entries at the same place summed), rows and columns including the
+/// constraints' multipliers.
+pub(super) fn dense_tangent(asm: &Assembler, at: &Assembly<'_>) -> Vec<Vec<Real>> {
+    let n = at.disc.num_unknowns() + at.terms.multipliers();
     let mut pattern = Vec::new();
     let mut lin = Linearisation::default();
-    asm.assemble(
-        disc,
-        state,
-        material,
-        actions,
-        damping,
-        None,
-        &mut lin,
-        &mut Sink::Pattern(&mut pattern),
-    );
+    asm.assemble(at, &mut lin, &mut Sink::Pattern(&mut pattern));
     let mut values = vec![0.0; pattern.len()];
     asm.assemble(
-        disc,
-        state,
-        material,
-        actions,
-        damping,
-        None,
+        at,
         &mut lin,
         &mut Sink::Values {
             values: &mut values,
@@ -110,26 +94,43 @@ fn dense_tangent(
     k
 }
 
-fn residual(
-    disc: &Discretisation,
-    asm: &Assembler,
-    state: &State,
-    material: StepMaterial<'_>,
-    actions: &Actions,
-    damping: Option<Damping<'_>>,
-) -> Vec<Real> {
+/// The residual of `at` (a residual-only assembly).
+pub(super) fn residual(asm: &Assembler, at: &Assembly<'_>) -> Vec<Real> {
     let mut lin = Linearisation::default();
-    asm.assemble(
-        disc,
-        state,
-        material,
-        actions,
-        damping,
-        None,
-        &mut lin,
-        &mut Sink::Discard,
-    );
+    asm.assemble(at, &mut lin, &mut Sink::Discard);
     lin.residual
+}
+
+/// A deformed state of `disc`: a smooth finite increment of the reference (translations ~5 % of the size,
+/// rotations ~0.3 rad), and `multipliers` multipliers of order 10.
+pub(super) fn deformed_state(disc: &Discretisation, multipliers: usize) -> State {
+    let n = disc.num_unknowns();
+    let mut state = State::reference(disc);
+    let delta: Vec<Real> = (0..n)
+        .map(|i| {
+            let x = i as Real;
+            if i % 6 < 3 {
+                0.05 * (0.37 * x).sin()
+            } else {
+                0.3 * (0.21 * x + 1.0).cos()
+            }
+        })
+        .collect();
+    state.apply_increment(disc, &delta);
+    state.multipliers = (0..multipliers)
+        .map(|j| 10.0 * (1.3 * j as Real + 0.4).sin())
+        .collect();
+    state
+}
+
+/// `state` moved by `eps` along unknown `j` (a multiplier when `j` is past the rod's unknowns) under the
+/// solver's own update.
+pub(super) fn perturbed(disc: &Discretisation, state: &State, j: usize, eps: Real) -> State {
+    let mut out = state.clone();
+    let mut e = vec![0.0; disc.num_unknowns() + state.multipliers.len()];
+    e[j] = eps;
+    out.apply_increment(disc, &e);
+    out
 }
 
 // Source: the tangent must be the exact directional derivative of the residual under the solver's own update
@@ -161,7 +162,7 @@ fn tangent_matches_central_differences_with_viscous_damping() {
         previous: &previous,
         rate: 1e5,
     };
-    check_tangent(&model, &disc, &laws, Some(damping));
+    check_tangent(&model, &disc, &laws, Some(&damping));
 }
 
 // Source: as above, where the temperature varies along the rods: every point's law has a modulus slope `Ē,s`
@@ -204,45 +205,57 @@ fn initial_laws(model: &Model, disc: &Discretisation) -> Vec<SectionLaw> {
         .collect()
 }
 
-/// The tangent of `model` with the section laws `laws` against central differences of its residual (see the
-/// tests' sources).
+/// The tangent of `model` with the section laws `laws`, its distributed loads and `damping`, against central
+/// differences of its residual (see the tests' sources).
 fn check_tangent(
     model: &Model,
     disc: &Discretisation,
     laws: &[SectionLaw],
-    damping: Option<Damping<'_>>,
+    damping: Option<&Damping<'_>>,
 ) {
     let asm = Assembler::new(model, disc);
     let actions = Actions::at(model, 1.0, &[]);
-    let material = StepMaterial { laws };
+    let mut point: Vec<&dyn PointTerm> = vec![&DistributedLoad];
+    point.extend(damping.map(|d| d as &dyn PointTerm));
     let n = disc.num_unknowns();
-    // A deformed state: a smooth finite increment (translations ~5 % of the size, rotations ~0.3 rad).
-    let mut state = State::reference(disc);
-    let delta: Vec<Real> = (0..n)
-        .map(|i| {
-            let x = i as Real;
-            if i % 6 < 3 {
-                0.05 * (0.37 * x).sin()
-            } else {
-                0.3 * (0.21 * x + 1.0).cos()
-            }
-        })
-        .collect();
-    state.apply_increment(disc, &delta);
-    let k = dense_tangent(disc, &asm, &state, material, &actions, damping);
+    let state = deformed_state(disc, 0);
+    let terms = Terms {
+        point: &point,
+        constraints: &[],
+    };
+    let material = StepMaterial { laws };
+    let residual_at = |state: &State| {
+        residual(
+            &asm,
+            &Assembly {
+                disc,
+                state,
+                material,
+                actions: &actions,
+                terms,
+            },
+        )
+    };
+    let k = dense_tangent(
+        &asm,
+        &Assembly {
+            disc,
+            state: &state,
+            material,
+            actions: &actions,
+            terms,
+        },
+    );
     let eps = 1e-6;
     let mut worst: Real = 0.0;
     let mut report = Vec::new();
     for j in 0..n {
-        let mut plus = state.clone();
-        let mut minus = state.clone();
-        let mut e = vec![0.0; n];
-        e[j] = eps;
-        plus.apply_increment(disc, &e);
-        e[j] = -eps;
-        minus.apply_increment(disc, &e);
-        let rp = residual(disc, &asm, &plus, material, &actions, damping);
-        let rm = residual(disc, &asm, &minus, material, &actions, damping);
+        let (plus, minus) = (
+            perturbed(disc, &state, j, eps),
+            perturbed(disc, &state, j, -eps),
+        );
+        let rp = residual_at(&plus);
+        let rm = residual_at(&minus);
         for i in 0..n {
             let fd = (rp[i] - rm[i]) / (2.0 * eps);
             let row_scale = k[i].iter().fold(0.0_f64, |m, v| m.max(v.abs())).max(1e-300);

@@ -36,7 +36,8 @@ use super::constitutive::with_step_input;
 use crate::material::{ConstitutiveLaw, SectionLaw};
 use crate::math::Real;
 use crate::solver::SolverError;
-use crate::solver::assembly::{Actions, Sink, StepMaterial, point_strains};
+use crate::solver::assembly::{Actions, Assembly, Sink, StepMaterial, point_strains};
+use crate::solver::terms::Terms;
 
 /// Order of the estimate in the step size: the local error of backward Euler, `O(h²)`.
 const ESTIMATE_ORDER: Real = 2.0;
@@ -145,13 +146,19 @@ impl Simulation<'_> {
             (Some((g, _, _)), true) => Some(g),
             _ => None,
         };
+        let damping = super::stabilisation::view(&self.damping);
+        let (point, constraints) = super::assembly_terms(&self.terms, damping.as_ref(), gauge);
         self.assembler.assemble(
-            &self.disc,
-            &self.state,
-            StepMaterial { laws: &laws },
-            &actions,
-            super::stabilisation::view(&self.damping),
-            gauge,
+            &Assembly {
+                disc: &self.disc,
+                state: &self.state,
+                material: StepMaterial { laws: &laws },
+                actions: &actions,
+                terms: Terms {
+                    point: &point,
+                    constraints: &constraints,
+                },
+            },
             &mut self.lin,
             &mut Sink::Discard,
         );

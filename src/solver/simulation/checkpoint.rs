@@ -4,10 +4,11 @@
 //! What "the whole state" is, beyond the configuration (control points, rotations, curvatures, multipliers)
 //! and the materials' internal variables: the time, step count, step size and cuts of the step in progress;
 //! the release ramps captured and the gauge constraints (their frozen positions) with whether they are active;
+//! the point terms' states ([`crate::solver::terms`]);
 //! the last step's increment (for extrapolation); the notices said and their flags; the solver's timing; and
 //! — because Newton reuses a factorisation of the tangent across iterations and steps while it contracts
 //! (`solver.reuse_factorisation`) — what the current factorisation was computed from: the state, the section
-//! laws, the loads and the gauge activity at the iterate where that tangent was assembled
+//! laws, the loads, the gauge activity and the terms' states at the iterate where that tangent was assembled
 //! ([`TangentOrigin`]). A restore assembles and factorises that tangent again (the same numbers in the same
 //! order give the same factors), so the restored run reuses exactly the factorisation the uninterrupted run
 //! does. Without it a restored run would refactorise at its first iteration and converge to a slightly
@@ -33,6 +34,7 @@ use crate::model::Model;
 use crate::solver::SolverError;
 use crate::solver::assembly::{Actions, ReleaseRamp};
 use crate::solver::state::State;
+use crate::solver::terms::{Constraint, PointTerm};
 
 /// Everything a simulation needs to continue exactly from where it was ([`Simulation::checkpoint`]); plain
 /// data (numbers, vectors, strings), so that any format can store it.
@@ -77,6 +79,9 @@ pub struct Checkpoint {
     pub arc: Option<super::ArcState>,
     /// The stabiliser's memory ([`super::stabilisation`]).
     pub stabiliser: super::StabiliserState,
+    /// Per point term of the simulation's list, in its order: the numbers it keeps between steps
+    /// ([`crate::solver::terms::PointTerm::save`]).
+    pub terms: Vec<Vec<Real>>,
 }
 
 /// The iterate at which the current factorisation's tangent was assembled (module docs).
@@ -90,6 +95,9 @@ pub struct TangentOrigin {
     pub actions: Actions,
     /// Whether the tangent includes the gauge constraints.
     pub gauge_active: bool,
+    /// The point terms' states ([`crate::solver::terms::PointTerm::save`]), in the order of the list: a term's
+    /// tangent may depend on what it keeps between steps.
+    pub terms: Vec<Vec<Real>>,
 }
 
 /// Why a checkpoint cannot be restored.
@@ -122,6 +130,18 @@ pub enum CheckpointError {
         material: usize,
         /// Why.
         source: MaterialError,
+    },
+    /// A point term cannot take the state the checkpoint kept for it.
+    #[error(
+        "the checkpoint's state of term `{term}` has {found} numbers where it needs {expected}"
+    )]
+    Term {
+        /// The term's name.
+        term: &'static str,
+        /// The numbers it needs.
+        expected: usize,
+        /// The checkpoint's.
+        found: usize,
     },
     /// The gauge system or the factorisation could not be rebuilt.
     #[error("rebuilding the linear system: {0}")]
@@ -191,6 +211,8 @@ struct Origin {
     laws: Vec<SectionLaw>,
     actions: Option<Actions>,
     gauge_active: bool,
+    /// The point terms' states.
+    terms: Vec<Vec<Real>>,
 }
 
 impl TangentRecord {
@@ -209,8 +231,14 @@ impl TangentRecord {
         }
     }
 
-    /// The tangent assembled last was factorised at this state, these laws and gauge activity.
-    pub(super) fn factorised(&mut self, state: &State, laws: &[SectionLaw], gauge_active: bool) {
+    /// The tangent assembled last was factorised at this state, these laws, gauge activity and terms.
+    pub(super) fn factorised(
+        &mut self,
+        state: &State,
+        laws: &[SectionLaw],
+        gauge_active: bool,
+        terms: &[Box<dyn PointTerm + Send>],
+    ) {
         if let Some((_, saved @ false)) = &mut self.attempt {
             // The first factorisation of an attempt: keep the one it started with (buffers swapped, no copy).
             std::mem::swap(&mut self.before, &mut self.current);
@@ -226,6 +254,11 @@ impl TangentRecord {
         origin.laws.extend_from_slice(laws);
         std::mem::swap(&mut origin.actions, &mut self.pending_actions);
         origin.gauge_active = gauge_active;
+        origin.terms.resize_with(terms.len(), Vec::new);
+        for (values, term) in origin.terms.iter_mut().zip(terms) {
+            values.clear();
+            term.save(values);
+        }
         origin.valid = origin.actions.is_some();
         self.generation += 1;
     }
@@ -306,6 +339,7 @@ impl Simulation<'_> {
                     laws: record.laws.iter().map(SectionLaw::to_numbers).collect(),
                     actions: actions.clone(),
                     gauge_active: record.gauge_active,
+                    terms: record.terms.clone(),
                 })
             }
             _ => None,
@@ -330,6 +364,7 @@ impl Simulation<'_> {
             timing: self.timing.clone(),
             arc: self.arc.clone(),
             stabiliser: self.stabiliser,
+            terms: term_states(&self.terms),
         }
     }
 
@@ -340,8 +375,8 @@ impl Simulation<'_> {
     /// # Errors
     /// [`CheckpointError::ModelMismatch`] for a checkpoint of another model, [`CheckpointError::Size`] or
     /// [`CheckpointError::Material`] for a damaged one (the simulation is then unchanged), and
-    /// [`CheckpointError::Solver`] when the gauge system or the factorisation cannot be rebuilt (then the
-    /// simulation must not be used).
+    /// [`CheckpointError::Solver`] when the gauge system or the factorisation cannot be rebuilt, and
+    /// [`CheckpointError::Term`] when a point term cannot take its state (then the simulation must not be used).
     pub fn restore(&mut self, checkpoint: &Checkpoint) -> Result<(), CheckpointError> {
         let expected = model_fingerprint(self.model);
         if checkpoint.model != expected {
@@ -374,6 +409,20 @@ impl Simulation<'_> {
             group.state = state;
         }
         self.materials.refresh_laws(&self.model.materials);
+        // Each term's state at the tangent's origin is checked by restoring it first (module docs of
+        // `crate::solver::terms`), then the checkpoint's own.
+        let no_origin = Vec::new();
+        let origin_terms = checkpoint.tangent.as_ref().map_or(&no_origin, |t| &t.terms);
+        for (k, (term, values)) in self.terms.iter_mut().zip(&checkpoint.terms).enumerate() {
+            for values in origin_terms.get(k).into_iter().chain([values]) {
+                term.restore(values)
+                    .map_err(|expected| CheckpointError::Term {
+                        term: term.name(),
+                        expected,
+                        found: values.len(),
+                    })?;
+            }
+        }
         self.materials.said.clone_from(&checkpoint.material_notices);
         self.time = checkpoint.time;
         self.step = checkpoint.step;
@@ -407,6 +456,7 @@ impl Simulation<'_> {
                 laws: origin.laws.iter().map(SectionLaw::from_numbers).collect(),
                 actions: Some(origin.actions.clone()),
                 gauge_active: origin.gauge_active,
+                terms: origin.terms.clone(),
             };
             self.refactor_recorded()?;
         }
@@ -426,9 +476,9 @@ impl Simulation<'_> {
         Ok(())
     }
 
-    /// Assembles and factorises again the tangent of the recorded origin (its state, section laws, loads and
-    /// gauge activity): the factorisation it had, bit for bit. The simulation's own state, laws and gauge
-    /// activity are left as they were.
+    /// Assembles and factorises again the tangent of the recorded origin (its state, section laws, loads, gauge
+    /// activity and terms' states): the factorisation it had, bit for bit. The simulation's own state, laws,
+    /// gauge activity and terms' states are left as they were.
     pub(super) fn refactor_recorded(&mut self) -> Result<(), SolverError> {
         let origin = std::mem::take(&mut self.tangent.current);
         let (Some(state), Some(actions)) = (&origin.state, &origin.actions) else {
@@ -440,6 +490,8 @@ impl Simulation<'_> {
             &mut self.gauge_active,
             origin.gauge_active && self.gauge.is_some(),
         );
+        let own_terms = term_states(&self.terms);
+        swap_term_states(&mut self.terms, &origin.terms);
         self.system.invalidate();
         if let Some((_, system, _)) = &mut self.gauge {
             system.invalidate();
@@ -450,10 +502,11 @@ impl Simulation<'_> {
         self.state = own_state;
         self.materials.laws = own_laws;
         self.gauge_active = own_gauge;
+        swap_term_states(&mut self.terms, &own_terms);
         result
     }
 
-    /// The checkpoint's sizes against this model's.
+    /// The checkpoint's sizes against this model's (the terms' states are checked as they are restored).
     fn check_sizes(&self, c: &Checkpoint) -> Result<(), CheckpointError> {
         let points = self.disc.points.len();
         let controls = self.disc.control0.len();
@@ -463,6 +516,7 @@ impl Simulation<'_> {
             ("curvatures", points, c.state.kappa.len()),
             ("curvature derivatives", points, c.state.kappa_s.len()),
             ("release ramps", self.model.nodes.len(), c.ramps.len()),
+            ("list of point terms", self.terms.len(), c.terms.len()),
             (
                 "list of materials",
                 self.materials.groups.len(),
@@ -487,6 +541,11 @@ impl Simulation<'_> {
                     origin.state.kappa_s.len(),
                 ),
                 ("tangent's section laws", points, origin.laws.len()),
+                (
+                    "tangent's point terms",
+                    self.terms.len(),
+                    origin.terms.len(),
+                ),
                 (
                     "tangent's node loads",
                     self.model.nodes.len(),
@@ -514,5 +573,30 @@ impl Simulation<'_> {
             });
         }
         Ok(())
+    }
+}
+
+/// Every term's state ([`PointTerm::save`]), in the order of the list.
+fn term_states(terms: &[Box<dyn PointTerm + Send>]) -> Vec<Vec<Real>> {
+    terms
+        .iter()
+        .map(|t| {
+            let mut values = Vec::new();
+            t.save(&mut values);
+            values
+        })
+        .collect()
+}
+
+/// Puts the states `values` (one per term, saved by [`PointTerm::save`] from these very terms or checked when a
+/// checkpoint was restored) into the terms.
+fn swap_term_states(terms: &mut [Box<dyn PointTerm + Send>], values: &[Vec<Real>]) {
+    for (term, values) in terms.iter_mut().zip(values) {
+        let restored = term.restore(values);
+        assert!(
+            restored.is_ok(),
+            "term `{}`: a state it saved or that a restore checked is refused",
+            term.name()
+        );
     }
 }

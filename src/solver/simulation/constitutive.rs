@@ -206,6 +206,10 @@ impl Simulation<'_> {
             let strains = |i: usize| point_strains(disc, state, points[i]);
             self.model.materials[group.material].commit_step(&mut group.state, &strains);
         }
+        // The point terms' state after the materials' (module docs of `crate::solver::terms`).
+        for term in &mut self.terms {
+            term.commit(disc, state);
+        }
         // Counted with the step's preparation.
         self.timing.material.1 += start.elapsed().as_secs_f64();
     }

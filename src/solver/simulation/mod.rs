@@ -87,12 +87,15 @@ pub use timing::SolverTiming;
 
 use super::SolverError;
 use super::assembly::{
-    Actions, Assembler, Linearisation, ReleaseRamp, Sink, StepMaterial, point_position,
+    Actions, Assembler, Assembly, Linearisation, ReleaseRamp, Sink, StepMaterial, point_position,
 };
 use super::discretisation::Discretisation;
 use super::gauge::Gauge;
 use super::linear::LinearSystem;
 use super::state::State;
+use super::terms::damping::Damping;
+use super::terms::distributed::DistributedLoad;
+use super::terms::{Constraint, PointTerm, Terms};
 use crate::math::{Real, Vec3};
 use crate::model::{Model, ProbeLocation};
 use constitutive::PointMaterials;
@@ -107,6 +110,9 @@ pub struct Simulation<'m> {
     model: &'m Model,
     disc: Discretisation,
     assembler: Assembler,
+    /// The point terms every assembly includes, in the order they add up (before the damping of
+    /// stabilisation): [`registered_terms`] and those added by [`Simulation::add_term`].
+    terms: Vec<Box<dyn PointTerm + Send>>,
     system: LinearSystem,
     state: State,
     time: Real,
@@ -200,15 +206,21 @@ impl<'m> Simulation<'m> {
         let mut lin = Linearisation::default();
         let actions = Actions::at(model, 0.0, &[]);
         let materials = PointMaterials::new(model, &disc);
+        let terms = registered_terms(model);
+        let (point, constraints) = assembly_terms(&terms, None, None);
         assembler.assemble(
-            &disc,
-            &state,
-            StepMaterial {
-                laws: &materials.laws,
+            &Assembly {
+                disc: &disc,
+                state: &state,
+                material: StepMaterial {
+                    laws: &materials.laws,
+                },
+                actions: &actions,
+                terms: Terms {
+                    point: &point,
+                    constraints: &constraints,
+                },
             },
-            &actions,
-            None,
-            None,
             &mut lin,
             &mut Sink::Pattern(&mut pattern),
         );
@@ -236,6 +248,7 @@ impl<'m> Simulation<'m> {
             model,
             disc,
             assembler,
+            terms,
             system,
             state,
             time: 0.0,
@@ -269,6 +282,14 @@ impl<'m> Simulation<'m> {
 }
 
 impl Simulation<'_> {
+    /// Adds a point term to every assembly from now on, after those already there ([`crate::solver::terms`]):
+    /// how a term that the model does not describe (a test's spring to ground) joins a simulation. A term
+    /// added after a checkpoint was taken is not in it: add the same terms before restoring.
+    pub fn add_term(&mut self, term: Box<dyn PointTerm + Send>) {
+        self.terms.push(term);
+        self.forget_factorisation();
+    }
+
     /// Messages worth telling the user, each added once (e.g. that relaxation froze below `Tg − C2`), in the
     /// order they arose.
     pub fn notices(&self) -> &[String] {
@@ -363,6 +384,28 @@ impl Simulation<'_> {
         self.assembler
             .node_end_resultants(&self.disc, &self.state, self.step_material(), k)
     }
+}
+
+/// The point terms of `model` that every assembly includes, in the order they add up: the registry of
+/// [`crate::solver::terms`] (a new term is one line here).
+fn registered_terms(_model: &Model) -> Vec<Box<dyn PointTerm + Send>> {
+    vec![Box::new(DistributedLoad)]
+}
+
+/// The terms of one assembly: the registered ones, then the damping of stabilisation when it is on, and the
+/// gauge constraints when they are active.
+fn assembly_terms<'a>(
+    registered: &'a [Box<dyn PointTerm + Send>],
+    damping: Option<&'a Damping<'a>>,
+    gauge: Option<&'a Gauge>,
+) -> (Vec<&'a dyn PointTerm>, Vec<&'a dyn Constraint>) {
+    let mut point: Vec<&dyn PointTerm> =
+        registered.iter().map(|t| &**t as &dyn PointTerm).collect();
+    if let Some(d) = damping {
+        point.push(d);
+    }
+    let constraints = gauge.map(|g| g as &dyn Constraint).into_iter().collect();
+    (point, constraints)
 }
 
 /// Each patch's first control point and count, for the block solver.

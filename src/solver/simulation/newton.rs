@@ -5,8 +5,9 @@ use super::report::NewtonReport;
 use super::{Observer, Simulation, SolverTiming};
 use crate::math::Real;
 use crate::solver::SolverError;
-use crate::solver::assembly::{Actions, Sink, StepMaterial};
+use crate::solver::assembly::{Actions, Assembly, Sink, StepMaterial};
 use crate::solver::linear::LinearSystem;
+use crate::solver::terms::Terms;
 use std::time::Instant;
 
 /// The tolerance that round-off is taken to allow. With a smaller `solver.tolerance`, an iterate whose
@@ -232,13 +233,19 @@ impl Simulation<'_> {
         } else {
             Sink::Discard
         };
+        let damping = super::stabilisation::view(&self.damping);
+        let (point, constraints) = super::assembly_terms(&self.terms, damping.as_ref(), gauge);
         self.assembler.assemble(
-            &self.disc,
-            &self.state,
-            material,
-            actions,
-            super::stabilisation::view(&self.damping),
-            gauge,
+            &Assembly {
+                disc: &self.disc,
+                state: &self.state,
+                material,
+                actions,
+                terms: Terms {
+                    point: &point,
+                    constraints: &constraints,
+                },
+            },
             &mut self.lin,
             &mut sink,
         );
@@ -299,8 +306,12 @@ impl Simulation<'_> {
             },
             e => e,
         })?;
-        self.tangent
-            .factorised(&self.state, &self.materials.laws, self.gauge_active);
+        self.tangent.factorised(
+            &self.state,
+            &self.materials.laws,
+            self.gauge_active,
+            &self.terms,
+        );
         SolverTiming::add(&mut self.timing.factorisation, start);
         Ok(())
     }

@@ -4,9 +4,12 @@
 use super::{Simulation, patch_ranges};
 use crate::math::{Real, Vec3};
 use crate::solver::SolverError;
-use crate::solver::assembly::{Actions, Linearisation, ReleaseRamp, Sink, point_position};
+use crate::solver::assembly::{
+    Actions, Assembly, Linearisation, ReleaseRamp, Sink, point_position,
+};
 use crate::solver::gauge::Gauge;
 use crate::solver::linear::LinearSystem;
+use crate::solver::terms::{Constraint, Terms};
 
 impl Simulation<'_> {
     /// Before a step ending at `t_np1`: every prescribed component released at or before `t_np1` and not yet
@@ -99,13 +102,18 @@ impl Simulation<'_> {
         let actions = Actions::at(self.model, t, &self.ramps);
         let material = self.step_material();
         let mut lin = Linearisation::default();
+        let (point, constraints) = super::assembly_terms(&self.terms, None, Some(&gauge));
         self.assembler.assemble(
-            &self.disc,
-            &self.state,
-            material,
-            &actions,
-            None,
-            Some(&gauge),
+            &Assembly {
+                disc: &self.disc,
+                state: &self.state,
+                material,
+                actions: &actions,
+                terms: Terms {
+                    point: &point,
+                    constraints: &constraints,
+                },
+            },
             &mut lin,
             &mut Sink::Pattern(&mut pattern),
         );

@@ -2,7 +2,7 @@
 //! viscous regularisation switched on where Newton stalls, its factor, and the energies it is judged by.
 //!
 //! **When.** A step whose Newton iteration fails (after the retry with a fresh tangent) is retried at the same
-//! size with the damping of [`crate::solver::assembly::Damping`] on, instead of being cut. A damped step that
+//! size with the damping of [`crate::solver::terms::damping::Damping`] on, instead of being cut. A damped step that
 //! still fails is retried with the factor ten times larger, [`MAX_ESCALATIONS`] times, and then cut as before
 //! (halving the step raises `c/h` as well). After a damped step converges the damping stays on for the next
 //! step while the step dissipated more than `dissipated_fraction` of the strain energy — the motion is still
@@ -56,8 +56,9 @@
 use super::Simulation;
 use crate::math::{Real, Vec3};
 use crate::model::StabilisationSettings;
-use crate::solver::assembly::{Actions, Damping, point_strains};
+use crate::solver::assembly::{Actions, point_strains};
 use crate::solver::state::State;
+use crate::solver::terms::damping::Damping;
 
 /// How many times a damped step that still fails has its factor multiplied by [`ESCALATION`] before it is cut.
 pub const MAX_ESCALATIONS: usize = 3;
