@@ -773,11 +773,9 @@ fn a_smoothing_tighter_than_the_points_is_refused_in_words() {
         let enough = suggested_smoothing(&error);
         let retried = edit(
             &text,
-            &text
-                .lines()
+            text.lines()
                 .find(|l| l.trim_start().starts_with("smoothing:"))
-                .expect("a smoothing line")
-                .to_string(),
+                .expect("a smoothing line"),
             &format!("      smoothing: {enough}"),
         );
         if let Err(e) = stentkit::io::design::parse_design(&retried, &path) {
