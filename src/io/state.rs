@@ -140,7 +140,7 @@ pub struct Recovery {
     pub ratio_mean: Real,
     /// Its largest value over the driven nodes.
     pub ratio_max: Real,
-    /// Mean radial contraction of the driven nodes [length], positive towards the axis (the paper's Δr),
+    /// Mean radial contraction of the driven nodes \[length\], positive towards the axis (the paper's Δr),
     /// for a radial-contraction programme.
     pub delta_r: Option<Real>,
     /// For a device of several materials, the mean ratio over the driven nodes of each material region, in the
@@ -238,7 +238,7 @@ pub fn recovery_warning(sim: &Simulation<'_>) -> Option<String> {
     ))
 }
 
-/// The largest displacement of any node from the reference shape [length] (0 for a model without nodes).
+/// The largest displacement of any node from the reference shape \[length\] (0 for a model without nodes).
 pub fn max_node_displacement(sim: &Simulation<'_>) -> Real {
     (0..sim.model().nodes.len())
         .map(|k| sim.probe_displacement(&ProbeLocation::Node(k)).norm())
@@ -250,9 +250,9 @@ pub fn max_node_displacement(sim: &Simulation<'_>) -> Real {
 pub struct StateSample {
     /// Step number (0 for the initial state).
     pub step: usize,
-    /// Time [time].
+    /// Time \[time\].
     pub time: Real,
-    /// Step size that reached it [time] (0 for the initial state).
+    /// Step size that reached it \[time\] (0 for the initial state).
     pub dt: Real,
     /// Temperature [°C].
     pub temperature: Real,
@@ -268,7 +268,7 @@ pub struct StateSample {
     pub error_estimate: Option<Real>,
     /// The load factor (an arc-length path; `None` for time steps).
     pub load_factor: Option<Real>,
-    /// Displacement of every probe of the model, in its order [length].
+    /// Displacement of every probe of the model, in its order \[length\].
     pub probes: Vec<Vec3>,
     /// Recovery measures, for a model with a programme.
     pub recovery: Option<Recovery>,
