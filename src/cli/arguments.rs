@@ -5,7 +5,7 @@
 //! argument with a value parser from here (`#[arg(value_parser = arguments::positive())]`). clap runs it while
 //! it reads the command line, before anything else: the command ends with exit status 2
 //! ([`super::EXIT_BAD_INPUT`], clap's own for usage errors) and one line naming the argument, its value quoted
-//! as design errors quote values ([`quoted`]: cut after 40 characters, with its length) and what is allowed:
+//! as design errors quote values (`quoted`: cut after 40 characters, with its length) and what is allowed:
 //!
 //! ```text
 //! error: --grid `-1`: must be a finite number > 0

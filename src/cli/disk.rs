@@ -89,7 +89,7 @@ pub fn check_sweep_space(
     .into())
 }
 
-/// What a sweep needs free: its estimate and [`FINISHING_RESERVE`] for each of the `concurrent` runs [bytes].
+/// What a sweep needs free: its estimate and [`FINISHING_RESERVE`] for each of the `concurrent` runs \[bytes\].
 pub fn sweep_bytes(estimate: &SweepEstimate, concurrent: usize) -> u64 {
     estimate.total + (concurrent.min(estimate.variants) * FINISHING_RESERVE) as u64
 }

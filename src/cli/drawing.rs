@@ -111,7 +111,7 @@ pub struct Drawing {
 }
 
 /// Refuses (exit status 2, [`BadInput`]) drawing `drawing` of `model` before anything is sampled: print
-/// settings out of range ([`PrintSettings::resolved`]), or an estimated cost ([`DrawingCost`]) above the
+/// settings out of range ([`PrintSettings::resolved`]), or an estimated cost (`DrawingCost`) above the
 /// memory limit designs get ([`MEMORY_LIMIT_BYTES`]) or, for a print solid, above [`TIME_LIMIT_SECONDS`];
 /// naming the argument to change and the value that fits.
 pub fn check_drawing(model: &Model, drawing: &Drawing) -> anyhow::Result<()> {

@@ -40,7 +40,7 @@ pub trait ParametricCurve {
         }
     }
 
-    /// The smallest radius of curvature `|c'|³ / |c' × c''|` over [`BEND_SAMPLES`] + 1 evenly spaced
+    /// The smallest radius of curvature `|c'|³ / |c' × c''|` over `BEND_SAMPLES` + 1 evenly spaced
     /// parameters, and the parameter (as a fraction of the domain) where it is; `c''` is the central difference
     /// of [`Self::derivative`] at a step of 1e-5 of the domain (one-sided at the ends). Infinite for a straight
     /// curve.
@@ -111,13 +111,13 @@ impl RigidPlacement {
 /// `t ∈ [0, 2π turns]`, placed rigidly.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Helix {
-    /// Radius [length], > 0.
+    /// Radius \[length\], > 0.
     pub radius: Real,
-    /// Rise per turn [length] (negative for a left-handed helix).
+    /// Rise per turn \[length\] (negative for a left-handed helix).
     pub pitch: Real,
     /// Number of turns, > 0.
     pub turns: Real,
-    /// Start angle φ0 [rad].
+    /// Start angle φ0 \[rad\].
     pub start_angle: Real,
     /// Placement of the local frame.
     pub placement: RigidPlacement,
@@ -154,17 +154,17 @@ impl ParametricCurve for Helix {
 /// full turn (the appendix's `n_w/2`). Placed rigidly.
 #[derive(Debug, Clone, PartialEq)]
 pub struct SineWire {
-    /// Cylinder radius `R` [length], > 0.
+    /// Cylinder radius `R` \[length\], > 0.
     pub radius: Real,
-    /// Amplitude `h` (half the crown height) [length].
+    /// Amplitude `h` (half the crown height) \[length\].
     pub amplitude: Real,
     /// Waves per full turn `m`, > 0.
     pub waves: Real,
-    /// Phase φ [rad].
+    /// Phase φ \[rad\].
     pub phase: Real,
-    /// Start angle ϑ0 [rad].
+    /// Start angle ϑ0 \[rad\].
     pub from: Real,
-    /// End angle ϑ1 [rad], ≠ ϑ0.
+    /// End angle ϑ1 \[rad\], ≠ ϑ0.
     pub to: Real,
     /// Placement of the local frame.
     pub placement: RigidPlacement,

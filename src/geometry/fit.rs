@@ -34,9 +34,9 @@ pub struct Fit {
     /// The analysis spline, `u ∈ [0, 1]`.
     pub curve: NurbsCurve,
     /// Largest distance between the fit and the analytic curve at equal arc-length parameter over the sample
-    /// points (an upper bound of the geometric distance there) [length].
+    /// points (an upper bound of the geometric distance there) \[length\].
     pub max_deviation: Real,
-    /// Length of the analytic curve [length].
+    /// Length of the analytic curve \[length\].
     pub length: Real,
 }
 
@@ -386,7 +386,7 @@ mod tests {
 pub struct SmoothFit {
     /// The cubic, `u ∈ [0, 1]` by chord length of the data.
     pub curve: NurbsCurve,
-    /// Largest distance from a data point to the curve at its parameter [length] (an upper bound of the
+    /// Largest distance from a data point to the curve at its parameter \[length\] (an upper bound of the
     /// distance to the curve).
     pub max_deviation: Real,
     /// Control points used.

@@ -42,9 +42,9 @@ pub struct ReferenceFrame {
     pub curvature: Vec3,
     /// Its arc-length derivative `K0,s` [1/length²].
     pub curvature_s: Vec3,
-    /// Parametric speed `J = |c0'(u)|` [length].
+    /// Parametric speed `J = |c0'(u)|` \[length\].
     pub jacobian: Real,
-    /// `J' = dJ/du` [length].
+    /// `J' = dJ/du` \[length\].
     pub jacobian_u: Real,
 }
 

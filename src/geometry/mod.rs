@@ -107,17 +107,17 @@ pub enum GeometryError {
         crate::math::Short(*enough)
     )]
     SmoothingTooTight {
-        /// The tolerance asked for [length].
+        /// The tolerance asked for \[length\].
         tolerance: Real,
         /// The points to fit.
         points: usize,
-        /// Largest distance of the closest fit found from a point [length].
+        /// Largest distance of the closest fit found from a point \[length\].
         closest: Real,
         /// The point (from 0) where that fit is farthest.
         worst_point: usize,
         /// Control points of that fit.
         control_points: usize,
-        /// A tolerance that the same search meets: `closest` rounded up to two significant digits [length].
+        /// A tolerance that the same search meets: `closest` rounded up to two significant digits \[length\].
         enough: Real,
     },
 }

@@ -41,7 +41,7 @@ pub struct TubeSettings {
     /// rotations are orthonormal to rounding (`~1e-15`); anything worse than `1e-6` would draw a visibly
     /// elliptic or skewed section and indicates a bug or unnormalised input.
     pub frame_tolerance: Real,
-    /// Largest angle [rad] between a ring's section normal (`d2 × d3`) and the sampled centreline direction
+    /// Largest angle \[rad\] between a ring's section normal (`d2 × d3`) and the sampled centreline direction
     /// that [`super::device_tubes::device_mesh`] draws as given. Coarse samples of a bent rod tilt the sections against the polyline
     /// that joins them (by half the angle the rod turns between two samples): two rings on a patch bent into a
     /// half circle put both sections edge-on to the chord, which no tube can be swept through. A ring tilted

@@ -44,32 +44,32 @@ use crate::post::device::{device_sample_counts, patch_copies};
 pub struct DiskEstimate {
     /// Snapshots written (the initial state, every `every` steps, the requested times, the end).
     pub snapshots: usize,
-    /// The binary STL files of all snapshots [bytes].
+    /// The binary STL files of all snapshots \[bytes\].
     pub snapshot_stl: u64,
-    /// The OBJ files of all snapshots [bytes].
+    /// The OBJ files of all snapshots \[bytes\].
     pub snapshot_obj: u64,
-    /// The field files of all snapshots and `run.pvd` [bytes] ([`crate::io::vtk`]).
+    /// The field files of all snapshots and `run.pvd` \[bytes\] ([`crate::io::vtk`]).
     pub snapshot_vtp: u64,
     /// The vessel's lumen, `snapshots/vessel_lumen.stl`, for a stent on a file centreline with a lumen
-    /// radius [bytes] ([`crate::io::snapshots::VESSEL_FILE`]).
+    /// radius \[bytes\] ([`crate::io::snapshots::VESSEL_FILE`]).
     pub vessel_lumen: u64,
-    /// `run.mcap` [bytes].
+    /// `run.mcap` \[bytes\].
     pub recording: u64,
-    /// `history.csv` [bytes].
+    /// `history.csv` \[bytes\].
     pub history: u64,
-    /// `charts/*.svg` [bytes].
+    /// `charts/*.svg` \[bytes\].
     pub charts: u64,
-    /// `summary.json` [bytes].
+    /// `summary.json` \[bytes\].
     pub summary: u64,
 }
 
 impl DiskEstimate {
-    /// The snapshot folder's files: STL, OBJ, the field files and the vessel's lumen [bytes].
+    /// The snapshot folder's files: STL, OBJ, the field files and the vessel's lumen \[bytes\].
     pub fn snapshots_bytes(&self) -> u64 {
         self.snapshot_stl + self.snapshot_obj + self.snapshot_vtp + self.vessel_lumen
     }
 
-    /// Everything [bytes].
+    /// Everything \[bytes\].
     pub fn total(&self) -> u64 {
         self.snapshots_bytes() + self.recording + self.history + self.charts + self.summary
     }

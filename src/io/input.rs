@@ -20,7 +20,7 @@ pub enum InputError {
     Io(std::io::Error),
     /// Not a regular file: what it is, in words ("a FIFO (named pipe)", "a character device", "a folder" …).
     NotRegular(&'static str),
-    /// The file holds more than the limit: its size [bytes] where known, else the bytes read (limit + 1).
+    /// The file holds more than the limit: its size \[bytes\] where known, else the bytes read (limit + 1).
     TooLarge(u64),
 }
 
@@ -73,7 +73,7 @@ fn kind(file_type: FileType) -> &'static str {
     }
 }
 
-/// Largest `summary.json` stentkit reads back [bytes]: 16 MiB. A summary is a few kB (the straight stent's,
+/// Largest `summary.json` stentkit reads back \[bytes\]: 16 MiB. A summary is a few kB (the straight stent's,
 /// with its snapshots and timing, 5 kB; a failure report adds the residuals of one step); the limit only keeps
 /// a file put in its place (a device, a FIFO, a huge file) from costing more than that.
 pub const MAX_SUMMARY_BYTES: u64 = 16 * 1024 * 1024;

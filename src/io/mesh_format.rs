@@ -39,7 +39,7 @@ pub struct SnapshotState<'a> {
     pub model: &'a Model,
     /// Step number (0: the initial state).
     pub step: usize,
-    /// Time [time].
+    /// Time \[time\].
     pub time: Real,
 }
 

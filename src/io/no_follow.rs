@@ -14,7 +14,7 @@
 //! - a folder that holds links where stentkit writes is refused before anything is changed, naming them
 //!   ([`links_inside`]; [`crate::io::run_folder::classify`] refuses a run folder that holds any);
 //! - a sweep folder's own files (`sweep.sbatch`, `slurm.json`, a variant's `log.txt` and `task_error.txt`, the
-//!   table's temporary) are written with [`write`] or [`open`], so a link in their place is an error, not a
+//!   table's temporary) are written with [`write()`] or [`open`], so a link in their place is an error, not a
 //!   way into a user's file.
 //!
 //! The folder the user names (`-o DIR`, `RUN_DIR`) may itself be a link: the user chose that place, as they

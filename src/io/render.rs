@@ -50,9 +50,9 @@ pub enum RenderError {
     /// The picture would exceed what tiny-skia allocates.
     #[error("a picture of {width} × {height} pixels cannot be allocated")]
     Size {
-        /// Width [px].
+        /// Width \[px\].
         width: u32,
-        /// Height [px].
+        /// Height \[px\].
         height: u32,
     },
     /// A mesh could not be read.

@@ -158,7 +158,7 @@ pub fn snapshot_name(model: &Model, step: usize, time: Real, phase: Option<Phase
 pub struct Snapshot {
     /// Step number (0: the initial state).
     pub step: usize,
-    /// Time [time].
+    /// Time \[time\].
     pub time: Real,
     /// Its phase in the model's cycle ([`Model::phase_at`]).
     pub phase: Option<Phase>,
@@ -168,7 +168,7 @@ pub struct Snapshot {
     pub files: Vec<PathBuf>,
     /// Triangles of the mesh.
     pub triangles: usize,
-    /// Enclosed volume [length³].
+    /// Enclosed volume \[length³\].
     pub volume: Real,
 }
 

@@ -138,9 +138,9 @@ impl LoadChannel {
 pub struct StateSample {
     /// Step number (0 for the initial state).
     pub step: usize,
-    /// Time [time].
+    /// Time \[time\].
     pub time: Real,
-    /// Step size that reached it [time] (0 for the initial state).
+    /// Step size that reached it \[time\] (0 for the initial state).
     pub dt: Real,
     /// Temperature [°C].
     pub temperature: Real,
@@ -156,7 +156,7 @@ pub struct StateSample {
     pub error_estimate: Option<Real>,
     /// The load factor (an arc-length path; `None` for time steps).
     pub load_factor: Option<Real>,
-    /// Displacement of every probe of the model, in its order [length].
+    /// Displacement of every probe of the model, in its order \[length\].
     pub probes: Vec<Vec3>,
     /// Recovery measures, for a model with a programme.
     pub recovery: Option<Recovery>,

@@ -51,13 +51,13 @@ pub struct FailureReport {
     /// What failed: `no_convergence` (Newton failed at the smallest step), `free_body`, `singular_tangent`,
     /// `geometry`, `material` or `linear_solver`.
     pub kind: String,
-    /// Time the failing step tried to reach [s] (no convergence only).
+    /// Time the failing step tried to reach \[s\] (no convergence only).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub time: Option<Real>,
     /// Number of the failing step, 1-based (no convergence only).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub step: Option<usize>,
-    /// Step size of the last attempt [s] (no convergence only).
+    /// Step size of the last attempt \[s\] (no convergence only).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub dt: Option<Real>,
     /// Newton iterations of the last attempt (no convergence only).
@@ -78,7 +78,7 @@ pub struct FailureReport {
     pub suggestions: Vec<String>,
     /// The last converged step (0: the initial state), whose state the outputs end with.
     pub last_converged_step: usize,
-    /// Its time [s].
+    /// Its time \[s\].
     pub last_converged_time: Real,
     /// The solver's message.
     pub message: String,
@@ -167,7 +167,7 @@ impl UnitsSummary {
     }
 }
 
-/// Where the wall time went [s]. `recording` splits the time spent in each output during the run; `solver`
+/// Where the wall time went \[s\]. `recording` splits the time spent in each output during the run; `solver`
 /// splits the solver's share (residual and tangent assembly, factorisation, solves, material updates: seconds
 /// as `<part>_s`, counts as `<part>_count`).
 #[derive(Debug, Clone, PartialEq, Default, Serialize)]
@@ -189,7 +189,7 @@ pub struct Timing {
 pub struct SnapshotEntry {
     /// Step (0: initial state).
     pub step: usize,
-    /// Time [s].
+    /// Time \[s\].
     pub time: Real,
     /// Its phase in the shape-memory cycle ([`crate::model::cycle::Phase`]: `programmed`, `fixed`, …), when
     /// the model has a cycle.
@@ -201,7 +201,7 @@ pub struct SnapshotEntry {
     pub files: std::collections::BTreeMap<String, String>,
     /// Triangles.
     pub triangles: usize,
-    /// Enclosed volume [length³].
+    /// Enclosed volume \[length³\].
     pub volume: Real,
 }
 
@@ -232,11 +232,11 @@ impl From<&Snapshot> for SnapshotEntry {
 pub struct FinalState {
     /// Step.
     pub step: usize,
-    /// Time [s].
+    /// Time \[s\].
     pub time: Real,
     /// Temperature [°C].
     pub temperature: Real,
-    /// Displacement `[ux, uy, uz]` of every probe [length].
+    /// Displacement `[ux, uy, uz]` of every probe \[length\].
     pub probes: BTreeMap<String, [Real; 3]>,
     /// Mean recovery ratio (programmes).
     #[serde(skip_serializing_if = "Option::is_none")]
@@ -244,7 +244,7 @@ pub struct FinalState {
     /// Largest recovery ratio (programmes).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub recovery_ratio_max: Option<Real>,
-    /// Mean radial contraction [length] (radial-contraction programmes).
+    /// Mean radial contraction \[length\] (radial-contraction programmes).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub delta_r: Option<Real>,
 }
@@ -315,9 +315,9 @@ pub struct RunSummaryFile {
     /// The failure report of a run whose solver failed.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub failure: Option<FailureReport>,
-    /// Wall time of the whole command [s].
+    /// Wall time of the whole command \[s\].
     pub wall_time_s: Real,
-    /// Peak resident memory of the process [MiB] (Linux `VmHWM`; absent elsewhere).
+    /// Peak resident memory of the process \[MiB\] (Linux `VmHWM`; absent elsewhere).
     pub peak_memory_mib: Option<Real>,
     /// Its split.
     pub timing: Timing,
@@ -335,11 +335,11 @@ pub struct RunSummaryFile {
     /// Automatic stabilisation, when the design asks for it (`solver.stabilisation`).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub stabilisation: Option<StabilisationSummary>,
-    /// Time reached [s].
+    /// Time reached \[s\].
     pub final_time: Real,
-    /// End time of the design [s].
+    /// End time of the design \[s\].
     pub end_time: Real,
-    /// Nominal time step [s].
+    /// Nominal time step \[s\].
     pub time_step: Real,
     /// Patches of the (possibly reduced) model.
     pub patches: usize,
@@ -385,9 +385,9 @@ pub struct TimeErrorControl {
     pub rejected_steps: usize,
     /// The largest estimate of an accepted step (above the tolerance only at the smallest step, with a notice).
     pub largest_estimate: Real,
-    /// The smallest step taken [s].
+    /// The smallest step taken \[s\].
     pub smallest_step: Real,
-    /// The largest step taken [s].
+    /// The largest step taken \[s\].
     pub largest_step: Real,
 }
 
@@ -401,9 +401,9 @@ pub struct StabilisationSummary {
     pub limit: Real,
     /// Steps taken with the damping on.
     pub damped_steps: usize,
-    /// Energy the damping dissipated [energy].
+    /// Energy the damping dissipated \[energy\].
     pub dissipated_energy: Real,
-    /// The largest strain energy of the run's states [energy].
+    /// The largest strain energy of the run's states \[energy\].
     pub peak_strain_energy: Real,
     /// `dissipated_energy / peak_strain_energy`.
     pub ratio: Real,
@@ -413,7 +413,7 @@ pub struct StabilisationSummary {
     /// damping) of a damped step: 0 quasi-static, 1 when the damping alone balanced the loads or the motion
     /// ([`crate::solver::simulation::stabilisation`], *The force*).
     pub largest_force_share: Real,
-    /// The time of the step with that share [s] (0 when no step was damped).
+    /// The time of the step with that share \[s\] (0 when no step was damped).
     pub largest_force_share_time: Real,
     /// Damped steps whose force share exceeded `limit`.
     pub steps_above_force_limit: usize,
@@ -516,7 +516,7 @@ impl RunSummaryFile {
     }
 }
 
-/// Peak resident memory of this process so far [MiB]: `VmHWM` of `/proc/self/status` (Linux); `None` where that
+/// Peak resident memory of this process so far \[MiB\]: `VmHWM` of `/proc/self/status` (Linux); `None` where that
 /// is not available.
 pub fn peak_memory_mib() -> Option<Real> {
     let status = std::fs::read_to_string("/proc/self/status").ok()?;

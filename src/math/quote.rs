@@ -10,7 +10,7 @@ use std::borrow::Cow;
 /// Characters of a user value shown before it is cut: 40, enough to show any real name whole.
 pub const QUOTED_CHARS: usize = 40;
 
-/// Longest field path shown whole [characters]: the format's paths have at most about 40
+/// Longest field path shown whole \[characters\]: the format's paths have at most about 40
 /// (`conditions[12].displacement[2]`); a longer one holds a user's key.
 pub const MAX_FIELD_CHARS: usize = 200;
 
@@ -19,7 +19,7 @@ pub const MAX_FIELD_CHARS: usize = 200;
 /// [`shortened_numbers`] rewrites in its short form ([`super::Short`]).
 pub const MAX_NUMBER_DIGITS: usize = 20;
 
-/// Longest message shown whole [characters]; a longer one (after its quoted values are shortened) is cut.
+/// Longest message shown whole \[characters\]; a longer one (after its quoted values are shortened) is cut.
 /// stentkit's longest messages (an unknown field with the list of allowed ones) have about 300.
 pub const MAX_MESSAGE_CHARS: usize = 1000;
 

@@ -84,7 +84,7 @@ pub struct Patch {
     pub section: usize,
     /// Index into [`Model::materials`].
     pub material: usize,
-    /// Largest deviation of `curve` from the analytic curve it was fitted to [length]; `None` when exact.
+    /// Largest deviation of `curve` from the analytic curve it was fitted to \[length\]; `None` when exact.
     pub fit_error: Option<Real>,
 }
 
@@ -139,7 +139,7 @@ pub enum Component {
     /// Neumann: the component is free and loaded by the given force/moment component (dead load, fixed in
     /// space) as a function of time.
     Load(TimeFunction),
-    /// Dirichlet: the displacement component [length] or rotation component [rad] is prescribed as a
+    /// Dirichlet: the displacement component \[length\] or rotation component \[rad\] is prescribed as a
     /// function of time; after `release` (if any) it becomes free with the given load.
     Prescribed {
         /// The prescribed value.
@@ -201,7 +201,7 @@ pub struct Node {
     pub name: String,
     /// The patch ends joined here (at least one).
     pub ends: Vec<PatchEnd>,
-    /// Reference position [length].
+    /// Reference position \[length\].
     pub position: Vec3,
     /// Boundary conditions and concentrated loads.
     pub conditions: NodeConditions,
@@ -215,7 +215,7 @@ pub struct DistributedLoad {
     pub patch: usize,
     /// Force per unit length `n̄` [force/length], global components.
     pub force: [TimeFunction; 3],
-    /// Couple per unit length `m̄` [force], global components.
+    /// Couple per unit length `m̄` \[force\], global components.
     pub couple: [TimeFunction; 3],
 }
 
@@ -245,14 +245,14 @@ pub struct Probe {
 /// Time stepping settings.
 #[derive(Debug, Clone, PartialEq)]
 pub struct TimeSettings {
-    /// End time [time] (the run starts at 0).
+    /// End time \[time\] (the run starts at 0).
     pub end: Real,
-    /// Nominal time step `h` [time]; steps are shortened to land on schedule breakpoints. With error-controlled
+    /// Nominal time step `h` \[time\]; steps are shortened to land on schedule breakpoints. With error-controlled
     /// stepping (`tolerance`), the first step.
     pub step: Real,
-    /// Smallest step that automatic step cutting may reach before giving up [time].
+    /// Smallest step that automatic step cutting may reach before giving up \[time\].
     pub min_step: Real,
-    /// Duration over which a released component's reaction is ramped to its load after release [time]
+    /// Duration over which a released component's reaction is ramped to its load after release \[time\]
     /// (default: one nominal step). At the release time the component becomes free under exactly the reaction
     /// that held it, so the node stays in equilibrium; the reaction then falls linearly to the prescribed load
     /// after release. This turns the release snap into a continuation that step cutting can subdivide.
@@ -262,7 +262,7 @@ pub struct TimeSettings {
     /// [`crate::solver::simulation`], *Error-controlled stepping*). Steps then grow and shrink with the estimate
     /// between `min_step` and `max_step`, starting from `step`. `None`: fixed steps of `step`.
     pub tolerance: Option<Real>,
-    /// The largest step error-controlled stepping takes [time] (`None`: no bound but the end time).
+    /// The largest step error-controlled stepping takes \[time\] (`None`: no bound but the end time).
     pub max_step: Option<Real>,
 }
 
@@ -511,7 +511,7 @@ pub struct Model {
     /// normal points into the modelled side). A patch lying in a plane ([`Model::patch_symmetry_plane`]) is its
     /// own mirror image and carries half its section in the reduced model.
     pub symmetry_planes: Vec<(Vec3, Vec3)>,
-    /// Times within `(0, end]` at which the state is recorded (snapshots) [time]: time stepping lands on each,
+    /// Times within `(0, end]` at which the state is recorded (snapshots) \[time\]: time stepping lands on each,
     /// as on a schedule breakpoint.
     pub record_times: Vec<Real>,
     /// The vessel a stent was placed on (a centreline read from a file), for the outputs to show beside it.
@@ -521,9 +521,9 @@ pub struct Model {
 /// A vessel segment: its smoothed centreline and, where the file gave it, the lumen radius along it.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Vessel {
-    /// Points along the centreline [length].
+    /// Points along the centreline \[length\].
     pub points: Vec<Vec3>,
-    /// The lumen radius at each point [length].
+    /// The lumen radius at each point \[length\].
     pub radius: Option<Vec<Real>>,
 }
 

@@ -19,9 +19,9 @@ use crate::math::{Real, Vec3};
 /// Which target a programme drives to.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum ProgrammeKind {
-    /// Radial contraction by `delta_r` [length] towards the stent axis.
+    /// Radial contraction by `delta_r` \[length\] towards the stent axis.
     RadialContraction {
-        /// `Δr` at the end of the ramp [length], `0 < Δr < R`.
+        /// `Δr` at the end of the ramp \[length\], `0 < Δr < R`.
         delta_r: Real,
     },
     /// The displacement to a temporary placement, `η_temp = P_temp − P_0`.
@@ -33,15 +33,15 @@ pub enum ProgrammeKind {
 pub struct DrivenNode {
     /// Index into [`super::Model::nodes`].
     pub node: usize,
-    /// Reference position `P_0` [length].
+    /// Reference position `P_0` \[length\].
     pub position: Vec3,
-    /// Displacement at the end of the ramp, `η_target` [length] (global components).
+    /// Displacement at the end of the ramp, `η_target` \[length\] (global components).
     pub target: Vec3,
-    /// Point of the stent axis at the node's crown station [length].
+    /// Point of the stent axis at the node's crown station \[length\].
     pub axis_point: Vec3,
     /// Unit direction of the stent axis there.
     pub axis_direction: Vec3,
-    /// Reference distance from the axis (the crown radius `R`) [length].
+    /// Reference distance from the axis (the crown radius `R`) \[length\].
     pub radius: Real,
     /// Number of nodes of the full device this node stands for (1, 2 or 4 in a reduced model): the weight of
     /// the node in device averages.
@@ -57,9 +57,9 @@ pub struct Programme {
     pub node_set: String,
     /// The driven nodes.
     pub nodes: Vec<DrivenNode>,
-    /// Ramp start and end times [time], `start < end`.
+    /// Ramp start and end times \[time\], `start < end`.
     pub ramp: (Real, Real),
-    /// Time from which the driven components are free [time]; `None` = never.
+    /// Time from which the driven components are free \[time\]; `None` = never.
     pub release: Option<Real>,
 }
 
@@ -76,7 +76,7 @@ pub enum ProgrammeError {
         node: String,
         /// Local axis, 1-based.
         axis: usize,
-        /// The target's component along it [length].
+        /// The target's component along it \[length\].
         value: Real,
     },
 }

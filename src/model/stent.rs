@@ -60,7 +60,7 @@ impl StentMaterials {
 pub enum ProgrammeTarget {
     /// Every driven node moves towards the axis by `delta_r` (paper §4.3, straight stent).
     RadialContraction {
-        /// Radius change Δr [length], `0 < Δr < R`.
+        /// Radius change Δr \[length\], `0 < Δr < R`.
         delta_r: Real,
     },
     /// Every driven node moves to its place in a temporary shape of the same crowns (paper §4.3, curved
@@ -81,7 +81,7 @@ pub struct ProgrammeSpec {
     pub target: ProgrammeTarget,
     /// The driven node set (`all_joints` by default in designs).
     pub node_set: String,
-    /// Start and end of the linear ramp to the temporary shape [time].
+    /// Start and end of the linear ramp to the temporary shape \[time\].
     pub ramp: (Real, Real),
     /// Time at which the driven components are released; `None` = never.
     pub release: Option<Real>,

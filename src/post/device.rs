@@ -46,17 +46,17 @@ pub enum ReferenceMeshError {
     },
 }
 
-/// Memory per sample of a patch's shape [bytes]: its point and section frame (a `Vec3` and a `Rot3`).
+/// Memory per sample of a patch's shape \[bytes\]: its point and section frame (a `Vec3` and a `Rot3`).
 pub const BYTES_PER_SHAPE_SAMPLE: Real = 96.0;
 
-/// Memory per point of the full device's rods [bytes] (a `Vec3`), for the print solid and the centrelines.
+/// Memory per point of the full device's rods \[bytes\] (a `Vec3`), for the print solid and the centrelines.
 pub const BYTES_PER_ROD_POINT: Real = 24.0;
 
-/// Memory per row of a centreline file [bytes]: `rod,point,x,y,z,radius` with the coordinates at full
+/// Memory per row of a centreline file \[bytes\]: `rod,point,x,y,z,radius` with the coordinates at full
 /// precision is at most about 100 characters.
 pub const BYTES_PER_CENTRELINE_ROW: Real = 100.0;
 
-/// Peak memory of the full device's tube mesh per triangle [bytes]: the mesh, its closedness check and the
+/// Peak memory of the full device's tube mesh per triangle \[bytes\]: the mesh, its closedness check and the
 /// file's bytes. Measured (peak resident memory of `stentkit mesh` on the straight stent over its triangles):
 /// 151 at its defaults (0.26 million triangles, with the program's own few MB), 163 at 10 samples per control
 /// point and 64 segments (2.6 million; STL, OBJ and 3MF alike) and 161 at 40 and 64 (10.5 million).

@@ -50,21 +50,21 @@ pub const MAX_SPACING_PER_RADIUS: Real = 1.0;
 /// r/4 5370 in 25.6 s, r/2 2450 and r 1454 in 27 s; `--deviation 1e9` had not finished after 15 minutes.
 pub const MAX_TOLERANCE_PER_RADIUS: Real = 0.25;
 
-/// Peak memory of a print solid per triangle of its contour [bytes]: the contour's vertices, normals and
+/// Peak memory of a print solid per triangle of its contour \[bytes\]: the contour's vertices, normals and
 /// edge-to-vertex map, the simplification's quadrics, edges and queue, and the output. With
 /// [`BYTES_PER_BAND_POINT`] fitted to the peak resident memory of `stentkit mesh --print` on the straight
 /// stent, 224, 535 and 960 MB at h = r/2, r/3 and r/4 (0.89, 2.02 and 3.60 million triangles): the estimate
 /// gives 238, 545 and 982 MB; and at r/6 (8.12 million), 2.29 GB measured, 2.28 GB estimated.
 pub const BYTES_PER_CONTOUR_TRIANGLE: Real = 235.0;
 
-/// Peak memory of a print solid per grid point sampled [bytes]: an entry of the sampled field (a point, its
+/// Peak memory of a print solid per grid point sampled \[bytes\]: an entry of the sampled field (a point, its
 /// distance and capsule: 40 bytes) in a hash map filled to at most 7/8, whose table doubles as it grows.
 pub const BYTES_PER_BAND_POINT: Real = 80.0;
 
-/// Memory per capsule united [bytes]: its ends and radius (56 bytes) and its point in the device's rods.
+/// Memory per capsule united \[bytes\]: its ends and radius (56 bytes) and its point in the device's rods.
 pub const BYTES_PER_CAPSULE: Real = 80.0;
 
-/// Processor time of a print solid of [`REFERENCE_TRIANGLES`] contour triangles [s]: contouring,
+/// Processor time of a print solid of [`REFERENCE_TRIANGLES`] contour triangles \[s\]: contouring,
 /// simplifying and placing it; it grows as the triangles to the power [`TIME_GROWTH`] (the larger maps miss
 /// the caches more often). Fitted (least squares on the logarithms) to the user + system time of `stentkit mesh
 /// --print` on the straight stent on this machine (2 cores shared with other work): 8.7 s for 0.89 million
@@ -78,12 +78,12 @@ pub const REFERENCE_TRIANGLES: Real = 2.0e6;
 /// How a print solid's time grows with its contour's triangles (see [`REFERENCE_SECONDS`]).
 pub const TIME_GROWTH: Real = 1.38;
 
-/// Processor time per grid point a print solid visits [s] (a capsule's distance there, and its entry in the
+/// Processor time per grid point a print solid visits \[s\] (a capsule's distance there, and its entry in the
 /// sampled field when within the band). Measured: the straight stent's print solid at 100 samples per control
 /// point (204 000 capsules, about 1500 points visited each) took 6.2 s longer than at the default 4 (8160).
 pub const SECONDS_PER_GRID_VISIT: Real = 21e-9;
 
-/// The longest a print solid may be estimated to take [s]: 10 minutes, 26 times the straight stent's
+/// The longest a print solid may be estimated to take \[s\]: 10 minutes, 26 times the straight stent's
 /// default solid (23 s). On the paper's 0.3 mm wires it stops the grid at about 0.032 mm (r/9.5, about 20
 /// million contour triangles and 6 GB, below stentkit's 8 GB memory limit) and the samples at about 8800 per
 /// control point (the polyline's segments then 1/1500 of the grid's spacing; `--samples 1000000` would take
@@ -171,9 +171,9 @@ pub struct PrintEstimate {
     pub contour: ContourSize,
     /// Capsules united.
     pub capsules: Real,
-    /// Peak memory [bytes].
+    /// Peak memory \[bytes\].
     pub bytes: Real,
-    /// Processor time on the machine the constants were measured on [s].
+    /// Processor time on the machine the constants were measured on \[s\].
     pub seconds: Real,
 }
 

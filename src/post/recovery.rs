@@ -15,7 +15,7 @@ pub struct Recovery {
     pub ratio_mean: Real,
     /// Its largest value over the driven nodes.
     pub ratio_max: Real,
-    /// Mean radial contraction of the driven nodes [length], positive towards the axis (the paper's Δr),
+    /// Mean radial contraction of the driven nodes \[length\], positive towards the axis (the paper's Δr),
     /// for a radial-contraction programme.
     pub delta_r: Option<Real>,
     /// For a device of several materials, the mean ratio over the driven nodes of each material region, in the
@@ -113,7 +113,7 @@ pub fn recovery_warning(sim: &Simulation<'_>) -> Option<String> {
     ))
 }
 
-/// The largest displacement of any node from the reference shape [length] (0 for a model without nodes).
+/// The largest displacement of any node from the reference shape \[length\] (0 for a model without nodes).
 pub fn max_node_displacement(sim: &Simulation<'_>) -> Real {
     (0..sim.model().nodes.len())
         .map(|k| sim.probe_displacement(&ProbeLocation::Node(k)).norm())

@@ -25,7 +25,7 @@ const NEUTRAL_MATERIAL_FIELDS: [&str; 5] = ["E_inf", "prony", "nu", "wlf", "inte
 
 /// Whether the field at `path` (or anything below it) cannot change what a run writes
 /// ([`estimated_disk`]): the section (`section…`) and the constitutive constants of a material
-/// (`material.wlf.Tg`, `materials[1].prony`, … : [`NEUTRAL_MATERIAL_FIELDS`]).
+/// (`material.wlf.Tg`, `materials[1].prony`, … : `NEUTRAL_MATERIAL_FIELDS`).
 pub fn size_neutral(path: &[PathStep]) -> bool {
     let neutral = |field: &str| NEUTRAL_MATERIAL_FIELDS.contains(&field);
     match path {

@@ -26,30 +26,30 @@ use std::path::Path;
 /// The metrics of one run (module docs); `None` where the run does not give it.
 #[derive(Debug, Clone, PartialEq, Default)]
 pub struct Metrics {
-    /// Wall time of the run [s].
+    /// Wall time of the run \[s\].
     pub wall_time_s: Option<Real>,
     /// Converged steps.
     pub steps: Option<u64>,
     /// The warnings in the run's `summary.json` (the design's, and the run's own: stabilisation above its
     /// limit, a device heated but not recovered).
     pub warnings: Option<u64>,
-    /// `u(t_r)` [length].
+    /// `u(t_r)` \[length\].
     pub programmed_displacement: Option<Real>,
-    /// `u(t_r) − u(t_r⁺)` [length].
+    /// `u(t_r) − u(t_r⁺)` \[length\].
     pub snap: Option<Real>,
     /// `ρ(t_r⁺) / ρ(t_r)`.
     pub fixity: Option<Real>,
     /// `ρ` at the chosen times, in their order.
     pub recovery_at: Vec<Option<Real>>,
-    /// Time from the release to `ρ ≤ 0.5` [time].
+    /// Time from the release to `ρ ≤ 0.5` \[time\].
     pub time_to_50: Option<Real>,
-    /// Time from the release to `ρ ≤ 0.1` [time].
+    /// Time from the release to `ρ ≤ 0.1` \[time\].
     pub time_to_90: Option<Real>,
     /// `ρ` at the last saved step.
     pub final_ratio_mean: Option<Real>,
     /// The largest `‖η‖ / ‖η_temp‖` over the driven nodes at the last saved step.
     pub final_ratio_max: Option<Real>,
-    /// `u` at the last saved step [length].
+    /// `u` at the last saved step \[length\].
     pub final_displacement: Option<Real>,
 }
 
@@ -134,9 +134,9 @@ fn first_at_or_below(series: &[(Real, Real)], from: Real, level: Real) -> Option
 /// When a programme releases the device: the release time and the duration of its ramp.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Release {
-    /// `t_r` [time].
+    /// `t_r` \[time\].
     pub time: Real,
-    /// The release ramp [time] (`time.release_ramp`).
+    /// The release ramp \[time\] (`time.release_ramp`).
     pub ramp: Real,
 }
 

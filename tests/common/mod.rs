@@ -46,6 +46,18 @@ pub fn replace_line(text: &str, prefix: &str, line: &str) -> String {
         .collect()
 }
 
+/// `text` with every occurrence of `from` replaced by `to`, as `str::replace` does, but panics when `from` does
+/// not occur: an edit of a design whose text has changed fails loudly instead of silently testing the unedited
+/// design.
+#[track_caller]
+pub fn edit(text: &str, from: &str, to: &str) -> String {
+    assert!(
+        text.contains(from),
+        "the text to replace is missing: `{from}`"
+    );
+    text.replace(from, to)
+}
+
 /// Removes every line that starts with `prefix` (after indentation); panics when none does.
 #[track_caller]
 pub fn remove_lines(text: &str, prefix: &str) -> String {

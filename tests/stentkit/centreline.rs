@@ -2,6 +2,7 @@
 //! writers in every encoding (tests/data/centrelines/, made by scripts/centreline_test_files.py) read to the
 //! values VTK's reader gives; bad files are refused with the file named and what is wrong.
 
+use crate::common::edit;
 use std::path::{Path, PathBuf};
 use stentkit::io::centreline::{CentrelineError, read_centreline};
 
@@ -84,7 +85,8 @@ fn a_csv_of_an_exact_arc_gives_the_arc_centrelines_device() {
         .lines()
         .find(|l| l.trim_start().starts_with("arc:"))
         .expect("an arc centreline");
-    let from_file = design.replace(
+    let from_file = edit(
+        &design,
         arc_line,
         &format!(
             "    file: {{path: {}, smoothing: 1.0e-4, reference: [1, 0, 0]}}",
@@ -355,9 +357,11 @@ fn the_aorta_stents_run_shows_the_vessel_lumen() {
 #[test]
 fn a_tapered_stent_follows_the_local_lumen() {
     let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("designs/aorta_stent.yaml");
-    let text = std::fs::read_to_string(&path)
-        .expect("design")
-        .replace("  oversize: 0.1 ", "  taper: true\n  oversize: 0.1 ");
+    let text = edit(
+        &std::fs::read_to_string(&path).expect("design"),
+        "  oversize: 0.1 ",
+        "  taper: true\n  oversize: 0.1 ",
+    );
     let design =
         stentkit::io::design::parse_design(&text, &path).expect("the tapered design reads");
     assert!(
@@ -408,7 +412,7 @@ fn a_tapered_stent_follows_the_local_lumen() {
         .iter()
         .fold((f64::MAX, 0.0_f64), |(lo, hi), &s| (lo.min(s), hi.max(s)));
     assert!(hi > 1.3 * lo, "the crowns taper: {sizes:?}");
-    let refused = text.replace("  oversize: 0.1 ", "  radius: 6 #");
+    let refused = edit(&text, "  oversize: 0.1 ", "  radius: 6 #");
     let err = stentkit::io::design::parse_design(&refused, &path).expect_err("no oversize");
     assert!(err.to_string().contains("stent.taper"), "{err}");
 }
@@ -515,9 +519,11 @@ fn a_zlib_bomb_is_refused_without_inflating_it() {
     let many = dir.join("many.vtp");
     std::fs::write(
         &many,
-        std::fs::read_to_string(&good)
-            .expect("good.vtp")
-            .replace("NumberOfPoints=\"409\"", "NumberOfPoints=\"300000\""),
+        edit(
+            &std::fs::read_to_string(&good).expect("good.vtp"),
+            "NumberOfPoints=\"409\"",
+            "NumberOfPoints=\"300000\"",
+        ),
     )
     .expect("write");
     let error = read_centreline(&many, None)
@@ -640,7 +646,11 @@ fn only_regular_files_within_the_size_limit_are_read() {
     let on_fifo = dir.join("on_fifo.yaml");
     std::fs::write(
         &on_fifo,
-        text.replace("data/aorta-centerline.vtp", fifo.to_str().expect("UTF-8")),
+        edit(
+            &text,
+            "data/aorta-centerline.vtp",
+            fifo.to_str().expect("UTF-8"),
+        ),
     )
     .expect("design");
     let out = check_within(&on_fifo);
@@ -765,12 +775,11 @@ fn a_smoothing_tighter_than_the_points_is_refused_in_words() {
             "{error}"
         );
         let enough = suggested_smoothing(&error);
-        let retried = text.replace(
-            &text
-                .lines()
+        let retried = edit(
+            &text,
+            text.lines()
                 .find(|l| l.trim_start().starts_with("smoothing:"))
-                .expect("a smoothing line")
-                .to_string(),
+                .expect("a smoothing line"),
             &format!("      smoothing: {enough}"),
         );
         if let Err(e) = stentkit::io::design::parse_design(&retried, &path) {

@@ -6,6 +6,7 @@
 //! a missing field). The test checks that loading fails with exactly that position, field and a message
 //! containing the fragment, and that nothing panics.
 
+use crate::common::edit;
 use std::path::{Path, PathBuf};
 use stentkit::io::design::{DesignError, load_design};
 
@@ -69,13 +70,11 @@ fn temperature_below_the_wlf_singularity_is_a_warning_with_the_freeze() {
     // design is accepted (DESIGN §4: the relaxation freezes, as Abaqus' TRS does), with a warning naming the
     // singularity and the freeze; the solver says once, when it gets there, that relaxation is frozen. This
     // fails if the design were rejected, or accepted silently.
-    let text = std::fs::read_to_string(data("good_small.yaml"))
-        .expect("base")
-        .replace(
-            "temperature: [[0, 90], [1, 40]]",
-            "temperature: [[0, 90], [1, 10]]",
-        );
-    assert!(text.contains("[1, 10]"));
+    let text = edit(
+        &std::fs::read_to_string(data("good_small.yaml")).expect("base"),
+        "temperature: [[0, 90], [1, 40]]",
+        "temperature: [[0, 90], [1, 10]]",
+    );
     let path = Path::new("wlf_freeze.yaml");
     let design = stentkit::io::design::parse_design(&text, path).expect("accepted with a warning");
     let warning = design
@@ -100,13 +99,16 @@ fn temperature_below_the_wlf_singularity_is_a_warning_with_the_freeze() {
     // that relaxation is frozen, and the run completes.
     let bend =
         std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join("designs/bend45.yaml"))
-            .expect("bend45")
-            .replace(
-                "  nu: 0.0\n",
-                "  nu: 0.0\n  prony: [[2.0e7, 0.1]]\n  wlf: {C1: 14.59, C2: 48.43, Tg: 70.0}\n",
-            )
-            .replace("time: {", "temperature: [[0, 90], [1, 10]]\ntime: {");
-    assert!(bend.contains("wlf:") && bend.contains("[1, 10]"));
+            .expect("bend45");
+    let bend = edit(
+        &edit(
+            &bend,
+            "  nu: 0.0\n",
+            "  nu: 0.0\n  prony: [[2.0e7, 0.1]]\n  wlf: {C1: 14.59, C2: 48.43, Tg: 70.0}\n",
+        ),
+        "time: {",
+        "temperature: [[0, 90], [1, 10]]\ntime: {",
+    );
     let design = stentkit::io::design::parse_design(&bend, path).expect("cooled bend");
     assert!(
         design
@@ -213,8 +215,7 @@ struct Generated {
 /// line 3.
 fn good_small_with(line: &str) -> String {
     let text = std::fs::read_to_string(data("good_small.yaml")).expect("base");
-    assert!(text.contains("version: 1\n"));
-    text.replacen("version: 1\n", &format!("version: 1\n{line}\n"), 1)
+    edit(&text, "version: 1\n", &format!("version: 1\n{line}\n"))
 }
 
 /// The generated broken designs. Each expected position is derived in its comment from how the text is made;
@@ -260,13 +261,11 @@ fn generated_corpus() -> Vec<Generated> {
     // repetition would be a patch of the design. Refused at the first alias: the patches list starts on line
     // 13 with `- &beam` (14), its two lines and the two of `hook`, so the first alias is line 19, column 5.
     let base = std::fs::read_to_string(data("good_small.yaml")).expect("base");
-    let repeated = base
-        .replacen("  - name: beam\n", "  - &beam\n    name: beam\n", 1)
-        .replacen(
-            "nodes:\n",
-            &format!("{}nodes:\n", "  - *beam\n".repeat(300_000)),
-            1,
-        );
+    let repeated = edit(
+        &edit(&base, "  - name: beam\n", "  - &beam\n    name: beam\n"),
+        "nodes:\n",
+        &format!("{}nodes:\n", "  - *beam\n".repeat(300_000)),
+    );
     corpus.push(Generated {
         name: "a patch repeated 300 000 times by an alias",
         text: repeated,
@@ -283,7 +282,8 @@ fn generated_corpus() -> Vec<Generated> {
         .collect();
     corpus.push(Generated {
         name: "a temperature table of 10⁶ breakpoints",
-        text: base.replace(
+        text: edit(
+            &base,
             "temperature: [[0, 90], [1, 40]]",
             &format!("temperature: [[0, 90],{rows}]"),
         ),
@@ -305,19 +305,19 @@ fn generated_corpus() -> Vec<Generated> {
         .collect();
     corpus.push(Generated {
         name: "170 000 breakpoints and 2000 probes",
-        text: base
-            .replace(
-                "temperature: [[0, 90], [1, 40]]",
-                &format!("temperature: [[0, 90],{rows}]"),
-            )
-            .replace(
+        text: edit(
+            &edit(
+                &edit(
+                    &base,
+                    "temperature: [[0, 90], [1, 40]]",
+                    &format!("temperature: [[0, 90],{rows}]"),
+                ),
                 "time: {end: 1.0, step: 0.01}",
                 "time: {end: 200000, step: 2000}",
-            )
-            .replace(
-                "    - {name: tip, node: hook.end}\n",
-                &format!("    - {{name: tip, node: hook.end}}\n{probes}"),
             ),
+            "    - {name: tip, node: hook.end}\n",
+            &format!("    - {{name: tip, node: hook.end}}\n{probes}"),
+        ),
         line: 25,
         column: 14,
         field: "temperature",
@@ -414,21 +414,21 @@ fn long_values_are_quoted_shortened_in_errors() {
     let cut = format!("`{}…` (1000000 characters)", "q".repeat(40));
     let base = std::fs::read_to_string(data("good_small.yaml")).expect("base");
     let cases = [
-        (
-            "units",
-            base.replacen("units: SI", &format!("units: {long}"), 1),
-        ),
+        ("units", edit(&base, "units: SI", &format!("units: {long}"))),
         (
             "patches[1].name",
-            base.replacen("name: beam", &format!("name: {long}"), 1)
-                .replacen("name: hook", &format!("name: {long}"), 1),
+            edit(
+                &edit(&base, "name: beam", &format!("name: {long}")),
+                "name: hook",
+                &format!("name: {long}"),
+            ),
         ),
         (
             "conditions[0].node",
-            base.replacen(
+            edit(
+                &base,
                 "{node: root, clamp: true}",
                 &format!("{{node: {long}, clamp: true}}"),
-                1,
             ),
         ),
     ];
@@ -450,7 +450,7 @@ fn long_values_are_quoted_shortened_in_errors() {
     // error at its end, which quotes nothing): serde_yaml names it in the message and the field path, and both
     // are shortened (the path without backticks).
     let key = "k".repeat(1000);
-    let text = base.replacen("units: SI", &format!("units: SI\n{key}: 1"), 1);
+    let text = edit(&base, "units: SI", &format!("units: SI\n{key}: 1"));
     let error =
         stentkit::io::design::parse_design(&text, Path::new("long.yaml")).expect_err("refused");
     let message = error.to_string();
@@ -485,7 +485,11 @@ fn a_design_name_is_one_folder_name() {
     );
     // Ordinary names, with spaces, dots inside and non-ASCII letters, are names.
     for name in ["straight stent v2", "stent.2024-05", "Stent für Öhrli", "a"] {
-        let text = base.replacen("version: 1\n", &format!("version: 1\nname: {name}\n"), 1);
+        let text = edit(
+            &base,
+            "version: 1\n",
+            &format!("version: 1\nname: {name}\n"),
+        );
         let design = stentkit::io::design::parse_design(&text, Path::new("named.yaml"))
             .unwrap_or_else(|e| panic!("{name}: {e}"));
         assert_eq!(design.model.name, name);

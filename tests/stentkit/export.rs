@@ -1,6 +1,7 @@
 //! Lean run folders named by the shape-memory cycle, and `stentkit export` of any state of a finished run
 //! (issue 19, items 2 and 3).
 
+use crate::common::edit;
 use crate::outputs::{design, path_str, run_ok, stentkit, summary, test_outputs, text};
 use crate::reliability::folder_bytes;
 
@@ -148,9 +149,11 @@ fn a_design_changed_since_the_run_is_not_exported() {
         path_str(&dir.join("adaptive.stl")),
     ]);
     assert!(out.status.success(), "{}", text(&out.stderr));
-    let edited = std::fs::read_to_string(&file)
-        .expect("design")
-        .replace("E_inf: 1.0e7", "E_inf: 2.0e7");
+    let edited = edit(
+        &std::fs::read_to_string(&file).expect("design"),
+        "E_inf: 1.0e7",
+        "E_inf: 2.0e7",
+    );
     std::fs::write(&file, edited).expect("edit");
     let out = export("b.stl");
     assert_eq!(out.status.code(), Some(2), "{}", text(&out.stderr));

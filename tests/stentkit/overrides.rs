@@ -2,6 +2,7 @@
 //! written in the file; an override's error names the `--set` argument; every other error is located in the file
 //! exactly as without overrides; the resolved design reads back as the model that was built.
 
+use crate::common::edit;
 use std::path::{Path, PathBuf};
 use stentkit::io::design::{
     DesignError, DesignOverrides, SetOverride, load_design, load_design_with, parse_design,
@@ -27,14 +28,17 @@ fn sets(args: &[&str]) -> DesignOverrides {
 fn overrides_give_the_model_of_the_edited_file() {
     let path = data("good_stent_small.yaml");
     let text = std::fs::read_to_string(&path).expect("readable");
-    let edited = text
-        .replace("crowns: 2", "crowns: 3")
-        .replace("Tg: 70.0", "Tg: 65.0")
-        .replace("  diameter: 0.6", "  diameter: 0.5")
-        .replace("mesh: {p: 4, n: 8}\n", "");
+    let edited = [
+        ("crowns: 2", "crowns: 3"),
+        ("Tg: 70.0", "Tg: 65.0"),
+        ("  diameter: 0.6", "  diameter: 0.5"),
+        ("mesh: {p: 4, n: 8}\n", ""),
+    ]
+    .iter()
+    .fold(text.clone(), |t, (from, to)| edit(&t, from, to));
     let edited = format!("{edited}mesh: {{p: 5, n: 9}}\n");
     let by_hand = parse_design(&edited, &path).expect("the edited design is valid");
-    let mut text_without_mesh = text.replace("mesh: {p: 4, n: 8}\n", "");
+    let mut text_without_mesh = edit(&text, "mesh: {p: 4, n: 8}\n", "");
     text_without_mesh.push('\n');
     let scratch = std::env::temp_dir().join(format!("stentkit-set-{}.yaml", std::process::id()));
     std::fs::write(&scratch, &text_without_mesh).expect("writable");

@@ -129,27 +129,27 @@ pub(crate) fn reported_volume(stdout: &str) -> f64 {
     words[at + 1].parse().expect("a number")
 }
 
-#[test]
-fn the_straight_and_curved_stents_print_as_one_solid_each() {
-    // Both paper stents, the flagship in 3MF and the curved one in STL (PrusaSlicer reads both), with their
-    // centrelines for the independent volume check. Here: the STL reads back closed, 2-manifold and in one
-    // piece, standing on z = 0, and its volume is the one the command reported to f32 rounding (1e-6); the
-    // 3MF is a ZIP package (its parts and units: io::threemf's unit test and check_print.py).
-    let dir = test_outputs("print");
+/// `stentkit mesh --print` of each `(design, solid file, overrides)` of `cases`, and its centrelines, into the test-output folder `folder` (for check_print.py). Here: the STL reads back closed,
+/// 2-manifold and in one piece, standing on z = 0, and its volume is the one the command reported to f32
+/// rounding (1e-6); the 3MF is a ZIP package (its parts and units: io::threemf's unit test and check_print.py).
+fn print_solids(folder: &str, cases: &[(&str, &str, &[&str])]) {
+    let dir = test_outputs(folder);
     std::fs::create_dir_all(&dir).expect("folder");
-    for (name, solid) in [
-        ("straight_stent", "straight_print.3mf"),
-        ("curved_stent", "curved_print.stl"),
-    ] {
+    for &(name, solid, sets) in cases {
+        let overrides: Vec<&str> = sets.iter().flat_map(|s| ["--set", s]).collect();
         let file = design(&format!("{name}.yaml"));
         let output = dir.join(solid);
-        let out = stentkit(&["mesh", path_str(&file), "--print", "-o", path_str(&output)]);
+        let mut args = vec!["mesh", path_str(&file), "--print", "-o", path_str(&output)];
+        args.extend(&overrides);
+        let out = stentkit(&args);
         assert!(out.status.success(), "{}", text(&out.stderr));
         let stdout = text(&out.stdout);
         assert!(stdout.contains("print solid: union of"), "{stdout}");
         let prefix = solid.split('_').next().expect("a name");
         let csv = dir.join(format!("{prefix}_centrelines.csv"));
-        let out = stentkit(&["mesh", path_str(&file), "-o", path_str(&csv)]);
+        let mut args = vec!["mesh", path_str(&file), "-o", path_str(&csv)];
+        args.extend(&overrides);
+        let out = stentkit(&args);
         assert!(out.status.success(), "{}", text(&out.stderr));
         let rows = std::fs::read_to_string(&csv).expect("centrelines");
         assert!(rows.lines().nth(1) == Some("rod,point,x,y,z,radius"));
@@ -168,17 +168,52 @@ fn the_straight_and_curved_stents_print_as_one_solid_each() {
 }
 
 #[test]
-fn a_saved_state_of_a_run_prints_as_one_solid() {
-    // The straight stent's final state, re-run from its design (`export`), as a print solid and with its
-    // centrelines, for the same independent checks (its volume against the union of its tubes is
-    // check_print.py's); here one closed body standing on z = 0.
-    let dir = test_outputs("print_export");
-    let run = dir.join("run");
-    run_ok(
-        &design("straight_stent.yaml"),
-        &run,
-        &["--quiet", "--set", "output.recording.enabled=false"],
+fn small_straight_and_curved_stents_print_as_one_solid_each() {
+    // The default tier's version of the paper stents' test below: two crowns each (the curved one on a 20° arc
+    // instead of 45°), the straight one in 3MF and the curved one in STL, with the same checks here and in
+    // check_print.py. Measured with the baseline binary on the loaded 2-core machine: 6 s and 8 s of CPU
+    // instead of the paper stents' minutes.
+    print_solids(
+        "print",
+        &[
+            (
+                "straight_stent",
+                "small-straight_print.3mf",
+                &["stent.crowns=2"],
+            ),
+            (
+                "curved_stent",
+                "small-curved_print.stl",
+                &["stent.crowns=2", "stent.centreline.arc.angle_deg=20"],
+            ),
+        ],
     );
+}
+
+#[test]
+#[ignore = "full size (minutes): run by .ci/run with cargo test --release -- --ignored"]
+fn the_straight_and_curved_stents_print_as_one_solid_each() {
+    // Both paper stents, the flagship in 3MF and the curved one in STL (PrusaSlicer reads both), with their
+    // centrelines for the independent volume check.
+    print_solids(
+        "print_full",
+        &[
+            ("straight_stent", "straight_print.3mf", &[]),
+            ("curved_stent", "curved_print.stl", &[]),
+        ],
+    );
+}
+
+/// The final state of a run of the straight stent with the overrides `sets`, re-run from its design
+/// (`export`, which applies the run's overrides again), as a print solid and with its centrelines, into the
+/// test-output folder `folder` for the same independent checks (its volume against the union of its tubes is
+/// check_print.py's); here one closed body standing on z = 0.
+fn final_state_prints(folder: &str, sets: &[&str]) {
+    let dir = test_outputs(folder);
+    let run = dir.join("run");
+    let mut extra = vec!["--quiet", "--set", "output.recording.enabled=false"];
+    extra.extend(sets.iter().flat_map(|s| ["--set", s]));
+    run_ok(&design("straight_stent.yaml"), &run, &extra);
     let solid = dir.join("final_print.stl");
     let out = stentkit(&[
         "export",
@@ -200,6 +235,18 @@ fn a_saved_state_of_a_run_prints_as_one_solid() {
         path_str(&dir.join("final_centrelines.csv")),
     ]);
     assert!(out.status.success(), "{}", text(&out.stderr));
+}
+
+#[test]
+fn a_saved_state_of_a_small_run_prints_as_one_solid() {
+    // The default tier's version of the test below: the straight stent with two crowns.
+    final_state_prints("print_export", &["stent.crowns=2"]);
+}
+
+#[test]
+#[ignore = "full size (minutes): run by .ci/run with cargo test --release -- --ignored"]
+fn a_saved_state_of_a_run_prints_as_one_solid() {
+    final_state_prints("print_export_full", &[]);
 }
 
 #[test]

@@ -10,7 +10,9 @@
 //! Most designs here are the 45° bend (`designs/bend45.yaml`: one arc patch `bend` of 20 control points,
 //! clamped at node `root`, loaded at node `tip`), changed in one place.
 
-use crate::common::{design_text, model_from_text, node_displacement, node_index, replace_line};
+use crate::common::{
+    design_text, edit, model_from_text, node_displacement, node_index, replace_line,
+};
 use crate::outputs::{path_str, stentkit};
 use std::cell::{Cell, RefCell};
 use std::ops::ControlFlow;
@@ -30,9 +32,7 @@ fn bend45() -> String {
 
 /// `bend45` with `from` replaced by `to` (which must occur).
 fn variant(from: &str, to: &str) -> String {
-    let text = bend45();
-    assert!(text.contains(from), "`{from}` in bend45");
-    text.replacen(from, to, 1)
+    edit(&bend45(), from, to)
 }
 
 #[test]
@@ -41,9 +41,15 @@ fn a_non_finite_residual_is_located_in_its_equation() {
     // of node `tip` are scaled by E A, so their normalised residual overflows to infinity in the very first
     // assembly — at the equation where the load enters, force equilibrium of `tip` along its third axis. The
     // failure must say so (it would not if the location were lost, or a different row were blamed).
-    let text = variant("E_inf: 1.0e7", "E_inf: 1.0e-2")
-        .replace("[[0, 0], [1, 600]]", "1.0e307")
-        .replace("step: 0.1}", "step: 0.1, min_step: 0.1}");
+    let text = edit(
+        &edit(
+            &variant("E_inf: 1.0e7", "E_inf: 1.0e-2"),
+            "[[0, 0], [1, 600]]",
+            "1.0e307",
+        ),
+        "step: 0.1}",
+        "step: 0.1, min_step: 0.1}",
+    );
     let design = parse_design(&text, Path::new("overflow.yaml")).expect("a valid design");
     let mut sim = Simulation::new(&design.model).expect("simulation");
     let error = sim.run(&mut []).expect_err("the step cannot converge");
@@ -296,16 +302,19 @@ fn a_tolerance_below_round_off_ends_in_bounded_iterations() {
         "{}solver: {{tolerance: 1.0e-12}}\n",
         design_text("bend45.yaml")
     );
-    let shifted = replace_line(
+    let shifted = edit(
         &replace_line(
-            &reported,
-            "force:",
-            "force: [0, 0, [[0, 0], [0.5, 0], [1, 600]]]",
+            &replace_line(
+                &reported,
+                "force:",
+                "force: [0, 0, [[0, 0], [0.5, 0], [1, 600]]]",
+            ),
+            "time:",
+            "time: {end: 1.0, step: 0.1, min_step: 1.0e-6}",
         ),
-        "time:",
-        "time: {end: 1.0, step: 0.1, min_step: 1.0e-6}",
-    )
-    .replace("tolerance: 1.0e-12", "tolerance: 1.0e-13");
+        "tolerance: 1.0e-12",
+        "tolerance: 1.0e-13",
+    );
     for (name, text, tolerance) in [
         ("1e-12", reported, "1e-12"),
         ("1e-13 from t = 0.5", shifted, "1e-13"),
@@ -635,10 +644,10 @@ fn planned_steps_are_the_steps_a_run_takes() {
         (bend45(), 10, 0),
         (variant("time: {", table), 8, 4),
         (
-            variant("time: {", table).replacen(
+            edit(
+                &variant("time: {", table),
                 "output:\n",
                 "output:\n  snapshots: {times: [0.123, 0.5]}\n",
-                1,
             ),
             7,
             6,
@@ -759,14 +768,12 @@ fn two_rings_per_patch_draw_a_rolled_up_beam() {
     // 10 the beam is a half circle: both end sections contain the chord between them, and the run used to stop
     // there ("stopped", exit 1, "section 0 is not transverse" printed twice). Now the rings are tilted to 60°
     // from the chord and the run completes with all 21 snapshots.
-    let text =
-        std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join("designs/rollup.yaml"))
-            .expect("rollup")
-            .replacen(
-                "output:\n",
-                "output:\n  snapshots: {rings: 2, every: 1, formats: [stl, obj]}\n  recording: {mesh_rings: 2}\n",
-                1,
-            );
+    let text = edit(
+        &std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join("designs/rollup.yaml"))
+            .expect("rollup"),
+        "output:\n",
+        "output:\n  snapshots: {rings: 2, every: 1, formats: [stl, obj]}\n  recording: {mesh_rings: 2}\n",
+    );
     let dir = crate::outputs::test_outputs("two_rings");
     std::fs::create_dir_all(&dir).expect("folder");
     let file = dir.join("rollup_two_rings.yaml");

@@ -8,7 +8,7 @@
 //! about a second and a half of solving: long enough to be killed in the middle), with checkpoints every
 //! 0.1 s of wall time (`--checkpoint-every`, a test interval; the default is 60 s). Exact comparisons.
 
-use crate::common::{design_text, replace_line};
+use crate::common::{design_text, edit, replace_line};
 use crate::outputs::{check_recording, path_str, stentkit, summary, text};
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
@@ -220,7 +220,7 @@ fn resuming_the_wrong_run_is_refused_with_status_2() {
     // The same design with another load: another model too.
     let changed = root.join("changed.yaml");
     let text = std::fs::read_to_string(&design).expect("design");
-    std::fs::write(&changed, text.replace("delta_r: 15", "delta_r: 14")).expect("written");
+    std::fs::write(&changed, edit(&text, "delta_r: 15", "delta_r: 14")).expect("written");
     let (code, stderr) = resume(&changed, &dir);
     assert_eq!(code, Some(2), "{stderr}");
     // A folder that is not a run folder, and one that does not exist.
@@ -252,7 +252,7 @@ fn resuming_the_wrong_run_is_refused_with_status_2() {
     assert_eq!(out.status.code(), Some(0));
     let summary_path = short.join("summary.json");
     let s = std::fs::read_to_string(&summary_path).expect("summary");
-    std::fs::write(&summary_path, s.replace("\"completed\"", "\"killed\"")).expect("written");
+    std::fs::write(&summary_path, edit(&s, "\"completed\"", "\"killed\"")).expect("written");
     let (code, stderr) = resume(&bend, &short);
     assert_eq!(code, Some(2), "{stderr}");
     assert!(stderr.contains("no checkpoint"), "{stderr}");

@@ -9,6 +9,7 @@
 //! with [`test_outputs`]; folders of refused or setup-interrupted runs (no snapshots by design) live under
 //! [`scratch`], which the script does not read.
 
+use crate::common::edit;
 use crate::outputs::{
     check_history, check_recording, check_snapshots, design, path_str, stentkit, summary,
     test_outputs, text,
@@ -389,10 +390,15 @@ fn sigkill_leaves_a_folder_that_repair_makes_whole() {
 fn a_signal_during_setup_leaves_a_summary_saying_so() {
     let dir = scratch("setup_signal");
     let file = dir.join("big.yaml");
-    let text_ = std::fs::read_to_string(design("straight_stent.yaml"))
-        .expect("design")
-        .replace("crowns: 6", "crowns: 60")
-        .replace("symmetry: quarter", "symmetry: none");
+    let text_ = edit(
+        &edit(
+            &std::fs::read_to_string(design("straight_stent.yaml")).expect("design"),
+            "crowns: 6",
+            "crowns: 60",
+        ),
+        "symmetry: quarter",
+        "symmetry: none",
+    );
     std::fs::write(&file, text_).expect("write");
     let run = dir.join("run");
     let child = spawn_run(&file, &run);
@@ -418,9 +424,11 @@ fn bad_input_exits_with_status_2() {
     let file = dir.join("broken.yaml");
     std::fs::write(
         &file,
-        std::fs::read_to_string(bend45())
-            .expect("design")
-            .replace("E_inf:", "E_infinity:"),
+        edit(
+            &std::fs::read_to_string(bend45()).expect("design"),
+            "E_inf:",
+            "E_infinity:",
+        ),
     )
     .expect("write");
     let out_dir = dir.join("run");
@@ -540,14 +548,15 @@ fn a_full_disk_leaves_every_output_finished_or_removed() {
 fn times_far_from_seconds_are_printed_short() {
     let dir = scratch("huge_time");
     let file = dir.join("huge.yaml");
-    let text_ = std::fs::read_to_string(bend45())
-        .expect("design")
-        .replace(
+    let text_ = edit(
+        &edit(
+            &std::fs::read_to_string(bend45()).expect("design"),
             "time: {end: 1.0, step: 0.1}",
             "time: {end: 1.0e300, step: 1.0e299, min_step: 1.0e299}",
-        )
-        .replace("[[0, 0], [1, 600]]", "[[0, 0], [1.0e300, 6.0e9]]");
-    assert!(text_.contains("1.0e299") && text_.contains("6.0e9"));
+        ),
+        "[[0, 0], [1, 600]]",
+        "[[0, 0], [1.0e300, 6.0e9]]",
+    );
     std::fs::write(&file, text_).expect("write");
     let out = stentkit(&[
         "run",

@@ -2,6 +2,7 @@
 //! `designs/` (wires on their cylinders, joint ends, frames, watertight tubes, node sets) and the symmetry check
 //! (a quarter or half model responds as the full device does), and the block solver against the sparse LU.
 
+use crate::common::edit;
 use std::ops::ControlFlow;
 use std::path::{Path, PathBuf};
 use stentkit::geometry::frame::{FrameField, FrameSettings};
@@ -26,7 +27,7 @@ fn devices() -> Vec<(String, Model)> {
         let text = std::fs::read_to_string(&path).expect("design readable");
         let model = load_design(&path).unwrap_or_else(|e| panic!("{e}")).model;
         out.push((name.to_string(), model));
-        let full = text.replacen("  symmetry:", "  full_model: true\n  symmetry:", 1);
+        let full = edit(&text, "  symmetry:", "  full_model: true\n  symmetry:");
         let model = parse_design(&full, &path)
             .unwrap_or_else(|e| panic!("{e}"))
             .model;

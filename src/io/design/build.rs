@@ -373,7 +373,7 @@ pub fn field_path(field: &Field, dto: &DesignDto) -> String {
     }
 }
 
-/// Longest design name [bytes]: the name is the run folder's name (`runs/<name>`), and 255 bytes is the
+/// Longest design name \[bytes\]: the name is the run folder's name (`runs/<name>`), and 255 bytes is the
 /// longest file name of the usual file systems (ext4, XFS, Btrfs, APFS).
 pub const MAX_NAME_BYTES: usize = 255;
 

@@ -321,7 +321,7 @@ pub struct MaterialDto {
     /// Name (required in `materials`; `material` is named `material` unless it says otherwise).
     #[serde(default)]
     pub name: Option<String>,
-    /// Equilibrium modulus E∞ [stress], ≥ 0.
+    /// Equilibrium modulus E∞ \[stress\], ≥ 0.
     #[serde(rename = "E_inf")]
     pub e_inf: NonNegative,
     /// Maxwell branches `[E_α, τ_G,α]`.
@@ -348,7 +348,7 @@ pub struct WlfDto {
     /// C1 [-].
     #[serde(rename = "C1")]
     pub c1: Finite,
-    /// C2 [K].
+    /// C2 \[K\].
     #[serde(rename = "C2")]
     pub c2: Finite,
     /// Glass transition (reference) temperature [°C].
@@ -372,19 +372,19 @@ pub enum IntegratorDto {
 #[derive(Debug, Clone, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct SectionDto {
-    /// Circular section diameter [length].
+    /// Circular section diameter \[length\].
     #[serde(default)]
     pub diameter: Option<Positive>,
-    /// Area [length²].
+    /// Area \[length²\].
     #[serde(default)]
     pub area: Option<Positive>,
-    /// Second moment of area about either section axis [length⁴].
+    /// Second moment of area about either section axis \[length⁴\].
     #[serde(default)]
     pub inertia: Option<Positive>,
-    /// Torsion constant [length⁴].
+    /// Torsion constant \[length⁴\].
     #[serde(default)]
     pub polar: Option<Positive>,
-    /// Diameter of the tube drawn for a section given by properties [length].
+    /// Diameter of the tube drawn for a section given by properties \[length\].
     #[serde(default)]
     pub draw_diameter: Option<Positive>,
     /// Shear correction factor (default: Cowper's value for a solid circle).
@@ -460,7 +460,7 @@ pub struct ArcDto {
     pub start: Vector,
     /// Rotation axis (right-hand rule).
     pub axis: Vector,
-    /// Swept angle [degrees].
+    /// Swept angle \[degrees\].
     pub angle_deg: Finite,
 }
 
@@ -474,7 +474,7 @@ pub struct HelixDto {
     pub pitch: Finite,
     /// Number of turns.
     pub turns: Positive,
-    /// Start angle [degrees].
+    /// Start angle \[degrees\].
     #[serde(default)]
     pub start_deg: Option<Finite>,
     /// Centre of the base circle.
@@ -498,11 +498,11 @@ pub struct SineWireDto {
     pub amplitude: Finite,
     /// Waves per full turn.
     pub waves: Positive,
-    /// Start angle [degrees].
+    /// Start angle \[degrees\].
     pub from_deg: Finite,
-    /// End angle [degrees].
+    /// End angle \[degrees\].
     pub to_deg: Finite,
-    /// Phase [degrees].
+    /// Phase \[degrees\].
     #[serde(default)]
     pub phase_deg: Option<Finite>,
     /// Cylinder centre.
@@ -520,7 +520,7 @@ pub struct SineWireDto {
 #[derive(Debug, Clone, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct JointsDto {
-    /// Join every set of patch ends closer than this [length].
+    /// Join every set of patch ends closer than this \[length\].
     pub tolerance: Positive,
 }
 
@@ -561,7 +561,7 @@ pub struct ConditionDto {
     /// Prescribed displacement components (in the local basis).
     #[serde(default)]
     pub displacement: Option<[ComponentValue; 3]>,
-    /// Prescribed rotation components [rad] (in the local basis).
+    /// Prescribed rotation components \[rad\] (in the local basis).
     #[serde(default)]
     pub rotation: Option<[ComponentValue; 3]>,
     /// Force components on free components (dead load).
@@ -755,7 +755,7 @@ pub struct ConfigurationsDto {
 #[derive(Debug, Clone, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct SnapshotsDto {
-    /// Times at which to write a snapshot [time], within [0, time.end]; time stepping lands on each.
+    /// Times at which to write a snapshot \[time\], within [0, time.end]; time stepping lands on each.
     #[serde(default)]
     pub times: Option<Vec<NonNegative>>,
     /// A snapshot every this many converged steps (0: none). Default: none (on an arc-length path, about 20
@@ -831,7 +831,7 @@ pub struct StentDto {
     pub family: StentFamilyDto,
     /// Number of crowns (the rings of a diamond stent).
     pub crowns: usize,
-    /// Crown radius `R` [length]; or give `oversize` to size the stent from a file centreline's lumen radius.
+    /// Crown radius `R` \[length\]; or give `oversize` to size the stent from a file centreline's lumen radius.
     #[serde(default)]
     pub radius: Option<Positive>,
     /// With a file centreline that has the lumen radius: `R` = the segment's mean lumen radius × (1 + oversize).
@@ -841,14 +841,14 @@ pub struct StentDto {
     /// the segment's mean; bridges taper between their crowns.
     #[serde(default)]
     pub taper: bool,
-    /// Crown amplitude `h_c` (half the crown height) [length].
+    /// Crown amplitude `h_c` (half the crown height) \[length\].
     pub amplitude: Positive,
     /// Crests per crown.
     pub peaks: usize,
-    /// Crown spacing `d_c` along the centreline [length].
+    /// Crown spacing `d_c` along the centreline \[length\].
     #[serde(default)]
     pub spacing: Option<Positive>,
-    /// Rotation of each crown about the axis relative to the previous one [degrees] (default `180/peaks`).
+    /// Rotation of each crown about the axis relative to the previous one \[degrees\] (default `180/peaks`).
     #[serde(default)]
     pub rotation_deg: Option<Finite>,
     /// Bridges between consecutive crowns (none when absent).
@@ -900,7 +900,7 @@ pub enum OneOrMany {
 #[derive(Debug, Clone, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct TemperatureFieldDto {
-    /// `X₀` [length] (default the origin).
+    /// `X₀` \[length\] (default the origin).
     #[serde(default)]
     pub origin: Option<Vector>,
     /// The axis along which the temperature varies.
@@ -917,7 +917,7 @@ pub struct TemperatureFieldDto {
 #[derive(Debug, Clone, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct StationDto {
-    /// Its coordinate `ζ` [length].
+    /// Its coordinate `ζ` \[length\].
     pub at: Finite,
     /// Its temperature [°C] as a function of time.
     #[serde(rename = "T")]
@@ -928,9 +928,9 @@ pub struct StationDto {
 #[derive(Debug, Clone, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct FrontDto {
-    /// Its position `ζ_f(t)` [length].
+    /// Its position `ζ_f(t)` \[length\].
     pub position: TimeFn,
-    /// Its width [length] (the temperature goes from 12 % to 88 % of the jump over four widths).
+    /// Its width \[length\] (the temperature goes from 12 % to 88 % of the jump over four widths).
     pub width: Positive,
     /// The temperature behind it (`ζ < ζ_f`) [°C].
     pub behind: TimeFn,
@@ -964,7 +964,7 @@ pub enum BridgeDirectionDto {
 pub struct BridgesDto {
     /// `straight` or `sinusoidal`.
     pub shape: BridgeShapeDto,
-    /// Amplitude `h_b` of a sinusoidal bridge [length].
+    /// Amplitude `h_b` of a sinusoidal bridge \[length\].
     #[serde(default)]
     pub amplitude: Option<Positive>,
     /// Waves over a sinusoidal bridge (default 1; a multiple of 1/2).
@@ -1024,7 +1024,7 @@ pub struct ArcCentrelineDto {
     pub start: Vector,
     /// Rotation axis (right-hand rule).
     pub axis: Vector,
-    /// Swept angle [degrees].
+    /// Swept angle \[degrees\].
     pub angle_deg: Finite,
     /// Direction of ϑ = 0 at the start (default: outward from the centre).
     #[serde(default)]
@@ -1075,7 +1075,7 @@ pub struct FileCentrelineDto {
     pub reference: Option<Vector>,
 }
 
-/// Which polyline of a centreline file: an index or `longest` (read by [`PolylineChoiceVisitor`], which says
+/// Which polyline of a centreline file: an index or `longest` (read by `PolylineChoiceVisitor`, which says
 /// what is allowed when neither fits; an untagged enum would only say that no variant matched).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, JsonSchema)]
 #[serde(untagged)]
@@ -1200,15 +1200,15 @@ pub struct ProgrammeDto {
     /// along the centreline), `bridge_ends` or `symmetry`.
     #[serde(default)]
     pub nodes: Option<String>,
-    /// Radial contraction `Δr` [length] (radial_contraction).
+    /// Radial contraction `Δr` \[length\] (radial_contraction).
     #[serde(default)]
     pub delta_r: Option<Positive>,
     /// The temporary placement (target_shape).
     #[serde(default)]
     pub temporary: Option<TemporaryDto>,
-    /// Ramp `[start, end]` [time]: the target is reached linearly over it and then held.
+    /// Ramp `[start, end]` \[time\]: the target is reached linearly over it and then held.
     pub ramp: [NonNegative; 2],
-    /// Release time [time]: the driven components become free (default: never).
+    /// Release time \[time\]: the driven components become free (default: never).
     #[serde(default)]
     pub release: Option<NonNegative>,
 }
@@ -1223,7 +1223,7 @@ pub struct TemporaryDto {
     /// Or a given centreline (crowns at the same arc lengths).
     #[serde(default, alias = "centerline")]
     pub centreline: Option<CentrelineDto>,
-    /// Crown radius in the temporary shape (default: the permanent one) [length].
+    /// Crown radius in the temporary shape (default: the permanent one) \[length\].
     #[serde(default)]
     pub radius: Option<Positive>,
     /// Place the temporary shape by the rigid motion that best fits its driven nodes to their permanent

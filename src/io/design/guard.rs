@@ -28,7 +28,7 @@
 
 use super::locate::Position;
 
-/// Largest design file stentkit reads [bytes]: 4 MiB. The largest design in the repository
+/// Largest design file stentkit reads \[bytes\]: 4 MiB. The largest design in the repository
 /// (`designs/curved_stent.yaml`) has 4.4 kB; a point-list centreline of 10 000 points or a measured
 /// temperature table of 100 000 rows still fits (about 400 kB and 2 MB). Reading a design of this size takes
 /// about 0.8 s and 170 MB (about 40 bytes of memory per byte of YAML, measured), so the limit also bounds what

@@ -35,7 +35,7 @@ use std::path::{Path, PathBuf};
 /// Which tube meshes of the full device a run writes (the design's `output.snapshots`).
 #[derive(Debug, Clone, PartialEq)]
 pub struct SnapshotSettings {
-    /// Requested snapshot times [time], sorted, within `[0, end]` (the model's record times: steps land on
+    /// Requested snapshot times \[time\], sorted, within `[0, end]` (the model's record times: steps land on
     /// them).
     pub times: Vec<Real>,
     /// A snapshot every this many converged steps; 0 for none.

@@ -7,7 +7,7 @@ use super::issue::{Result, issue};
 use crate::math::Real;
 use crate::math::quote::quoted;
 use crate::model::{StepPlan, TimeSettings};
-/// Memory a design may need before it is refused [bytes]: 8 GB. The estimate ([`estimated_memory`]) is
+/// Memory a design may need before it is refused \[bytes\]: 8 GB. The estimate ([`estimated_memory`]) is
 /// checked before any geometry is generated, so that a typo (`n: 100000000`, `step: 1e-12`) gets an error
 /// naming the field and the estimate instead of exhausting the machine. The paper's curved stent needs about
 /// 0.1 GB; 8 GB leaves two orders of magnitude for refined studies while staying below the memory of a
@@ -54,7 +54,7 @@ pub struct MemoryEstimate {
 }
 
 impl MemoryEstimate {
-    /// All contributions [bytes] (NaN if one is).
+    /// All contributions \[bytes\] (NaN if one is).
     pub fn total(&self) -> Real {
         self.terms.iter().map(|t| t.bytes).sum()
     }
@@ -115,7 +115,7 @@ impl StepCount {
         }
     }
 
-    /// The steps the run takes (`plan`, [`Model::planned_steps`] with nominal step `step`): charged to
+    /// The steps the run takes (`plan`, `Model::planned_steps` with nominal step `step`): charged to
     /// `time.step` unless the steps shortened to land on breakpoints outnumber the full ones, then to the
     /// schedule with the most breakpoints.
     pub fn planned(plan: &StepPlan, step: Real, dto: &DesignDto) -> Self {

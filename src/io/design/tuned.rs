@@ -197,6 +197,14 @@ mod tests {
     #[test]
     fn a_block_style_time_and_per_patch_meshes_are_replaced() {
         let arch = include_str!("../../../designs/circular_arch.yaml");
+        // Each edit below must find its text (a silent no-op would test the unedited design).
+        for from in [
+            "time: {end: 5.0, step: 1.0e-3}",
+            "mesh: {p: 6, n: 20}\n",
+            "angle_deg: 90}",
+        ] {
+            assert!(arch.contains(from), "circular_arch.yaml: `{from}`");
+        }
         let block = arch
             .replace(
                 "time: {end: 5.0, step: 1.0e-3}",

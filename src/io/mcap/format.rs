@@ -10,7 +10,7 @@ use std::fmt::Write as _;
 pub const FRAME_ID: &str = "world";
 
 /// Decimals of recorded coordinates for a device of size `scale` (largest distance of a control point from
-/// the origin) [length]: `max(0, 5 − ⌊log₁₀ scale⌋)`, a resolution `10^(⌊log₁₀ scale⌋ − 5)` between `10⁻⁶` and
+/// the origin) \[length\]: `max(0, 5 − ⌊log₁₀ scale⌋)`, a resolution `10^(⌊log₁₀ scale⌋ − 5)` between `10⁻⁶` and
 /// `10⁻⁵` of the size.
 pub fn coordinate_decimals(scale: Real) -> usize {
     if !(scale > 0.0 && scale.is_finite()) {

@@ -115,7 +115,7 @@ pub enum PatchShape {
         start: Vec3,
         /// Axis (right-hand rule).
         axis: Vec3,
-        /// Angle [rad].
+        /// Angle \[rad\].
         angle: Real,
     },
     /// Any curve, fitted by a spline of the patch's degree and control points ([`fit_curve`]).
@@ -178,9 +178,9 @@ pub struct ConditionSpec {
     pub basis: Option<BasisSpec>,
     /// Hold all six components at zero.
     pub clamp: bool,
-    /// Prescribed displacements `u1, u2, u3` [length].
+    /// Prescribed displacements `u1, u2, u3` \[length\].
     pub displacement: [Option<TimeFunction>; 3],
-    /// Prescribed rotations `θ1, θ2, θ3` [rad].
+    /// Prescribed rotations `θ1, θ2, θ3` \[rad\].
     pub rotation: [Option<TimeFunction>; 3],
     /// Forces on free components (or on prescribed ones after the release).
     pub force: [Option<TimeFunction>; 3],
@@ -262,7 +262,7 @@ pub struct DistributedLoadSpec {
     pub patches: PatchTarget,
     /// Force per unit length [force/length].
     pub force: [TimeFunction; 3],
-    /// Couple per unit length [force].
+    /// Couple per unit length \[force\].
     pub couple: [TimeFunction; 3],
 }
 
@@ -394,7 +394,7 @@ impl TimeSpec {
 pub struct JointRule {
     /// Join every group of coincident free ends automatically (otherwise each is a node of its own).
     pub automatic: bool,
-    /// Distance within which ends coincide [length]; default [`DEFAULT_JOINT_TOLERANCE`] of the model's
+    /// Distance within which ends coincide \[length\]; default [`DEFAULT_JOINT_TOLERANCE`] of the model's
     /// bounding-box diagonal.
     pub tolerance: Option<Real>,
 }
