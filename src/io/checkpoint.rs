@@ -2,12 +2,13 @@
 //! output stood at that step ([`OutputsCheckpoint`]), from which `stentkit run --resume` continues a killed or
 //! interrupted run exactly.
 //!
-//! # Format (version 8; version 7's stabiliser state had no force share and no times of its warnings, version 6 had no snapshot phase, version 5 no stabiliser state, version 4 no load factor per chart sample, version 3 no arc-length state, version 2 had 18 numbers per section law and no
+//! # Format (version 9; version 8 named the model and the output settings by a hash of their `Debug` text and had a fixed
+//! list of outputs, version 7's stabiliser state had no force share and no times of its warnings, version 6 had no snapshot phase, version 5 no stabiliser state, version 4 no load factor per chart sample, version 3 no arc-length state, version 2 had 18 numbers per section law and no
 //! per-material recovery, version 1, before error-controlled stepping, no step-control memory)
 //!
 //! ```text
 //! magic     8 bytes   "STKCKPT\0"
-//! version   u32       8
+//! version   u32       9
 //! length    u64       bytes of the payload
 //! payload   …         the fields below, in order
 //! crc32     u32       CRC-32 (IEEE 802.3, as zlib and PNG) of everything before it
@@ -49,7 +50,7 @@ pub const FILE_NAME: &str = crate::io::run_folder::CHECKPOINT_FILE;
 const MAGIC: &[u8; 8] = b"STKCKPT\0";
 
 /// The format version this build writes and reads.
-pub const VERSION: u32 = 8;
+pub const VERSION: u32 = 9;
 
 /// Bytes before the payload: magic, version, length.
 const HEADER: usize = 8 + 4 + 8;
@@ -123,10 +124,18 @@ pub enum CheckpointFileError {
     },
 }
 
-/// The fingerprint of the outputs' settings of a design (as the model's,
-/// [`crate::solver::simulation::model_fingerprint`]: FNV-1a of the `Debug` text).
+/// The version of the output settings' description hashed by [`settings_fingerprint`]: raised when its form
+/// changes (as [`crate::model::fingerprint::VERSION`] is for the model's).
+pub const SETTINGS_DESCRIPTION_VERSION: u32 = 1;
+
+/// The fingerprint of the outputs' settings of a design: as the model's ([`crate::model::fingerprint`]), a
+/// hash of their serialised, versioned description (every field of [`super::design::OutputSettings`]).
 pub fn settings_fingerprint(settings: &super::design::OutputSettings) -> u64 {
-    crate::solver::simulation::checkpoint::debug_fingerprint(settings)
+    crate::model::fingerprint::fingerprint_of(
+        "stentkit output settings",
+        SETTINGS_DESCRIPTION_VERSION,
+        settings,
+    )
 }
 
 /// Writes `checkpoint` to `path` atomically (a temporary in the same folder, synced, renamed over `path`).
