@@ -39,7 +39,7 @@ pub const RUN: Messages = Messages {
 /// A sweep's messages (`cli::sweep`).
 pub const SWEEP: Messages = Messages {
     first: "no new variant is prepared or started; the running ones finish their files and stop (the same command continues the sweep)",
-    second: "still waiting for the running variants (a third signal quits the sweep; they finish on their own)",
+    second: "still waiting for the running variants (a third signal quits the sweep and them; the same command continues them)",
 };
 
 /// Starts the thread that receives SIGINT, SIGTERM and SIGHUP for the rest of the process, with a run's
