@@ -7,13 +7,15 @@
 //! ## Layers
 //!
 //! Dependencies point one way, left to right never imported from the right:
-//! `math → geometry → material → model → solver → post → io → study → sweep → cli`, and no two modules import each
+//! `math → geometry → material → model → solver → post → io → study → run → sweep → cli`, and no two modules import each
 //! other, directly or through others (`scripts/module_cycles.py`, run by CI, checks both from the source).
 //! `math`, `geometry`, `material`, `model`, `solver` and `post` are pure: no files, no printing, no serde.
 //! `study` writes no file and prints nothing either, but sits above `io`: it re-builds designs whose geometry it
 //! varies through `io::design` and draws its results as `io::chart` charts, which `cli` writes. `sweep` owns a
 //! sweep folder's files and asks Slurm (`sbatch`, `squeue`) about its jobs; the processes that run variants are
-//! `cli`'s.
+//! `cli`'s. `run` is a run as a library call: the recorders of a run folder in one registry, the heartbeat,
+//! checkpoints and resume, with the interruption and the console passed in; `cli` parses, prints and maps
+//! signals onto it.
 //!
 //! | module | owns |
 //! |---|---|
@@ -25,6 +27,7 @@
 //! | [`post`] | the full device from a (symmetry-reduced) model or state: sampled shapes, mirror copies, tube meshes |
 //! | [`io`] | YAML design files (a translation into [`model::builder`] calls); writers of STL/OBJ, the run folder, checkpoints, charts |
 //! | [`study`] | accuracy against cost: scenarios, exact references, error measures and fits, sweeps over variants of a model |
+//! | [`run`] | a run of a design into its run folder: the recorders ([`run::recorder::RECORDERS`]), summary, heartbeat, checkpoints, resume, the disk check; interruption and console passed in |
 //! | [`sweep`] | families of variants of a design: swept parameters, the sweep folder and its variants' states, their metrics, `sweep.csv` and charts, the Slurm batch script |
 //! | [`cli`] | the `stentkit` command line |
 //!
@@ -49,6 +52,7 @@ pub mod material;
 pub mod math;
 pub mod model;
 pub mod post;
+pub mod run;
 pub mod solver;
 pub mod study;
 pub mod sweep;

@@ -583,15 +583,7 @@ pub fn error_text(error: &anyhow::Error) -> String {
     crate::math::quote::shortened_numbers(&text).into_owned()
 }
 
-/// A time for messages: at most 9 decimals, trailing zeros dropped (`0.1`, not `0.10000000000000005`).
-pub fn short_time(t: crate::math::Real) -> String {
-    // Far from the seconds a run spans (1e300 after a typo), fixed-point would print hundreds of digits.
-    if !(1e-9..1e9).contains(&t.abs()) && t != 0.0 {
-        return crate::math::Short(t).to_string();
-    }
-    let s = format!("{t:.9}");
-    s.trim_end_matches('0').trim_end_matches('.').to_string()
-}
+pub use crate::math::quote::short_time;
 
 /// Runs the command line and returns the process exit code.
 pub fn main() -> ExitCode {

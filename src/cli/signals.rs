@@ -8,18 +8,17 @@
 //!   recording is closed, the charts drawn and `summary.json` written.
 //! - A third quits at once (exit status 130); `stentkit repair DIR` then finishes the folder.
 //!
-//! A dedicated thread receives the signals (signal-hook's iterator), so nothing here runs in a signal handler.
-//! SIGKILL cannot be caught: what it leaves is made useful by the periodic summary and chunk flushes
-//! (`cli::run`) and by `stentkit repair`.
+//! A dedicated thread receives the signals (signal-hook's iterator), so nothing here runs in a signal handler;
+//! it passes each on as a request to [`INTERRUPT`], the [`crate::run::Interrupt`] a run of this process is
+//! given. SIGKILL cannot be caught: what it leaves is made useful by the periodic summary and chunk flushes
+//! ([`crate::run`]) and by `stentkit repair`.
 
+use crate::run::Interrupt;
 use signal_hook::consts::{SIGHUP, SIGINT, SIGTERM};
 use std::sync::Once;
-use std::sync::atomic::{AtomicI32, AtomicUsize, Ordering};
 
-/// Signals received so far.
-static COUNT: AtomicUsize = AtomicUsize::new(0);
-/// The first signal received (0: none).
-static FIRST: AtomicI32 = AtomicI32::new(0);
+/// The signals received, as requests to stop: what `stentkit run` and the sweep's workers are given.
+pub static INTERRUPT: Interrupt = Interrupt::new();
 static INSTALL: Once = Once::new();
 
 /// What the first and second signal make the process do, said when they arrive.
@@ -40,7 +39,7 @@ pub const RUN: Messages = Messages {
 /// A sweep's messages (`cli::sweep`).
 pub const SWEEP: Messages = Messages {
     first: "no new variant is prepared or started; the running ones finish their files and stop (the same command continues the sweep)",
-    second: "still waiting for the running variants (a third signal quits the sweep; they finish on their own)",
+    second: "still waiting for the running variants (a third signal quits the sweep and them; the same command continues them)",
 };
 
 /// Starts the thread that receives SIGINT, SIGTERM and SIGHUP for the rest of the process, with a run's
@@ -63,10 +62,11 @@ pub fn install_with(messages: Messages) {
         let spawned = std::thread::Builder::new()
             .name("stentkit-signals".into())
             .spawn(move || {
+                let mut n = 0;
                 for signal in signals.forever() {
-                    let _ = FIRST.compare_exchange(0, signal, Ordering::SeqCst, Ordering::SeqCst);
-                    let n = COUNT.fetch_add(1, Ordering::SeqCst) + 1;
                     let name = name(signal);
+                    INTERRUPT.request(name);
+                    n += 1;
                     match n {
                         1 => eprintln!("\n{name}: {}", messages.first),
                         2 => eprintln!("{name} again: {}", messages.second),
@@ -87,20 +87,12 @@ pub fn install_with(messages: Messages) {
 
 /// Whether a run was asked to stop (any handled signal received).
 pub fn stop_requested() -> bool {
-    COUNT.load(Ordering::SeqCst) > 0
-}
-
-/// Whether a second signal asked to finish the files at once (skip the optional work).
-pub fn hurry() -> bool {
-    COUNT.load(Ordering::SeqCst) > 1
+    INTERRUPT.requested()
 }
 
 /// The name of the first signal received (`SIGINT`, `SIGTERM`, `SIGHUP`), if any.
 pub fn first() -> Option<&'static str> {
-    match FIRST.load(Ordering::SeqCst) {
-        0 => None,
-        s => Some(name(s)),
-    }
+    INTERRUPT.cause()
 }
 
 fn name(signal: i32) -> &'static str {

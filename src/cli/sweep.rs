@@ -2,9 +2,10 @@
 //! job array, `sweep collect` (sweep.csv and charts), `sweep status`, and `sweep task` (one variant: what each
 //! worker and each array task runs). The sweep folder and the variants' states are [`crate::sweep`]'s.
 //!
-//! Local workers are `stentkit sweep task DIR INDEX` child processes, each in its own process group with
-//! `RAYON_NUM_THREADS` set to the threads per run, their output appended to the variant's `log.txt`. On SIGINT,
-//! SIGTERM or SIGHUP no new variant starts and each running one gets one SIGTERM (it finishes its files and
+//! Local workers are threads of the sweep's process, each running one variant at a time in process through
+//! [`crate::run`] on a rayon pool of the threads per run, its messages appended to the variant's `log.txt` (as
+//! `stentkit sweep task DIR INDEX`, which a Slurm array task runs, prints them). On SIGINT, SIGTERM or SIGHUP no
+//! new variant starts and each running one is asked once to stop (as by one SIGTERM: it finishes its files and
 //! writes a checkpoint); the sweep waits for them, collects, and exits with status 130. A signal while the
 //! designs are read for the disk estimate ends the sweep with nothing written, one while the variants are
 //! prepared ends it after the variant in hand (status 130 both). A rerun continues.
@@ -12,13 +13,13 @@
 use super::{BadInput, Interrupted, signals};
 use crate::io::design::size::human_bytes;
 use crate::math::Real;
+use crate::run::{Console, Interrupt};
 use crate::sweep::collect::{Collected, collect};
 use crate::sweep::slurm::{self, Job, SlurmOptions};
 use crate::sweep::{Parameter, Plan, Prepared, SweepDir, VariantState, disk};
 use anyhow::Context as _;
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use std::path::{Path, PathBuf};
-use std::process::{Child, Command, Stdio};
 use std::time::{Duration, Instant};
 
 /// What `stentkit sweep DESIGN …` was asked.
@@ -164,12 +165,11 @@ pub fn run(design: &Path, options: SweepOptions) -> anyhow::Result<()> {
     Ok(())
 }
 
-/// One running worker.
-struct Worker {
+/// One running worker: a thread running one variant.
+struct Worker<'scope> {
     index: usize,
-    child: Child,
+    thread: std::thread::ScopedJoinHandle<'scope, ()>,
     started: Instant,
-    signalled: bool,
 }
 
 /// A sweep error as the command's: a refused folder or plan is bad input (exit status 2), an I/O error is not.
@@ -200,7 +200,6 @@ fn run_locally(
         return Ok(false);
     }
     eprintln!("{jobs} workers, {threads} thread(s) per run");
-    let exe = std::env::current_exe().context("cannot find the stentkit executable")?;
     let bar = ProgressBar::with_draw_target(Some(todo.len() as u64), ProgressDrawTarget::stderr());
     bar.set_style(
         ProgressStyle::with_template(
@@ -209,108 +208,136 @@ fn run_locally(
         .expect("valid progress template")
         .progress_chars("=> "),
     );
-    let (mut queue, mut running) = (todo.iter().copied(), Vec::<Worker>::new());
-    let (mut done, mut failed) = (0usize, 0usize);
-    loop {
-        let stopping = signals::stop_requested();
-        while !stopping && running.len() < jobs {
-            let Some(index) = queue.next() else {
+    // What the running variants are told when the sweep is signalled: one request, as the one SIGTERM each
+    // worker process was sent (a second would make a run skip its final snapshot).
+    let variants = Interrupt::new();
+    std::thread::scope(|scope| {
+        let (mut queue, mut running) = (todo.iter().copied(), Vec::<Worker<'_>>::new());
+        let (mut done, mut failed) = (0usize, 0usize);
+        loop {
+            let stopping = signals::stop_requested();
+            while !stopping && running.len() < jobs {
+                let Some(index) = queue.next() else {
+                    break;
+                };
+                let variants = &variants;
+                let retry_failed = options.retry_failed;
+                running.push(Worker {
+                    index,
+                    thread: scope.spawn(move || {
+                        run_variant(dir, plan, index, threads, retry_failed, variants)
+                    }),
+                    started: Instant::now(),
+                });
+            }
+            if stopping && !variants.requested() {
+                variants.request("SIGTERM");
+                // What each worker process printed into its log on the SIGTERM it was sent.
+                for w in &running {
+                    let log = dir.log(&plan.variants[w.index].id);
+                    let line = format!("\nSIGTERM: {}\n", signals::RUN.first);
+                    let _ = crate::io::no_follow::open(
+                        &log,
+                        std::fs::OpenOptions::new().create(true).append(true),
+                    )
+                    .and_then(|mut f| std::io::Write::write_all(&mut f, line.as_bytes()));
+                }
+            }
+            let mut k = 0;
+            while k < running.len() {
+                if !running[k].thread.is_finished() {
+                    k += 1;
+                    continue;
+                }
+                let w = running.swap_remove(k);
+                if let Err(panic) = w.thread.join() {
+                    std::panic::resume_unwind(panic);
+                }
+                let id = &plan.variants[w.index].id;
+                let state = dir.state(id);
+                match &state {
+                    VariantState::Completed => done += 1,
+                    VariantState::Failed(_) => failed += 1,
+                    _ => {}
+                }
+                bar.inc(1);
+                bar.suspend(|| {
+                    eprintln!(
+                        "{id} [{}] {} in {:.1} s",
+                        plan.label(w.index),
+                        state.name(),
+                        w.started.elapsed().as_secs_f64()
+                    );
+                });
+            }
+            bar.set_message(format!(
+                "{done} done, {failed} failed, {} running",
+                running.len()
+            ));
+            if running.is_empty() && (stopping || queue.len() == 0) {
                 break;
-            };
-            running.push(Worker {
-                index,
-                child: spawn_task(&exe, dir, plan, index, threads, options.retry_failed)?,
-                started: Instant::now(),
-                signalled: false,
-            });
-        }
-        if stopping {
-            for w in running.iter_mut().filter(|w| !w.signalled) {
-                terminate(&w.child);
-                w.signalled = true;
             }
+            std::thread::sleep(Duration::from_millis(100));
         }
-        let mut k = 0;
-        while k < running.len() {
-            if running[k].child.try_wait()?.is_none() {
-                k += 1;
-                continue;
-            }
-            let w = running.swap_remove(k);
-            let id = &plan.variants[w.index].id;
-            let state = dir.state(id);
-            match &state {
-                VariantState::Completed => done += 1,
-                VariantState::Failed(_) => failed += 1,
-                _ => {}
-            }
-            bar.inc(1);
-            bar.suspend(|| {
-                eprintln!(
-                    "{id} [{}] {} in {:.1} s",
-                    plan.label(w.index),
-                    state.name(),
-                    w.started.elapsed().as_secs_f64()
-                );
-            });
-        }
-        bar.set_message(format!(
-            "{done} done, {failed} failed, {} running",
-            running.len()
-        ));
-        if running.is_empty() && (stopping || queue.len() == 0) {
-            break;
-        }
-        std::thread::sleep(Duration::from_millis(100));
-    }
+    });
     bar.finish_and_clear();
     Ok(signals::stop_requested())
 }
 
-/// Starts `stentkit sweep task DIR INDEX` in its own process group, its output appended to the variant's log.
-fn spawn_task(
-    exe: &Path,
+/// Runs variant `index` in process, on a rayon pool of `threads` threads, its messages appended to the
+/// variant's log (what `stentkit sweep task DIR INDEX` with `RAYON_NUM_THREADS=threads` wrote there, its error
+/// line included).
+fn run_variant(
     dir: &SweepDir,
     plan: &Plan,
     index: usize,
     threads: usize,
     retry_failed: bool,
-) -> anyhow::Result<Child> {
-    use std::os::unix::process::CommandExt as _;
+    interrupt: &Interrupt,
+) {
     let log_path = dir.log(&plan.variants[index].id);
-    let log = crate::io::no_follow::open(
+    let log = match crate::io::no_follow::open(
         &log_path,
         std::fs::OpenOptions::new().create(true).append(true),
-    )
-    .with_context(|| format!("cannot open {}", log_path.display()))?;
-    let mut command = Command::new(exe);
-    command
-        .arg("sweep")
-        .arg("task")
-        .arg(&dir.dir)
-        .arg(index.to_string())
-        .env("RAYON_NUM_THREADS", threads.to_string())
-        .stdin(Stdio::null())
-        .stdout(log.try_clone()?)
-        .stderr(log)
-        // A Ctrl-C at the terminal reaches only the sweep, which passes one SIGTERM on (a second signal would
-        // make a run skip its final snapshot).
-        .process_group(0);
-    if retry_failed {
-        command.arg("--retry-failed");
-    }
-    command
-        .spawn()
-        .with_context(|| format!("cannot start {}", exe.display()))
-}
-
-/// Sends SIGTERM to `child`.
-fn terminate(child: &Child) {
-    if let Ok(pid) = i32::try_from(child.id()) {
-        // SAFETY: kill(2) with a pid this process started and has not yet reaped; no memory is involved.
-        unsafe {
-            libc::kill(pid, libc::SIGTERM);
+    ) {
+        Ok(log) => log,
+        Err(e) => {
+            eprintln!("warning: cannot open {}: {e}", log_path.display());
+            return;
         }
+    };
+    let mut console = super::run::Terminal::new(true, false, super::run::Out::log(log));
+    // The command line a worker process had, as its runs record it.
+    let command = std::env::current_exe()
+        .map(|exe| {
+            let mut args = vec![exe.display().to_string(), "sweep".into(), "task".into()];
+            args.push(dir.dir.display().to_string());
+            args.push(index.to_string());
+            if retry_failed {
+                args.push("--retry-failed".into());
+            }
+            super::run::quoted_command_line(args)
+        })
+        .unwrap_or_else(|_| super::run::command_line());
+    let started = (Instant::now(), command);
+    let result = rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .build()
+        .map_err(anyhow::Error::from)
+        .and_then(|pool| {
+            pool.install(|| {
+                task_with(
+                    &dir.dir,
+                    index,
+                    retry_failed,
+                    started,
+                    &mut console,
+                    interrupt,
+                )
+            })
+        });
+    if let Err(e) = result {
+        console.say(&format!("error: {}", super::error_text(&e)));
     }
 }
 
@@ -368,6 +395,32 @@ fn submit(
 /// [`BadInput`] for an unknown index, a refused design or a failed variant without `retry_failed`; the run's
 /// own errors.
 pub fn task(dir: &Path, index: usize, retry_failed: bool) -> anyhow::Result<()> {
+    signals::install();
+    let mut console = super::run::Terminal::new(true, false, super::run::Out::default());
+    let started = (Instant::now(), super::run::command_line());
+    task_with(
+        dir,
+        index,
+        retry_failed,
+        started,
+        &mut console,
+        &signals::INTERRUPT,
+    )
+}
+
+/// [`task`] started at `started.0` by the command line `started.1`, its messages going to `console`, stopped
+/// by `interrupt` (a local worker's, in process).
+///
+/// # Errors
+/// As [`task`].
+fn task_with(
+    dir: &Path,
+    index: usize,
+    retry_failed: bool,
+    started: (Instant, String),
+    console: &mut dyn Console,
+    interrupt: &Interrupt,
+) -> anyhow::Result<()> {
     let sweep = SweepDir {
         dir: dir.to_path_buf(),
     };
@@ -383,7 +436,10 @@ pub fn task(dir: &Path, index: usize, retry_failed: bool) -> anyhow::Result<()> 
                 plan.variants.len()
             ))
         })?;
-    eprintln!("stentkit sweep task {index}: {id} [{}]", plan.label(index));
+    console.say(&format!(
+        "stentkit sweep task {index}: {id} [{}]",
+        plan.label(index)
+    ));
     if sweep.error(&id).exists() {
         return Err(BadInput(format!(
             "{id}: its design was refused ({})",
@@ -396,7 +452,7 @@ pub fn task(dir: &Path, index: usize, retry_failed: bool) -> anyhow::Result<()> 
     let checkpoint = run_dir.join(crate::io::checkpoint::FILE_NAME).exists();
     let (resume, force) = match &state {
         VariantState::Completed => {
-            eprintln!("{id}: completed earlier");
+            console.say(&format!("{id}: completed earlier"));
             return Ok(());
         }
         VariantState::Failed(why) if !retry_failed => {
@@ -419,7 +475,8 @@ pub fn task(dir: &Path, index: usize, retry_failed: bool) -> anyhow::Result<()> 
         time_tolerance: None,
         sets: Vec::new(),
     };
-    let result = super::run::run(&sweep.design(&id), options);
+    let result = super::run::run_with(&sweep.design(&id), options, started, console, interrupt)
+        .map(|completed| console.say(&completed.report));
     if let Err(e) = &result
         && !run_dir.join("summary.json").exists()
     {

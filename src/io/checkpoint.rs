@@ -2,7 +2,8 @@
 //! output stood at that step ([`OutputsCheckpoint`]), from which `stentkit run --resume` continues a killed or
 //! interrupted run exactly.
 //!
-//! # Format (version 9; version 8 had no point terms' states, version 7's stabiliser state had no force share and no times of its warnings, version 6 had no snapshot phase, version 5 no stabiliser state, version 4 no load factor per chart sample, version 3 no arc-length state, version 2 had 18 numbers per section law and no
+//! # Format (version 9; version 8 named the model and the output settings by a hash of their `Debug` text, had a fixed
+//! list of outputs and no point terms' states, version 7's stabiliser state had no force share and no times of its warnings, version 6 had no snapshot phase, version 5 no stabiliser state, version 4 no load factor per chart sample, version 3 no arc-length state, version 2 had 18 numbers per section law and no
 //! per-material recovery, version 1, before error-controlled stepping, no step-control memory)
 //!
 //! ```text
@@ -17,8 +18,10 @@
 //! back exactly; a `usize` is a `u64`; a vector or string is its length (`u64`) then its items; an option is a
 //! byte 0/1 then the value. The payload is the model fingerprint of the outputs' settings, the solver's
 //! checkpoint (time, step, step control, state, materials, ramps, gauge, tangent origin, notices, timing, arc-length
-//! state, stabiliser, point terms' states) and the outputs'
-//! positions, in the order [`write()`] writes them.
+//! state, stabiliser, point terms' states) and the outputs: each
+//! recorder's position under its name (bytes in the recorder's own encoding, written and read with this
+//! module's [`Encoder`] and [`Decoder`] by `crate::run::recorder`), the run's totals and each recorder's wall
+//! time, in the order [`write()`] writes them.
 //!
 //! Why this format: a checkpoint must restore every number bit for bit (a text format would need round-trip
 //! formatting for millions of floats and be three times larger); it is read only by the version of stentkit
@@ -28,14 +31,8 @@
 //! beyond `crc32fast`, already in the tree through `mcap`. The solver's checkpoint is plain data and has no
 //! serde derive (the solver layer is pure, DESIGN §2): its encoding lives here.
 
-use super::history::HistoryPosition;
-use super::mcap::RecordingPosition;
-use super::snapshots::Snapshot;
-use super::state::StateSample;
 use crate::material::LAW_NUMBERS;
 use crate::math::{Mat3, Real, Vec3};
-use crate::model::cycle::Phase;
-use crate::post::recovery::Recovery;
 use crate::solver::assembly::{Actions, ReleaseRamp};
 use crate::solver::simulation::adaptive::StepControl;
 use crate::solver::simulation::{ArcState, StabiliserState, TangentOrigin};
@@ -69,22 +66,25 @@ pub struct RunCheckpoint {
 pub struct OutputsCheckpoint {
     /// Fingerprint of the design's output settings (snapshots, recording): a resumed run must write the same.
     pub settings: u64,
-    /// `history.csv`.
-    pub history: HistoryPosition,
-    /// The snapshots written, and the last state the snapshot writer saw `(step, time)`.
-    pub snapshots: Vec<Snapshot>,
-    /// The snapshot writer's last state.
-    pub snapshots_last: Option<(usize, Real)>,
-    /// `run.mcap`.
-    pub recording: RecordingPosition,
-    /// The states collected for the charts.
-    pub samples: Vec<StateSample>,
+    /// Each recorder's position, by its name, in the recorder's own encoding (`crate::run::recorder`: each
+    /// recorder writes and reads its position with an [`Encoder`] and a [`Decoder`]).
+    pub positions: Vec<(String, Vec<u8>)>,
     /// What the run did so far.
     pub totals: RunSummary,
-    /// Wall time spent in each output so far (history, snapshots, mcap, charts) \[s\].
-    pub spent: [Real; 4],
+    /// Wall time spent in each recorder so far, by name \[s\].
+    pub spent: Vec<(String, Real)>,
     /// Wall time of the run so far, over every process that ran it \[s\].
     pub wall_time_s: Real,
+}
+
+impl OutputsCheckpoint {
+    /// The position saved by the recorder named `name`.
+    pub fn position(&self, name: &str) -> Option<&[u8]> {
+        self.positions
+            .iter()
+            .find(|(n, _)| n == name)
+            .map(|(_, bytes)| bytes.as_slice())
+    }
 }
 
 /// Why a checkpoint file cannot be read.
@@ -124,10 +124,18 @@ pub enum CheckpointFileError {
     },
 }
 
-/// The fingerprint of the outputs' settings of a design (as the model's,
-/// [`crate::solver::simulation::model_fingerprint`]: FNV-1a of the `Debug` text).
+/// The version of the output settings' description hashed by [`settings_fingerprint`]: raised when its form
+/// changes (as [`crate::model::fingerprint::VERSION`] is for the model's).
+pub const SETTINGS_DESCRIPTION_VERSION: u32 = 1;
+
+/// The fingerprint of the outputs' settings of a design: as the model's ([`crate::model::fingerprint`]), a
+/// hash of their serialised, versioned description (every field of [`super::design::OutputSettings`]).
 pub fn settings_fingerprint(settings: &super::design::OutputSettings) -> u64 {
-    crate::solver::simulation::checkpoint::debug_fingerprint(settings)
+    crate::model::fingerprint::fingerprint_of(
+        "stentkit output settings",
+        SETTINGS_DESCRIPTION_VERSION,
+        settings,
+    )
 }
 
 /// Writes `checkpoint` to `path` atomically (a temporary in the same folder, synced, renamed over `path`).
@@ -205,11 +213,24 @@ fn decode(bytes: &[u8]) -> Result<RunCheckpoint, Problem> {
 }
 
 /// A decoding problem, before the path is known.
-#[derive(Debug)]
-enum Problem {
+#[derive(Debug, Clone, PartialEq)]
+pub enum Problem {
+    /// No magic at the file's start.
     NotACheckpoint,
+    /// Another version of the format.
     Version(u32),
+    /// What does not add up.
     Damaged(String),
+}
+
+impl std::fmt::Display for Problem {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Problem::NotACheckpoint => write!(f, "not a checkpoint"),
+            Problem::Version(v) => write!(f, "format version {v}"),
+            Problem::Damaged(what) => write!(f, "damaged ({what})"),
+        }
+    }
 }
 
 impl Problem {
@@ -223,50 +244,62 @@ impl Problem {
     }
 }
 
-/// Appends little-endian fields to a byte buffer.
-struct Encoder(Vec<u8>);
+/// Appends little-endian fields to a byte buffer (the format's encoding, module docs).
+#[derive(Debug, Default)]
+pub struct Encoder(pub Vec<u8>);
 
 impl Encoder {
-    fn u8(&mut self, v: u8) {
+    /// A byte.
+    pub fn u8(&mut self, v: u8) {
         self.0.push(v);
     }
-    fn u32(&mut self, v: u32) {
+    /// A `u32`.
+    pub fn u32(&mut self, v: u32) {
         self.0.extend_from_slice(&v.to_le_bytes());
     }
-    fn u64(&mut self, v: u64) {
+    /// A `u64`.
+    pub fn u64(&mut self, v: u64) {
         self.0.extend_from_slice(&v.to_le_bytes());
     }
-    fn usize(&mut self, v: usize) {
+    /// A `usize`, as a `u64`.
+    pub fn usize(&mut self, v: usize) {
         self.u64(v as u64);
     }
-    fn bool(&mut self, v: bool) {
+    /// A flag, as a byte 0/1.
+    pub fn bool(&mut self, v: bool) {
         self.u8(u8::from(v));
     }
-    fn f64(&mut self, v: Real) {
+    /// A float, by its bits.
+    pub fn f64(&mut self, v: Real) {
         self.u64(v.to_bits());
     }
-    fn f64s(&mut self, v: &[Real]) {
+    /// A list of floats.
+    pub fn f64s(&mut self, v: &[Real]) {
         self.usize(v.len());
         for &x in v {
             self.f64(x);
         }
     }
-    fn vec3(&mut self, v: &Vec3) {
+    /// A vector's three components.
+    pub fn vec3(&mut self, v: &Vec3) {
         for &x in v.iter() {
             self.f64(x);
         }
     }
-    fn vec3s(&mut self, v: &[Vec3]) {
+    /// A list of vectors.
+    pub fn vec3s(&mut self, v: &[Vec3]) {
         self.usize(v.len());
         for x in v {
             self.vec3(x);
         }
     }
-    fn str(&mut self, s: &str) {
+    /// A string: its length, then its UTF-8 bytes.
+    pub fn str(&mut self, s: &str) {
         self.usize(s.len());
         self.0.extend_from_slice(s.as_bytes());
     }
-    fn option<T>(&mut self, v: Option<&T>, mut f: impl FnMut(&mut Self, &T)) {
+    /// An option: a flag, then the value written by `f`.
+    pub fn option<T>(&mut self, v: Option<&T>, mut f: impl FnMut(&mut Self, &T)) {
         match v {
             None => self.bool(false),
             Some(x) => {
@@ -275,7 +308,8 @@ impl Encoder {
             }
         }
     }
-    fn list<T>(&mut self, v: &[T], mut f: impl FnMut(&mut Self, &T)) {
+    /// A list: its length, then each item written by `f`.
+    pub fn list<T>(&mut self, v: &[T], mut f: impl FnMut(&mut Self, &T)) {
         self.usize(v.len());
         for x in v {
             f(self, x);
@@ -284,13 +318,35 @@ impl Encoder {
 }
 
 /// Reads little-endian fields from a byte buffer; every read checks the bytes are there.
-struct Decoder<'a> {
+#[derive(Debug)]
+pub struct Decoder<'a> {
     bytes: &'a [u8],
     at: usize,
 }
 
-impl Decoder<'_> {
-    fn take(&mut self, n: usize) -> Result<&[u8], Problem> {
+impl<'a> Decoder<'a> {
+    /// Reads `bytes` from their start.
+    pub fn new(bytes: &'a [u8]) -> Self {
+        Self { bytes, at: 0 }
+    }
+
+    /// Refuses bytes left after the last field.
+    ///
+    /// # Errors
+    /// [`Problem::Damaged`] naming how many are left.
+    pub fn finish(&self) -> Result<(), Problem> {
+        if self.at == self.bytes.len() {
+            Ok(())
+        } else {
+            Err(Problem::Damaged(format!(
+                "{} bytes left after the last field",
+                self.bytes.len() - self.at
+            )))
+        }
+    }
+
+    /// The next `n` bytes.
+    pub fn take(&mut self, n: usize) -> Result<&[u8], Problem> {
         let end = self
             .at
             .checked_add(n)
@@ -302,26 +358,30 @@ impl Decoder<'_> {
         self.at = end;
         Ok(out)
     }
-    fn u8(&mut self) -> Result<u8, Problem> {
+    /// A byte.
+    pub fn u8(&mut self) -> Result<u8, Problem> {
         Ok(self.take(1)?[0])
     }
-    fn u32(&mut self) -> Result<u32, Problem> {
+    /// A `u32`.
+    pub fn u32(&mut self) -> Result<u32, Problem> {
         let b = self.take(4)?;
         Ok(u32::from_le_bytes([b[0], b[1], b[2], b[3]]))
     }
-    fn u64(&mut self) -> Result<u64, Problem> {
+    /// A `u64`.
+    pub fn u64(&mut self) -> Result<u64, Problem> {
         let b = self.take(8)?;
         let mut a = [0u8; 8];
         a.copy_from_slice(b);
         Ok(u64::from_le_bytes(a))
     }
-    fn usize(&mut self) -> Result<usize, Problem> {
+    /// A `usize` (written as a `u64`).
+    pub fn usize(&mut self) -> Result<usize, Problem> {
         let v = self.u64()?;
         usize::try_from(v).map_err(|_| Problem::Damaged(format!("a count of {v}")))
     }
     /// A count of items of at least `item_bytes` each: refused when the rest of the file cannot hold them (so a
     /// damaged count never allocates absurdly).
-    fn count(&mut self, item_bytes: usize) -> Result<usize, Problem> {
+    pub fn count(&mut self, item_bytes: usize) -> Result<usize, Problem> {
         let n = self.usize()?;
         let left = self.bytes.len() - self.at;
         if n.saturating_mul(item_bytes.max(1)) > left {
@@ -331,33 +391,40 @@ impl Decoder<'_> {
         }
         Ok(n)
     }
-    fn bool(&mut self) -> Result<bool, Problem> {
+    /// A flag.
+    pub fn bool(&mut self) -> Result<bool, Problem> {
         match self.u8()? {
             0 => Ok(false),
             1 => Ok(true),
             b => Err(Problem::Damaged(format!("a flag of {b}"))),
         }
     }
-    fn f64(&mut self) -> Result<Real, Problem> {
+    /// A float.
+    pub fn f64(&mut self) -> Result<Real, Problem> {
         Ok(Real::from_bits(self.u64()?))
     }
-    fn f64s(&mut self) -> Result<Vec<Real>, Problem> {
+    /// A list of floats.
+    pub fn f64s(&mut self) -> Result<Vec<Real>, Problem> {
         let n = self.count(8)?;
         (0..n).map(|_| self.f64()).collect()
     }
-    fn vec3(&mut self) -> Result<Vec3, Problem> {
+    /// A vector.
+    pub fn vec3(&mut self) -> Result<Vec3, Problem> {
         Ok(Vec3::new(self.f64()?, self.f64()?, self.f64()?))
     }
-    fn vec3s(&mut self) -> Result<Vec<Vec3>, Problem> {
+    /// A list of vectors.
+    pub fn vec3s(&mut self) -> Result<Vec<Vec3>, Problem> {
         let n = self.count(24)?;
         (0..n).map(|_| self.vec3()).collect()
     }
-    fn str(&mut self) -> Result<String, Problem> {
+    /// A string.
+    pub fn str(&mut self) -> Result<String, Problem> {
         let n = self.count(1)?;
         String::from_utf8(self.take(n)?.to_vec())
             .map_err(|_| Problem::Damaged("a text that is not UTF-8".into()))
     }
-    fn option<T>(
+    /// An option, its value read by `f`.
+    pub fn option<T>(
         &mut self,
         mut f: impl FnMut(&mut Self) -> Result<T, Problem>,
     ) -> Result<Option<T>, Problem> {
@@ -367,7 +434,8 @@ impl Decoder<'_> {
             Ok(None)
         }
     }
-    fn list<T>(
+    /// A list of items of at least `item_bytes` each, read by `f`.
+    pub fn list<T>(
         &mut self,
         item_bytes: usize,
         mut f: impl FnMut(&mut Self) -> Result<T, Problem>,
@@ -615,117 +683,34 @@ fn decode_solver(d: &mut Decoder<'_>) -> Result<Checkpoint, Problem> {
     })
 }
 
-fn encode_sample(e: &mut Encoder, s: &StateSample) {
-    e.usize(s.step);
-    e.f64(s.time);
-    e.f64(s.dt);
-    e.f64(s.temperature);
-    e.f64s(&s.loads);
-    e.usize(s.iterations);
-    e.f64s(&s.residuals);
-    e.usize(s.cuts);
-    e.option(s.error_estimate.as_ref(), |e, v| e.f64(*v));
-    e.option(s.load_factor.as_ref(), |e, v| e.f64(*v));
-    e.vec3s(&s.probes);
-    e.option(s.recovery.as_ref(), |e, r| {
-        e.f64(r.ratio_mean);
-        e.f64(r.ratio_max);
-        e.option(r.delta_r.as_ref(), |e, v| e.f64(*v));
-        e.f64s(&r.by_material);
-    });
-}
-
-fn decode_sample(d: &mut Decoder<'_>) -> Result<StateSample, Problem> {
-    Ok(StateSample {
-        step: d.usize()?,
-        time: d.f64()?,
-        dt: d.f64()?,
-        temperature: d.f64()?,
-        loads: d.f64s()?,
-        iterations: d.usize()?,
-        residuals: d.f64s()?,
-        cuts: d.usize()?,
-        error_estimate: d.option(|d| d.f64())?,
-        load_factor: d.option(|d| d.f64())?,
-        probes: d.vec3s()?,
-        recovery: d.option(|d| {
-            Ok(Recovery {
-                ratio_mean: d.f64()?,
-                ratio_max: d.f64()?,
-                delta_r: d.option(|d| d.f64())?,
-                by_material: d.f64s()?,
-            })
-        })?,
-    })
-}
-
 fn encode_outputs(e: &mut Encoder, o: &OutputsCheckpoint) {
     e.u64(o.settings);
-    e.u64(o.history.bytes);
-    e.usize(o.history.rows);
-    e.option(o.history.last_time.as_ref(), |e, t| e.f64(*t));
-    e.list(&o.snapshots, |e, s| {
-        e.usize(s.step);
-        e.f64(s.time);
-        e.option(s.phase.as_ref(), |e, p| e.str(p.name()));
-        e.list(&s.files, |e, f| e.str(&f.to_string_lossy()));
-        e.usize(s.triangles);
-        e.f64(s.volume);
+    e.list(&o.positions, |e, (name, bytes)| {
+        e.str(name);
+        e.usize(bytes.len());
+        e.0.extend_from_slice(bytes);
     });
-    e.option(o.snapshots_last.as_ref(), |e, (step, time)| {
-        e.usize(*step);
-        e.f64(*time);
-    });
-    e.u32(o.recording.sequence);
-    e.option(o.recording.last.as_ref(), |e, (log_time, step, time)| {
-        e.u64(*log_time);
-        e.usize(*step);
-        e.f64(*time);
-    });
-    e.option(o.recording.last_mesh.as_ref(), |e, step| e.usize(*step));
-    e.list(&o.samples, encode_sample);
     let t = &o.totals;
     for v in [t.steps, t.iterations, t.cuts, t.rejected, t.factorisations] {
         e.usize(v);
     }
     e.f64(t.time);
     e.bool(t.stopped);
-    for s in o.spent {
-        e.f64(s);
-    }
+    e.list(&o.spent, |e, (name, s)| {
+        e.str(name);
+        e.f64(*s);
+    });
     e.f64(o.wall_time_s);
 }
 
 fn decode_outputs(d: &mut Decoder<'_>) -> Result<OutputsCheckpoint, Problem> {
     Ok(OutputsCheckpoint {
         settings: d.u64()?,
-        history: HistoryPosition {
-            bytes: d.u64()?,
-            rows: d.usize()?,
-            last_time: d.option(|d| d.f64())?,
-        },
-        snapshots: d.list(40, |d| {
-            Ok(Snapshot {
-                step: d.usize()?,
-                time: d.f64()?,
-                phase: d.option(|d| {
-                    let name = d.str()?;
-                    Phase::parse(&name).ok_or_else(|| {
-                        Problem::Damaged(format!("an unknown snapshot phase `{name}`"))
-                    })
-                })?,
-                files: d.list(8, |d| Ok(PathBuf::from(d.str()?)))?,
-                triangles: d.usize()?,
-                volume: d.f64()?,
-            })
+        positions: d.list(16, |d| {
+            let name = d.str()?;
+            let n = d.count(1)?;
+            Ok((name, d.take(n)?.to_vec()))
         })?,
-        snapshots_last: d.option(|d| Ok((d.usize()?, d.f64()?)))?,
-        recording: RecordingPosition {
-            sequence: d.u32()?,
-            last: d.option(|d| Ok((d.u64()?, d.usize()?, d.f64()?)))?,
-            last_mesh: d.option(|d| d.usize())?,
-        },
-        samples: d.list(64, decode_sample)?,
         totals: RunSummary {
             steps: d.usize()?,
             iterations: d.usize()?,
@@ -735,7 +720,7 @@ fn decode_outputs(d: &mut Decoder<'_>) -> Result<OutputsCheckpoint, Problem> {
             time: d.f64()?,
             stopped: d.bool()?,
         },
-        spent: [d.f64()?, d.f64()?, d.f64()?, d.f64()?],
+        spent: d.list(16, |d| Ok((d.str()?, d.f64()?)))?,
         wall_time_s: d.f64()?,
     })
 }
@@ -835,47 +820,10 @@ mod tests {
         };
         let outputs = OutputsCheckpoint {
             settings: 42,
-            history: HistoryPosition {
-                bytes: 1234,
-                rows: 10,
-                last_time: Some(0.9),
-            },
-            snapshots: vec![Snapshot {
-                step: 0,
-                time: 0.0,
-                phase: Some(Phase::Initial),
-                files: vec![
-                    "snapshots/t0.000_initial.stl".into(),
-                    "snapshots/t0.000_initial.obj".into(),
-                ],
-                triangles: 88,
-                volume: 1.5,
-            }],
-            snapshots_last: Some((9, 0.9)),
-            recording: RecordingPosition {
-                sequence: 20,
-                last: Some((900_000_000, 9, 0.9)),
-                last_mesh: Some(0),
-            },
-            samples: vec![StateSample {
-                step: 1,
-                time: 0.1,
-                dt: 0.1,
-                temperature: 90.0,
-                loads: vec![1.0],
-                iterations: 3,
-                residuals: vec![1e-3, 1e-11],
-                cuts: 0,
-                error_estimate: Some(2.5e-4),
-                load_factor: Some(0.5),
-                probes: vec![Vec3::new(1.0, 2.0, 3.0)],
-                recovery: Some(Recovery {
-                    ratio_mean: 0.5,
-                    ratio_max: 0.75,
-                    delta_r: None,
-                    by_material: vec![0.25, 0.125],
-                }),
-            }],
+            positions: vec![
+                ("history".into(), vec![1, 2, 3, 0, 255]),
+                ("nothing".into(), Vec::new()),
+            ],
             totals: RunSummary {
                 steps: 9,
                 iterations: 30,
@@ -885,7 +833,7 @@ mod tests {
                 time: 0.9,
                 stopped: false,
             },
-            spent: [0.1, 0.2, 0.3, 0.4],
+            spent: vec![("history".into(), 0.1), ("charts".into(), 0.4)],
             wall_time_s: 12.5,
         };
         RunCheckpoint { solver, outputs }

@@ -38,7 +38,7 @@ pub struct Configuration {
 }
 
 /// How a panel looks at the device.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
 pub enum View {
     /// From the direction of azimuth −55° and elevation 25° (x3 up).
     Axonometric,

@@ -231,7 +231,7 @@ macro_rules! register_laws {
     ($($(#[$doc:meta])* $variant:ident($law:ty),)+) => {
         /// A material of the model: one of the registered constitutive laws (the list in `material/mod.rs`;
         /// see [`crate::material::constitutive`]).
-        #[derive(Debug, Clone, PartialEq)]
+        #[derive(Debug, Clone, PartialEq, serde::Serialize)]
         pub enum MaterialLaw {
             $($(#[$doc])* $variant($law),)+
         }

@@ -12,7 +12,7 @@ use super::{MaterialError, MaterialNotice, SectionLaw, SectionShape};
 use crate::math::Real;
 
 /// A linear-elastic material (module docs).
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
 pub struct ElasticLaw {
     /// Young's modulus `E` \[stress\].
     modulus: Real,

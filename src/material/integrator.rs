@@ -78,7 +78,7 @@ pub const MAX_STEP_RATE: Real = 1e100;
 const EXP_SERIES_BELOW: Real = 0.5;
 
 /// The scheme advancing the branch strains over a time step.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, serde::Serialize)]
 pub enum Integrator {
     /// Trapezoidal rule (paper Eq. `evol_f_thermal_disc`): second order, A- but not L-stable (fast branches
     /// ring after a jump). The default, as in the paper.

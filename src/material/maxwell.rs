@@ -65,7 +65,7 @@ use crate::math::{Real, Vec3};
 use rayon::prelude::*;
 
 /// The generalized Maxwell/WLF material with its time integrator (module docs).
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
 pub struct MaxwellLaw {
     material: Material,
     integrator: Integrator,

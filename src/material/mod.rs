@@ -235,7 +235,7 @@ pub enum MaterialError {
 
 /// A validated thermo-viscoelastic material: a Prony series, the Poisson ratio shared by all branches and an
 /// optional WLF shift (none: temperature-independent relaxation times).
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
 pub struct Material {
     prony: Prony,
     poisson: Real,

@@ -6,7 +6,7 @@ use crate::math::Real;
 /// One Maxwell branch: a spring `E_α` in series with a dashpot of relaxation time `τ_G,α` at the glass
 /// transition temperature. A plain record; it is validated as part of a [`Prony`] series, which knows its
 /// index.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
 pub struct PronyBranch {
     /// Branch modulus `E_α` \[stress\], `> 0`.
     pub modulus: Real,
@@ -15,7 +15,7 @@ pub struct PronyBranch {
 }
 
 /// A validated Prony series: equilibrium modulus `E∞ ≥ 0` and `m ≥ 0` branches (`m = 0`: linear elastic).
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
 pub struct Prony {
     e_inf: Real,
     branches: Vec<PronyBranch>,

@@ -22,7 +22,7 @@ use crate::math::{Mat3, Real, Vec3};
 use std::f64::consts::PI;
 
 /// How the transverse-shear correction factor `k_s` is chosen.
-#[derive(Debug, Clone, Copy, PartialEq, Default)]
+#[derive(Debug, Clone, Copy, PartialEq, Default, serde::Serialize)]
 pub enum ShearFactor {
     /// Cowper's factor for a solid circle, `k_s = 6(1+ν)/(7+6ν)` (G. R. Cowper, *The shear coefficient in
     /// Timoshenko's beam theory*, J. Appl. Mech. 33 (1966) 335–340, Table 1); `0.8886` at `ν = 0.33`.
@@ -43,7 +43,7 @@ impl ShearFactor {
 }
 
 /// A validated solid circular cross-section.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
 pub struct CircularSection {
     diameter: Real,
     shear_factor: ShearFactor,
@@ -105,7 +105,7 @@ impl CircularSection {
 /// A cross-section given by its properties rather than its shape: for verification problems stated in terms
 /// of `A`, `I`, `J` and `k_s` (e.g. the unit square section of Bathe & Bolourchi's 45° bend). Both bending
 /// axes share `I`.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
 pub struct SectionProperties {
     /// Area `A` \[length²\].
     pub area: Real,
@@ -120,7 +120,7 @@ pub struct SectionProperties {
 }
 
 /// A rod cross-section: a solid circle, or given properties.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
 pub enum Section {
     /// A solid circle (the devices' wires).
     Circular(CircularSection),

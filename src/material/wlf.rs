@@ -30,7 +30,7 @@ use crate::math::Real;
 pub const MAX_C1: Real = 300.0;
 
 /// Validated WLF constants: `C1 > 0` \[-\], `C2 > 0` \[K\], reference (glass-transition) temperature `Tg` \[°C\].
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
 pub struct Wlf {
     c1: Real,
     c2: Real,

@@ -16,9 +16,10 @@ type Hom = Vector4<Real>;
 
 /// A NURBS curve `c(u) = Σ R_j(u) p_j` with control points `p_j` and positive weights `w_j` (all 1 for a
 /// plain B-spline).
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
 pub struct NurbsCurve {
     knots: KnotVector,
+    #[serde(serialize_with = "crate::math::serial::components")]
     points: Vec<Vec3>,
     weights: Vec<Real>,
 }

@@ -9,7 +9,7 @@ use super::{MathError, Real};
 
 /// A validated, non-decreasing knot vector of a degree-`p` spline with `n` basis functions
 /// (`n + p + 1` knots). Clamped (open): the first and last knots repeat `p + 1` times.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
 pub struct KnotVector {
     degree: usize,
     knots: Vec<Real>,

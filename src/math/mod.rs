@@ -11,6 +11,7 @@ pub mod curve;
 pub mod interp;
 pub mod knots;
 pub mod quote;
+pub mod serial;
 pub mod so3;
 
 pub use basis::BasisTable;

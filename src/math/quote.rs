@@ -177,6 +177,16 @@ fn shortened_quotes(message: &str) -> Cow<'_, str> {
     }
 }
 
+/// A time for messages: at most 9 decimals, trailing zeros dropped (`0.1`, not `0.10000000000000005`).
+pub fn short_time(t: super::Real) -> String {
+    // Far from the seconds a run spans (1e300 after a typo), fixed-point would print hundreds of digits.
+    if !(1e-9..1e9).contains(&t.abs()) && t != 0.0 {
+        return super::Short(t).to_string();
+    }
+    let s = format!("{t:.9}");
+    s.trim_end_matches('0').trim_end_matches('.').to_string()
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

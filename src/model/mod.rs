@@ -9,6 +9,7 @@
 
 pub mod builder;
 pub mod cycle;
+pub mod fingerprint;
 pub mod programme;
 pub mod schedule;
 pub mod stent;
@@ -23,7 +24,7 @@ use crate::math::{Mat3, NurbsCurve, Real, Vec3};
 use std::collections::BTreeMap;
 
 /// The consistent unit system a design declares; every length, force, stress and time in the model is in it.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
 pub enum Units {
     /// m, N, Pa, s.
     Si,
@@ -71,7 +72,7 @@ impl Units {
 }
 
 /// One rod patch: a reference centreline with its discretisation, cross-section and material.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
 pub struct Patch {
     /// Unique name (design files refer to its ends as `name.start`, `name.end`).
     pub name: String,
@@ -79,6 +80,7 @@ pub struct Patch {
     pub curve: NurbsCurve,
     /// Optional hint for the first section axis `d2` at `u = 0` (projected normal to the tangent);
     /// `None` lets the frame pick one. Irrelevant to the mechanics of circular sections.
+    #[serde(serialize_with = "crate::math::serial::components")]
     pub normal_hint: Option<Vec3>,
     /// Index into [`Model::sections`].
     pub section: usize,
@@ -89,7 +91,7 @@ pub struct Patch {
 }
 
 /// Which end of a patch.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, serde::Serialize)]
 pub enum End {
     /// `u = 0`; outward sign σ = −1.
     Start,
@@ -124,7 +126,7 @@ impl End {
 }
 
 /// One end of one patch.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, serde::Serialize)]
 pub struct PatchEnd {
     /// Index into [`Model::patches`].
     pub patch: usize,
@@ -134,7 +136,7 @@ pub struct PatchEnd {
 
 /// What is known at one of a node's six components (three translations, three rotations, in the node's
 /// local basis).
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
 pub enum Component {
     /// Neumann: the component is free and loaded by the given force/moment component (dead load, fixed in
     /// space) as a function of time.
@@ -176,9 +178,10 @@ impl Component {
 }
 
 /// The conditions at a node: six components in a local orthonormal basis fixed in space.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
 pub struct NodeConditions {
     /// Local basis: columns are the unit axes `e1, e2, e3` in global coordinates (identity by default).
+    #[serde(serialize_with = "crate::math::serial::components")]
     pub basis: Mat3,
     /// Components `[u1, u2, u3, θ1, θ2, θ3]`: translations along and rotations about `e1, e2, e3`
     /// (loads: forces along and moments about them).
@@ -195,13 +198,14 @@ impl Default for NodeConditions {
 }
 
 /// A point where patch ends meet (a joint), or a single free end.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
 pub struct Node {
     /// Unique name; an end that no declared node names gets the node `patch.start` / `patch.end`.
     pub name: String,
     /// The patch ends joined here (at least one).
     pub ends: Vec<PatchEnd>,
     /// Reference position \[length\].
+    #[serde(serialize_with = "crate::math::serial::components")]
     pub position: Vec3,
     /// Boundary conditions and concentrated loads.
     pub conditions: NodeConditions,
@@ -209,7 +213,7 @@ pub struct Node {
 
 /// A distributed load on a patch: force and couple per unit reference length, fixed in space (dead), each
 /// global component a function of time.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
 pub struct DistributedLoad {
     /// Index into [`Model::patches`].
     pub patch: usize,
@@ -220,7 +224,7 @@ pub struct DistributedLoad {
 }
 
 /// Where a probe reads the displacement.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
 pub enum ProbeLocation {
     /// At a node.
     Node(usize),
@@ -234,7 +238,7 @@ pub enum ProbeLocation {
 }
 
 /// A named point whose displacement is recorded (`P.ux`, `P.uy`, `P.uz` in `history.csv`).
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
 pub struct Probe {
     /// Name used in the output columns.
     pub name: String,
@@ -243,7 +247,7 @@ pub struct Probe {
 }
 
 /// Time stepping settings.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
 pub struct TimeSettings {
     /// End time \[time\] (the run starts at 0).
     pub end: Real,
@@ -308,7 +312,7 @@ impl StepPlan {
 }
 
 /// How the Newton systems are solved (DESIGN §6).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, serde::Serialize)]
 pub enum LinearMethod {
     /// Banded LU per patch interior and a sparse LU of the Schur complement on the patch ends
     /// ([`crate::solver::block`]); the general sparse LU where that is impossible.
@@ -320,7 +324,7 @@ pub enum LinearMethod {
 
 /// What drives the solution along its path: time (the schedules), or the load factor under an arc-length
 /// constraint ([`crate::solver::simulation`] module docs, *Arc-length continuation*).
-#[derive(Debug, Clone, Copy, PartialEq, Default)]
+#[derive(Debug, Clone, Copy, PartialEq, Default, serde::Serialize)]
 pub enum PathControl {
     /// Time steps through the schedules (the default; every material).
     #[default]
@@ -342,7 +346,7 @@ impl PathControl {
 
 /// The arc-length constraint's form (Crisfield, *Non-linear Finite Element Analysis of Solids and Structures*,
 /// vol. 1, §9.3).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, serde::Serialize)]
 pub enum ArcConstraint {
     /// `‖Δx‖² = Δs²`: the load factor takes no part in the arc length (Crisfield's recommendation).
     #[default]
@@ -354,7 +358,7 @@ pub enum ArcConstraint {
 /// Settings of arc-length continuation. The reference load is every load and prescribed value of the design at
 /// `time.end`; the load factor λ scales it (λ = 1: the design's end state). The first increment takes
 /// `time.step / time.end` of the reference load; later arc lengths adapt to Newton's iterations.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
 pub struct ArcLengthSettings {
     /// The path ends where the load factor reaches this value (landing on it exactly).
     pub end_load_factor: Real,
@@ -394,7 +398,7 @@ impl Default for ArcLengthSettings {
 /// it exceeds `limit` of the largest strain energy the run reached, or when a damped step's damping force is
 /// more than `limit` of the loads and reactions on the device (the result is then not quasi-static;
 /// [`crate::solver::simulation::stabilisation`]).
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
 pub struct StabilisationSettings {
     /// Dissipated energy aimed at by the first damped step, as a fraction of the strain energy (in (0, 1):
     /// the builder refuses others).
@@ -420,7 +424,7 @@ impl Default for StabilisationSettings {
 }
 
 /// Newton settings.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
 pub struct SolverSettings {
     /// Convergence tolerance: Newton stops when the normalised increment (translations over the patch length,
     /// rotations in radians) is below it and the normalised residual (strain-like, DESIGN §4) below
@@ -473,7 +477,7 @@ impl Default for SolverSettings {
 }
 
 /// The whole continuous problem.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
 pub struct Model {
     /// Design name.
     pub name: String,
@@ -510,6 +514,7 @@ pub struct Model {
     /// Symmetry planes `(point, unit normal)` of a reduced model; exports mirror the model about each (the
     /// normal points into the modelled side). A patch lying in a plane ([`Model::patch_symmetry_plane`]) is its
     /// own mirror image and carries half its section in the reduced model.
+    #[serde(serialize_with = "crate::math::serial::components")]
     pub symmetry_planes: Vec<(Vec3, Vec3)>,
     /// Times within `(0, end]` at which the state is recorded (snapshots) \[time\]: time stepping lands on each,
     /// as on a schedule breakpoint.
@@ -519,9 +524,10 @@ pub struct Model {
 }
 
 /// A vessel segment: its smoothed centreline and, where the file gave it, the lumen radius along it.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
 pub struct Vessel {
     /// Points along the centreline \[length\].
+    #[serde(serialize_with = "crate::math::serial::components")]
     pub points: Vec<Vec3>,
     /// The lumen radius at each point \[length\].
     pub radius: Option<Vec<Real>>,

@@ -17,7 +17,7 @@ use super::{Component, Node, TimeFunction};
 use crate::math::{Real, Vec3};
 
 /// Which target a programme drives to.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
 pub enum ProgrammeKind {
     /// Radial contraction by `delta_r` \[length\] towards the stent axis.
     RadialContraction {
@@ -29,17 +29,21 @@ pub enum ProgrammeKind {
 }
 
 /// One driven node.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
 pub struct DrivenNode {
     /// Index into [`super::Model::nodes`].
     pub node: usize,
     /// Reference position `P_0` \[length\].
+    #[serde(serialize_with = "crate::math::serial::components")]
     pub position: Vec3,
     /// Displacement at the end of the ramp, `η_target` \[length\] (global components).
+    #[serde(serialize_with = "crate::math::serial::components")]
     pub target: Vec3,
     /// Point of the stent axis at the node's crown station \[length\].
+    #[serde(serialize_with = "crate::math::serial::components")]
     pub axis_point: Vec3,
     /// Unit direction of the stent axis there.
+    #[serde(serialize_with = "crate::math::serial::components")]
     pub axis_direction: Vec3,
     /// Reference distance from the axis (the crown radius `R`) \[length\].
     pub radius: Real,
@@ -49,7 +53,7 @@ pub struct DrivenNode {
 }
 
 /// A programme: nodes driven along a ramp, held, and released.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
 pub struct Programme {
     /// Radial contraction or target shape.
     pub kind: ProgrammeKind,

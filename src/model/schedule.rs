@@ -4,7 +4,7 @@ use crate::math::{Real, Short};
 
 /// A piecewise-linear function of time given by a table of `(t, value)` points with strictly increasing
 /// times; constant before the first and after the last point. A single point is a constant.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
 pub struct TimeFunction {
     points: Vec<(Real, Real)>,
 }

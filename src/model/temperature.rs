@@ -15,7 +15,7 @@ use super::TimeFunction;
 use crate::math::{Real, Vec3};
 
 /// How the temperature varies with `ζ` and time.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
 pub enum Profile {
     /// Schedules at stations `ζ_k` (strictly increasing, at least two): linear in `ζ` between consecutive
     /// stations, `T(ζ, t) = (1 − w) T_k(t) + w T_{k+1}(t)`, `w = (ζ − ζ_k)/(ζ_{k+1} − ζ_k)`; constant beyond the
@@ -37,11 +37,13 @@ pub enum Profile {
 }
 
 /// A temperature field over the reference configuration (module docs).
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
 pub struct TemperatureField {
     /// `X₀` \[length\].
+    #[serde(serialize_with = "crate::math::serial::components")]
     pub origin: Vec3,
     /// `e`, a unit vector.
+    #[serde(serialize_with = "crate::math::serial::components")]
     pub direction: Vec3,
     /// `T(ζ, t)`.
     pub profile: Profile,

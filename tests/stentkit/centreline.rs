@@ -288,24 +288,8 @@ const BRIEF_RUN: [&str; 2] = ["time.end=0.004", "output={snapshots: {times: [0.0
 /// 0.1 mm (1.6 %); the mean over the samples of the lumen differs from the segment's by their spacing.
 #[test]
 fn the_aorta_stents_run_shows_the_vessel_lumen() {
-    let dir = crate::outputs::test_outputs("aorta_stent_vessel");
+    let dir = crate::materials::run("designs/aorta_stent.yaml", "aorta_stent_vessel", &BRIEF_RUN);
     let design = Path::new(env!("CARGO_MANIFEST_DIR")).join("designs/aorta_stent.yaml");
-    let out = crate::outputs::stentkit(&[
-        "run",
-        design.to_str().expect("UTF-8"),
-        "-q",
-        "-o",
-        dir.to_str().expect("UTF-8"),
-        "--set",
-        "time.end=0.004",
-        "--set",
-        "output={snapshots: {times: [0.004]}}",
-    ]);
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
     let recording = std::fs::read(dir.join("run.mcap")).expect("run.mcap");
     assert!(
         recording.windows(b"/vessel".len()).any(|w| w == b"/vessel"),
@@ -816,8 +800,7 @@ fn a_dense_centrelines_lumen_is_bounded_and_counted() {
     let rings = loaded.model.vessel.as_ref().expect("a vessel").points.len();
     assert_eq!(rings, stentkit::io::design::vessel::MAX_LUMEN_RINGS);
     let estimate = stentkit::io::estimate::estimated_disk(&loaded);
-    let sets: Vec<&str> = BRIEF_RUN.iter().flat_map(|set| ["--set", set]).collect();
-    let run = crate::materials::run(design.to_str().expect("UTF-8"), "dense_lumen", &sets);
+    let run = crate::materials::run(design.to_str().expect("UTF-8"), "dense_lumen", &BRIEF_RUN);
     let lumen = std::fs::metadata(run.join("snapshots/vessel_lumen.stl"))
         .expect("the lumen")
         .len();

@@ -2,7 +2,7 @@
 //! recover in the order of their glass transitions, and a heat front recovers a cantilever section by section.
 //! The rod-level references (two materials in series, a temperature gradient) are in `viscoelastic.rs`.
 
-use crate::outputs::{stentkit, test_outputs};
+use crate::outputs::{run_in_process, test_outputs};
 use std::collections::HashMap;
 use std::path::Path;
 
@@ -29,24 +29,13 @@ fn history(dir: &Path) -> Vec<HashMap<String, f64>> {
         .collect()
 }
 
-/// Runs `design` (relative to the crate) into a fresh folder named `name`, with extra arguments.
-pub(crate) fn run(design: &str, name: &str, extra: &[&str]) -> std::path::PathBuf {
+/// Runs `design` (relative to the crate) into a fresh folder named `name` with the `--set` overrides `sets`, in
+/// process ([`crate::outputs::run_in_process`]).
+pub(crate) fn run(design: &str, name: &str, sets: &[&str]) -> std::path::PathBuf {
     let dir = test_outputs(name);
     let design = Path::new(env!("CARGO_MANIFEST_DIR")).join(design);
-    let mut args = vec![
-        "run",
-        design.to_str().expect("UTF-8"),
-        "-q",
-        "-o",
-        dir.to_str().expect("UTF-8"),
-    ];
-    args.extend(extra);
-    let out = stentkit(&args);
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    let (code, stderr) = run_in_process(&design, &dir, sets);
+    assert_eq!(code, 0, "{stderr}");
     dir
 }
 
@@ -63,7 +52,7 @@ fn the_sequential_stents_crowns_recover_in_the_order_of_their_glass_transitions(
     let dir = run(
         "designs/sequential_stent.yaml",
         "sequential_stent",
-        &["--set", "output={snapshots: {times: [15]}}"],
+        &["output={snapshots: {times: [15]}}"],
     );
     let rows = history(&dir);
     let temperature_at = |t: f64| 40.0 + 5.0 * (t - 2.0); // the design's heating ramp, 2–14 s
@@ -121,7 +110,7 @@ fn a_heat_front_recovers_the_cantilever_section_by_section() {
     let dir = run(
         "tests/data/front_bending.yaml",
         "front_bending",
-        &["--set", "output.snapshots={times: [3.0]}"],
+        &["output.snapshots={times: [3.0]}"],
     );
     let rows = history(&dir);
     let at = |t: f64| {

@@ -51,6 +51,50 @@ pub(crate) fn stentkit(args: &[&str]) -> Output {
         .expect("stentkit runs")
 }
 
+/// Runs `design` with the `--set` overrides `sets` into the fresh folder `dir` in process, through
+/// [`stentkit::cli::run::run_with`] and [`stentkit::run`] — no binary spawned: for tests of what a run writes,
+/// where the command line is not what is tested. Returns the exit status `stentkit run -q -o DIR` would end
+/// with ([`stentkit::cli::exit_code`]) and what it would print on stderr: the design's warnings, the run's
+/// lines and the error line (`summary.json`'s `command_line` is the test binary's).
+pub(crate) fn run_in_process(design: &Path, dir: &Path, sets: &[&str]) -> (u8, String) {
+    use stentkit::cli::run::{RunOptions, run_with};
+    let options = RunOptions {
+        output: Some(dir.to_path_buf()),
+        force: false,
+        quiet: true,
+        verbose: false,
+        resume: None,
+        checkpoint_every: 60.0,
+        time_tolerance: None,
+        sets: sets
+            .iter()
+            .map(|s| s.parse().expect("a valid --set argument"))
+            .collect(),
+    };
+    let mut console = stentkit::run::Lines::default();
+    let command = format!(
+        "stentkit run {} -q -o {} (in process)",
+        design.display(),
+        dir.display()
+    );
+    let result = run_with(
+        design,
+        options,
+        (std::time::Instant::now(), command),
+        &mut console,
+        &stentkit::run::Interrupt::new(),
+    );
+    let mut stderr = console.lines();
+    let code = match &result {
+        Ok(_) => 0,
+        Err(e) => {
+            stderr.push(format!("error: {}", stentkit::cli::error_text(e)));
+            stentkit::cli::exit_code(e)
+        }
+    };
+    (code, stderr.iter().map(|l| format!("{l}\n")).collect())
+}
+
 /// Runs `stentkit` with `args`, failing the test if it has not ended within `limit` (the deadline of a hang,
 /// not a timing: it is killed and its stderr so far shown).
 pub(crate) fn stentkit_within(args: &[&str], limit: std::time::Duration) -> Output {

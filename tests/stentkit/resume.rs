@@ -3,7 +3,7 @@
 //! snapshot files, the recording's messages (topic, sequence number, log time, body) all equal — and resuming
 //! with another design, a run that completed, or a folder without a checkpoint is refused with exit status 2.
 //!
-//! Source: the contract (`cli::run` module docs; `solver::simulation::checkpoint` restores the simulation bit
+//! Source: the contract (`stentkit::run` module docs; `solver::simulation::checkpoint` restores the simulation bit
 //! for bit). Design: the straight stent of designs/straight_stent.yaml with two crowns (1301 steps of 2.5 ms,
 //! about a second and a half of solving: long enough to be killed in the middle), with checkpoints every
 //! 0.1 s of wall time (`--checkpoint-every`, a test interval; the default is 60 s). Exact comparisons.
@@ -256,4 +256,101 @@ fn resuming_the_wrong_run_is_refused_with_status_2() {
     let (code, stderr) = resume(&bend, &short);
     assert_eq!(code, Some(2), "{stderr}");
     assert!(stderr.contains("no checkpoint"), "{stderr}");
+}
+
+/// A console that asks the run to stop when the simulation reaches step `at` (an interruption at a chosen,
+/// reproducible point, where a signal's arrives at whatever step the process is in).
+struct StopAt<'a> {
+    at: usize,
+    interrupt: &'a stentkit::run::Interrupt,
+}
+
+impl stentkit::solver::Observer for StopAt<'_> {
+    fn step(
+        &mut self,
+        _: &stentkit::solver::Simulation<'_>,
+        report: &stentkit::solver::StepReport,
+    ) -> std::ops::ControlFlow<()> {
+        if report.step == self.at {
+            self.interrupt.request("a test");
+        }
+        std::ops::ControlFlow::Continue(())
+    }
+}
+
+impl stentkit::run::Console for StopAt<'_> {
+    fn begin(&mut self, _: &stentkit::model::Model, _: usize) {}
+    fn progress(&mut self) -> Option<&mut dyn stentkit::solver::Observer> {
+        Some(self)
+    }
+    fn say(&self, _: &str) {}
+    fn end(&mut self, _: &stentkit::solver::Simulation<'_>) {}
+}
+
+/// The run as a library call ([`stentkit::run::run`], no process, no signal): the two-crown stent stopped by an
+/// [`stentkit::run::Interrupt`] requested at step 400 of 1301 ends with [`stentkit::run::RunError::Interrupted`]
+/// and a checkpoint at that step, and [`stentkit::run::Folder::Resume`] continues it to the uninterrupted
+/// in-process run's files: history.csv byte for byte, the snapshots, the recorded messages (the contract of
+/// `stentkit::run`, as the test above for signals).
+#[test]
+fn an_in_process_run_stopped_by_its_interrupt_resumes_to_the_uninterrupted_result() {
+    use stentkit::run::{Folder, Interrupt, Lines, RunError, RunSettings, run};
+    let root = scratch("in_process");
+    let design = stentkit::io::design::load_design(&two_crown_stent(&root)).expect("design");
+    let full = root.join("full");
+    let settings = RunSettings::new("in-process test");
+    let new = |dir: &Path| Folder::New {
+        dir: dir.to_path_buf(),
+        force: false,
+    };
+    let done = run(
+        &design,
+        new(&full),
+        &settings,
+        &Interrupt::new(),
+        &mut Lines::default(),
+    )
+    .expect("the uninterrupted run completes");
+    assert!(done.report.contains("1301 steps"), "{}", done.report);
+
+    let dir = root.join("stopped");
+    let interrupt = Interrupt::new();
+    let mut console = StopAt {
+        at: 400,
+        interrupt: &interrupt,
+    };
+    let stopped = run(&design, new(&dir), &settings, &interrupt, &mut console);
+    match stopped {
+        Err(RunError::Interrupted(message)) => assert!(
+            message.contains("interrupted by a test after 400 steps"),
+            "{message}"
+        ),
+        other => panic!("not interrupted: {other:?}"),
+    }
+    assert_eq!(summary(&dir)["status"], "interrupted");
+    assert!(dir.join("checkpoint.bin").exists());
+    let mut lines = Lines::default();
+    run(
+        &design,
+        Folder::Resume(dir.clone()),
+        &settings,
+        &Interrupt::new(),
+        &mut lines,
+    )
+    .expect("the resumed run completes");
+    assert!(
+        lines.lines()[0].starts_with(&format!(
+            "stentkit run: resuming {} from its checkpoint at step 400",
+            dir.display()
+        )),
+        "{:?}",
+        lines.lines()
+    );
+    assert_eq!(
+        std::fs::read(dir.join("history.csv")).expect("history"),
+        std::fs::read(full.join("history.csv")).expect("history")
+    );
+    assert_eq!(snapshot_files(&dir), snapshot_files(&full));
+    assert_eq!(messages(&dir), messages(&full));
+    assert!(!dir.join("checkpoint.bin").exists());
 }

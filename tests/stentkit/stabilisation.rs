@@ -183,9 +183,10 @@ fn a_damped_run_continues_bit_for_bit_from_a_checkpoint() {
 /// allowed (`min_step` = step), with `extra` appended to the design, run by `stentkit run` into a fresh folder:
 /// the exit status, stderr and summary.json. Undamped with cuts the bend carries that load to a tip
 /// displacement of (−47.7, −25.1, 68.6), |u| = 87.2 (measured with the design's step of 0.1); undamped with
-/// these steps Newton fails at the first; with `factor: 1e9` every step stalls, is damped and converges.
+/// these steps Newton fails at the first; with `factor: 1e9` every step stalls, is damped and converges. Run
+/// in process ([`crate::outputs::run_in_process`]: the exit status and stderr `stentkit run -q` would give).
 fn overloaded_bend(name: &str, extra: &str) -> (Option<i32>, String, serde_json::Value) {
-    use crate::outputs::{path_str, stentkit, test_outputs, text};
+    use crate::outputs::{run_in_process, test_outputs};
     let root = test_outputs(name);
     std::fs::create_dir_all(&root).expect("folder");
     let file = root.join("bend45_damped.yaml");
@@ -200,11 +201,11 @@ fn overloaded_bend(name: &str, extra: &str) -> (Option<i32>, String, serde_json:
     ) + extra;
     std::fs::write(&file, design).expect("design written");
     let dir = root.join("run");
-    let out = stentkit(&["run", path_str(&file), "-o", path_str(&dir), "--quiet"]);
+    let (code, stderr) = run_in_process(&file, &dir, &[]);
     let summary = std::fs::read_to_string(dir.join("summary.json")).expect("summary.json");
     (
-        out.status.code(),
-        text(&out.stderr),
+        Some(i32::from(code)),
+        stderr,
         serde_json::from_str(&summary).expect("JSON"),
     )
 }

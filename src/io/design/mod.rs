@@ -33,7 +33,7 @@ use std::fmt;
 use std::path::{Path, PathBuf};
 
 /// Which tube meshes of the full device a run writes (the design's `output.snapshots`).
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
 pub struct SnapshotSettings {
     /// Requested snapshot times \[time\], sorted, within `[0, end]` (the model's record times: steps land on
     /// them).
@@ -83,7 +83,7 @@ impl SnapshotSettings {
 }
 
 /// What `run.mcap` records (the design's `output.recording`).
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
 pub struct RecordingSettings {
     /// Whether `run.mcap` is written at all.
     pub enabled: bool,
@@ -110,7 +110,7 @@ impl RecordingSettings {
 }
 
 /// The validated `output:` block besides the probes (which are part of the model).
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
 pub struct OutputSettings {
     /// Snapshot meshes.
     pub snapshots: SnapshotSettings,

@@ -148,42 +148,11 @@ pub enum CheckpointError {
     Solver(#[from] SolverError),
 }
 
-/// A fingerprint of everything in `model` (geometry, materials, conditions, schedules, settings): 64-bit
-/// FNV-1a of its `Debug` text, which writes every number exactly (shortest round-trip form). Two models with
-/// the same fingerprint are the same model for all practical purposes (a collision of two different models
-/// has probability ~2⁻⁶⁴).
+/// The fingerprint of `model` ([`crate::model::fingerprint`]: a hash of its serialised, versioned
+/// description). Two models with the same fingerprint are the same model for all practical purposes (a
+/// collision of two different models has probability ~2⁻⁶⁴).
 pub fn model_fingerprint(model: &Model) -> u64 {
-    debug_fingerprint(model)
-}
-
-/// 64-bit FNV-1a of the `Debug` text of `value` (see [`model_fingerprint`]), for anything else a checkpoint
-/// must match (e.g. a run's output settings).
-pub fn debug_fingerprint(value: &dyn std::fmt::Debug) -> u64 {
-    use std::fmt::Write as _;
-    let mut hasher = Fnv1a::default();
-    // (Writing into a hasher cannot fail.)
-    let _ = write!(hasher, "{value:?}");
-    hasher.0
-}
-
-/// 64-bit FNV-1a (Fowler, Noll, Vo; offset basis and prime from the reference, IETF draft
-/// draft-eastlake-fnv-17, §2): a fast, stable, well-distributed hash, enough to tell models apart.
-struct Fnv1a(u64);
-
-impl Default for Fnv1a {
-    fn default() -> Self {
-        Self(0xcbf2_9ce4_8422_2325)
-    }
-}
-
-impl std::fmt::Write for Fnv1a {
-    fn write_str(&mut self, s: &str) -> std::fmt::Result {
-        for &b in s.as_bytes() {
-            self.0 ^= u64::from(b);
-            self.0 = self.0.wrapping_mul(0x0000_0100_0000_01b3);
-        }
-        Ok(())
-    }
+    crate::model::fingerprint::fingerprint(model)
 }
 
 /// The simulation's record of its current factorisation's origin, kept as it goes (module docs).

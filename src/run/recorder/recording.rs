@@ -1,0 +1,212 @@
+//! `run.mcap` as a recorder: [`crate::io::mcap`]'s recording, its position the last message; resumed by copying
+//! the old recording up to it.
+
+use super::{Finishing, Recorder, RecorderKind, Setup, damaged, upto};
+use crate::io::checkpoint::{Decoder, Encoder, Problem};
+use crate::io::mcap::{McapRecorder, RecordingPosition};
+use crate::io::mcap_salvage::{Salvage, salvage};
+use crate::math::Real;
+use crate::run::RunError;
+use crate::solver::Simulation;
+use std::path::Path;
+
+/// `run.mcap` ([`crate::io::mcap`]), unless the design turns it off (`output.recording.enabled`).
+pub(super) const RECORDING: RecorderKind = RecorderKind {
+    name: "mcap",
+    create: |setup, _| {
+        let design = setup.design;
+        if !design.output.recording.enabled {
+            return Ok(Box::new(None::<McapRecorder>));
+        }
+        setup
+            .folder
+            .manifest()
+            .claim(Path::new(MCAP_FILE))
+            .map_err(RunError::other)?;
+        let recorder = McapRecorder::create(
+            &setup.folder.dir().join(MCAP_FILE),
+            design,
+            setup.info,
+            &design.output.snapshots,
+        )
+        .map_err(RunError::other)?;
+        Ok(Box::new(Some(recorder)))
+    },
+    check_resume: |_, position, _| {
+        decode_recording(position).map_err(|p| damaged(MCAP_FILE, p))?;
+        Ok(())
+    },
+    resume: |setup, _, position| {
+        if !setup.design.output.recording.enabled {
+            return Ok(Box::new(None::<McapRecorder>));
+        }
+        let position = decode_recording(position).map_err(|p| damaged(MCAP_FILE, p))?;
+        Ok(Box::new(Some(resume_recording(setup, &position)?)))
+    },
+};
+
+/// The recording's file name in the run folder.
+const MCAP_FILE: &str = "run.mcap";
+
+fn decode_recording(bytes: &[u8]) -> Result<RecordingPosition, Problem> {
+    let mut d = Decoder::new(bytes);
+    let position = RecordingPosition {
+        sequence: d.u32()?,
+        last: d.option(|d| Ok((d.u64()?, d.usize()?, d.f64()?)))?,
+        last_mesh: d.option(|d| d.usize())?,
+    };
+    d.finish()?;
+    Ok(position)
+}
+
+/// The recording of a resumed run: the killed or interrupted run's `run.mcap` (salvaged, if it was cut short)
+/// is copied up to the checkpoint's last message into a new recording built in a temporary file beside it,
+/// which then replaces it. A recording that cannot be read is started afresh with a warning (its states before
+/// the checkpoint are lost; the other outputs are whole).
+fn resume_recording(
+    setup: &Setup<'_>,
+    position: &RecordingPosition,
+) -> Result<McapRecorder, RunError> {
+    let (design, dir) = (setup.design, setup.folder.dir());
+    let path = dir.join(MCAP_FILE);
+    let temporary = dir.join(crate::io::stl::temporary_name(std::ffi::OsStr::new(
+        MCAP_FILE,
+    )));
+    let mut recorder =
+        McapRecorder::create(&temporary, design, setup.info, &design.output.snapshots)
+            .map_err(RunError::other)?;
+    let previous = salvage(&path)
+        .map_err(RunError::other)
+        .and_then(|_| std::fs::read(&path).map_err(RunError::other));
+    let copied = match previous {
+        Ok(bytes) => recorder
+            .resume(&bytes, &path, position)
+            .map_err(|e| e.to_string()),
+        Err(e) => Err(crate::run::error_text(&e)),
+    };
+    match copied {
+        Ok(n) if n as u64 == u64::from(position.sequence) => {}
+        Ok(n) => setup.console.say(&format!(
+            "warning: {} kept {n} of the {} messages recorded up to the checkpoint; the recording has a gap before it",
+            path.display(),
+            position.sequence
+        )),
+        Err(e) => setup.console.say(&format!(
+            "warning: the recording {} cannot be continued ({e}); it holds the states from the checkpoint on",
+            path.display()
+        )),
+    }
+    recorder.flush_chunk().map_err(RunError::other)?;
+    recorder
+        .rename(&path)
+        .map_err(|e| RunError::context(format!("cannot replace {}", path.display()), e))?;
+    Ok(recorder)
+}
+
+impl Recorder for Option<McapRecorder> {
+    fn name(&self) -> &'static str {
+        RECORDING.name
+    }
+
+    fn position(&self) -> Vec<u8> {
+        let p = self
+            .as_ref()
+            .map(McapRecorder::position)
+            .unwrap_or_default();
+        let mut e = Encoder::default();
+        e.u32(p.sequence);
+        e.option(p.last.as_ref(), |e, (log_time, step, time)| {
+            e.u64(*log_time);
+            e.usize(*step);
+            e.f64(*time);
+        });
+        e.option(p.last_mesh.as_ref(), |e, step| e.usize(*step));
+        e.0
+    }
+
+    fn flush(&mut self) -> Result<(), RunError> {
+        match self {
+            Some(recorder) => recorder.flush_chunk().map_err(RunError::other),
+            None => Ok(()),
+        }
+    }
+
+    fn abandon(&mut self) {
+        if let Some(recorder) = self {
+            let _ = recorder.close();
+        }
+    }
+
+    /// Finishes the recording (or, after a write error or a second signal, closes it and salvages what it
+    /// holds, removing it only if even that fails: a full disk).
+    fn finish(&mut self, sim: &Simulation<'_>, f: &mut Finishing<'_>) {
+        let Some(recorder) = self else {
+            return;
+        };
+        let record_error = recorder.take_error().map(RunError::other);
+        // A writer that failed once refuses every later write: only the salvage can finish the file.
+        let closed = if record_error.is_some() || f.hurry {
+            recorder.close()
+        } else {
+            recorder.finish(sim)
+        };
+        let mcap_path = f.dir.join(MCAP_FILE);
+        let complete_to = format!("complete up to {}", upto(recorder.last_time()));
+        // The first error is the cause; closing after it fails for that reason too.
+        let (closed_bytes, cause) = match closed {
+            Ok(bytes) => (bytes, record_error),
+            Err(e) => (0, Some(record_error.unwrap_or_else(|| RunError::other(e)))),
+        };
+        f.mcap_bytes = match cause {
+            None => {
+                f.state(MCAP_FILE, true, complete_to);
+                closed_bytes
+            }
+            Some(e) => {
+                let text = crate::run::error_text(&e);
+                let bytes = match salvage(&mcap_path) {
+                    Ok(Salvage::Finished {
+                        after,
+                        last_log_time,
+                        ..
+                    }) => {
+                        let t = last_log_time.map(|ns| ns as Real * 1e-9);
+                        f.state(
+                            MCAP_FILE,
+                            true,
+                            format!(
+                                "finalised up to {}; later states not recorded: {text}",
+                                upto(t)
+                            ),
+                        );
+                        after
+                    }
+                    Ok(Salvage::AlreadyValid { bytes }) => {
+                        f.state(
+                            MCAP_FILE,
+                            true,
+                            format!("{complete_to}; later states not recorded: {text}"),
+                        );
+                        bytes
+                    }
+                    Err(salvage_error) => {
+                        let removed =
+                            crate::io::no_follow::remove_inside(f.dir, Path::new(MCAP_FILE))
+                                .unwrap_or(false);
+                        f.state(
+                            MCAP_FILE,
+                            false,
+                            format!(
+                                "incomplete ({text}) and cannot be finished ({salvage_error}){}",
+                                if removed { ": removed" } else { "" }
+                            ),
+                        );
+                        0
+                    }
+                };
+                f.problems.push(e);
+                bytes
+            }
+        };
+    }
+}
