@@ -99,6 +99,16 @@ pub fn run(run_dir: &Path, options: &ExportOptions) -> anyhow::Result<()> {
     let design = load_design_with(&design_path, &overrides)?;
     let model = &design.model;
     let fingerprint = model_fingerprint_text(model);
+    let form = fingerprint.split('-').next().unwrap_or_default();
+    if let Some(ran) = summary["model_fingerprint"].as_str()
+        && ran.split('-').next() != Some(form)
+    {
+        return Err(BadInput(format!(
+            "{}: its summary.json holds a model fingerprint of another form ({ran}; this stentkit writes {form}-…), from a stentkit that fingerprinted models otherwise, so the design cannot be checked against the model that ran: run the design again with this stentkit",
+            run_dir.display()
+        ))
+        .into());
+    }
     if let Some(ran) = summary["model_fingerprint"].as_str()
         && ran != fingerprint
     {

@@ -289,8 +289,8 @@ pub struct RunSummaryFile {
     pub design: String,
     /// The design file as given on the command line.
     pub design_file: String,
-    /// The fingerprint of the model that ran ([`crate::solver::simulation::model_fingerprint`], 16 hex
-    /// digits): `stentkit export` checks the design it re-runs against it.
+    /// The fingerprint of the model that ran ([`model_fingerprint_text`]): `stentkit export` checks the design
+    /// it re-runs against it.
     pub model_fingerprint: String,
     /// The `--set` overrides applied to it, as given.
     #[serde(skip_serializing_if = "Vec::is_empty")]
@@ -422,11 +422,15 @@ pub struct StabilisationSummary {
     pub above_limit: bool,
 }
 
-/// A model's fingerprint as summary.json writes it: 16 hex digits of
-/// [`crate::solver::simulation::model_fingerprint`].
+/// A model's fingerprint as summary.json writes it: `v`, the version of the fingerprint's form
+/// ([`crate::model::fingerprint::VERSION`]), `-` and 16 hex digits of
+/// [`crate::solver::simulation::model_fingerprint`] (`v1-63e8c603b3fbccd4`). The version tells a fingerprint of
+/// another form — a summary written by a stentkit that hashed the model otherwise (before version 1: 16 hex
+/// digits alone) — from one of another model.
 pub fn model_fingerprint_text(model: &Model) -> String {
     format!(
-        "{:016x}",
+        "v{}-{:016x}",
+        crate::model::fingerprint::VERSION,
         crate::solver::simulation::model_fingerprint(model)
     )
 }

@@ -162,6 +162,30 @@ fn a_design_changed_since_the_run_is_not_exported() {
         "{}",
         text(&out.stderr)
     );
+    // A run folder written before the fingerprint became a hash of the serialised model (issue 32 item 5):
+    // its summary.json holds 16 hex digits without the form's version. Its design is unchanged, yet its
+    // fingerprint cannot match; the refusal says why instead of calling it another model.
+    let summary_path = adaptive.join("summary.json");
+    let mut summary: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&summary_path).expect("summary"))
+            .expect("JSON");
+    summary["model_fingerprint"] = serde_json::Value::from("0123456789abcdef");
+    std::fs::write(&summary_path, summary.to_string()).expect("write");
+    let out = stentkit(&[
+        "export",
+        path_str(&adaptive),
+        "--phase",
+        "final",
+        "-o",
+        path_str(&dir.join("old.stl")),
+    ]);
+    assert_eq!(out.status.code(), Some(2), "{}", text(&out.stderr));
+    assert!(
+        text(&out.stderr).contains("holds a model fingerprint of another form (0123456789abcdef; this stentkit writes v1-…)"),
+        "{}",
+        text(&out.stderr)
+    );
+    assert!(!dir.join("old.stl").exists());
 }
 
 #[test]
