@@ -18,7 +18,7 @@
 //! their components ([`crate::math::serial`]), every float in its shortest round-trip form, so that two models
 //! share a description exactly when every number is bit for bit the same (except that NaN and ±∞, which the
 //! builder refuses anywhere they could reach a model, would all be `null`). The hash is 64-bit FNV-1a of those
-//! bytes ([`Fnv1a`]); a collision of two different models has a probability of about 2⁻⁶⁴.
+//! bytes (`Fnv1a`); a collision of two different models has a probability of about 2⁻⁶⁴.
 //!
 //! **Why serialised, and why versioned.** The fingerprint used to hash the model's `Debug` text, so a change
 //! to a `Debug` impl — or a dependency's — changed every fingerprint and refused every checkpoint. The
