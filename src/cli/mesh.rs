@@ -193,7 +193,7 @@ pub(super) fn write_centrelines(
         }
         rods += 1;
     }
-    crate::io::stl::write_bytes_atomically(output, text.as_bytes())
+    crate::io::atomic::write_bytes_atomically(output, text.as_bytes())
         .with_context(|| format!("cannot write {}", output.display()))?;
     println!("wrote {} ({rods} rods)", output.display());
     Ok(())

@@ -88,7 +88,7 @@ pub fn run(dir: &Path) -> anyhow::Result<()> {
             mark_killed(&mut summary, &rows, dir, &listed, mcap_bytes);
             let mut text = serde_json::to_string_pretty(&summary)?;
             text.push('\n');
-            crate::io::stl::write_bytes_atomically(&summary_path, text.as_bytes())
+            crate::io::atomic::write_bytes_atomically(&summary_path, text.as_bytes())
                 .with_context(|| format!("cannot write {}", summary_path.display()))?;
             done.push(format!(
                 "summary.json: status `killed`, the run folder holds steps 0–{} up to t = {} s",

@@ -326,6 +326,6 @@ fn refuse_existing<'a>(
 
 /// Writes `text` to `file` atomically (a link in its place is replaced, not written through).
 fn write(file: &Path, text: &str) -> anyhow::Result<()> {
-    crate::io::stl::write_bytes_atomically(file, text.as_bytes())
+    crate::io::atomic::write_bytes_atomically(file, text.as_bytes())
         .with_context(|| format!("cannot write {}", file.display()))
 }

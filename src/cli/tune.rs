@@ -172,7 +172,7 @@ fn write_tuned(
         design_path.display()
     );
     if target.force {
-        crate::io::stl::write_bytes_atomically(out, text.as_bytes())
+        crate::io::atomic::write_bytes_atomically(out, text.as_bytes())
     } else {
         // `create_new`: a file that appeared since the check is not replaced either.
         std::fs::OpenOptions::new()

@@ -214,7 +214,7 @@ pub fn render_svg(chart: &LineChart) -> Result<String, ChartError> {
 /// Renders the chart and writes it to `path`, atomically (no partial SVG is ever visible).
 pub fn write_svg(chart: &LineChart, path: &Path) -> Result<(), ChartError> {
     let svg = render_svg(chart)?;
-    super::stl::write_bytes_atomically(path, svg.as_bytes()).map_err(|source| ChartError::Io {
+    super::atomic::write_bytes_atomically(path, svg.as_bytes()).map_err(|source| ChartError::Io {
         path: path.to_path_buf(),
         source,
     })

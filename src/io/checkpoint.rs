@@ -27,7 +27,7 @@
 //! formatting for millions of floats and be three times larger); it is read only by the version of stentkit
 //! that wrote it, so a version number that refuses other versions is simpler and safer than a self-describing
 //! schema; the CRC catches a file damaged on disk or copied short (a torn write cannot happen: the file is
-//! written to a temporary and renamed, [`crate::io::stl::write_bytes_atomically`]); and it needs no dependency
+//! written to a temporary and renamed, [`crate::io::atomic::write_bytes_atomically`]); and it needs no dependency
 //! beyond `crc32fast`, already in the tree through `mcap`. The solver's checkpoint is plain data and has no
 //! serde derive (the solver layer is pure, DESIGN §2): its encoding lives here.
 
@@ -153,7 +153,7 @@ pub fn write(path: &Path, checkpoint: &RunCheckpoint) -> std::io::Result<()> {
     e.0[12..HEADER].copy_from_slice(&length.to_le_bytes());
     let crc = crc32fast::hash(&e.0);
     e.u32(crc);
-    super::stl::write_bytes_atomically(path, &e.0)
+    super::atomic::write_bytes_atomically(path, &e.0)
 }
 
 /// Reads the checkpoint at `path`.

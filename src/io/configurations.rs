@@ -324,7 +324,7 @@ pub fn write(
         })?;
         let svg = render(&title, length, initial, &shown, views)?;
         let target = folder.join(&file);
-        super::stl::write_bytes_atomically(&target, svg.as_bytes()).map_err(|source| {
+        super::atomic::write_bytes_atomically(&target, svg.as_bytes()).map_err(|source| {
             ChartError::Io {
                 path: target,
                 source,

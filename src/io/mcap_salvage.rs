@@ -150,7 +150,7 @@ fn cut_in_place(path: &Path, bytes: &[u8]) -> Result<Cut, SalvageError> {
 /// `bytes` is the file's content.
 fn rewrite_indexed(path: &Path, bytes: &[u8]) -> Result<(), Box<dyn std::error::Error>> {
     use ::mcap::records::Record;
-    crate::io::stl::write_atomically(path, |out| {
+    crate::io::atomic::write_atomically(path, |out| {
         let other = |e: ::mcap::McapError| io::Error::other(e.to_string());
         let mut writer: Option<::mcap::Writer<io::Cursor<Vec<u8>>>> = None;
         for record in ::mcap::read::ChunkFlattener::new(bytes).map_err(other)? {

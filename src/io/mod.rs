@@ -2,6 +2,7 @@
 //! charts, summary), SVG charts. What the meshes and recorded centrelines show (the full device mirrored from a
 //! reduced model) is computed in [`crate::post`]; this layer writes it.
 
+pub mod atomic;
 pub mod centreline;
 pub mod chart;
 pub mod checkpoint;

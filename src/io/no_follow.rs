@@ -19,7 +19,7 @@
 //!
 //! The folder the user names (`-o DIR`, `RUN_DIR`) may itself be a link: the user chose that place, as they
 //! choose any path they type. Only what lies inside it is held to the rule. A file written atomically (a
-//! temporary renamed over the target, [`crate::io::stl::write_bytes_atomically`]) replaces a link in its place
+//! temporary renamed over the target, [`crate::io::atomic::write_bytes_atomically`]) replaces a link in its place
 //! and never writes through it, so it needs nothing from here.
 
 use std::ffi::{CString, OsStr};

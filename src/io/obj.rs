@@ -9,7 +9,8 @@ use std::io::{self, Write};
 use std::path::Path;
 
 use crate::geometry::mesh::TriangleMesh;
-use crate::io::stl::{MeshIoError, check_writable, write_atomically};
+use crate::io::atomic::write_atomically;
+use crate::io::stl::{MeshIoError, check_writable};
 
 /// OBJ snapshots ([`super::formats::FORMATS`]): a comment naming the design, step, time and units.
 pub struct Obj;

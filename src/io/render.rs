@@ -447,7 +447,7 @@ pub fn write_png(path: &Path, pixmap: &Pixmap) -> Result<(), RenderError> {
         path: path.to_path_buf(),
         message: e.to_string(),
     })?;
-    super::stl::write_bytes_atomically(path, &bytes).map_err(|e| RenderError::Write {
+    super::atomic::write_bytes_atomically(path, &bytes).map_err(|e| RenderError::Write {
         path: path.to_path_buf(),
         message: e.to_string(),
     })

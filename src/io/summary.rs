@@ -516,7 +516,7 @@ impl RunSummaryFile {
     pub fn write(&self, path: &Path) -> std::io::Result<()> {
         let mut text = serde_json::to_string_pretty(self).map_err(std::io::Error::other)?;
         text.push('\n');
-        super::stl::write_bytes_atomically(path, text.as_bytes())
+        super::atomic::write_bytes_atomically(path, text.as_bytes())
     }
 }
 

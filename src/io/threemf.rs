@@ -11,7 +11,8 @@ use std::io::{self, Seek, Write};
 use std::path::Path;
 
 use crate::geometry::mesh::TriangleMesh;
-use crate::io::stl::{MeshIoError, check_writable, write_atomically};
+use crate::io::atomic::write_atomically;
+use crate::io::stl::{MeshIoError, check_writable};
 use crate::model::Units;
 
 /// 3MF snapshots and print files ([`super::formats::FORMATS`]): the model's title names the design, step and

@@ -240,7 +240,10 @@ pub fn write_polydata(
     probe_points: &[Option<usize>],
     time: Real,
 ) -> std::io::Result<()> {
-    super::stl::write_bytes_atomically(path, polydata(model, fields, probe_points, time).as_bytes())
+    super::atomic::write_bytes_atomically(
+        path,
+        polydata(model, fields, probe_points, time).as_bytes(),
+    )
 }
 
 /// The text of a ParaView collection (`.pvd`) of `entries`: `(time, file relative to the collection)`.
@@ -264,7 +267,7 @@ pub fn collection(entries: &[(Real, String)]) -> String {
 /// # Errors
 /// The I/O error; the target is then left as it was.
 pub fn write_collection(path: &Path, entries: &[(Real, String)]) -> std::io::Result<()> {
-    super::stl::write_bytes_atomically(path, collection(entries).as_bytes())
+    super::atomic::write_bytes_atomically(path, collection(entries).as_bytes())
 }
 
 /// The `(time, file)` entries of a collection's text as [`write_collection`] writes it (the times in full).

@@ -69,7 +69,7 @@ fn resume_recording(
 ) -> Result<McapRecorder, RunError> {
     let (design, dir) = (setup.design, setup.folder.dir());
     let path = dir.join(MCAP_FILE);
-    let temporary = dir.join(crate::io::stl::temporary_name(std::ffi::OsStr::new(
+    let temporary = dir.join(crate::io::atomic::temporary_name(std::ffi::OsStr::new(
         MCAP_FILE,
     )));
     let mut recorder =
