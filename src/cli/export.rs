@@ -99,25 +99,25 @@ pub fn run(run_dir: &Path, options: &ExportOptions) -> anyhow::Result<()> {
     let design = load_design_with(&design_path, &overrides)?;
     let model = &design.model;
     let fingerprint = model_fingerprint_text(model);
-    let form = fingerprint.split('-').next().unwrap_or_default();
-    if let Some(ran) = summary["model_fingerprint"].as_str()
-        && ran.split('-').next() != Some(form)
-    {
-        return Err(BadInput(format!(
-            "{}: its summary.json holds a model fingerprint of another form ({ran}; this stentkit writes {form}-…), from a stentkit that fingerprinted models otherwise, so the design cannot be checked against the model that ran: run the design again with this stentkit",
-            run_dir.display()
-        ))
-        .into());
-    }
     if let Some(ran) = summary["model_fingerprint"].as_str()
         && ran != fingerprint
     {
-        return Err(BadInput(format!(
-            "{}: this design (with the run's overrides) is not the model that ran in {} (fingerprint {fingerprint}, the run's {ran}): restore the design as it ran, or give it with --design",
-            design_path.display(),
-            run_dir.display()
-        ))
-        .into());
+        // The form's version (`v1-…`, io::summary::model_fingerprint_text) tells a run of an earlier stentkit,
+        // which hashed models otherwise, from a run of another model.
+        let form = fingerprint.split('-').next().unwrap_or_default();
+        let why = if ran.split('-').next() == Some(form) {
+            format!(
+                "{}: this design (with the run's overrides) is not the model that ran in {} (fingerprint {fingerprint}, the run's {ran}): restore the design as it ran, or give it with --design",
+                design_path.display(),
+                run_dir.display()
+            )
+        } else {
+            format!(
+                "{}: its summary.json holds a model fingerprint of another form ({ran}; this stentkit writes {form}-…), from a stentkit that fingerprinted models otherwise, so the design cannot be checked against the model that ran: run the design again with this stentkit",
+                run_dir.display()
+            )
+        };
+        return Err(BadInput(why).into());
     }
     // Before the simulation: what drawing the state would cost.
     super::drawing::check_drawing(

@@ -140,14 +140,17 @@ fn a_design_changed_since_the_run_is_not_exported() {
     // A run with `--tol` is re-run at the tolerance its summary records: the same model.
     let adaptive = dir.join("adaptive");
     run_ok(&file, &adaptive, &["--quiet", "--tol", "1e-3"]);
-    let out = stentkit(&[
-        "export",
-        path_str(&adaptive),
-        "--phase",
-        "final",
-        "-o",
-        path_str(&dir.join("adaptive.stl")),
-    ]);
+    let export_final = |name: &str| {
+        stentkit(&[
+            "export",
+            path_str(&adaptive),
+            "--phase",
+            "final",
+            "-o",
+            path_str(&dir.join(name)),
+        ])
+    };
+    let out = export_final("adaptive.stl");
     assert!(out.status.success(), "{}", text(&out.stderr));
     let edited = edit(
         &std::fs::read_to_string(&file).expect("design"),
@@ -171,14 +174,7 @@ fn a_design_changed_since_the_run_is_not_exported() {
             .expect("JSON");
     summary["model_fingerprint"] = serde_json::Value::from("0123456789abcdef");
     std::fs::write(&summary_path, summary.to_string()).expect("write");
-    let out = stentkit(&[
-        "export",
-        path_str(&adaptive),
-        "--phase",
-        "final",
-        "-o",
-        path_str(&dir.join("old.stl")),
-    ]);
+    let out = export_final("old.stl");
     assert_eq!(out.status.code(), Some(2), "{}", text(&out.stderr));
     assert!(
         text(&out.stderr).contains("holds a model fingerprint of another form (0123456789abcdef; this stentkit writes v1-…)"),
