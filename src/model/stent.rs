@@ -15,7 +15,7 @@ use crate::geometry::fit::{FitSettings, best_fit_rigid, fit_curve};
 use crate::geometry::frame::basis_from_unit_axis;
 use crate::geometry::primitives;
 use crate::geometry::stent::{
-    GeneratedPatch, PatchRole, StentFamily, StentGeometry, StentParameter, TemporarySpec, WireEnd,
+    GeneratedPatch, StentFamily, StentGeometry, StentParameter, TemporarySpec, WireEnd,
 };
 use crate::material::{Section, SectionProperties};
 use crate::math::quote::quoted;
@@ -42,15 +42,16 @@ pub struct StentMaterials {
 }
 
 impl StentMaterials {
-    /// The material of a patch of the given role.
-    pub fn of(&self, role: &PatchRole) -> usize {
-        match role {
-            PatchRole::Crown { crown, .. } => match self.crowns.as_slice() {
-                [] => 0,
-                [one] => *one,
-                many => many[*crown],
-            },
-            PatchRole::Bridge { .. } => self.bridges,
+    /// The material of a part of crown `crown` (0-based), or of a connector between crowns (a bridge)
+    /// ([`StentFamily::is_connector`]).
+    pub fn of(&self, crown: usize, connector: bool) -> usize {
+        if connector {
+            return self.bridges;
+        }
+        match self.crowns.as_slice() {
+            [] => 0,
+            [one] => *one,
+            many => many[crown],
         }
     }
 }
@@ -158,7 +159,7 @@ pub fn generate(
         )?;
     }
     let full = sections[0];
-    if let Some(w) = crowns_touch(&geometry, full.diameter()) {
+    if let Some(w) = crowns_touch(&geometry, &family.facing_nodes(&geometry), full.diameter()) {
         warnings.push(w);
     }
     let mut half_section = None;
@@ -168,10 +169,8 @@ pub fn generate(
     let mut folds: Option<(usize, String)> = None;
     let whole = |message: String| BuildError::new(Field::Stent(StentField::Whole), message);
     for g in &geometry.patches {
-        let (p, n) = match g.role {
-            PatchRole::Crown { .. } => mesh.crown,
-            PatchRole::Bridge { .. } => mesh.bridge,
-        };
+        let connector = family.is_connector(&g.role);
+        let (p, n) = if connector { mesh.bridge } else { mesh.crown };
         let (curve, fit_error) = match g.straight_segment() {
             Some((a, b)) => (
                 primitives::line(a, b, p, n).map_err(|e| whole(e.to_string()))?,
@@ -187,7 +186,7 @@ pub fn generate(
                     // The temporary placement keeps the crowns' amplitude on a smaller radius: its wires are
                     // where the nodes go, not how the wires bend (module docs of `cli::mesh`), so a fold is said.
                     if placement.is_none() {
-                        return Err(fold.refusal(g));
+                        return Err(fold.refusal(g, connector));
                     }
                     folds.get_or_insert((0, fold.describe(&g.name))).0 += 1;
                 }
@@ -213,7 +212,7 @@ pub fn generate(
             curve,
             normal_hint: Some(g.normal_hint),
             section,
-            material: materials.of(&g.role),
+            material: materials.of(g.role.crown, connector),
             fit_error,
         });
     }
@@ -307,17 +306,19 @@ impl Fold {
         )
     }
 
-    /// The refusal of a permanent shape with this fold, with what to change.
-    fn refusal(&self, g: &GeneratedPatch) -> BuildError {
-        let (parameter, advice) = match g.role {
-            PatchRole::Bridge { .. } => (
+    /// The refusal of a permanent shape with this fold in `g` (a `connector` between crowns, or a part of
+    /// one), with what to change.
+    fn refusal(&self, g: &GeneratedPatch, connector: bool) -> BuildError {
+        let (parameter, advice) = if connector {
+            (
                 StentParameter::Bridges,
                 "where the centreline bends, the crowns on its inner side come close and the bridge between them is squeezed or turns back: bend the centreline less, use fewer or lower crowns (more room between them), or a smaller bridge amplitude",
-            ),
-            PatchRole::Crown { .. } => (
+            )
+        } else {
+            (
                 StentParameter::Amplitude,
                 "lower the crown amplitude or the number of peaks, or raise the radius",
-            ),
+            )
         };
         BuildError::new(
             Field::Stent(StentField::Parameter(parameter)),
@@ -354,22 +355,19 @@ fn wire_fits(spec: &dyn StentFamily, diameter: Real) -> Result<()> {
 }
 
 /// A warning when the wires of two consecutive crowns come closer, centre to centre, than the wire's
-/// `diameter`: the closest crest of one crown to a trough of the next (the crowns' axial extremes, so the
-/// distance across the gap between them). Their surfaces then touch or overlap: a printer fuses them, and the rods
-/// know of no contact. Said, not refused: the simulation runs all the same.
-fn crowns_touch(geometry: &StentGeometry, diameter: Real) -> Option<String> {
-    use crate::geometry::stent::NodeKind;
-    let (gap, crest) = geometry
-        .nodes
+/// `diameter`: the closest of the `facing` pairs of nodes ([`StentFamily::facing_nodes`]: a crest of one crown
+/// and a trough of the next, the crowns' axial extremes, so the distance across the gap between them). Their
+/// surfaces then touch or overlap: a printer fuses them, and the rods know of no contact. Said, not refused:
+/// the simulation runs all the same.
+fn crowns_touch(
+    geometry: &StentGeometry,
+    facing: &[(usize, usize)],
+    diameter: Real,
+) -> Option<String> {
+    let nodes = &geometry.nodes;
+    let (gap, crest) = facing
         .iter()
-        .filter(|c| c.kind == NodeKind::Crest)
-        .flat_map(|c| {
-            geometry
-                .nodes
-                .iter()
-                .filter(move |q| q.kind == NodeKind::Trough && q.crown == c.crown + 1)
-                .map(move |q| ((q.position - c.position).norm(), c))
-        })
+        .map(|&(c, q)| ((nodes[q].position - nodes[c].position).norm(), &nodes[c]))
         .min_by(|a, b| a.0.total_cmp(&b.0))?;
     (gap < diameter).then(|| {
         format!(

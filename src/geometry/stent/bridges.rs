@@ -3,16 +3,19 @@
 //! consecutive crowns do not overlap.
 
 use super::axis::Axis;
-use super::crowns::{Layout, NodeIndex};
+use super::crowns::{CREST, Layout, NodeIndex, TROUGH};
 use super::curve::{CurveKind, Offset, StentCurve};
 use super::sector::Sector;
 use super::{
     ANGLE_TOLERANCE, BridgeDirection, BridgeShape, BridgeSpec, GeneratedNode, GeneratedPatch,
-    NodeKind, PatchRole, StentParameter, StentSpec, Symmetry, invalid, same_angle,
+    PartKind, PatchRole, StentParameter, StentSpec, Symmetry, invalid, same_angle,
 };
 use crate::geometry::GeometryError;
 use crate::math::{Real, Vec3};
 use std::sync::Arc;
+
+/// The ring family's bridge, from a crest of crown `k` to the facing trough of crown `k + 1`.
+pub(super) const BRIDGE: PartKind = PartKind(1);
 
 /// The bridges between consecutive crowns that the sector keeps, pair by pair and by increasing angle, with
 /// the nodes they end at (each once, sorted).
@@ -71,7 +74,11 @@ pub(super) fn bridges(
             bridge_ends.extend([start, end]);
             patches.push(GeneratedPatch {
                 name: format!("b{}_{}", k + 1, layout.number(k, 2 * c) + 1),
-                role: PatchRole::Bridge { pair: k, crest: c },
+                role: PatchRole {
+                    kind: BRIDGE,
+                    crown: k,
+                    index: c,
+                },
                 curve: StentCurve::new(
                     axis,
                     &spec.crown,
@@ -105,14 +112,14 @@ impl StentSpec {
         nodes: &[GeneratedNode],
     ) -> Result<(), GeometryError> {
         for crest in nodes {
-            if crest.kind != NodeKind::Crest || crest.crown + 1 >= stations.len() {
+            if crest.kind != CREST || crest.crown + 1 >= stations.len() {
                 continue;
             }
             let k = crest.crown;
             let (_, r) = axis.frame(0.5 * (stations[k] + stations[k + 1]));
-            let facing = nodes.iter().find(|q| {
-                q.crown == k + 1 && q.kind == NodeKind::Trough && same_angle(q.angle, crest.angle)
-            });
+            let facing = nodes
+                .iter()
+                .find(|q| q.crown == k + 1 && q.kind == TROUGH && same_angle(q.angle, crest.angle));
             if let Some(q) = facing
                 && (q.position - crest.position).dot(&r.column(0)) <= 0.0
             {

@@ -4,10 +4,19 @@
 use super::axis::Axis;
 use super::curve::{CurveKind, StentCurve};
 use super::sector::Sector;
-use super::{ANGLE_TOLERANCE, GeneratedNode, GeneratedPatch, NodeKind, PatchRole, StentSpec};
+use super::{
+    ANGLE_TOLERANCE, GeneratedNode, GeneratedPatch, NodeKind, PartKind, PatchRole, StentSpec,
+};
 use crate::math::{Real, Vec3};
 use std::f64::consts::{PI, TAU};
 use std::sync::Arc;
+
+/// The ring family's crest: a node at `x = +h_c`, facing crown `k + 1`.
+pub(super) const CREST: NodeKind = NodeKind(0);
+/// The ring family's trough: a node at `x = −h_c`.
+pub(super) const TROUGH: NodeKind = NodeKind(1);
+/// The ring family's crown wire, from a node of a crown to the next.
+pub(super) const WIRE: PartKind = PartKind(0);
 
 /// Index of every crown node in the generated node list, `[crown][node]` (node `j` at `ϑ = α_k + j π/m`, even
 /// `j` a crest), `None` where the symmetry cut removed it.
@@ -116,11 +125,7 @@ pub(super) fn crown_nodes(
                 ends: Vec::new(),
                 crown: k,
                 index: j,
-                kind: if j % 2 == 0 {
-                    NodeKind::Crest
-                } else {
-                    NodeKind::Trough
-                },
+                kind: if j % 2 == 0 { CREST } else { TROUGH },
                 angle: a,
                 station: s,
                 axis_point: c,
@@ -160,7 +165,11 @@ pub(super) fn crown_wires(
             let (sa, ca) = from.sin_cos();
             patches.push(GeneratedPatch {
                 name: format!("c{}_w{}", k + 1, layout.number(k, j) + 1),
-                role: PatchRole::Crown { crown: k, wire: j },
+                role: PatchRole {
+                    kind: WIRE,
+                    crown: k,
+                    index: j,
+                },
                 curve: StentCurve::new(
                     axis,
                     &spec.crown,

@@ -7,7 +7,7 @@
 //! The device has `N` rings of `m` crests, radius `R` and amplitude `h`, and `N + 1` rows of nodes at stations
 //! `s_r = s_0 + 2 h r` (`r = 0 … N`) on the centreline, centred on a bounded one. Row `r` has its `m` nodes at
 //! the angles `ϑ = q π/m` with `q ≡ r (mod 2)`; ring `k` runs between rows `k` (its troughs) and `k + 1` (its
-//! crests), so a crest of ring `k` *is* a trough of ring `k + 1`: one node (a [`NodeKind::Junction`]) where
+//! crests), so a crest of ring `k` *is* a trough of ring `k + 1`: one node (a `JUNCTION`) where
 //! four struts meet. Only the first row (troughs of ring 1) and the last (crests of ring `N`) are free.
 //!
 //! Strut `q` of ring `k` joins its nodes at `ϑ_q = q π/m` and `ϑ_{q+1}`; with `u ∈ [0, 1]` it is
@@ -35,16 +35,25 @@ use super::checks::check_bend_radius;
 use super::curve::{CurveKind, StentCurve};
 use super::family::{FamilyCounts, StentFamily};
 use super::sector::{Sector, check_axis_symmetry};
-use super::temporary::temporary_axis;
+use super::temporary::{Placement, placement, temporary_axis};
 use super::{
     CentrelineSpec, CrownSpec, GeneratedNode, GeneratedPatch, NodeKind, PLANARITY_TOLERANCE,
-    PatchRole, StentGeometry, StentParameter, Symmetry, TemporarySpec, WireEnd, invalid,
+    PartKind, PatchRole, StentGeometry, StentParameter, Symmetry, TemporarySpec, WireEnd, invalid,
 };
 use crate::geometry::GeometryError;
 use crate::math::{Real, Vec3};
 use std::collections::BTreeMap;
 use std::f64::consts::PI;
 use std::sync::Arc;
+
+/// The diamond family's free trough: a node of the first row (troughs of ring 1).
+const TROUGH_END: NodeKind = NodeKind(0);
+/// The diamond family's free crest: a node of the last row (crests of ring `N`).
+const CREST_END: NodeKind = NodeKind(1);
+/// The diamond family's junction: a crest of ring `k` that is a trough of ring `k + 1`, where four struts meet.
+const JUNCTION: NodeKind = NodeKind(2);
+/// The diamond family's strut, half a wave of a ring from a node of one row to the next node of the other.
+const STRUT: PartKind = PartKind(0);
 
 /// Everything that defines a closed diamond-cell stent.
 #[derive(Debug, Clone, PartialEq)]
@@ -169,9 +178,9 @@ impl DiamondSpec {
                     crown: r.saturating_sub(1),
                     index: q,
                     kind: match r {
-                        0 => NodeKind::Trough,
-                        _ if r == n => NodeKind::Crest,
-                        _ => NodeKind::Junction,
+                        0 => TROUGH_END,
+                        _ if r == n => CREST_END,
+                        _ => JUNCTION,
                     },
                     angle: a,
                     station: s,
@@ -209,7 +218,11 @@ impl DiamondSpec {
                 };
                 patches.push(GeneratedPatch {
                     name: format!("c{}_w{}", k + 1, q + 1),
-                    role: PatchRole::Crown { crown: k, wire: q },
+                    role: PatchRole {
+                        kind: STRUT,
+                        crown: k,
+                        index: q,
+                    },
                     curve: StentCurve::new(
                         &axis,
                         &crown,
@@ -251,20 +264,18 @@ fn node_sets(nodes: &[GeneratedNode], rings: usize) -> BTreeMap<String, Vec<usiz
     };
     // A node's rows: a junction belongs to ring `crown` (its crest) and `crown + 1` (its trough).
     let in_ring = |node: &GeneratedNode, k: usize| match node.kind {
-        NodeKind::Trough => k == 0,
-        NodeKind::Crest => k == node.crown,
-        NodeKind::Junction => k == node.crown || k == node.crown + 1,
+        TROUGH_END => k == 0,
+        CREST_END => k == node.crown,
+        JUNCTION => k == node.crown || k == node.crown + 1,
+        _ => false,
     };
     let mut sets = BTreeMap::new();
     sets.insert("all_joints".to_string(), select(&|_| true));
     for k in 0..rings {
         sets.insert(format!("crown_{}", k + 1), select(&|g| in_ring(g, k)));
     }
-    sets.insert(
-        "junctions".into(),
-        select(&|g| g.kind == NodeKind::Junction),
-    );
-    sets.insert("ends".into(), select(&|g| g.kind != NodeKind::Junction));
+    sets.insert("junctions".into(), select(&|g| g.kind == JUNCTION));
+    sets.insert("ends".into(), select(&|g| g.kind != JUNCTION));
     sets.insert("symmetry".into(), select(&|g| g.symmetry_plane.is_some()));
     sets
 }
@@ -287,17 +298,19 @@ impl StentFamily for DiamondSpec {
         shrink: Real,
     ) -> Result<StentGeometry, GeometryError> {
         self.check_numbers()?;
-        let permanent = Axis::new(&self.centreline)?;
-        let stations = self.stations(&permanent)?;
-        let axis = temporary_axis(permanent, &stations, temporary)?;
-        let radius = temporary.radius.unwrap_or(self.radius - shrink);
-        if !(radius > 0.0) {
-            return Err(invalid(
-                StentParameter::TemporaryRadius,
-                format!("a ring's temporary radius must be > 0, got {radius}"),
-            ));
-        }
-        self.generate_on(Arc::new(axis), stations, radius, false)
+        let Placement {
+            axis,
+            stations,
+            radii,
+        } = placement(
+            &self.centreline,
+            |axis| self.stations(axis),
+            temporary,
+            [self.radius],
+            shrink,
+            "ring",
+        )?;
+        self.generate_on(Arc::new(axis), stations, radii[0], false)
     }
 
     fn temporary_node_positions(
@@ -324,6 +337,15 @@ impl StentFamily for DiamondSpec {
 
     fn crowns(&self) -> usize {
         self.rings
+    }
+
+    fn is_connector(&self, _role: &PatchRole) -> bool {
+        false
+    }
+
+    fn facing_nodes(&self, _geometry: &StentGeometry) -> Vec<(usize, usize)> {
+        // Consecutive rings meet at their junctions: no gap between them to keep open.
+        Vec::new()
     }
 
     fn counts(&self) -> FamilyCounts {
@@ -389,13 +411,14 @@ mod tests {
                 let rings: Vec<usize> = node
                     .ends
                     .iter()
-                    .map(|&(p, _)| match g.patches[p].role {
-                        PatchRole::Crown { crown, .. } => crown,
-                        PatchRole::Bridge { .. } => unreachable!("no bridges"),
+                    .map(|&(p, _)| {
+                        let role = g.patches[p].role;
+                        assert_eq!(role.kind, STRUT, "no part but struts");
+                        role.crown
                     })
                     .collect();
                 match node.kind {
-                    NodeKind::Junction => {
+                    JUNCTION => {
                         assert_eq!(node.ends.len(), 4, "{}", node.name);
                         for k in [node.crown, node.crown + 1] {
                             assert_eq!(
@@ -421,11 +444,7 @@ mod tests {
         let (h, m) = (spec.amplitude, spec.peaks as Real);
         let (k, middle) = (1, 0.5 * (g.stations[1] + g.stations[2]));
         let phase = (k + 1) as Real * PI / m;
-        for p in g
-            .patches
-            .iter()
-            .filter(|p| matches!(p.role, PatchRole::Crown { crown, .. } if crown == k))
-        {
+        for p in g.patches.iter().filter(|p| p.role.crown == k) {
             for t in [0.1, 0.3, 0.5, 0.8] {
                 let x = p.curve.point(t);
                 let a = x.z.atan2(x.y);

@@ -290,36 +290,29 @@ pub enum TemporaryCentreline {
     Given(CentrelineSpec),
 }
 
-/// What a patch is in the device.
+/// A family's kind of part, numbered by the family (the ring family's crown wires and bridges, the diamond
+/// family's struts): the family answers what a kind means ([`StentFamily::is_connector`]), so a new family
+/// numbers its own kinds without editing this type or any `match` over it.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum PatchRole {
-    /// Wire `wire` (0-based, from node `wire` to node `wire + 1`) of crown `crown`.
-    Crown {
-        /// Crown index, 0-based.
-        crown: usize,
-        /// Wire index within the crown, 0-based.
-        wire: usize,
-    },
-    /// The bridge from crest `crest` (0-based) of crown `pair` to the facing trough of crown `pair + 1`.
-    Bridge {
-        /// Index of the first crown of the pair, 0-based.
-        pair: usize,
-        /// Crest index within that crown, 0-based.
-        crest: usize,
-    },
+pub struct PartKind(pub u8);
+
+/// What a patch is in the device: the family's kind of part, the crown (ring) it belongs to and its index
+/// there.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct PatchRole {
+    /// The family's kind of part.
+    pub kind: PartKind,
+    /// Crown index, 0-based; of a connector between crowns (a bridge), the first crown of the pair it joins.
+    pub crown: usize,
+    /// Index of the part within its crown, 0-based (a wire's from its first node, a bridge's crest).
+    pub index: usize,
 }
 
-/// Whether a node is a crest (`x = +h_c`, facing the next crown), a trough, or both at once: a junction where a
-/// crest of one crown is a trough of the next (the closed cells of [`DiamondSpec`]).
+/// A family's kind of node, numbered by the family (the ring family's crests and troughs, the diamond
+/// family's free ends and junctions): what a kind means is the family's, which is asked through
+/// [`StentFamily`], so a new family numbers its own kinds without editing this type.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum NodeKind {
-    /// `x = +h_c`.
-    Crest,
-    /// `x = −h_c`.
-    Trough,
-    /// A crest of crown `crown` that is a trough of crown `crown + 1`.
-    Junction,
-}
+pub struct NodeKind(pub u8);
 
 /// Which end of a generated patch.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -338,7 +331,7 @@ pub struct GeneratedPatch {
     /// from node `c<k>_n<i>` (a crest) to crown `k + 1` (see [`GeneratedNode::name`]; names are those of the full
     /// device, so a reduced model's names say where its patches are).
     pub name: String,
-    /// Crown wire or bridge.
+    /// What the patch is (its family's kind of part, crown and index).
     pub role: PatchRole,
     /// The analytic centreline.
     pub curve: StentCurve,
@@ -375,7 +368,7 @@ pub struct GeneratedNode {
     pub crown: usize,
     /// Node index within the crown, 0-based (even: crest); of a diamond stent's node, its angle in half waves.
     pub index: usize,
-    /// Crest or trough.
+    /// The family's kind of node (the ring family's crest or trough).
     pub kind: NodeKind,
     /// Angle `ϑ` in the crown's section plane \[rad\].
     pub angle: Real,
@@ -656,6 +649,54 @@ mod tests {
                 );
                 assert_eq!(nodes as Real, counts.nodes, "{label}");
             }
+        }
+    }
+
+    // What the ring family answers about its own kinds, checked against the topology it generates: a connector
+    // (a bridge) joins a node of crown k to one of crown k + 1 with k its role's crown, every other part joins
+    // two nodes of its role's crown; the facing pairs are crests of crown k and troughs of crown k + 1, the
+    // closest of them the crest and the trough at the same angle, `d_c − 2 h_c = 15 − 2 × 5 = 5` apart on the
+    // straight device (by hand).
+    #[test]
+    fn ring_roles_and_facing_nodes_match_the_topology() {
+        let spec = straight(Symmetry::None, false);
+        let g = spec.generate().unwrap();
+        let mut connectors = 0;
+        for p in &g.patches {
+            let (a, b) = (&g.nodes[p.start_node], &g.nodes[p.end_node]);
+            if StentFamily::is_connector(&spec, &p.role) {
+                connectors += 1;
+                assert_eq!(
+                    (a.crown, b.crown),
+                    (p.role.crown, p.role.crown + 1),
+                    "{}",
+                    p.name
+                );
+            } else {
+                assert_eq!(
+                    (a.crown, b.crown),
+                    (p.role.crown, p.role.crown),
+                    "{}",
+                    p.name
+                );
+            }
+        }
+        assert_eq!(connectors, 12);
+        let facing = StentFamily::facing_nodes(&spec, &g);
+        // 2 pairs of crowns × 6 crests × 6 troughs.
+        assert_eq!(facing.len(), 72);
+        let gap = facing
+            .iter()
+            .map(|&(c, q)| (g.nodes[q].position - g.nodes[c].position).norm())
+            .fold(Real::INFINITY, Real::min);
+        assert!((gap - 5.0).abs() < 1e-12, "{gap}");
+        for &(c, q) in &facing {
+            assert_eq!(g.nodes[q].crown, g.nodes[c].crown + 1);
+            // A crest lies ahead of its crown's station along the axis (x = +h_c), a trough behind.
+            let ahead = |i: usize| {
+                (g.nodes[i].position - g.nodes[i].axis_point).dot(&g.nodes[i].axis_tangent)
+            };
+            assert!(ahead(c) > 0.0 && ahead(q) < 0.0);
         }
     }
 

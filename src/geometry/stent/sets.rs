@@ -1,7 +1,8 @@
 //! The named node sets of a generated device ([`super::StentGeometry::node_sets`]), which designs use to apply
 //! conditions and programmes to many nodes at once.
 
-use super::{GeneratedNode, NodeKind};
+use super::GeneratedNode;
+use super::crowns::{CREST, TROUGH};
 use std::collections::BTreeMap;
 
 /// `all_joints`, `crown_<k>` (1-based) for each of `crowns` crowns, `crests`, `troughs`, `bridge_ends` (given)
@@ -19,7 +20,7 @@ pub(super) fn node_sets(
             (0..nodes.len()).filter(|&i| nodes[i].crown == k).collect(),
         );
     }
-    for (name, kind) in [("crests", NodeKind::Crest), ("troughs", NodeKind::Trough)] {
+    for (name, kind) in [("crests", CREST), ("troughs", TROUGH)] {
         node_sets.insert(
             name.into(),
             (0..nodes.len())

@@ -2,9 +2,10 @@
 //! and angles on another centreline and/or radius.
 
 use super::axis::Axis;
+use super::crowns::CREST;
 use super::{
-    NodeKind, PLANARITY_TOLERANCE, StentGeometry, StentParameter, StentSpec, TemporaryCentreline,
-    TemporarySpec, invalid,
+    CentrelineSpec, PLANARITY_TOLERANCE, StentGeometry, StentParameter, StentSpec,
+    TemporaryCentreline, TemporarySpec, invalid,
 };
 use crate::geometry::GeometryError;
 use crate::math::{Real, Vec3};
@@ -57,6 +58,49 @@ pub(super) fn temporary_axis(
     })
 }
 
+/// Where a family's temporary placement puts its crowns: the temporary axis, the crowns' stations on it (those
+/// of the permanent axis) and each crown's temporary radius.
+pub(super) struct Placement {
+    /// The temporary axis.
+    pub(super) axis: Axis,
+    /// The crowns' (or rows') arc-length stations, as on the permanent axis \[length\].
+    pub(super) stations: Vec<Real>,
+    /// The temporary radius of each of `radii` given \[length\], all > 0.
+    pub(super) radii: Vec<Real>,
+}
+
+/// The opening every family's `generate_temporary` shares: the permanent axis of `centreline`, the stations
+/// `stations` places on it, the temporary axis ([`temporary_axis`]) and, for each permanent radius in `radii`,
+/// the temporary radius (the given one, or that radius less `shrink`), refused where it is not positive with
+/// the family's word for a crown (`part`: "crown", "ring").
+pub(super) fn placement(
+    centreline: &CentrelineSpec,
+    stations: impl FnOnce(&Axis) -> Result<Vec<Real>, GeometryError>,
+    temporary: &TemporarySpec,
+    radii: impl IntoIterator<Item = Real>,
+    shrink: Real,
+    part: &str,
+) -> Result<Placement, GeometryError> {
+    let permanent = Axis::new(centreline)?;
+    let stations = stations(&permanent)?;
+    let axis = temporary_axis(permanent, &stations, temporary)?;
+    let radii: Vec<Real> = radii
+        .into_iter()
+        .map(|r| temporary.radius.unwrap_or(r - shrink))
+        .collect();
+    if let Some(&r) = radii.iter().find(|r| !(**r > 0.0)) {
+        return Err(invalid(
+            StentParameter::TemporaryRadius,
+            format!("a {part}'s temporary radius must be > 0, got {r}"),
+        ));
+    }
+    Ok(Placement {
+        axis,
+        stations,
+        radii,
+    })
+}
+
 impl StentSpec {
     /// Positions of the nodes of `geometry` (generated from `self`) in a temporary placement: the same crowns at
     /// the same stations and angles on another centreline and/or radius (paper Eq. `target_disp`: `P_temp`).
@@ -72,7 +116,7 @@ impl StentSpec {
             .iter()
             .map(|node| {
                 let (c, r) = axis.frame(node.station);
-                let x = if node.kind == NodeKind::Crest { h } else { -h };
+                let x = if node.kind == CREST { h } else { -h };
                 let (sa, ca) = node.angle.sin_cos();
                 let radius = temporary.radius.unwrap_or(self.radius_of(node.crown));
                 c + r * Vec3::new(x, radius * ca, radius * sa)
@@ -95,18 +139,18 @@ impl StentSpec {
         shrink: Real,
     ) -> Result<StentGeometry, GeometryError> {
         self.check_numbers()?;
-        let permanent = Axis::new(&self.centreline)?;
-        let stations = self.stations(&permanent)?;
-        let axis = temporary_axis(permanent, &stations, temporary)?;
-        let radii: Vec<Real> = (0..self.crowns)
-            .map(|k| temporary.radius.unwrap_or(self.radius_of(k) - shrink))
-            .collect();
-        if let Some(&r) = radii.iter().find(|r| !(**r > 0.0)) {
-            return Err(invalid(
-                StentParameter::TemporaryRadius,
-                format!("a crown's temporary radius must be > 0, got {r}"),
-            ));
-        }
+        let Placement {
+            axis,
+            stations,
+            radii,
+        } = placement(
+            &self.centreline,
+            |axis| self.stations(axis),
+            temporary,
+            (0..self.crowns).map(|k| self.radius_of(k)),
+            shrink,
+            "crown",
+        )?;
         let placed = StentSpec {
             crown_radii: Some(radii),
             ..self.clone()
