@@ -11,7 +11,7 @@
 //! clamped at node `root`, loaded at node `tip`), changed in one place.
 
 use crate::common::{edit, fixtures, node_displacement, node_index};
-use crate::outputs::run_in_process;
+use crate::outputs::completed_in_process;
 use std::cell::{Cell, RefCell};
 use std::ops::ControlFlow;
 use std::path::Path;
@@ -684,8 +684,7 @@ fn the_disk_estimate_bounds_a_run_folder_from_above() {
     let design = stentkit::io::design::load_design(&file).expect("valid");
     let estimate = stentkit::io::estimate::estimated_disk(&design);
     let run = dir.join("run");
-    let (code, stderr) = run_in_process(&file, &run, &[]);
-    assert_eq!(code, 0, "{stderr}");
+    completed_in_process(&file, &run, &[]);
     let written = folder_bytes(&run) as f64;
     let ratio = estimate.total() as f64 / written;
     assert!(
@@ -718,8 +717,7 @@ fn two_rings_per_patch_draw_a_rolled_up_beam() {
         )
         .set("output.recording", "{mesh_rings: 2}")
         .write(&dir.join("rollup_two_rings.yaml"));
-    let (code, stderr) = run_in_process(&file, &dir.join("run"), &[]);
-    assert_eq!(code, 0, "{stderr}");
+    completed_in_process(&file, &dir.join("run"), &[]);
     let summary = std::fs::read_to_string(dir.join("run/summary.json")).expect("summary");
     assert!(summary.contains("\"status\": \"completed\""), "{summary}");
     let snapshots = std::fs::read_dir(dir.join("run/snapshots"))
