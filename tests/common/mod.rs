@@ -5,6 +5,8 @@
 // Each binary uses a different subset.
 #![allow(dead_code)]
 
+pub mod fixtures;
+
 use std::ops::ControlFlow;
 use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};

@@ -2,9 +2,7 @@
 //! load and in displacement, against closed forms and published values. Run with `--nocapture` to see the
 //! measured numbers.
 
-use crate::common::{
-    design_text, model_from_text, node_displacement, replace_line, repo_file, solve,
-};
+use crate::common::{fixtures, node_displacement, repo_file, solve};
 use stentkit::math::Real;
 use stentkit::model::Model;
 use stentkit::solver::Simulation;
@@ -90,7 +88,7 @@ fn truss_limit(mut lo: Real, mut hi: Real) -> Real {
 
 #[test]
 fn a_shallow_truss_snaps_through_both_limit_points_on_its_closed_form() {
-    let model = model_from_text(&design_text("von_mises_truss.yaml"), "von_mises_truss.yaml");
+    let model = fixtures::design("von_mises_truss.yaml").model();
     let (path, iterations) = follow(&model, "apex");
     let p_max = truss_limit(0.0, 1.0);
     let p_min = truss_limit(1.0, 2.0);
@@ -179,7 +177,7 @@ fn arch_shooting_limit() -> Real {
 
 #[test]
 fn the_215_degree_arch_passes_its_limit_load_at_the_published_value() {
-    let model = model_from_text(&design_text("arch215.yaml"), "arch215.yaml");
+    let model = fixtures::design("arch215.yaml").model();
     let (path, iterations) = follow(&model, "crown");
     // P R²/EI = 1000 λ · 100² / 1e6.
     let scale = 10.0;
@@ -245,10 +243,11 @@ fn the_215_degree_arch_passes_its_limit_load_at_the_published_value() {
 /// measured 4e-10 of the tip's displacement at n = 80; bound 1e-8.
 #[test]
 fn the_arc_length_path_lands_on_the_end_load_factor_at_the_load_stepped_state() {
-    let text = replace_line(&design_text("bend45.yaml"), "mesh:", "mesh: {p: 6, n: 80}");
-    let stepped = model_from_text(&text, "bend45.yaml");
-    let arc_text = format!("{text}solver: {{path: arc-length}}\n");
-    let arc = model_from_text(&arc_text, "bend45.yaml");
+    let stepped = fixtures::bend45().mesh(6, 80).model();
+    let arc = fixtures::bend45()
+        .mesh(6, 80)
+        .set("solver.path", "arc-length")
+        .model();
     let (path, _) = follow(&arc, "tip");
     let (sim, _) = solve(&stepped);
     let expected = node_displacement(&sim, "tip");
@@ -267,7 +266,7 @@ fn the_arc_length_path_lands_on_the_end_load_factor_at_the_load_stepped_state() 
 /// load factors and displacements at every later increment (source: the restore's promise, exact equality).
 #[test]
 fn an_arc_length_path_continues_bit_for_bit_from_a_checkpoint() {
-    let model = model_from_text(&design_text("von_mises_truss.yaml"), "von_mises_truss.yaml");
+    let model = fixtures::design("von_mises_truss.yaml").model();
     let (whole, _) = follow(&model, "apex");
     let split = 70;
     assert!(
@@ -426,12 +425,9 @@ fn an_arc_length_run_writes_the_load_factor_and_its_load_path_chart() {
 /// a non-finite residual blamed on a support's equation).
 #[test]
 fn an_arc_length_path_without_a_load_says_so() {
-    let text = replace_line(
-        &design_text("von_mises_truss.yaml"),
-        "force:",
-        "force: [free, 0, free]",
-    );
-    let model = model_from_text(&text, "unloaded.yaml");
+    let model = fixtures::design("von_mises_truss.yaml")
+        .set("conditions[1].force", "[free, 0, free]")
+        .model();
     let mut sim = Simulation::new(&model).expect("valid");
     let error = sim.step().expect_err("no path").to_string();
     assert!(error.contains("the reference load is zero"), "{error}");

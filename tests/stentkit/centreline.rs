@@ -2,7 +2,7 @@
 //! writers in every encoding (tests/data/centrelines/, made by scripts/centreline_test_files.py) read to the
 //! values VTK's reader gives; bad files are refused with the file named and what is wrong.
 
-use crate::common::edit;
+use crate::common::{edit, fixtures};
 use std::path::{Path, PathBuf};
 use stentkit::io::centreline::{CentrelineError, read_centreline};
 
@@ -77,25 +77,17 @@ fn a_csv_of_an_exact_arc_gives_the_arc_centrelines_device() {
         ));
     }
     std::fs::write(&csv, text).expect("csv");
-    let design = std::fs::read_to_string(
-        Path::new(env!("CARGO_MANIFEST_DIR")).join("designs/curved_stent.yaml"),
-    )
-    .expect("design");
-    let arc_line = design
-        .lines()
-        .find(|l| l.trim_start().starts_with("arc:"))
-        .expect("an arc centreline");
-    let from_file = edit(
-        &design,
-        arc_line,
-        &format!(
-            "    file: {{path: {}, smoothing: 1.0e-4, reference: [1, 0, 0]}}",
-            csv.display()
-        ),
-    );
-    let exact = stentkit::io::design::parse_design(&design, Path::new("arc.yaml")).expect("arc");
-    let fitted =
-        stentkit::io::design::parse_design(&from_file, Path::new("file.yaml")).expect("file");
+    let curved = fixtures::design("curved_stent.yaml");
+    let exact = curved.design();
+    let fitted = curved
+        .set(
+            "stent.centreline",
+            &format!(
+                "{{file: {{path: {}, smoothing: 1.0e-4, reference: [1, 0, 0]}}}}",
+                csv.display()
+            ),
+        )
+        .design();
     std::fs::remove_dir_all(&dir).ok();
     assert_eq!(exact.model.nodes.len(), fitted.model.nodes.len());
     let largest = exact
@@ -340,14 +332,9 @@ fn the_aorta_stents_run_shows_the_vessel_lumen() {
 // design asking to taper without the lumen radius is refused at `stent.taper`.
 #[test]
 fn a_tapered_stent_follows_the_local_lumen() {
-    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("designs/aorta_stent.yaml");
-    let text = edit(
-        &std::fs::read_to_string(&path).expect("design"),
-        "  oversize: 0.1 ",
-        "  taper: true\n  oversize: 0.1 ",
-    );
-    let design =
-        stentkit::io::design::parse_design(&text, &path).expect("the tapered design reads");
+    let design = fixtures::design("aorta_stent.yaml")
+        .set("stent.taper", "true")
+        .design();
     assert!(
         design
             .notes
@@ -396,7 +383,13 @@ fn a_tapered_stent_follows_the_local_lumen() {
         .iter()
         .fold((f64::MAX, 0.0_f64), |(lo, hi), &s| (lo.min(s), hi.max(s)));
     assert!(hi > 1.3 * lo, "the crowns taper: {sizes:?}");
-    let refused = edit(&text, "  oversize: 0.1 ", "  radius: 6 #");
+    // Edited as text, not through `fixtures`: a refused design (a field removed, which `--set` cannot do).
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("designs/aorta_stent.yaml");
+    let refused = edit(
+        &std::fs::read_to_string(&path).expect("design"),
+        "  oversize: 0.1 ",
+        "  taper: true\n  radius: 6 #",
+    );
     let err = stentkit::io::design::parse_design(&refused, &path).expect_err("no oversize");
     assert!(err.to_string().contains("stent.taper"), "{err}");
 }
@@ -628,6 +621,7 @@ fn only_regular_files_within_the_size_limit_are_read() {
     let design = Path::new(env!("CARGO_MANIFEST_DIR")).join("designs/aorta_stent.yaml");
     let text = std::fs::read_to_string(&design).expect("design");
     let on_fifo = dir.join("on_fifo.yaml");
+    // Edited as text, not through `fixtures`: reading the design is what is tested (and would block here).
     std::fs::write(
         &on_fifo,
         edit(

@@ -12,7 +12,7 @@
 //! reads the last step's increment), and the stent with error-controlled steps (rejected attempts, the
 //! controller's memory). Exact comparisons: no tolerance.
 
-use crate::common::{design_text, model_from_text, replace_line};
+use crate::common::fixtures;
 use std::ops::ControlFlow;
 use stentkit::model::Model;
 use stentkit::solver::{CheckpointError, Observer, Simulation, StepOutcome, StepReport};
@@ -28,32 +28,23 @@ fn finish(sim: &mut Simulation<'_>) -> Vec<StepReport> {
 
 /// The straight stent with two crowns, to t = 2 s in steps of 0.01 s (release at 1.75 s: step 175).
 fn small_stent() -> Model {
-    let text = replace_line(&design_text("straight_stent.yaml"), "crowns:", "crowns: 2");
-    let text = replace_line(&text, "time:", "time: {end: 2.0, step: 0.01}");
-    model_from_text(&text, "straight_stent_2_crowns.yaml")
+    fixtures::straight_stent().crowns(2).time(2.0, 0.01).model()
 }
 
 /// The same stent with error-controlled steps (tolerance 1e-3 from a first step of 0.01): the step-size
 /// controller's memory, rejected attempts (which keep their factorisation) and the error estimates (which may
 /// factorise) must continue exactly too.
 fn small_stent_adaptive() -> Model {
-    let text = replace_line(&design_text("straight_stent.yaml"), "crowns:", "crowns: 2");
-    let text = replace_line(
-        &text,
-        "time:",
-        "time: {end: 2.0, step: 0.01, tolerance: 1.0e-3}",
-    );
-    model_from_text(&text, "straight_stent_2_crowns_adaptive.yaml")
+    fixtures::straight_stent()
+        .crowns(2)
+        .time(2.0, 0.01)
+        .set("time.tolerance", "1.0e-3")
+        .model()
 }
 
 /// The 45° bend in steps of 0.5: the first is cut twice, so the step size is below the nominal one for a step.
 fn cut_bend() -> Model {
-    let text = replace_line(
-        &design_text("bend45.yaml"),
-        "time:",
-        "time: {end: 1.0, step: 0.5}",
-    );
-    model_from_text(&text, "bend45_cut.yaml")
+    fixtures::bend45().time(1.0, 0.5).model()
 }
 
 #[test]
@@ -145,7 +136,7 @@ fn a_restored_simulation_continues_bit_for_bit() {
 #[test]
 fn a_checkpoint_of_another_model_is_refused() {
     let stent = small_stent();
-    let bend = model_from_text(&design_text("bend45.yaml"), "bend45.yaml");
+    let bend = fixtures::bend45().model();
     let checkpoint = Simulation::new(&bend).expect("simulation").checkpoint();
     let mut sim = Simulation::new(&stent).expect("simulation");
     let error = sim.restore(&checkpoint).expect_err("another model");

@@ -57,3 +57,53 @@ fn elastic_designs_use_the_elastic_law() {
         }
     }
 }
+
+/// The builder fixture of the 45° bend (`fixtures::bend45_builder`, which `solver.rs` uses to split the bend
+/// into patches and vary its load steps) is the model of designs/bend45.yaml: the two serialise to the same
+/// description (`stentkit::model::fingerprint`'s JSON), so what the solver tests find of one holds for the file.
+#[test]
+fn the_bend_built_in_code_is_the_design_files_bend() {
+    use crate::common::fixtures;
+    let built = fixtures::bend45_builder(1, 6, 20, 10)
+        .build()
+        .unwrap_or_else(|e| panic!("{e}"));
+    assert!(built.warnings.is_empty(), "{:?}", built.warnings);
+    let json = |m: &stentkit::model::Model| serde_json::to_string(m).expect("a model serialises");
+    let (code, file) = (json(&built.model), json(&fixtures::bend45().model()));
+    let first = code
+        .bytes()
+        .zip(file.bytes())
+        .position(|(a, b)| a != b)
+        .unwrap_or(code.len().min(file.len()));
+    let around = |s: &str| {
+        s.get(first.saturating_sub(80)..(first + 80).min(s.len()))
+            .map(str::to_string)
+    };
+    assert!(
+        code == file,
+        "they differ at byte {first}: built {:?}, file {:?}",
+        around(&code),
+        around(&file)
+    );
+}
+
+/// A fixture change fails loudly where a text edit did nothing: a path that names no field of the design
+/// format (`stent.crown`) is refused when the design is read, naming the change, and a change of an
+/// existing field takes effect (the crown count is the model's).
+#[test]
+fn a_fixture_change_of_a_field_that_does_not_exist_is_refused() {
+    use crate::common::fixtures;
+    let error = fixtures::straight_stent()
+        .set("stent.crown", "2")
+        .try_design()
+        .expect_err("no field `stent.crown`");
+    assert!(error.to_string().contains("stent.crown=2"), "{error}");
+    let two = fixtures::straight_stent().crowns(2).model();
+    let six = fixtures::straight_stent().model();
+    assert!(
+        two.patches.len() < six.patches.len(),
+        "{} patches with 2 crowns, {} with 6",
+        two.patches.len(),
+        six.patches.len()
+    );
+}

@@ -1,8 +1,10 @@
 //! Lean run folders named by the shape-memory cycle, and `stentkit export` of any state of a finished run
 //! (issue 19, items 2 and 3).
 
-use crate::common::edit;
-use crate::outputs::{design, path_str, run_ok, stentkit, summary, test_outputs, text};
+use crate::common::fixtures;
+use crate::outputs::{
+    completed_in_process, design, path_str, run_ok, stentkit, summary, test_outputs, text,
+};
 use crate::reliability::folder_bytes;
 
 #[test]
@@ -13,7 +15,7 @@ fn the_flagship_run_folder_is_lean_and_its_snapshots_are_named_by_phase_and_expo
     // 6 pieces: 0.5 s, and 2.2517 and 2.7508 s in the recovery, taken at the first steps after them.
     let dir = test_outputs("lean_flagship");
     let file = design("straight_stent.yaml");
-    run_ok(&file, &dir, &["--quiet"]);
+    completed_in_process(&file, &dir, &[]);
     let s = summary(&dir);
     let names: Vec<(String, String)> = s["snapshots"]
         .as_array()
@@ -121,10 +123,9 @@ fn a_design_changed_since_the_run_is_not_exported() {
     // Before the edit, its run and a run with `--tol` export.
     let dir = test_outputs("export_changed_design");
     std::fs::create_dir_all(&dir).expect("folder");
-    let file = dir.join("bend45.yaml");
-    std::fs::copy(design("bend45.yaml"), &file).expect("copy");
+    let file = fixtures::bend45().write(&dir.join("bend45.yaml"));
     let run = dir.join("run");
-    run_ok(&file, &run, &["--quiet"]);
+    completed_in_process(&file, &run, &[]);
     let export = |name: &str| {
         stentkit(&[
             "export",
@@ -152,12 +153,9 @@ fn a_design_changed_since_the_run_is_not_exported() {
     };
     let out = export_final("adaptive.stl");
     assert!(out.status.success(), "{}", text(&out.stderr));
-    let edited = edit(
-        &std::fs::read_to_string(&file).expect("design"),
-        "E_inf: 1.0e7",
-        "E_inf: 2.0e7",
-    );
-    std::fs::write(&file, edited).expect("edit");
+    fixtures::bend45()
+        .set("material.E_inf", "2.0e7")
+        .write(&file);
     let out = export("b.stl");
     assert_eq!(out.status.code(), Some(2), "{}", text(&out.stderr));
     assert!(
@@ -195,7 +193,7 @@ fn a_device_of_patches_programmed_by_conditions_has_the_cycle_too() {
     // 96.6 %; bound 90 %), and back above Tg it recovers (measured: 0.077 mm left at 3.25 s; bound 5 % of the
     // stretch, 0.3 mm).
     let dir = test_outputs("coil_programme");
-    run_ok(&design("coil_programme.yaml"), &dir, &["--quiet"]);
+    completed_in_process(&design("coil_programme.yaml"), &dir, &[]);
     let s = summary(&dir);
     let phases: Vec<&str> = s["snapshots"]
         .as_array()

@@ -3,7 +3,7 @@
 //! or, when the design says so, does not write. CI reads the field files with VTK's own reader
 //! (`scripts/check_outputs.py`).
 
-use crate::outputs::{run_ok, test_outputs};
+use crate::outputs::{completed_in_process, run_in_process, test_outputs};
 use std::path::Path;
 
 fn design(name: &str) -> std::path::PathBuf {
@@ -38,11 +38,9 @@ fn columns(dir: &Path, names: &[&str]) -> Vec<Vec<String>> {
 #[test]
 fn the_rolled_up_rod_strains_its_surface_by_r_kappa() {
     let dir = test_outputs("fields_rollup");
-    let out = run_ok(
-        &design("rollup.yaml"),
-        &dir,
-        &["--quiet", "--set", "material.strain_limit=0.3"],
-    );
+    let (code, stderr) =
+        run_in_process(&design("rollup.yaml"), &dir, &["material.strain_limit=0.3"]);
+    assert_eq!(code, 0, "{stderr}");
     let r = 0.5 * (4.0 / std::f64::consts::PI).sqrt();
     let rows = columns(
         &dir,
@@ -68,7 +66,6 @@ fn the_rolled_up_rod_strains_its_surface_by_r_kappa() {
     // The limit (30 %) is crossed where r κ(t) = 0.3 (t = 0.846) and said once, at the first step after it
     // (steps of 0.05), on stderr and in the summary.
     let crossing = 0.3 / (r * std::f64::consts::TAU / 10.0);
-    let stderr = String::from_utf8_lossy(&out.stderr);
     assert_eq!(stderr.matches("strain_limit").count(), 1, "{stderr}");
     let summary: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(dir.join("summary.json")).expect("summary"))
@@ -162,11 +159,7 @@ fn drawn_pixels(pixmap: &tiny_skia::Pixmap) -> usize {
 #[test]
 fn a_design_can_turn_the_field_files_off() {
     let dir = test_outputs("fields_off");
-    run_ok(
-        &design("bend45.yaml"),
-        &dir,
-        &["--quiet", "--set", "output.vtk=false"],
-    );
+    completed_in_process(&design("bend45.yaml"), &dir, &["output.vtk=false"]);
     assert!(!dir.join("run.pvd").exists());
     let vtp = std::fs::read_dir(dir.join("snapshots"))
         .expect("snapshots")

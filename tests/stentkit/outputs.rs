@@ -7,7 +7,7 @@
 //! The run folders are left in [`test_outputs`] for the independent check with the official readers
 //! (`scripts/check_outputs.py`, run by `.ci/run` after the tests).
 
-use crate::common::edit;
+use crate::common::fixtures;
 use crate::mesh::designs_and_good_small;
 use serde_json::Value;
 use std::collections::BTreeMap;
@@ -93,6 +93,15 @@ pub(crate) fn run_in_process(design: &Path, dir: &Path, sets: &[&str]) -> (u8, S
         }
     };
     (code, stderr.iter().map(|l| format!("{l}\n")).collect())
+}
+
+/// Runs `design` with the `--set` overrides `sets` into the fresh folder `dir` in process
+/// ([`run_in_process`]) and checks that it completed: [`run_ok`] with `--quiet`, for tests of what a run
+/// writes rather than of what `stentkit run` prints.
+#[track_caller]
+pub(crate) fn completed_in_process(design: &Path, dir: &Path, sets: &[&str]) {
+    let (code, stderr) = run_in_process(design, dir, sets);
+    assert_eq!(code, 0, "{} {sets:?}: {stderr}", design.display());
 }
 
 /// Runs `stentkit` with `args`, failing the test if it has not ended within `limit` (the deadline of a hang,
@@ -430,25 +439,6 @@ fn rod_run_writes_the_run_folder() {
     assert_eq!(summary(&dir)["status"], "completed");
 }
 
-/// The straight stent's design with its end time and snapshot settings replaced.
-fn shortened(file: &Path, end: &str, output: &str) -> String {
-    let text = std::fs::read_to_string(file).expect("design");
-    let mut out: String = text
-        .lines()
-        .map(|l| {
-            if l.starts_with("time:") {
-                format!("time: {{end: {end}, step: 2.5e-3}}")
-            } else {
-                l.to_string()
-            }
-        })
-        .collect::<Vec<_>>()
-        .join("\n");
-    out.push('\n');
-    out.push_str(output);
-    out
-}
-
 #[test]
 fn straight_stent_run_writes_closed_full_device_snapshots() {
     // The flagship quarter model run for 11 steps (t = 0.025 s, Δr reaches 0.375 mm), snapshots every 4 steps
@@ -457,20 +447,13 @@ fn straight_stent_run_writes_closed_full_device_snapshots() {
     // where they cross the symmetry planes, and the bridges lying in a plane are drawn once.
     let root = test_outputs("straight_stent_short");
     let dir = root.join("run");
-    std::fs::create_dir_all(&root).expect("folder");
-    let file = root.join("straight_stent_short.yaml");
-    std::fs::write(
-        &file,
-        shortened(
-            &design("straight_stent.yaml"),
-            "0.025",
-            "output:\n  snapshots: {times: [0.0137], every: 4}\n",
-        ),
-    )
-    .expect("design written");
-    let out = run_ok(&file, &dir, &[]);
+    let file = fixtures::straight_stent()
+        .set("time.end", "0.025")
+        .set("output.snapshots", "{times: [0.0137], every: 4}")
+        .write(&root.join("straight_stent_short.yaml"));
+    completed_in_process(&file, &dir, &[]);
     let s = summary(&dir);
-    assert_eq!(s["status"], "completed", "{}", text(&out.stderr));
+    assert_eq!(s["status"], "completed");
     assert_eq!(
         s["steps"], 11,
         "10 steps of 2.5 ms plus the landing on 0.0137 s"
@@ -629,18 +612,13 @@ fn failed_run_leaves_every_file_valid() {
     // where it stopped; the run folder holds the three converged steps, a snapshot of the last one, a finished
     // recording and a summary with status `failed`.
     let root = test_outputs("failed_run");
-    std::fs::create_dir_all(&root).expect("folder");
-    let file = root.join("bend45_overload.yaml");
-    let text = edit(
-        &edit(
-            &std::fs::read_to_string(design("bend45.yaml")).expect("design"),
-            "[[0, 0], [1, 600]]",
+    let file = fixtures::bend45()
+        .set(
+            "conditions[1].force[2]",
             "[[0, 0], [0.3, 180], [0.4, 600000]]",
-        ),
-        "time: {end: 1.0, step: 0.1}",
-        "time: {end: 1.0, step: 0.1, min_step: 0.1}",
-    );
-    std::fs::write(&file, text).expect("design written");
+        )
+        .set("time.min_step", "0.1")
+        .write(&root.join("bend45_overload.yaml"));
     let dir = root.join("run");
     let out = stentkit(&["run", path_str(&file), "-o", path_str(&dir), "--quiet"]);
     assert_eq!(out.status.code(), Some(1), "exit status of a failed run");

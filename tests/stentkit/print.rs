@@ -5,7 +5,7 @@
 //! which checks them with independent tools: trimesh (one body, watertight), Manifold (the volume of the
 //! union of tubes swept from the centrelines) and Debian's PrusaSlicer (slices with no repair message).
 
-use crate::outputs::{design, path_str, run_ok, stentkit, test_outputs, text};
+use crate::outputs::{completed_in_process, design, path_str, stentkit, test_outputs, text};
 use stentkit::io::stl::read_stl;
 
 /// The one closed surface of a print STL: closed and oriented after the STL round trip, one connected
@@ -211,9 +211,9 @@ fn the_straight_and_curved_stents_print_as_one_solid_each() {
 fn final_state_prints(folder: &str, sets: &[&str]) {
     let dir = test_outputs(folder);
     let run = dir.join("run");
-    let mut extra = vec!["--quiet", "--set", "output.recording.enabled=false"];
-    extra.extend(sets.iter().flat_map(|s| ["--set", s]));
-    run_ok(&design("straight_stent.yaml"), &run, &extra);
+    let mut all = vec!["output.recording.enabled=false"];
+    all.extend(sets);
+    completed_in_process(&design("straight_stent.yaml"), &run, &all);
     let solid = dir.join("final_print.stl");
     let out = stentkit(&[
         "export",

@@ -10,10 +10,8 @@
 //! Most designs here are the 45° bend (`designs/bend45.yaml`: one arc patch `bend` of 20 control points,
 //! clamped at node `root`, loaded at node `tip`), changed in one place.
 
-use crate::common::{
-    design_text, edit, model_from_text, node_displacement, node_index, replace_line,
-};
-use crate::outputs::{path_str, stentkit};
+use crate::common::{edit, fixtures, node_displacement, node_index};
+use crate::outputs::completed_in_process;
 use std::cell::{Cell, RefCell};
 use std::ops::ControlFlow;
 use std::path::Path;
@@ -25,32 +23,17 @@ use stentkit::model::Model;
 use stentkit::solver::simulation::{ROUND_OFF_TOLERANCE, STEP_ROUND_OFF_ULPS};
 use stentkit::solver::{NewtonReport, Observer, RunSummary, Simulation, SolverError, StepReport};
 
-fn bend45() -> String {
-    std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join("designs/bend45.yaml"))
-        .expect("bend45")
-}
-
-/// `bend45` with `from` replaced by `to` (which must occur).
-fn variant(from: &str, to: &str) -> String {
-    edit(&bend45(), from, to)
-}
-
 #[test]
 fn a_non_finite_residual_is_located_in_its_equation() {
     // A modulus of 0.01 (E A = 0.01) and a tip force of 1e307 in a single step with no cutting: the force rows
     // of node `tip` are scaled by E A, so their normalised residual overflows to infinity in the very first
     // assembly — at the equation where the load enters, force equilibrium of `tip` along its third axis. The
     // failure must say so (it would not if the location were lost, or a different row were blamed).
-    let text = edit(
-        &edit(
-            &variant("E_inf: 1.0e7", "E_inf: 1.0e-2"),
-            "[[0, 0], [1, 600]]",
-            "1.0e307",
-        ),
-        "step: 0.1}",
-        "step: 0.1, min_step: 0.1}",
-    );
-    let design = parse_design(&text, Path::new("overflow.yaml")).expect("a valid design");
+    let design = fixtures::bend45()
+        .set("material.E_inf", "1.0e-2")
+        .set("conditions[1].force[2]", "1.0e307")
+        .set("time.min_step", "0.1")
+        .design();
     let mut sim = Simulation::new(&design.model).expect("simulation");
     let error = sim.run(&mut []).expect_err("the step cannot converge");
     let SolverError::StepFailed {
@@ -82,8 +65,12 @@ fn a_free_free_rod_is_refused_naming_its_patch_and_nodes() {
     // No condition at all (the clamp removed): the rod can translate freely, so the tangent is singular
     // whatever the load. `check` warns, the simulation refuses before factorising, naming the patch and the
     // nodes where a condition would help.
-    let text = variant("  - {node: root, clamp: true}\n", "");
-    let design = parse_design(&text, Path::new("free.yaml")).expect("accepted with a warning");
+    let design = fixtures::bend45()
+        .set(
+            "conditions",
+            "[{node: tip, force: [0, 0, [[0, 0], [1, 600]]]}]",
+        )
+        .design();
     assert!(
         design
             .warnings
@@ -109,11 +96,13 @@ fn a_free_free_rod_is_refused_naming_its_patch_and_nodes() {
 fn a_patch_joined_to_nothing_is_named() {
     // A second patch, `floating`, away from the clamped bend and joined to nothing: only it is free. The error
     // names it and its end nodes, not the clamped `bend`.
-    let text = variant(
-        "nodes:\n",
-        "  - name: floating\n    line: {from: [50, 0, 0], to: [60, 0, 0]}\nnodes:\n",
+    // The patch list is set whole, the file's `bend` restated: a change replaces a value, it cannot append.
+    let floating = fixtures::bend45().set(
+        "patches",
+        "[{name: bend, arc: {center: [0, 100, 0], start: [0, 0, 0], axis: [0, 0, 1], angle_deg: 45}}, \
+          {name: floating, line: {from: [50, 0, 0], to: [60, 0, 0]}}]",
     );
-    let design = parse_design(&text, Path::new("floating.yaml")).expect("accepted with a warning");
+    let design = floating.design();
     let error = Simulation::new(&design.model)
         .err()
         .expect("refused: a free body");
@@ -128,8 +117,7 @@ fn a_patch_joined_to_nothing_is_named() {
     // The same through the command line: a clear error, no panic, no LU message.
     let dir = crate::outputs::test_outputs("floating_patch");
     std::fs::create_dir_all(&dir).expect("folder");
-    let file = dir.join("floating.yaml");
-    std::fs::write(&file, &text).expect("design written");
+    let file = floating.write(&dir.join("floating.yaml"));
     let out = Command::new(env!("CARGO_BIN_EXE_stentkit"))
         .args(["run", file.to_str().expect("path"), "-o"])
         .arg(dir.join("run"))
@@ -151,11 +139,9 @@ fn a_weakly_held_rod_gets_a_singular_tangent_diagnosis() {
     // tangent is nearly singular: Newton's first increments are absurd. The run fails at the smallest step
     // with a diagnosis naming the singular tangent and a control point of `bend`, instead of a bare residual
     // list.
-    let text = variant(
-        "{node: root, clamp: true}",
-        "{node: root, displacement: [0, 0, 0]}",
-    );
-    let design = parse_design(&text, Path::new("pinned.yaml")).expect("a valid design");
+    let design = fixtures::bend45()
+        .set("conditions[0]", "{node: root, displacement: [0, 0, 0]}")
+        .design();
     let mut sim = Simulation::new(&design.model).expect("a component is prescribed");
     let error = sim.run(&mut []).expect_err("no equilibrium");
     let SolverError::StepFailed { ref diagnosis, .. } = error else {
@@ -295,31 +281,19 @@ fn a_tolerance_below_round_off_ends_in_bounded_iterations() {
     // step and 25 iterations (max_iterations) per attempt. The tip displacement must agree with the
     // default-tolerance run to 1e-8 relative: both are converged to ~1e-9 in normalised terms (translations
     // over the patch length 78.5, tip displacement 61), measured 2.1e-9.
-    let base = model_from_text(&design_text("bend45.yaml"), "bend45.yaml");
+    let base = fixtures::bend45().model();
     let (reference, _) = crate::common::solve(&base);
     let u_ref = node_displacement(&reference, "tip");
-    let reported = format!(
-        "{}solver: {{tolerance: 1.0e-12}}\n",
-        design_text("bend45.yaml")
-    );
-    let shifted = edit(
-        &replace_line(
-            &replace_line(
-                &reported,
-                "force:",
-                "force: [0, 0, [[0, 0], [0.5, 0], [1, 600]]]",
-            ),
-            "time:",
-            "time: {end: 1.0, step: 0.1, min_step: 1.0e-6}",
-        ),
-        "tolerance: 1.0e-12",
-        "tolerance: 1.0e-13",
-    );
-    for (name, text, tolerance) in [
+    let reported = fixtures::bend45().set("solver.tolerance", "1.0e-12");
+    let shifted = fixtures::bend45()
+        .set("solver.tolerance", "1.0e-13")
+        .set("conditions[1].force[2]", "[[0, 0], [0.5, 0], [1, 600]]")
+        .set("time.min_step", "1.0e-6");
+    for (name, fixture, tolerance) in [
         ("1e-12", reported, "1e-12"),
         ("1e-13 from t = 0.5", shifted, "1e-13"),
     ] {
-        let model = model_from_text(&text, "bend45_tight.yaml");
+        let model = fixture.model();
         let mut script = Script::new();
         let (sim, result) = run_guarded(&model, &mut script, POLL_GUARD);
         let summary = result.unwrap_or_else(|e| panic!("{name}: {e}"));
@@ -384,19 +358,11 @@ fn failing_at_the_smallest_step_at_a_large_time_ends_the_run() {
     // Counts: each step from 0.5 starts at the nominal 0.1 and halves at most ⌈log2(0.1 / 1e-6)⌉ = 17 times, each
     // attempt failing twice (reused then fresh factorisation) — but the run ends at the first failure at the
     // smallest step. Measured: 8 converged steps and 62 failed attempts; the bound is 20 steps × 2 × 18 attempts.
-    let text = replace_line(
-        &replace_line(
-            &format!(
-                "{}solver: {{max_iterations: 1}}\n",
-                design_text("bend45.yaml")
-            ),
-            "force:",
-            "force: [0, 0, [[0, 0], [0.5, 0], [1, 600]]]",
-        ),
-        "time:",
-        "time: {end: 1.0, step: 0.1, min_step: 1.0e-6}",
-    );
-    let model = model_from_text(&text, "bend45_one_iteration.yaml");
+    let model = fixtures::bend45()
+        .set("solver.max_iterations", "1")
+        .set("conditions[1].force[2]", "[[0, 0], [0.5, 0], [1, 600]]")
+        .set("time.min_step", "1.0e-6")
+        .model();
     let mut script = Script::new();
     let (sim, result) = run_guarded(&model, &mut script, POLL_GUARD);
     println!(
@@ -437,14 +403,8 @@ fn the_uncooled_straight_stent_fails_at_the_release_with_a_report() {
     // run with its outputs). Expected: either the run completes (a better solver may get through the snap) or it
     // fails with a dt within STEP_ROUND_OFF_ULPS ulps of min_step after few failed attempts: 500 is ten times
     // the measured count and far below the old one (hundreds per second, until the poll guard stops the run).
-    let text = design_text("straight_stent.yaml");
-    let text = replace_line(&text, "temperature:", "temperature: 90");
     // `check` and `run` warn about exactly this design (issue 18): the one warning it has.
-    let design = stentkit::io::design::parse_design(
-        &text,
-        std::path::Path::new("straight_stent_uncooled.yaml"),
-    )
-    .expect("accepted with a warning");
+    let design = fixtures::straight_stent().set("temperature", "90").design();
     assert!(
         matches!(&design.warnings[..], [w] if w.contains("above the glass transition")),
         "{:?}",
@@ -533,12 +493,7 @@ fn an_interrupt_is_honoured_within_a_step_and_rolled_back() {
     // Expected values come from the same design's uninterrupted run, recorded call by call, and from a run
     // stopped by `step` after step 1: the interrupted runs must repeat the first run's calls up to the poll that
     // answers true and end with bitwise the second run's state (exact: the same operations on the same numbers).
-    let text = replace_line(
-        &design_text("bend45.yaml"),
-        "time:",
-        "time: {end: 1.0, step: 0.5}",
-    );
-    let model = model_from_text(&text, "bend45_two_steps.yaml");
+    let model = fixtures::bend45().time(1.0, 0.5).model();
     let mut full = Script::new();
     let (full_sim, result) = run_guarded(&model, &mut full, usize::MAX);
     let full_summary = result.expect("completes");
@@ -609,12 +564,9 @@ fn an_interrupted_viscoelastic_step_restores_its_history_stresses() {
     // (PLA, 15 Maxwell branches, loaded at 90 °C, cooled from 0.5 s) in steps of 0.25 s to 1.5 s. Interrupted
     // within Newton in step 3 (0.5 → 0.75, the first cooling step); expected: bitwise the state and the root
     // resultants of the run stopped after step 2.
-    let text = replace_line(
-        &design_text("cantilever_morphing.yaml"),
-        "time:",
-        "time: {end: 1.5, step: 0.25}",
-    );
-    let model = model_from_text(&text, "cantilever_coarse.yaml");
+    let model = fixtures::design("cantilever_morphing.yaml")
+        .time(1.5, 0.25)
+        .model();
     let mut full = Script::new();
     let (_, result) = run_guarded(&model, &mut full, usize::MAX);
     result.expect("completes");
@@ -639,27 +591,26 @@ fn planned_steps_are_the_steps_a_run_takes() {
     // take 1, 2 + 1, 4 + 1 and 2 + 1 steps: 8 full and 4 shortened. Snapshot times 0.123 and 0.5 are landed on
     // too: 0.123 splits the second interval (0.073: 1 shortened; 0.207: 2 full + 1 shortened) and 0.5 the third
     // (0.17: 1 full + 1 shortened; 0.27: 2 full + 1 shortened), so 7 full and 6 shortened.
-    let table = "temperature: [[0, 20], [0.05, 20], [0.33, 25], [0.77, 20], [1, 20]]\ntime: {";
+    let table = fixtures::bend45().set(
+        "temperature",
+        "[[0, 20], [0.05, 20], [0.33, 25], [0.77, 20], [1, 20]]",
+    );
     let cases = [
-        (bend45(), 10, 0),
-        (variant("time: {", table), 8, 4),
-        (
-            edit(
-                &variant("time: {", table),
-                "output:\n",
-                "output:\n  snapshots: {times: [0.123, 0.5]}\n",
-            ),
-            7,
-            6,
-        ),
+        (fixtures::bend45(), 10, 0),
+        (table.clone(), 8, 4),
+        (table.set("output.snapshots", "{times: [0.123, 0.5]}"), 7, 6),
     ];
-    for (text, full, shortened) in cases {
-        let design = parse_design(&text, Path::new("steps.yaml")).expect("a valid design");
+    for (fixture, full, shortened) in cases {
+        let design = fixture.design();
         let plan = design.model.planned_steps();
-        assert_eq!((plan.full, plan.shortened), (full, shortened), "{text}");
+        assert_eq!(
+            (plan.full, plan.shortened),
+            (full, shortened),
+            "{fixture:?}"
+        );
         let mut sim = Simulation::new(&design.model).expect("simulation");
         let summary = sim.run(&mut []).expect("the bend converges");
-        assert_eq!(summary.steps, plan.total(), "{text}");
+        assert_eq!(summary.steps, plan.total(), "{fixture:?}");
     }
 }
 
@@ -672,10 +623,12 @@ fn breakpoints_count_in_the_steps_and_the_snapshot_spacing() {
     // ⌈10 / 20⌉ = 1, once gave a snapshot at every one of the 200 000 steps). At 536 bytes per step the memory
     // estimate is 0.11 GB:
     // accepted (a million breakpoints would be 0.54 GB, but their table is over the size limit).
+    // Edited as text, not through `fixtures`: the table's size in the design file is part of what is read.
     let rows: String = (1..=200_000)
         .map(|k| format!("[{:.6}, 20],", k as f64 * 5e-6))
         .collect();
-    let text = variant(
+    let text = edit(
+        &crate::common::design_text("bend45.yaml"),
         "time: {",
         &format!("temperature: [[0, 20],{rows}]\ntime: {{"),
     );
@@ -723,27 +676,15 @@ fn the_disk_estimate_bounds_a_run_folder_from_above() {
     // picture is left out: it is charged at the stents' 0.5 bytes a pixel, and the bend's thin line compresses
     // 20 times better (25 kB against 0.8 MB charged), which with 7 small default snapshots would be most of the
     // estimate; the flagship's folder, picture included, is checked in tests/stentkit/export.rs.
-    let text = variant("step: 0.1}", "step: 1.0e-3}") + "  configurations: {render: false}\n";
     let dir = crate::outputs::test_outputs("disk_estimate");
-    std::fs::create_dir_all(&dir).expect("folder");
-    let file = dir.join("bend_fine.yaml");
-    std::fs::write(&file, &text).expect("design written");
+    let file = fixtures::bend45()
+        .time(1.0, 1.0e-3)
+        .set("output.configurations.render", "false")
+        .write(&dir.join("bend_fine.yaml"));
     let design = stentkit::io::design::load_design(&file).expect("valid");
     let estimate = stentkit::io::estimate::estimated_disk(&design);
     let run = dir.join("run");
-    let out = stentkit(&[
-        "run",
-        path_str(&file),
-        "--force",
-        "--quiet",
-        "-o",
-        path_str(&run),
-    ]);
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    completed_in_process(&file, &run, &[]);
     let written = folder_bytes(&run) as f64;
     let ratio = estimate.total() as f64 / written;
     assert!(
@@ -768,26 +709,15 @@ fn two_rings_per_patch_draw_a_rolled_up_beam() {
     // 10 the beam is a half circle: both end sections contain the chord between them, and the run used to stop
     // there ("stopped", exit 1, "section 0 is not transverse" printed twice). Now the rings are tilted to 60°
     // from the chord and the run completes with all 21 snapshots.
-    let text = edit(
-        &std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join("designs/rollup.yaml"))
-            .expect("rollup"),
-        "output:\n",
-        "output:\n  snapshots: {rings: 2, every: 1, formats: [stl, obj]}\n  recording: {mesh_rings: 2}\n",
-    );
     let dir = crate::outputs::test_outputs("two_rings");
-    std::fs::create_dir_all(&dir).expect("folder");
-    let file = dir.join("rollup_two_rings.yaml");
-    std::fs::write(&file, &text).expect("design written");
-    let out = stentkit(&[
-        "run",
-        path_str(&file),
-        "--force",
-        "--quiet",
-        "-o",
-        path_str(&dir.join("run")),
-    ]);
-    let stderr = String::from_utf8_lossy(&out.stderr);
-    assert!(out.status.success(), "{stderr}");
+    let file = fixtures::rollup()
+        .set(
+            "output.snapshots",
+            "{rings: 2, every: 1, formats: [stl, obj]}",
+        )
+        .set("output.recording", "{mesh_rings: 2}")
+        .write(&dir.join("rollup_two_rings.yaml"));
+    completed_in_process(&file, &dir.join("run"), &[]);
     let summary = std::fs::read_to_string(dir.join("run/summary.json")).expect("summary");
     assert!(summary.contains("\"status\": \"completed\""), "{summary}");
     let snapshots = std::fs::read_dir(dir.join("run/snapshots"))
@@ -807,9 +737,7 @@ fn a_million_breakpoints_are_counted_in_linear_time() {
     // 1) given a temperature table at t = k · 1e-6, k = 0 … 10⁶: every interval is shorter than the step, so
     // the run would land on each of the 10⁶ breakpoints; counted in well under a second (the count is linear
     // after a sort; the bound leaves a hundredfold margin on this shared machine).
-    let mut model = parse_design(&bend45(), Path::new("bend45.yaml"))
-        .expect("bend45")
-        .model;
+    let mut model = fixtures::bend45().model();
     let table = (0..=1_000_000).map(|k| (k as f64 * 1e-6, 20.0)).collect();
     model.temperature = stentkit::model::TimeFunction::try_table(table).expect("increasing");
     let started = std::time::Instant::now();

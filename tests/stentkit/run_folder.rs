@@ -9,7 +9,7 @@
 //! with [`test_outputs`]; folders of refused or setup-interrupted runs (no snapshots by design) live under
 //! [`scratch`], which the script does not read.
 
-use crate::common::edit;
+use crate::common::{edit, fixtures};
 use crate::outputs::{
     check_history, check_recording, check_snapshots, design, path_str, stentkit, summary,
     test_outputs, text,
@@ -389,17 +389,10 @@ fn sigkill_leaves_a_folder_that_repair_makes_whole() {
 #[test]
 fn a_signal_during_setup_leaves_a_summary_saying_so() {
     let dir = scratch("setup_signal");
-    let file = dir.join("big.yaml");
-    let text_ = edit(
-        &edit(
-            &std::fs::read_to_string(design("straight_stent.yaml")).expect("design"),
-            "crowns: 6",
-            "crowns: 60",
-        ),
-        "symmetry: quarter",
-        "symmetry: none",
-    );
-    std::fs::write(&file, text_).expect("write");
+    let file = fixtures::straight_stent()
+        .crowns(60)
+        .set("stent.symmetry", "none")
+        .write(&dir.join("big.yaml"));
     let run = dir.join("run");
     let child = spawn_run(&file, &run);
     // summary.json is written as soon as the folder is taken, before the discretisation is built.
@@ -422,6 +415,7 @@ fn a_signal_during_setup_leaves_a_summary_saying_so() {
 fn bad_input_exits_with_status_2() {
     let dir = scratch("exit_codes");
     let file = dir.join("broken.yaml");
+    // Edited as text, not through `fixtures`: a design with an unknown field is what is tested.
     std::fs::write(
         &file,
         edit(
@@ -547,17 +541,11 @@ fn a_full_disk_leaves_every_output_finished_or_removed() {
 #[test]
 fn times_far_from_seconds_are_printed_short() {
     let dir = scratch("huge_time");
-    let file = dir.join("huge.yaml");
-    let text_ = edit(
-        &edit(
-            &std::fs::read_to_string(bend45()).expect("design"),
-            "time: {end: 1.0, step: 0.1}",
-            "time: {end: 1.0e300, step: 1.0e299, min_step: 1.0e299}",
-        ),
-        "[[0, 0], [1, 600]]",
-        "[[0, 0], [1.0e300, 6.0e9]]",
-    );
-    std::fs::write(&file, text_).expect("write");
+    let file = fixtures::bend45()
+        .time(1.0e300, 1.0e299)
+        .set("time.min_step", "1.0e299")
+        .set("conditions[1].force[2]", "[[0, 0], [1.0e300, 6.0e9]]")
+        .write(&dir.join("huge.yaml"));
     let out = stentkit(&[
         "run",
         path_str(&file),

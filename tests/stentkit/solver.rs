@@ -5,61 +5,14 @@
 
 use crate::common::{
     BATHE_BOLOURCHI_1979_TIP, SIMO_VU_QUOC_1986_TIP, bend45_reference_tip,
-    bend45_shooting_displacement, centreline_point, design_text, log_log_slope, model_from_text,
-    node_displacement, node_index, replace_line, rollup_centreline, solve,
+    bend45_shooting_displacement, centreline_point, fixtures, log_log_slope, model_from_text,
+    node_displacement, node_index, rollup_centreline, solve,
 };
-use stentkit::material::{ElasticLaw, Section, SectionProperties};
+use stentkit::material::ElasticLaw;
 use stentkit::math::{Real, Vec3};
-use stentkit::model::builder::{
-    ConditionSpec, ModelBuilder, NodeEnds, PatchShape, ProbeAt, TimeSpec,
-};
+use stentkit::model::builder::{ConditionSpec, ModelBuilder, NodeEnds, PatchShape, TimeSpec};
 use stentkit::model::{Model, ProbeLocation, SolverSettings, TimeFunction};
 use stentkit::solver::Simulation;
-
-/// The 45° bend of designs/bend45.yaml built in code, split into `patches` exact arcs of `45° / patches`
-/// each (joined end to start), degree `p` and `n` control points per patch, in `steps` load steps.
-fn bend45_in_code(patches: usize, p: usize, n: usize, steps: usize) -> ModelBuilder {
-    let material = ElasticLaw::try_new(1e7, 0.0).expect("E > 0, ν = 0");
-    let section = Section::try_from_properties(SectionProperties {
-        area: 1.0,
-        second_moment: 1.0 / 12.0,
-        polar_moment: 1.0 / 6.0,
-        shear_factor: 5.0 / 6.0,
-        drawing_diameter: (4.0 / std::f64::consts::PI).sqrt(),
-    })
-    .expect("positive properties");
-    let mut b = ModelBuilder::new("bend45", material, section);
-    let angle = 45.0 / patches as Real;
-    for k in 0..patches {
-        let a = (k as Real * angle).to_radians();
-        // Start of arc k on the circle of radius 100 about (0, 100, 0), starting at the origin.
-        let start = Vec3::new(100.0 * a.sin(), 100.0 - 100.0 * a.cos(), 0.0);
-        let arc = PatchShape::Arc {
-            centre: Vec3::new(0.0, 100.0, 0.0),
-            start,
-            axis: Vec3::z(),
-            angle: angle.to_radians(),
-        };
-        b.patch(format!("b{k}"), arc, p, n);
-    }
-    b.node("root", NodeEnds::Named(vec!["b0.start".into()]));
-    for k in 1..patches {
-        b.node(
-            format!("j{k}"),
-            NodeEnds::Named(vec![format!("b{}.end", k - 1), format!("b{k}.start")]),
-        );
-    }
-    b.node(
-        "tip",
-        NodeEnds::Named(vec![format!("b{}.end", patches - 1)]),
-    );
-    b.condition(ConditionSpec::clamp("root"));
-    let ramp = TimeFunction::try_table(vec![(0.0, 0.0), (1.0, 600.0)]).expect("increasing times");
-    b.condition(ConditionSpec::at("tip").with_force(2, ramp));
-    b.time(TimeSpec::new(1.0, 1.0 / steps as Real));
-    b.probe("tip", ProbeAt::Node("tip".into()));
-    b
-}
 
 /// A model the builder accepts without warnings.
 #[track_caller]
@@ -70,14 +23,11 @@ fn built(b: &ModelBuilder) -> Model {
 }
 
 /// The 45° bend (designs/bend45.yaml) at degree `p` with `n` control points, in `steps` load steps.
-fn bend45_text(p: usize, n: usize, steps: usize) -> String {
-    let text = design_text("bend45.yaml");
-    let text = replace_line(&text, "mesh:", &format!("mesh: {{p: {p}, n: {n}}}"));
-    replace_line(
-        &text,
-        "time:",
-        &format!("time: {{end: 1.0, step: {}}}", 1.0 / steps as Real),
-    )
+fn bend45(p: usize, n: usize, steps: usize) -> Model {
+    fixtures::bend45()
+        .mesh(p, n)
+        .time(1.0, 1.0 / steps as Real)
+        .model()
 }
 
 // ---------------------------------------------------------------------------------------------------------
@@ -104,7 +54,7 @@ fn bend45_text(p: usize, n: usize, steps: usize) -> String {
 fn newton_converges_quadratically() {
     // Newton's method proper from the last converged state: a factorisation per iteration (the default reuses it
     // while it contracts) and no extrapolated start (which puts the first iterate inside the quadratic basin).
-    let mut b = bend45_in_code(1, 6, 20, 50);
+    let mut b = fixtures::bend45_builder(1, 6, 20, 50);
     b.solver(SolverSettings {
         reuse_factorisation: false,
         extrapolate: false,
@@ -190,7 +140,6 @@ fn fmt(v: &[Real]) -> Vec<String> {
 #[test]
 fn rollup_becomes_a_full_circle() {
     let length = 10.0;
-    let base = design_text("rollup.yaml");
     let mut report = Vec::new();
     for p in 3..=8usize {
         let ns = [16usize, 24, 32, 48, 64];
@@ -199,9 +148,10 @@ fn rollup_becomes_a_full_circle() {
             // Newton's method proper: the algebraic error must be far below the finest discretisation error
             // (5.6e-13), and quadratic convergence puts the iterate at ~‖Δ‖² when the estimated error (Hairer's
             // θ/(1 − θ)‖Δ‖) passes the tolerance, where the chord method stops at ~1e-9.
-            let text = replace_line(&base, "mesh:", &format!("mesh: {{p: {p}, n: {n}}}"));
-            let text = format!("{text}\nsolver: {{reuse_factorisation: false}}\n");
-            let model = model_from_text(&text, "rollup.yaml");
+            let model = fixtures::rollup()
+                .mesh(p, n)
+                .set("solver.reuse_factorisation", "false")
+                .model();
             let (sim, _) = solve(&model);
             let error = (0..=100)
                 .map(|i| {
@@ -278,7 +228,7 @@ fn bend45_matches_published_values_and_a_shooting_reference() {
     let reference = bend45_shooting_displacement();
     let x0 = bend45_reference_tip();
     for (p, n) in [(6, 20), (6, 80)] {
-        let model = model_from_text(&bend45_text(p, n, 10), "bend45.yaml");
+        let model = bend45(p, n, 10);
         let (sim, rec) = solve(&model);
         let u = node_displacement(&sim, "tip");
         let tip = x0 + u;
@@ -324,7 +274,7 @@ fn splitting_the_bend_into_patches_changes_only_the_discretisation_error() {
     let reference = bend45_shooting_displacement();
     let mut results = Vec::new();
     for (patches, n) in [(1usize, 60usize), (2, 30), (5, 12)] {
-        let model = built(&bend45_in_code(patches, 6, n, 10));
+        let model = built(&fixtures::bend45_builder(patches, 6, n, 10));
         assert_eq!(model.patches.len(), patches);
         let (sim, rec) = solve(&model);
         let u = node_displacement(&sim, "tip");
@@ -580,14 +530,11 @@ solver: {{tolerance: 1.0e-13, reuse_factorisation: false}}
 /// The viscoelastic circular arch of designs/circular_arch.yaml at p = 8, n = 32 to t = 3 s (3000 steps of 1 ms,
 /// as the committed convergence study), with the given Newton tolerance: the tip displacement at every step.
 fn arch_tip_history(tolerance: Real) -> Vec<Vec3> {
-    let text = design_text("circular_arch.yaml");
-    let text = replace_line(&text, "mesh:", "mesh: {p: 8, n: 32}");
-    let text = replace_line(
-        &text,
-        "time:",
-        &format!("solver: {{tolerance: {tolerance:e}}}\ntime: {{end: 3.0, step: 1.0e-3}}"),
-    );
-    let model = model_from_text(&text, "circular_arch.yaml");
+    let model = fixtures::design("circular_arch.yaml")
+        .mesh(8, 32)
+        .set("solver.tolerance", &format!("{tolerance:e}"))
+        .time(3.0, 1.0e-3)
+        .model();
     let tip = node_index(&model, "tip");
     let mut sim = Simulation::new(&model).expect("simulation");
     let mut history = Vec::new();
@@ -628,7 +575,7 @@ fn the_elastic_bend_ends_where_it_ends_whatever_the_number_of_load_steps() {
     let tips: Vec<(usize, Vec3)> = [20, 25, 40, 50]
         .into_iter()
         .map(|steps| {
-            let model = built(&bend45_in_code(1, 8, 20, steps));
+            let model = built(&fixtures::bend45_builder(1, 8, 20, steps));
             let (sim, _) = solve(&model);
             (steps, node_displacement(&sim, "tip"))
         })

@@ -3,9 +3,7 @@
 //! stent's release, the strain energy it is judged by, and checkpoints of a damped run. Run with `--nocapture`
 //! to see the measured numbers.
 
-use crate::common::{design_text, model_from_text, node_displacement, replace_line, solve};
-use std::path::Path;
-use stentkit::io::design::parse_design;
+use crate::common::{fixtures, model_from_text, node_displacement, solve};
 use stentkit::math::Real;
 use stentkit::model::StabilisationSettings;
 use stentkit::solver::Simulation;
@@ -65,12 +63,10 @@ fn the_strain_energy_of_a_cantilever_bent_by_an_end_couple_is_the_closed_form() 
 /// and the warning gives the run's final ratio.
 #[test]
 fn a_hot_release_runs_through_with_stabilisation_and_says_it_is_not_quasi_static() {
-    let text = replace_line(
-        &design_text("straight_stent.yaml"),
-        "temperature:",
-        "temperature: [[0, 90], [3.25, 90]]",
-    ) + "solver: {stabilisation: {}}\n";
-    let design = parse_design(&text, Path::new("hot.yaml")).expect("a valid design");
+    let design = fixtures::straight_stent()
+        .set("temperature", "[[0, 90], [3.25, 90]]")
+        .set("solver.stabilisation", "{}")
+        .design();
     assert!(
         design
             .warnings
@@ -115,16 +111,12 @@ fn a_hot_release_runs_through_with_stabilisation_and_says_it_is_not_quasi_static
 /// model's own release path folds, as the coarse bend's and roll-up's load paths do.)
 #[test]
 fn the_coarse_stent_whose_release_folds_completes_with_stabilisation() {
-    let text = replace_line(
-        &replace_line(
-            &replace_line(&design_text("straight_stent.yaml"), "crowns:", "crowns: 2"),
-            "mesh:",
-            "mesh: {p: 5, n: 14}",
-        ),
-        "time:",
-        "time: {end: 2.0, step: 0.01, release_ramp: 0.01}",
-    );
-    let plain = model_from_text(&text, "p5n14.yaml");
+    let plain = fixtures::straight_stent()
+        .crowns(2)
+        .mesh(5, 14)
+        .time(2.0, 0.01)
+        .set("time.release_ramp", "0.01")
+        .model();
     let mut sim = Simulation::new(&plain).expect("valid");
     let failure = sim
         .run(&mut [])
@@ -149,9 +141,10 @@ fn the_coarse_stent_whose_release_folds_completes_with_stabilisation() {
 /// load steps stall at a limit point of its path (issue 18 item 4), is damped over several steps.
 #[test]
 fn a_damped_run_continues_bit_for_bit_from_a_checkpoint() {
-    let text = replace_line(&design_text("rollup.yaml"), "mesh:", "mesh: {p: 4, n: 8}")
-        + "solver: {stabilisation: {}}\n";
-    let model = model_from_text(&text, "rollup_coarse.yaml");
+    let model = fixtures::rollup()
+        .mesh(4, 8)
+        .set("solver.stabilisation", "{}")
+        .model();
     let mut whole = Simulation::new(&model).expect("valid");
     let mut checkpoint = None;
     let mut after = Vec::new();
@@ -180,26 +173,21 @@ fn a_damped_run_continues_bit_for_bit_from_a_checkpoint() {
 }
 
 /// The 45° bend (designs/bend45.yaml) overloaded to a tip force of 3000 reached in two steps of 0.5 with no cut
-/// allowed (`min_step` = step), with `extra` appended to the design, run by `stentkit run` into a fresh folder:
+/// allowed (`min_step` = step), with `solver.stabilisation` set to `stabilisation`, run into a fresh folder:
 /// the exit status, stderr and summary.json. Undamped with cuts the bend carries that load to a tip
 /// displacement of (−47.7, −25.1, 68.6), |u| = 87.2 (measured with the design's step of 0.1); undamped with
 /// these steps Newton fails at the first; with `factor: 1e9` every step stalls, is damped and converges. Run
 /// in process ([`crate::outputs::run_in_process`]: the exit status and stderr `stentkit run -q` would give).
-fn overloaded_bend(name: &str, extra: &str) -> (Option<i32>, String, serde_json::Value) {
+fn overloaded_bend(name: &str, stabilisation: &str) -> (Option<i32>, String, serde_json::Value) {
     use crate::outputs::{run_in_process, test_outputs};
     let root = test_outputs(name);
     std::fs::create_dir_all(&root).expect("folder");
-    let file = root.join("bend45_damped.yaml");
-    let design = replace_line(
-        &replace_line(
-            &design_text("bend45.yaml"),
-            "force:",
-            "force: [0, 0, [[0, 0], [1, 3000]]]",
-        ),
-        "time:",
-        "time: {end: 1.0, step: 0.5, min_step: 0.5}",
-    ) + extra;
-    std::fs::write(&file, design).expect("design written");
+    let file = fixtures::bend45()
+        .set("conditions[1].force", "[0, 0, [[0, 0], [1, 3000]]]")
+        .time(1.0, 0.5)
+        .set("time.min_step", "0.5")
+        .set("solver.stabilisation", stabilisation)
+        .write(&root.join("bend45_damped.yaml"));
     let dir = root.join("run");
     let (code, stderr) = run_in_process(&file, &dir, &[]);
     let summary = std::fs::read_to_string(dir.join("summary.json")).expect("summary.json");
@@ -236,10 +224,8 @@ pub(crate) fn warning_said(summary: &serde_json::Value, stderr: &str, fragment: 
 /// still completes, with a warning in summary.json and on stderr, and `above_limit` true.
 #[test]
 fn a_damping_that_carries_the_load_is_warned_about_by_force() {
-    let (code, stderr, summary) = overloaded_bend(
-        "stabilisation_carries_the_load",
-        "solver: {stabilisation: {factor: 1.0e9}}\n",
-    );
+    let (code, stderr, summary) =
+        overloaded_bend("stabilisation_carries_the_load", "{factor: 1.0e9}");
     assert_eq!(code, Some(0), "{stderr}");
     assert_eq!(summary["status"], "completed");
     let s = &summary["stabilisation"];
@@ -264,7 +250,7 @@ fn a_damping_that_carries_the_load_is_warned_about_by_force() {
 fn the_dissipated_energy_warning_reports_the_final_ratio() {
     let (code, stderr, summary) = overloaded_bend(
         "stabilisation_final_ratio",
-        "solver: {stabilisation: {factor: 1.0e9, limit: 1.0e-3}}\n",
+        "{factor: 1.0e9, limit: 1.0e-3}",
     );
     assert_eq!(code, Some(0), "{stderr}");
     let ratio = summary["stabilisation"]["ratio"].as_f64().expect("ratio");

@@ -2,36 +2,25 @@
 //! `designs/` (wires on their cylinders, joint ends, frames, watertight tubes, node sets) and the symmetry check
 //! (a quarter or half model responds as the full device does), and the block solver against the sparse LU.
 
-use crate::common::edit;
+use crate::common::fixtures;
 use std::ops::ControlFlow;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use stentkit::geometry::frame::{FrameField, FrameSettings};
-use stentkit::io::design::{load_design, parse_design};
+use stentkit::io::design::parse_design;
 use stentkit::io::stl::{read_stl, write_stl};
 use stentkit::math::{Real, Vec3};
 use stentkit::model::{Model, ProbeLocation};
 use stentkit::post::device::reference_device_mesh;
 use stentkit::solver::{Observer, Simulation, StepReport};
 
-fn design(name: &str) -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("designs")
-        .join(name)
-}
-
 /// The paper devices as modelled (reduced) and as full devices (`full_model: true`).
 fn devices() -> Vec<(String, Model)> {
     let mut out = Vec::new();
     for name in ["straight_stent.yaml", "curved_stent.yaml"] {
-        let path = design(name);
-        let text = std::fs::read_to_string(&path).expect("design readable");
-        let model = load_design(&path).unwrap_or_else(|e| panic!("{e}")).model;
-        out.push((name.to_string(), model));
-        let full = edit(&text, "  symmetry:", "  full_model: true\n  symmetry:");
-        let model = parse_design(&full, &path)
-            .unwrap_or_else(|e| panic!("{e}"))
-            .model;
-        out.push((format!("{name} (full)"), model));
+        let device = fixtures::design(name);
+        out.push((name.to_string(), device.design().model));
+        let full = device.set("stent.full_model", "true");
+        out.push((format!("{name} (full)"), full.design().model));
     }
     out
 }

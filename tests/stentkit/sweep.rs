@@ -8,7 +8,7 @@
 //! design run by `stentkit run` with the same `--set` (byte-identical history), and the uninterrupted local
 //! sweep (identical metrics: the runs are deterministic and a resumed run continues bit for bit).
 
-use crate::outputs::{design, path_str, stentkit, test_outputs, text};
+use crate::outputs::{completed_in_process, design, path_str, stentkit, test_outputs, text};
 use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
@@ -96,20 +96,15 @@ fn a_local_sweep_runs_continues_after_a_signal_and_tabulates() {
     let reference = local_reference();
     // Variant v001 (Tg = 65, d = 0.6) is the design run with those values.
     let single = test_outputs("sweep_single");
-    let out = stentkit(&[
-        "run",
-        path_str(&design("straight_stent.yaml")),
-        "-q",
-        "-o",
-        path_str(&single),
-        "--set",
-        "stent.crowns=2",
-        "--set",
-        "material.wlf.Tg=65",
-        "--set",
-        "section.diameter=0.6",
-    ]);
-    assert!(out.status.success(), "{}", text(&out.stderr));
+    completed_in_process(
+        &design("straight_stent.yaml"),
+        &single,
+        &[
+            "stent.crowns=2",
+            "material.wlf.Tg=65",
+            "section.diameter=0.6",
+        ],
+    );
     let history = |dir: &Path| std::fs::read(dir.join("history.csv")).expect("history.csv");
     assert_eq!(
         history(&reference.join("variants/v001/run")),

@@ -3,29 +3,23 @@
 //! and `check` say nothing untrue of an error-controlled stent; a wire thicker than its stent's radius is
 //! refused. (The stabilisation's warnings are in `stabilisation.rs`.)
 
-use crate::common::{design_text, replace_line};
-use crate::outputs::{design, path_str, stentkit, test_outputs, text};
+use crate::common::{design_text, fixtures, replace_line};
+use crate::outputs::{design, path_str, run_in_process, stentkit, test_outputs, text};
 use crate::stabilisation::warning_said;
 use std::path::{Path, PathBuf};
 use stentkit::io::design::{DesignOverrides, load_design, load_design_with};
+use stentkit::math::Real;
 
 /// The straight stent (designs/straight_stent.yaml) with two crowns and error-controlled steps (tolerance
 /// 1e-2), whose temperature schedule is replaced by `temperature` and whose run ends at `end`, written as
 /// `name.yaml` into `dir`.
-fn two_crown_stent(dir: &Path, name: &str, temperature: &str, end: &str) -> PathBuf {
-    let text = replace_line(
-        &replace_line(
-            &replace_line(&design_text("straight_stent.yaml"), "crowns:", "crowns: 2"),
-            "temperature:",
-            &format!("temperature: {temperature}"),
-        ),
-        "time:",
-        &format!("time: {{end: {end}, step: 0.01, tolerance: 1.0e-2}}"),
-    );
-    std::fs::create_dir_all(dir).expect("folder");
-    let file = dir.join(format!("{name}.yaml"));
-    std::fs::write(&file, text).expect("design written");
-    file
+fn two_crown_stent(dir: &Path, name: &str, temperature: &str, end: Real) -> PathBuf {
+    fixtures::straight_stent()
+        .crowns(2)
+        .set("temperature", temperature)
+        .time(end, 0.01)
+        .set("time.tolerance", "1.0e-2")
+        .write(&dir.join(format!("{name}.yaml")))
 }
 
 /// The schedule of the stent heated above its Tg (70 °C) at the end but only for a moment: cooled to 45 °C
@@ -47,28 +41,28 @@ fn summary(dir: &Path) -> serde_json::Value {
 #[test]
 fn a_run_that_ends_heated_but_not_recovered_completes_with_a_warning() {
     let root = test_outputs("recovery_warning");
-    let brief = two_crown_stent(&root, "brief", BRIEFLY_HEATED, "2.05");
+    let brief = two_crown_stent(&root, "brief", BRIEFLY_HEATED, 2.05);
     let dir = root.join("brief_run");
-    let out = stentkit(&["run", path_str(&brief), "-o", path_str(&dir), "-q"]);
-    assert_eq!(out.status.code(), Some(0), "{}", text(&out.stderr));
+    let (code, stderr) = run_in_process(&brief, &dir, &[]);
+    assert_eq!(code, 0, "{stderr}");
     let s = summary(&dir);
     assert_eq!(s["status"], "completed");
     let ratio = s["final_state"]["recovery_ratio_mean"]
         .as_f64()
         .expect("a ratio");
     assert!(ratio > 0.5, "{ratio}");
-    let said = warning_said(&s, &text(&out.stderr), "recovery ratio");
+    let said = warning_said(&s, &stderr, "recovery ratio");
     assert!(said.contains(&format!("{ratio:.3}")), "{said}");
 
     let full = two_crown_stent(
         &root,
         "full",
         "[[0, 90], [1, 90], [1.75, 45], [3.16876, 90], [3.25, 90]]",
-        "3.25",
+        3.25,
     );
     let dir = root.join("full_run");
-    let out = stentkit(&["run", path_str(&full), "-o", path_str(&dir), "-q"]);
-    assert_eq!(out.status.code(), Some(0), "{}", text(&out.stderr));
+    let (code, stderr) = run_in_process(&full, &dir, &[]);
+    assert_eq!(code, 0, "{stderr}");
     let s = summary(&dir);
     assert!(
         s["final_state"]["recovery_ratio_mean"]
@@ -79,11 +73,7 @@ fn a_run_that_ends_heated_but_not_recovered_completes_with_a_warning() {
         s["final_state"]
     );
     assert_eq!(s["warnings"], serde_json::json!([]), "{}", s["warnings"]);
-    assert!(
-        !text(&out.stderr).contains("warning"),
-        "{}",
-        text(&out.stderr)
-    );
+    assert!(!stderr.contains("warning"), "{stderr}");
 }
 
 /// Issue 31 item 20: `sweep collect` shows the warnings of every variant. The briefly heated two-crown stent
@@ -93,7 +83,7 @@ fn a_run_that_ends_heated_but_not_recovered_completes_with_a_warning() {
 #[test]
 fn sweep_collect_counts_the_warnings_of_each_variant() {
     let root = test_outputs("sweep_warnings");
-    let file = two_crown_stent(&root, "brief", BRIEFLY_HEATED, "2.05");
+    let file = two_crown_stent(&root, "brief", BRIEFLY_HEATED, 2.05);
     let dir = root.join("sweep");
     let out = stentkit(&[
         "sweep",
@@ -210,6 +200,8 @@ fn a_stent_sized_from_a_tiny_lumen_is_refused() {
         csv.push_str(&format!("{k},0,0,1e-9\n"));
     }
     std::fs::write(dir.join("tiny.csv"), csv).expect("centreline written");
+    // Edited as text, not through `fixtures`: the design is refused, and its file, which names the centreline
+    // file beside it, is what `check` reads.
     let text = replace_line(
         &replace_line(&design_text("aorta_stent.yaml"), "path:", "path: tiny.csv"),
         "polyline:",
