@@ -10,7 +10,7 @@
 
 use std::error::Error;
 use std::path::Path;
-use stentkit::io::design::parse_design;
+use stentkit::design::parse_design;
 use stentkit::math::{Real, Vec3};
 use stentkit::model::Model;
 use stentkit::solver::Simulation;

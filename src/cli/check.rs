@@ -1,7 +1,7 @@
 //! `stentkit check`: validate a design and describe what a run would solve.
 
-use crate::io::design::size::{MEMORY_LIMIT_BYTES, human_bytes};
-use crate::io::design::{Design, DesignOverrides, SetOverride, load_design_with};
+use crate::design::size::{MEMORY_LIMIT_BYTES, human_bytes};
+use crate::design::{Design, DesignOverrides, SetOverride, load_design_with};
 use crate::io::estimate::estimated_disk;
 use crate::material::{ConstitutiveLaw, MaterialLaw};
 use crate::model::Component;

@@ -15,7 +15,7 @@
 //! 161, 0.07 % apart); a `.csv` output holds the state's centrelines instead of a mesh.
 
 use super::BadInput;
-use crate::io::design::{DesignOverrides, SetOverride, load_design_with};
+use crate::design::{DesignOverrides, SetOverride, load_design_with};
 use crate::io::formats;
 use crate::io::mesh_format::SnapshotState;
 use crate::io::snapshots::{current_device_mesh, snapshot_name};

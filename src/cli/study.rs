@@ -4,9 +4,9 @@
 use super::BadInput;
 use super::Target;
 use super::arguments::{count, rounded_up, short};
+use crate::design::size::{StepCount, over_limit};
+use crate::design::{Design, load_design};
 use crate::io::chart::write_svg;
-use crate::io::design::size::{StepCount, over_limit};
-use crate::io::design::{Design, load_design};
 use crate::material::Integrator;
 use crate::study::convergence::{
     ConvergenceStudy, convergence_charts, convergence_csv, convergence_study,
@@ -121,7 +121,7 @@ pub fn degree_and_points(text: &str) -> Result<(usize, usize), String> {
 pub const MAPS: &[&str] = &["material", "bend45", "heating", "release", "coarse"];
 
 /// Refuses (exit status 2, naming `argument`) a study run of `design` changed by `variant` whose time steps
-/// would need more memory than a design may ([`crate::io::design::size::MemoryEstimate::with_steps`]: the
+/// would need more memory than a design may ([`crate::design::size::MemoryEstimate::with_steps`]: the
 /// guard designs get, for the run's steps landing on every breakpoint), or that the variant itself refuses
 /// (a step beyond the end). The argument's value is `scale` times the run's step.
 fn check_steps(
@@ -281,6 +281,7 @@ pub fn stability_maps(output: Target<'_>, maps: &[String]) -> anyhow::Result<()>
     create(output)?;
     let summary = stability(
         &study,
+        &crate::design::variants::read_varied,
         |map| -> anyhow::Result<()> {
             write(&output.join(format!("{}.csv", map.name)), &map.csv)?;
             write_svg(&map.chart, &output.join(format!("{}.svg", map.name)))?;

@@ -170,7 +170,7 @@ pub struct HistoryWriter {
 
 impl HistoryWriter {
     /// Creates (truncates) the file and writes the header for the model's probes; `strain_limits` (per material,
-    /// [`crate::io::design::OutputSettings::strain_limits`]) adds a peak column per material with a limit.
+    /// [`crate::design::OutputSettings::strain_limits`]) adds a peak column per material with a limit.
     pub fn create(
         path: &Path,
         sim: &Simulation<'_>,

@@ -9,8 +9,8 @@
 
 use super::chart::ChartError;
 use super::configurations::{self, CENTRELINE_SAMPLES, Configuration};
-use super::design::SnapshotSettings;
 use super::mesh_format::{MeshFormat, SnapshotState};
+use super::output::SnapshotSettings;
 use super::run_folder::Manifest;
 use super::stl::MeshIoError;
 use super::{formats, render, stl, vtk};

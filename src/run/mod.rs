@@ -44,9 +44,9 @@ pub mod recorder;
 
 pub use recorder::{RECORDERS, Recorder, RecorderKind};
 
+use crate::design::Design;
+use crate::design::size::human_bytes;
 use crate::io::checkpoint::{self, OutputsCheckpoint, RunCheckpoint};
-use crate::io::design::Design;
-use crate::io::design::size::human_bytes;
 use crate::io::mcap::RunInfo;
 use crate::io::run_folder::{self, Manifest, RunFolder, RunFolderError};
 use crate::io::summary::{FailureReport, OutputState, RunStatus, RunSummaryFile, peak_memory_mib};

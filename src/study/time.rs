@@ -18,10 +18,10 @@ use super::fit::{fit_log_slope, relative_error};
 use super::sample::{SampledRun, sample_run};
 use super::variant::TimeVariant;
 use super::{StudyError, error_chain};
-use crate::io::chart::LineChart;
 use crate::material::Integrator;
 use crate::math::Real;
 use crate::model::Model;
+use crate::post::chart::LineChart;
 use std::fmt::Write as _;
 
 /// Which run the errors of a time-step study are measured against.

@@ -48,8 +48,7 @@
 
 use super::StudyError;
 use super::sample::{Watched, WatchedRun, watched_run};
-use super::variant::{Remesh, TimeVariant, rebuild};
-use crate::io::design::Design;
+use super::variant::{Remesh, TimeVariant, VariedDesign};
 use crate::math::{Real, Short, Vec3};
 use crate::model::{Model, ProbeLocation};
 use std::fmt;
@@ -213,7 +212,7 @@ impl fmt::Display for RunKey {
 
 /// Runs `tune`'s variants of one design, each once.
 struct Runner<'d> {
-    design: &'d Design,
+    design: &'d dyn VariedDesign,
     /// Names of the watched locations (`probe tip`, `node base`).
     names: Vec<String>,
     locations: Vec<ProbeLocation>,
@@ -241,7 +240,7 @@ impl Runner<'_> {
             points: Some(key.points),
             crowns: None,
         };
-        let mut model = rebuild(self.design, &remesh)?;
+        let mut model = self.design.rebuild(&remesh)?;
         let whole = key.end >= model.time.end;
         model.time.end = key.end;
         let (step, tolerance) = match key.stepping {
@@ -449,7 +448,7 @@ fn round_sig(x: Real) -> Real {
 /// estimate (not the trapezoidal one); [`StudyError::Run`] when no candidate's results settle in time or pass
 /// verification within [`MAX_ROUNDS`] rounds (each one's reason given).
 pub fn tune(
-    design: &Design,
+    design: &dyn VariedDesign,
     settings: &TuneSettings,
     mut progress: impl FnMut(&Trial),
 ) -> Result<Tuned, StudyError> {
@@ -461,7 +460,7 @@ pub fn tune(
             expected: "at least one",
         });
     }
-    let model = &design.model;
+    let model = design.model();
     let end = model.time.end;
     // Every candidate controls its time error: refused at once for an update without an estimate.
     TimeVariant {
@@ -589,7 +588,7 @@ fn time_ladder(
     mut tau: Real,
     tol: Real,
 ) -> Option<Real> {
-    let end = runner.design.model.time.end;
+    let end = runner.design.model().time.end;
     for _ in 0..MAX_TIME_RUNGS {
         let finer = round_sig(tau / 10.0);
         let key = |stepping| RunKey {
@@ -617,9 +616,9 @@ fn time_ladder(
 
 /// Wall time of the design's own settings \[s\]: fixed steps are timed over their first twentieth (at least 20
 /// steps) and extrapolated by the planned step count; error-controlled ones are run in full.
-fn design_cost(design: &Design) -> Result<Real, StudyError> {
-    let mut model = design.model.clone();
-    let planned = design.steps.total().max(1);
+fn design_cost(design: &dyn VariedDesign) -> Result<Real, StudyError> {
+    let mut model = design.model().clone();
+    let planned = design.steps().total().max(1);
     let fraction = if model.time.tolerance.is_some() {
         1.0
     } else {

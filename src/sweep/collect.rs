@@ -5,8 +5,8 @@
 
 use super::metrics::{Metrics, Release, run_metrics};
 use super::{Plan, SweepDir, SweepError, VariantState, short_name};
+use crate::design::load_design;
 use crate::io::chart::{LineChart, Series, write_svg};
-use crate::io::design::load_design;
 use crate::math::Real;
 use std::fmt::Write as _;
 use std::path::PathBuf;

@@ -4,7 +4,7 @@
 use crate::mesh::{TempDir, designs_and_good_small};
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
-use stentkit::io::design::load_design;
+use stentkit::design::load_design;
 
 /// Runs `stentkit` with `args`.
 fn stentkit(args: &[&str]) -> Output {
@@ -270,7 +270,7 @@ fn run_with_overrides_records_the_resolved_design() {
     let resolved = summary["resolved_design"]
         .as_str()
         .expect("resolved_design");
-    let model = stentkit::io::design::parse_design(resolved, Path::new("resolved.yaml"))
+    let model = stentkit::design::parse_design(resolved, Path::new("resolved.yaml"))
         .expect("the resolved design reads")
         .model;
     assert_eq!(model.time.end, 0.1);

@@ -18,7 +18,7 @@ use std::cell::{Cell, RefCell};
 use std::ops::ControlFlow;
 use std::path::Path;
 use std::process::Command;
-use stentkit::io::design::parse_design;
+use stentkit::design::parse_design;
 use stentkit::io::snapshots::SnapshotSchedule;
 use stentkit::math::Real;
 use stentkit::model::Model;
@@ -440,11 +440,9 @@ fn the_uncooled_straight_stent_fails_at_the_release_with_a_report() {
     let text = design_text("straight_stent.yaml");
     let text = replace_line(&text, "temperature:", "temperature: 90");
     // `check` and `run` warn about exactly this design (issue 18): the one warning it has.
-    let design = stentkit::io::design::parse_design(
-        &text,
-        std::path::Path::new("straight_stent_uncooled.yaml"),
-    )
-    .expect("accepted with a warning");
+    let design =
+        stentkit::design::parse_design(&text, std::path::Path::new("straight_stent_uncooled.yaml"))
+            .expect("accepted with a warning");
     assert!(
         matches!(&design.warnings[..], [w] if w.contains("above the glass transition")),
         "{:?}",
@@ -728,7 +726,7 @@ fn the_disk_estimate_bounds_a_run_folder_from_above() {
     std::fs::create_dir_all(&dir).expect("folder");
     let file = dir.join("bend_fine.yaml");
     std::fs::write(&file, &text).expect("design written");
-    let design = stentkit::io::design::load_design(&file).expect("valid");
+    let design = stentkit::design::load_design(&file).expect("valid");
     let estimate = stentkit::io::estimate::estimated_disk(&design);
     let run = dir.join("run");
     let out = stentkit(&[

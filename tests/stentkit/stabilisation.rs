@@ -5,7 +5,7 @@
 
 use crate::common::{design_text, model_from_text, node_displacement, replace_line, solve};
 use std::path::Path;
-use stentkit::io::design::parse_design;
+use stentkit::design::parse_design;
 use stentkit::math::Real;
 use stentkit::model::StabilisationSettings;
 use stentkit::solver::Simulation;

@@ -5,8 +5,8 @@
 use crate::common::edit;
 use std::ops::ControlFlow;
 use std::path::{Path, PathBuf};
+use stentkit::design::{load_design, parse_design};
 use stentkit::geometry::frame::{FrameField, FrameSettings};
-use stentkit::io::design::{load_design, parse_design};
 use stentkit::io::stl::{read_stl, write_stl};
 use stentkit::math::{Real, Vec3};
 use stentkit::model::{Model, ProbeLocation};
@@ -532,7 +532,7 @@ time: {end: 2, step: 0.5}
 // path and a message containing the fragment.
 #[test]
 fn stent_block_errors_are_located() {
-    use stentkit::io::design::DesignError;
+    use stentkit::design::DesignError;
     let base = parse_design(BASE, Path::new("base.yaml")).unwrap_or_else(|e| panic!("{e}"));
     assert_eq!(base.model.programme.as_ref().unwrap().nodes.len(), 4);
     // (text replaced, replacement, (line, column), field path, message fragment)

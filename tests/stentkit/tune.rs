@@ -4,7 +4,7 @@
 use crate::mesh::TempDir;
 use std::path::Path;
 use std::process::Command;
-use stentkit::io::design::load_design;
+use stentkit::design::load_design;
 use stentkit::math::Real;
 use stentkit::model::ProbeLocation;
 use stentkit::study::sample::watched_run;

@@ -7,7 +7,7 @@ use crate::common::{design_text, replace_line};
 use crate::outputs::{design, path_str, stentkit, test_outputs, text};
 use crate::stabilisation::warning_said;
 use std::path::{Path, PathBuf};
-use stentkit::io::design::{DesignOverrides, load_design, load_design_with};
+use stentkit::design::{DesignOverrides, load_design, load_design_with};
 
 /// The straight stent (designs/straight_stent.yaml) with two crowns and error-controlled steps (tolerance
 /// 1e-2), whose temperature schedule is replaced by `temperature` and whose run ends at `end`, written as

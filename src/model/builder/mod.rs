@@ -2,7 +2,7 @@
 //! (by end or by coincidence), conditions, loads, temperature, material, time and solver settings, probes.
 //! [`ModelBuilder::build`] makes and checks the model; every check that involves more than one value is made
 //! here, and a failed one is a [`BuildError`] naming the input [`Field`]. The design-file layer
-//! ([`crate::io::design`]) is a translation of YAML into builder calls that maps fields back to lines.
+//! ([`crate::design`]) is a translation of YAML into builder calls that maps fields back to lines.
 //!
 //! ```
 //! use stentkit::material::{CircularSection, ElasticLaw};

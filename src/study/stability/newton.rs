@@ -2,9 +2,9 @@
 //! converges without cuts, how many iterations a step takes, where steps are cut or the run fails. The
 //! scenarios that make the maps are in [`super::scenarios`].
 
-use crate::io::chart::{LineChart, Scale, Series};
 use crate::math::Real;
 use crate::model::Model;
+use crate::post::chart::{LineChart, Scale, Series};
 use crate::solver::{NewtonReport, Observer, Simulation, SolverError, StepReport};
 use std::fmt::Write as _;
 use std::ops::ControlFlow;
