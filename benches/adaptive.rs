@@ -167,7 +167,7 @@ fn main() {
             case.tuned_to,
             tuned.model.patches[0].curve.knots().degree(),
             tuned.model.patches[0].curve.points().len(),
-            tuned.model.time.tolerance.unwrap_or(Real::NAN)
+            tuned.model.time().tolerance.unwrap_or(Real::NAN)
         );
         let mut rows = vec![Row {
             label: "paper settings (fixed steps)".into(),

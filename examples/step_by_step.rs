@@ -30,7 +30,7 @@ fn main() -> Result<(), Box<dyn Error>> {
         model.patches.len(),
         model.num_unknowns(),
         design.steps.total(),
-        model.time.end,
+        model.time().end,
         probe.name
     );
 

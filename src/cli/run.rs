@@ -67,7 +67,7 @@ impl Progress {
         }
         Self {
             bar,
-            end: model.time.end,
+            end: model.time().end,
             said: 0,
             verbose,
             cuts: 0,

@@ -64,7 +64,7 @@ pub fn convergence(
     let study = ConvergenceStudy {
         degrees,
         points,
-        time: time.unwrap_or(model.time.end),
+        time: time.unwrap_or(model.time().end),
         reference,
         samples,
         time_tolerance,
@@ -142,8 +142,8 @@ fn check_steps(
         what: format!(
             "{} time steps of h = {} s to t = {} s",
             count(steps),
-            short(model.time.step),
-            short(model.time.end)
+            short(model.time().step),
+            short(model.time().end)
         ),
     };
     let estimate = design.memory.with_steps(&counted);
@@ -151,7 +151,7 @@ fn check_steps(
         let most = estimate.steps_within_limit();
         return Err(BadInput(format!(
             "{argument}: the run {refusal}: give a step of at least {} s, or an earlier --time (at most {} steps fit)",
-            rounded_up(scale * model.time.end / most.max(1.0)),
+            rounded_up(scale * model.time().end / most.max(1.0)),
             count(most.floor())
         ))
         .into());
@@ -179,7 +179,7 @@ pub fn time(
     refuse_existing(output, TIME_FILES, force)?;
     let design = load_design(design)?;
     let model = &design.model;
-    let end = time.unwrap_or(model.time.end);
+    let end = time.unwrap_or(model.time().end);
     // Every run's steps, before any runs: the reference's (the smallest step halved by default) first.
     let smallest = steps.iter().copied().fold(f64::INFINITY, f64::min);
     // A step suggested for --steps must also hold for the reference run when that halves it.

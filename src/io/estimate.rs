@@ -273,7 +273,7 @@ fn snapshot_count(model: &Model, steps: usize, settings: &SnapshotSettings) -> u
     let due = SnapshotSchedule::new(settings, model)
         .times()
         .iter()
-        .filter(|&&t| t > 0.0 && t < model.time.end)
+        .filter(|&&t| t > 0.0 && t < model.time().end)
         .count();
     1 + periodic + last + due
 }

@@ -41,6 +41,7 @@ pub use fit::{fit_log_slope, relative_error};
 use crate::material::MaterialError;
 use crate::math::Real;
 use crate::model::ScheduleError;
+use crate::model::builder::BuildError;
 use crate::solver::SolverError;
 
 /// Why a study could not be carried out. A run that fails inside a sweep meant to find failures (a time-step
@@ -60,6 +61,10 @@ pub enum StudyError {
     /// A schedule a study sets (a temperature history) was refused.
     #[error(transparent)]
     Schedule(#[from] ScheduleError),
+    /// Settings a study gives a model (its time stepping, its Newton settings) were refused by the builder's
+    /// checks ([`crate::model::Model::with_settings`]).
+    #[error(transparent)]
+    Model(#[from] BuildError),
     /// A study setting is out of range.
     #[error("{setting} must be {expected}, got {value}")]
     InvalidSetting {

@@ -145,7 +145,7 @@ pub fn time_study(
     });
     for variant in fixed.chain(controlled) {
         let integrator = variant.integrator.unwrap_or(Integrator::Trapezoidal);
-        let first = variant.step.unwrap_or(model.time.step);
+        let first = variant.step.unwrap_or(model.time().step);
         let mut row = TimePoint {
             integrator,
             step: first,

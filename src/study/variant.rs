@@ -30,14 +30,15 @@ pub struct TimeVariant {
 }
 
 impl TimeVariant {
-    /// Changes `model` to this variant.
+    /// A copy of `model` changed to this variant: the time settings through [`Model::with_time`], which checks
+    /// them as the builder does.
     ///
     /// # Errors
     /// [`StudyError::InvalidSetting`] when a value is not positive and finite, [`StudyError::StepBeyondEnd`]
     /// when the step exceeds the end time, [`StudyError::Refused`] for error control with an internal-variable
-    /// update that has no estimate; `model` may then be partly changed.
-    pub fn apply(&self, model: &mut Model) -> Result<(), StudyError> {
-        let time = &mut model.time;
+    /// update that has no estimate, [`StudyError::Model`] for settings the builder refuses otherwise.
+    pub fn of(&self, model: &Model) -> Result<Model, StudyError> {
+        let mut time = model.time().clone();
         if let Some(end) = self.end {
             time.end = positive("the end time", end)?;
         }
@@ -65,6 +66,7 @@ impl TimeVariant {
                 end: time.end,
             });
         }
+        let mut model = model.clone();
         if let Some(integrator) = self.integrator {
             for law in &mut model.materials {
                 if let MaterialLaw::Maxwell(maxwell) = law {
@@ -73,20 +75,10 @@ impl TimeVariant {
             }
         }
         // As the builder does: error control only where its estimate holds (`Integrator::companion`).
-        if let Some(why) = model.time.error_control_refusal(&model.materials) {
+        if let Some(why) = time.error_control_refusal(&model.materials) {
             return Err(StudyError::Refused(why));
         }
-        Ok(())
-    }
-
-    /// A copy of `model` changed to this variant ([`TimeVariant::apply`]).
-    ///
-    /// # Errors
-    /// As [`TimeVariant::apply`].
-    pub fn of(&self, model: &Model) -> Result<Model, StudyError> {
-        let mut model = model.clone();
-        self.apply(&mut model)?;
-        Ok(model)
+        Ok(model.with_time(time)?)
     }
 }
 

@@ -106,7 +106,7 @@ pub fn collect(dir: &SweepDir, times: Option<&[Real]>) -> Result<Collected, Swee
     let times: Vec<Real> = match times {
         Some(t) => t.to_vec(),
         None => models.iter().flatten().next().map_or_else(Vec::new, |m| {
-            let end = m.time.end;
+            let end = m.time().end;
             match Release::of(m) {
                 Some(r) if r.time < end => vec![r.time + 0.5 * (end - r.time), end],
                 _ => vec![end],

@@ -409,7 +409,7 @@ fn failing_at_the_smallest_step_at_a_large_time_ends_the_run() {
     let SolverError::StepFailed { time, dt, step, .. } = error else {
         panic!("expected StepFailed, got {error}");
     };
-    let min_step = model.time.min_step;
+    let min_step = model.time().min_step;
     let ulp = time.next_up() - time;
     assert!(
         (dt - min_step).abs() <= STEP_ROUND_OFF_ULPS * ulp,
@@ -470,12 +470,12 @@ fn the_uncooled_straight_stent_fails_at_the_release_with_a_report() {
     match result {
         Ok(summary) => {
             assert!(!summary.stopped, "the guard stopped the run");
-            assert_eq!(sim.time(), model.time.end);
+            assert_eq!(sim.time(), model.time().end);
         }
         Err(SolverError::StepFailed { time, dt, .. }) => {
             let ulp = time.next_up() - time;
             assert!(
-                (dt - model.time.min_step).abs() <= STEP_ROUND_OFF_ULPS * ulp,
+                (dt - model.time().min_step).abs() <= STEP_ROUND_OFF_ULPS * ulp,
                 "dt = {dt:e}"
             );
             assert!(time > 1.75, "fails after the release, at {time}");

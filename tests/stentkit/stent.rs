@@ -322,7 +322,7 @@ time: {{end: 1, step: 0.25}}
 fn solve(model: &Model) -> Vec<(String, Vec3, Vec3)> {
     let mut sim = Simulation::new(model).unwrap_or_else(|e| panic!("{e}"));
     let summary = sim.run(&mut []).unwrap_or_else(|e| panic!("{e}"));
-    assert!((summary.time - model.time.end).abs() < 1e-12);
+    assert!((summary.time - model.time().end).abs() < 1e-12);
     let mut out = Vec::new();
     for (k, n) in model.nodes.iter().enumerate() {
         out.push((
@@ -721,8 +721,13 @@ fn block_solver_matches_the_sparse_lu() {
     let programme =
         "{kind: radial_contraction, nodes: crown_1, delta_r: 0.6, ramp: [0, 0.5], release: 0.75}";
     let block = small_stent(layout, "symmetry: quarter", programme);
-    let mut sparse = block.clone();
-    sparse.solver.linear = stentkit::model::LinearMethod::SparseLu;
+    let sparse = block
+        .clone()
+        .with_solver(stentkit::model::SolverSettings {
+            linear: stentkit::model::LinearMethod::SparseLu,
+            ..block.solver().clone()
+        })
+        .expect("valid settings");
     /// Every node's displacement after every step, up to a given time.
     struct Histories(Vec<Vec3>, Real);
     impl Observer for Histories {

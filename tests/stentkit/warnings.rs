@@ -182,7 +182,7 @@ fn check_of_an_error_controlled_design_says_what_error_control_does() {
     let model = load_design(&design("aorta_stent.yaml"))
         .expect("valid")
         .model;
-    let bound = model.planned_steps_at(model.time.min_step).total()
+    let bound = model.planned_steps_at(model.time().min_step).total()
         + model.schedule_breakpoints().len()
         + 1;
     assert!(steps.contains(&format!("at most {bound}")), "{steps}");

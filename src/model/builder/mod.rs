@@ -389,6 +389,68 @@ impl TimeSpec {
     }
 }
 
+impl From<&TimeSettings> for TimeSpec {
+    /// The spec whose [`TimeSpec::settings`] are `time` again, every default spelled out.
+    fn from(time: &TimeSettings) -> Self {
+        Self {
+            end: time.end,
+            step: time.step,
+            min_step: Some(time.min_step),
+            release_ramp: Some(time.release_ramp),
+            tolerance: time.tolerance,
+            max_step: time.max_step,
+        }
+    }
+}
+
+impl Model {
+    /// This model with the time stepping `time`, checked as [`ModelBuilder::build`] checks it
+    /// ([`Model::with_settings`]).
+    ///
+    /// # Errors
+    /// As [`Model::with_settings`].
+    pub fn with_time(self, time: TimeSettings) -> Result<Model> {
+        let solver = self.solver.clone();
+        self.with_settings(time, solver)
+    }
+
+    /// This model with the Newton settings `solver`, checked as [`ModelBuilder::build`] checks them
+    /// ([`Model::with_settings`]).
+    ///
+    /// # Errors
+    /// As [`Model::with_settings`].
+    pub fn with_solver(self, solver: SolverSettings) -> Result<Model> {
+        let time = self.time.clone();
+        self.with_settings(time, solver)
+    }
+
+    /// This model with the time stepping `time` and the Newton settings `solver`, after the checks
+    /// [`ModelBuilder::build`] runs on them: the time spec's ([`TimeSpec::settings`]), error control only where
+    /// every material's estimate holds, the solver's tolerances and stabilisation, and an arc-length path only
+    /// for an elastic model without programme, error control or releases. What the builder made from the old
+    /// settings stays as it was (a programme's times, the record times).
+    ///
+    /// # Errors
+    /// The [`BuildError`] of the first check that fails, at the field the builder would name.
+    pub fn with_settings(mut self, time: TimeSettings, solver: SolverSettings) -> Result<Model> {
+        let time = TimeSpec::from(&time).settings()?;
+        if let Some(why) = time.error_control_refusal(&self.materials) {
+            return Err(BuildError::new(Field::Time(TimeField::Tolerance), why));
+        }
+        check_solver(&solver)?;
+        check_path(
+            &solver,
+            &self.materials,
+            &self.material_names,
+            self.programme.is_some() || time.tolerance.is_some(),
+            &self.nodes,
+        )?;
+        self.time = time;
+        self.solver = solver;
+        Ok(self)
+    }
+}
+
 /// How patch ends that no node names are joined.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct JointRule {

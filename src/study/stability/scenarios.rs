@@ -9,7 +9,10 @@ use super::newton::{
 };
 use super::{MapReport, ReadDesign};
 use crate::math::Real;
-use crate::model::TimeFunction;
+use crate::model::{
+    ArcLengthSettings, Model, PathControl, SolverSettings, StabilisationSettings, TimeFunction,
+    TimeSettings,
+};
 use crate::study::variant::{Remesh, TimeVariant, VariedDesign};
 use crate::study::{StudyError, positive};
 use std::fmt::Write as _;
@@ -200,7 +203,7 @@ pub fn release_map(
         }
         .of(&stent.rebuild(&remesh)?)?;
         if stabilised {
-            model.solver.stabilisation = Some(crate::model::StabilisationSettings::default());
+            model = stabilised_model(model)?;
         }
         if hot {
             model.temperature = TimeFunction::constant(HOT);
@@ -283,15 +286,22 @@ pub fn coarse_map(
         let stepped = parsed.rebuild(&remesh)?;
         // Short arcs (the first 1 % of the load, growing at most fourfold) sample the path densely enough to
         // locate its limit points to about 1e-3.
-        let mut arc = stepped.clone();
-        arc.time.step = arc.time.end / 100.0;
-        arc.time.min_step = arc.time.step / 1024.0;
-        arc.solver.path = crate::model::PathControl::ArcLength(crate::model::ArcLengthSettings {
-            max_growth: 4.0,
-            ..crate::model::ArcLengthSettings::default()
-        });
-        let mut stabilised = stepped.clone();
-        stabilised.solver.stabilisation = Some(crate::model::StabilisationSettings::default());
+        let step = stepped.time().end / 100.0;
+        let arc = stepped.clone().with_settings(
+            TimeSettings {
+                step,
+                min_step: step / 1024.0,
+                ..stepped.time().clone()
+            },
+            SolverSettings {
+                path: PathControl::ArcLength(ArcLengthSettings {
+                    max_growth: 4.0,
+                    ..ArcLengthSettings::default()
+                }),
+                ..stepped.solver().clone()
+            },
+        )?;
+        let stabilised = stabilised_model(stepped.clone())?;
         for (route, model) in [(0.0, &stepped), (1.0, &arc), (2.0, &stabilised)] {
             let run = newton_run(model)?;
             progress(&format!(
@@ -483,6 +493,15 @@ pub fn release_report(map: &SolverMap) -> MapReport {
         ),
         summary,
     }
+}
+
+/// `model` with automatic stabilisation at its defaults (`solver.stabilisation`).
+fn stabilised_model(model: Model) -> Result<Model, StudyError> {
+    let solver = SolverSettings {
+        stabilisation: Some(StabilisationSettings::default()),
+        ..model.solver().clone()
+    };
+    Ok(model.with_solver(solver)?)
 }
 
 /// The embedded design `text`, named `file` in errors and as its default name.
