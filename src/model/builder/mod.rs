@@ -1243,6 +1243,50 @@ mod tests {
         assert!(b.validate().is_ok());
     }
 
+    // A built model's settings change only through the checked setters, which refuse what the builder refuses
+    // at the field the builder names (the reference: the builder given the same settings, `field_of`) and take
+    // valid settings as given.
+    #[test]
+    fn changed_settings_are_checked_as_the_builder_checks_them() {
+        let model = elastic().build().expect("valid").model;
+        let beyond = TimeSettings {
+            step: 2.0 * model.time().end,
+            ..model.time().clone()
+        };
+        let mut b = elastic();
+        b.time(TimeSpec::from(&beyond));
+        let refused = model
+            .clone()
+            .with_time(beyond)
+            .expect_err("a step beyond the end");
+        assert_eq!(refused.field, Field::Time(TimeField::Step));
+        assert_eq!(refused.field, field_of(&b));
+
+        let no_iterations = SolverSettings {
+            max_iterations: 0,
+            ..model.solver().clone()
+        };
+        let mut b = elastic();
+        b.solver(no_iterations.clone());
+        let refused = model
+            .clone()
+            .with_solver(no_iterations)
+            .expect_err("no Newton iteration");
+        assert_eq!(refused.field, Field::Solver(SolverField::MaxIterations));
+        assert_eq!(refused.field, field_of(&b));
+
+        let longer = TimeSettings {
+            end: 2.0 * model.time().end,
+            ..model.time().clone()
+        };
+        let changed = model
+            .clone()
+            .with_time(longer.clone())
+            .expect("a longer run");
+        assert_eq!(changed.time(), &longer);
+        assert_eq!(changed.solver(), model.solver());
+    }
+
     #[test]
     fn errors_name_the_input_they_are_about() {
         let mut b = elastic();
