@@ -27,12 +27,12 @@
 //! -- curved` (or `straight`, `arch`, `cantilever`) one. The tables in docs/speed.md come from it.
 
 use std::path::Path;
-use stentkit::io::design::load_design;
+use stentkit::design::load_design;
 use stentkit::math::Real;
 use stentkit::model::{Model, ProbeLocation};
 use stentkit::study::sample::{Watched, WatchedRun, node_lengths, watched_run};
 use stentkit::study::tune::{comparison_times, difference, watched_locations};
-use stentkit::study::variant::{Remesh, TimeVariant, rebuild};
+use stentkit::study::variant::{Remesh, TimeVariant, VariedDesign};
 
 /// A quantity of a case: its name, unit and value in a watched state.
 struct Quantity {
@@ -167,7 +167,7 @@ fn main() {
             case.tuned_to,
             tuned.model.patches[0].curve.knots().degree(),
             tuned.model.patches[0].curve.points().len(),
-            tuned.model.time.tolerance.unwrap_or(Real::NAN)
+            tuned.model.time().tolerance.unwrap_or(Real::NAN)
         );
         let mut rows = vec![Row {
             label: "paper settings (fixed steps)".into(),
@@ -193,7 +193,7 @@ fn main() {
                 points: Some(n),
                 crowns: None,
             };
-            let model = rebuild(&paper, &remesh).expect("the finer mesh builds");
+            let model = paper.rebuild(&remesh).expect("the finer mesh builds");
             let variant = TimeVariant {
                 tolerance: Some(tol),
                 ..TimeVariant::default()

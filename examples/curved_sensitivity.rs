@@ -19,8 +19,8 @@
 
 use std::error::Error;
 use std::path::Path;
+use stentkit::design::{DesignOverrides, SetOverride, parse_design_with};
 use stentkit::geometry::fit::best_fit_rigid;
-use stentkit::io::design::{DesignOverrides, SetOverride, parse_design_with};
 use stentkit::math::{Real, Vec3};
 use stentkit::model::{Model, ProbeLocation};
 use stentkit::post::device::reflect;

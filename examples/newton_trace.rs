@@ -8,7 +8,7 @@
 use anyhow::Context;
 use std::ops::ControlFlow;
 use std::path::Path;
-use stentkit::io::design::{DesignOverrides, parse_design_with};
+use stentkit::design::{DesignOverrides, parse_design_with};
 use stentkit::solver::{Observer, Simulation, StepReport};
 
 /// Prints every `0`-th step.

@@ -46,7 +46,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     println!("final Δr, model built in code:      {delta_code:.15e} mm");
 
     let design = Path::new(env!("CARGO_MANIFEST_DIR")).join("designs/straight_stent.yaml");
-    let from_yaml = stentkit::io::design::load_design(&design)?.model;
+    let from_yaml = stentkit::design::load_design(&design)?.model;
     println!(
         "the two models are {}",
         if in_code == from_yaml {

@@ -10,7 +10,7 @@
 
 use std::error::Error;
 use std::path::Path;
-use stentkit::io::design::parse_design;
+use stentkit::design::parse_design;
 use stentkit::math::{Real, Vec3};
 use stentkit::model::Model;
 use stentkit::solver::Simulation;
@@ -30,7 +30,7 @@ fn main() -> Result<(), Box<dyn Error>> {
         model.patches.len(),
         model.num_unknowns(),
         design.steps.total(),
-        model.time.end,
+        model.time().end,
         probe.name
     );
 

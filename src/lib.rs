@@ -6,16 +6,18 @@
 //!
 //! ## Layers
 //!
-//! Dependencies point one way, left to right never imported from the right:
-//! `math → geometry → material → model → solver → post → io → study → run → sweep → cli`, and no two modules import each
-//! other, directly or through others (`scripts/module_cycles.py`, run by CI, checks both from the source).
-//! `math`, `geometry`, `material`, `model`, `solver` and `post` are pure: no files, no printing, no serde.
-//! `study` writes no file and prints nothing either, but sits above `io`: it re-builds designs whose geometry it
-//! varies through `io::design` and draws its results as `io::chart` charts, which `cli` writes. `sweep` owns a
-//! sweep folder's files and asks Slurm (`sbatch`, `squeue`) about its jobs; the processes that run variants are
-//! `cli`'s. `run` is a run as a library call: the recorders of a run folder in one registry, the heartbeat,
-//! checkpoints and resume, with the interruption and the console passed in; `cli` parses, prints and maps
-//! signals onto it.
+//! Dependencies point one way, left to right never imported from the right: `math → geometry → material → model →
+//! solver → post → study → io → design → run → sweep → cli`, and no two modules import each other, directly or
+//! through others (`scripts/module_cycles.py`, run by CI, checks both from the source). `math`, `geometry`,
+//! `material`, `model`, `solver` and `post` are pure: no files, no printing, no serde. `study` writes no file and
+//! prints nothing either: it varies built models and returns its charts as descriptions ([`post::chart`]) that `cli`
+//! draws through `io`; a design whose geometry it varies is re-built by the design language above it, through
+//! [`study::variant::VariedDesign`]. `design` is the YAML design language: it translates a design file into
+//! [`model::builder`] calls and sits above `io`, whose centreline files it reads and whose output formats it names;
+//! `io`'s writers see a design through [`io::output::RunDesign`]. `sweep` owns a sweep folder's files and asks Slurm
+//! (`sbatch`, `squeue`) about its jobs; the processes that run variants are `cli`'s. `run` is a run as a library
+//! call: the recorders of a run folder in one registry, the heartbeat, checkpoints and resume, with the interruption
+//! and the console passed in; `cli` parses, prints and maps signals onto it.
 //!
 //! | module | owns |
 //! |---|---|
@@ -24,9 +26,10 @@
 //! | [`material`] | the constitutive interface and its laws (elastic, Maxwell/WLF), Prony series, WLF shift, section stiffness |
 //! | [`model`] | the continuous problem: patches, nodes, conditions, loads, schedules; [`model::builder`], which makes and checks one in Rust, and [`model::stent`], a generated stent and its programme in it; [`model::cycle`], the shape-memory cycle read off the conditions |
 //! | [`solver`] | collocation, residual and tangent, Newton, time stepping as an API (step, checkpoint, restore) |
-//! | [`post`] | the full device from a (symmetry-reduced) model or state: sampled shapes, mirror copies, tube meshes |
-//! | [`io`] | YAML design files (a translation into [`model::builder`] calls); writers of STL/OBJ, the run folder, checkpoints, charts |
+//! | [`post`] | the full device from a (symmetry-reduced) model or state: sampled shapes, mirror copies, tube meshes; recovery measures; chart descriptions |
 //! | [`study`] | accuracy against cost: scenarios, exact references, error measures and fits, sweeps over variants of a model |
+//! | [`io`] | file formats: writers of STL/OBJ/3MF/VTK, the MCAP recording, the run folder, checkpoints, charts; centreline readers; a run's output settings |
+//! | [`design`] | the YAML design language: DTOs, validation with line and column, device families' YAML, `--set` overrides, the translation into [`model::builder`] calls |
 //! | [`run`] | a run of a design into its run folder: the recorders ([`run::recorder::RECORDERS`]), summary, heartbeat, checkpoints, resume, the disk check; interruption and console passed in |
 //! | [`sweep`] | families of variants of a design: swept parameters, the sweep folder and its variants' states, their metrics, `sweep.csv` and charts, the Slurm batch script |
 //! | [`cli`] | the `stentkit` command line |
@@ -46,6 +49,7 @@
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
 
 pub mod cli;
+pub mod design;
 pub mod geometry;
 pub mod io;
 pub mod material;

@@ -16,8 +16,8 @@
 //! refused as [`super::BadInput`] (also exit status 2) with [`too_costly`]'s wording.
 
 use super::BadInput;
-use crate::io::design::SetOverride;
-use crate::io::design::size::{MEMORY_LIMIT_BYTES, human_bytes};
+use crate::design::SetOverride;
+use crate::design::size::{MEMORY_LIMIT_BYTES, human_bytes};
 use crate::math::quote::{QUOTED_CHARS, quoted_up_to};
 use crate::math::{Real, Short};
 use crate::post::print::TIME_LIMIT_SECONDS;

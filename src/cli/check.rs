@@ -1,7 +1,7 @@
 //! `stentkit check`: validate a design and describe what a run would solve.
 
-use crate::io::design::size::{MEMORY_LIMIT_BYTES, human_bytes};
-use crate::io::design::{Design, DesignOverrides, SetOverride, load_design_with};
+use crate::design::size::{MEMORY_LIMIT_BYTES, human_bytes};
+use crate::design::{Design, DesignOverrides, SetOverride, load_design_with};
 use crate::io::estimate::estimated_disk;
 use crate::material::{ConstitutiveLaw, MaterialLaw};
 use crate::model::Component;
@@ -132,21 +132,21 @@ pub fn describe(design: &Design, file: &str) -> String {
     let _ = writeln!(s, "unknowns            {}", model.num_unknowns());
     let plan = design.steps;
     let bound = error_controlled_bound(design);
-    match model.solver.path {
-        crate::model::PathControl::Time => match (model.time.tolerance, bound) {
+    match model.solver().path {
+        crate::model::PathControl::Time => match (model.time().tolerance, bound) {
             (Some(tolerance), Some(most)) => {
                 let _ = writeln!(
                     s,
                     "time steps          error-controlled (tolerance {tolerance:e}): from h = {} s, as many as the time-error estimate needs, between min_step = {:e} s and {}; at most {} (every step at min_step); {} at h; end {} s",
-                    model.time.step,
-                    model.time.min_step,
+                    model.time().step,
+                    model.time().min_step,
                     model
-                        .time
+                        .time()
                         .max_step
                         .map_or("no max_step".to_string(), |m| format!("max_step = {m} s")),
                     most.total(),
                     plan.total(),
-                    model.time.end
+                    model.time().end
                 );
             }
             _ => {
@@ -155,9 +155,9 @@ pub fn describe(design: &Design, file: &str) -> String {
                     "time steps          {} ({} of h = {} s + {} shortened to land on breakpoints; end {} s)",
                     plan.total(),
                     plan.full,
-                    model.time.step,
+                    model.time().step,
                     plan.shortened,
-                    model.time.end
+                    model.time().end
                 );
             }
         },
@@ -167,8 +167,8 @@ pub fn describe(design: &Design, file: &str) -> String {
                 "arc-length path     at most {} increments to load factor {} (the loads at t = {} s; first increment {} of them)",
                 a.max_increments,
                 a.end_load_factor,
-                model.time.end,
-                model.time.step / model.time.end
+                model.time().end,
+                model.time().step / model.time().end
             );
         }
     }
@@ -276,9 +276,9 @@ pub fn describe(design: &Design, file: &str) -> String {
 /// allows.
 fn error_controlled_bound(design: &Design) -> Option<crate::model::StepPlan> {
     let model = &design.model;
-    model.time.tolerance?;
-    model.solver.path.arc_length().is_none().then(|| {
-        let mut plan = model.planned_steps_at(model.time.min_step);
+    model.time().tolerance?;
+    model.solver().path.arc_length().is_none().then(|| {
+        let mut plan = model.planned_steps_at(model.time().min_step);
         plan.full = plan
             .full
             .saturating_add(model.schedule_breakpoints().len() + 1);

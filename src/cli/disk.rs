@@ -3,7 +3,7 @@
 //! refused ([`crate::run::disk`]).
 
 use super::BadInput;
-use crate::io::design::size::human_bytes;
+use crate::design::size::human_bytes;
 use crate::math::Real;
 use crate::run::disk::{free_space, largest_part, parts, position};
 use crate::sweep::Plan;

@@ -1,12 +1,12 @@
 //! What `mesh` and `export` are asked to draw, and what it would cost: the samples along every patch, the
 //! tubes' triangles or the print solid's contour, estimated from the model and the arguments before anything
 //! is sampled ([`check_drawing`]), and refused above the memory limit designs get
-//! ([`crate::io::design::size::MEMORY_LIMIT_BYTES`]) or, for a print solid, above
+//! ([`crate::design::size::MEMORY_LIMIT_BYTES`]) or, for a print solid, above
 //! [`crate::post::print::TIME_LIMIT_SECONDS`], naming the argument to change and a value that fits.
 
 use super::BadInput;
 use super::arguments::{count, rounded_up, short, too_costly};
-use crate::io::design::size::{MEMORY_LIMIT_BYTES, human_bytes};
+use crate::design::size::{MEMORY_LIMIT_BYTES, human_bytes};
 use crate::math::{Real, Short};
 use crate::model::Model;
 use crate::post::device::{

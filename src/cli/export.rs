@@ -15,7 +15,7 @@
 //! 161, 0.07 % apart); a `.csv` output holds the state's centrelines instead of a mesh.
 
 use super::BadInput;
-use crate::io::design::{DesignOverrides, SetOverride, load_design_with};
+use crate::design::{DesignOverrides, SetOverride, load_design_with};
 use crate::io::formats;
 use crate::io::mesh_format::SnapshotState;
 use crate::io::snapshots::{current_device_mesh, snapshot_name};
@@ -129,7 +129,7 @@ pub fn run(run_dir: &Path, options: &ExportOptions) -> anyhow::Result<()> {
             centrelines: extension == "csv",
         },
     )?;
-    let snap = model.time.landing_tolerance();
+    let snap = model.time().landing_tolerance();
     let target = match &options.which {
         Which::Time(t) => *t,
         Which::Phase(name) => {
@@ -150,7 +150,7 @@ pub fn run(run_dir: &Path, options: &ExportOptions) -> anyhow::Result<()> {
             })?
         }
     };
-    let reached = summary["final_time"].as_f64().unwrap_or(model.time.end);
+    let reached = summary["final_time"].as_f64().unwrap_or(model.time().end);
     if !(0.0..=reached + snap).contains(&target) {
         return Err(BadInput(format!(
             "t = {} is outside the run in {}, which reached t = {}",

@@ -15,8 +15,8 @@
 
 use super::BadInput;
 use super::drawing::{Drawing, Sampling, check_drawing};
+use crate::design::{DesignOverrides, SetOverride, load_design_with};
 use crate::geometry::fit::best_fit_rigid;
-use crate::io::design::{DesignOverrides, SetOverride, load_design_with};
 use crate::io::{obj, stl, threemf};
 use crate::math::{Real, Vec3};
 use crate::model::Model;

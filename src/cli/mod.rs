@@ -16,7 +16,7 @@ pub mod study;
 pub mod sweep;
 pub mod tune;
 
-use crate::io::design::SetOverride;
+use crate::design::SetOverride;
 use clap::{Parser, Subcommand};
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -546,7 +546,7 @@ pub struct Interrupted(pub String);
 
 /// The exit status of a command that ended with `error`.
 pub fn exit_code(error: &anyhow::Error) -> u8 {
-    use crate::io::design::DesignError;
+    use crate::design::DesignError;
     use crate::io::run_folder::RunFolderError;
     for cause in error.chain() {
         if cause.is::<Interrupted>() {
@@ -810,7 +810,7 @@ fn sweep(cli: SweepCli) -> anyhow::Result<()> {
 fn schema() -> anyhow::Result<()> {
     println!(
         "{}",
-        serde_json::to_string_pretty(&crate::io::design::design_schema())?
+        serde_json::to_string_pretty(&crate::design::design_schema())?
     );
     Ok(())
 }

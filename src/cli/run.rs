@@ -8,7 +8,7 @@
 
 use super::signals;
 use super::{BadInput, Interrupted};
-use crate::io::design::{DesignOverrides, load_design_with};
+use crate::design::{DesignOverrides, load_design_with};
 use crate::math::Real;
 use crate::model::Model;
 use crate::run::{Console, Folder, Interrupt, RunError, RunSettings};
@@ -67,7 +67,7 @@ impl Progress {
         }
         Self {
             bar,
-            end: model.time.end,
+            end: model.time().end,
             said: 0,
             verbose,
             cuts: 0,
@@ -174,13 +174,13 @@ pub struct RunOptions {
     /// Error-controlled stepping at this time-error tolerance, replacing the design's (`--tol`).
     pub time_tolerance: Option<Real>,
     /// `--set PATH=VALUE` overrides of the design's fields.
-    pub sets: Vec<crate::io::design::SetOverride>,
+    pub sets: Vec<crate::design::SetOverride>,
 }
 
 /// Simulates the design and writes the run folder, on this terminal, stopped by the process's signals.
 ///
 /// # Errors
-/// A [`BadInput`] or [`crate::io::design::DesignError`] for a design or folder refused before anything ran
+/// A [`BadInput`] or [`crate::design::DesignError`] for a design or folder refused before anything ran
 /// (exit status 2), [`Interrupted`] for a run stopped by a signal (130), anything else for a failed run (1).
 pub fn run(design_path: &Path, options: RunOptions) -> anyhow::Result<()> {
     let started = Instant::now();

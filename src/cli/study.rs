@@ -4,9 +4,9 @@
 use super::BadInput;
 use super::Target;
 use super::arguments::{count, rounded_up, short};
+use crate::design::size::{StepCount, over_limit};
+use crate::design::{Design, load_design};
 use crate::io::chart::write_svg;
-use crate::io::design::size::{StepCount, over_limit};
-use crate::io::design::{Design, load_design};
 use crate::material::Integrator;
 use crate::study::convergence::{
     ConvergenceStudy, convergence_charts, convergence_csv, convergence_study,
@@ -64,7 +64,7 @@ pub fn convergence(
     let study = ConvergenceStudy {
         degrees,
         points,
-        time: time.unwrap_or(model.time.end),
+        time: time.unwrap_or(model.time().end),
         reference,
         samples,
         time_tolerance,
@@ -121,7 +121,7 @@ pub fn degree_and_points(text: &str) -> Result<(usize, usize), String> {
 pub const MAPS: &[&str] = &["material", "bend45", "heating", "release", "coarse"];
 
 /// Refuses (exit status 2, naming `argument`) a study run of `design` changed by `variant` whose time steps
-/// would need more memory than a design may ([`crate::io::design::size::MemoryEstimate::with_steps`]: the
+/// would need more memory than a design may ([`crate::design::size::MemoryEstimate::with_steps`]: the
 /// guard designs get, for the run's steps landing on every breakpoint), or that the variant itself refuses
 /// (a step beyond the end). The argument's value is `scale` times the run's step.
 fn check_steps(
@@ -142,8 +142,8 @@ fn check_steps(
         what: format!(
             "{} time steps of h = {} s to t = {} s",
             count(steps),
-            short(model.time.step),
-            short(model.time.end)
+            short(model.time().step),
+            short(model.time().end)
         ),
     };
     let estimate = design.memory.with_steps(&counted);
@@ -151,7 +151,7 @@ fn check_steps(
         let most = estimate.steps_within_limit();
         return Err(BadInput(format!(
             "{argument}: the run {refusal}: give a step of at least {} s, or an earlier --time (at most {} steps fit)",
-            rounded_up(scale * model.time.end / most.max(1.0)),
+            rounded_up(scale * model.time().end / most.max(1.0)),
             count(most.floor())
         ))
         .into());
@@ -179,7 +179,7 @@ pub fn time(
     refuse_existing(output, TIME_FILES, force)?;
     let design = load_design(design)?;
     let model = &design.model;
-    let end = time.unwrap_or(model.time.end);
+    let end = time.unwrap_or(model.time().end);
     // Every run's steps, before any runs: the reference's (the smallest step halved by default) first.
     let smallest = steps.iter().copied().fold(f64::INFINITY, f64::min);
     // A step suggested for --steps must also hold for the reference run when that halves it.
@@ -281,6 +281,7 @@ pub fn stability_maps(output: Target<'_>, maps: &[String]) -> anyhow::Result<()>
     create(output)?;
     let summary = stability(
         &study,
+        &crate::design::variants::read_varied,
         |map| -> anyhow::Result<()> {
             write(&output.join(format!("{}.csv", map.name)), &map.csv)?;
             write_svg(&map.chart, &output.join(format!("{}.svg", map.name)))?;

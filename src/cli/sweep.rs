@@ -11,7 +11,7 @@
 //! prepared ends it after the variant in hand (status 130 both). A rerun continues.
 
 use super::{BadInput, Interrupted, signals};
-use crate::io::design::size::human_bytes;
+use crate::design::size::human_bytes;
 use crate::math::Real;
 use crate::run::{Console, Interrupt};
 use crate::sweep::collect::{Collected, collect};

@@ -1,8 +1,8 @@
 //! `stentkit tune`: the design tuned by the library ([`crate::study::tune`]), each trial printed as a table row
 //! as it finishes, the choice summarised, and the tuned design written with `-o`
-//! ([`crate::io::design::tuned_text`]).
+//! ([`crate::design::tuned_text`]).
 
-use crate::io::design::{
+use crate::design::{
     DesignOverrides, SetOverride, TunedChoice, load_design_with, parse_design, tuned_text,
 };
 use crate::math::Short;
@@ -165,7 +165,7 @@ fn write_tuned(
         time_tolerance: Some(tuned.time_tolerance),
         ..DesignOverrides::default()
     };
-    let expected = crate::io::design::parse_design_with(source, design_path, &overrides)?;
+    let expected = crate::design::parse_design_with(source, design_path, &overrides)?;
     anyhow::ensure!(
         written.model == expected.model,
         "the tuned text of {} does not give the tuned model (please report this)",

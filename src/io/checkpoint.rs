@@ -129,8 +129,8 @@ pub enum CheckpointFileError {
 pub const SETTINGS_DESCRIPTION_VERSION: u32 = 1;
 
 /// The fingerprint of the outputs' settings of a design: as the model's ([`crate::model::fingerprint`]), a
-/// hash of their serialised, versioned description (every field of [`super::design::OutputSettings`]).
-pub fn settings_fingerprint(settings: &super::design::OutputSettings) -> u64 {
+/// hash of their serialised, versioned description (every field of [`super::output::OutputSettings`]).
+pub fn settings_fingerprint(settings: &super::output::OutputSettings) -> u64 {
     crate::model::fingerprint::fingerprint_of(
         "stentkit output settings",
         SETTINGS_DESCRIPTION_VERSION,

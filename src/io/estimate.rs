@@ -22,7 +22,7 @@
 //!
 //! The snapshots, which dominate the stents' runs, are counted almost exactly: the STL to the byte (caps on
 //! every tube end: a welded end would make it an overestimate; the vessel's lumen of a stent on a file
-//! centreline too, at most [`crate::io::design::vessel::MAX_LUMEN_RINGS`] rings), the OBJ 5 % over (coordinates at their longest
+//! centreline too, at most [`crate::design::vessel::MAX_LUMEN_RINGS`] rings), the OBJ 5 % over (coordinates at their longest
 //! usual length). The recording is compressed (zstd level 1), and how much depends on how much the device
 //! moves per step: a centreline point whose coordinates all change costs about 10 bytes compressed (the bend
 //! at 1000 steps), one that barely moves 4–5 (the stents, the bend at 10⁵ steps). The estimate charges the
@@ -30,8 +30,8 @@
 //! measured one.
 
 use super::configurations::{CENTRELINE_SAMPLES, MAX_ROWS};
-use super::design::{Design, SnapshotSettings};
 use super::mcap::coordinate_decimals;
+use super::output::{RunDesign, SnapshotSettings};
 use super::render::PANEL_WIDTH;
 use super::snapshots::SnapshotSchedule;
 use super::state::load_channels;
@@ -140,11 +140,11 @@ const SUMMARY_SNAPSHOT_BYTES: Real = 250.0;
 
 /// The bytes the run of `design` is estimated to write, part by part, assuming no step is cut; see the module
 /// documentation for how conservative each part is.
-pub fn estimated_disk(design: &Design) -> DiskEstimate {
-    let model = &design.model;
-    let snapshot = &design.output.snapshots;
-    let recording = &design.output.recording;
-    let steps = design.steps.total();
+pub fn estimated_disk(design: &impl RunDesign) -> DiskEstimate {
+    let model = design.model();
+    let snapshot = &design.output().snapshots;
+    let recording = &design.output().recording;
+    let steps = design.steps().total();
     let states = steps as Real + 1.0;
     let snapshots = snapshot_count(model, steps, snapshot);
     let count = snapshots as Real;
@@ -219,7 +219,7 @@ pub fn estimated_disk(design: &Design) -> DiskEstimate {
             + meshes
             + vessel_message
             + RECORDING_FIXED_BYTES
-            + design.source.len() as Real
+            + design.source().len() as Real
     } else {
         0.0
     };
@@ -233,7 +233,7 @@ pub fn estimated_disk(design: &Design) -> DiskEstimate {
         0.0
     };
 
-    let history = (states + 1.0) * history_row_bytes(model, &design.output.strain_limits);
+    let history = (states + 1.0) * history_row_bytes(model, &design.output().strain_limits);
     let (charts, series) = chart_counts(model);
     // The configuration figures: up to MAX_ROWS rows and one figure per row, each panel the initial and the
     // current centrelines of the full device in two views.
@@ -273,7 +273,7 @@ fn snapshot_count(model: &Model, steps: usize, settings: &SnapshotSettings) -> u
     let due = SnapshotSchedule::new(settings, model)
         .times()
         .iter()
-        .filter(|&&t| t > 0.0 && t < model.time.end)
+        .filter(|&&t| t > 0.0 && t < model.time().end)
         .count();
     1 + periodic + last + due
 }
@@ -372,58 +372,4 @@ fn chart_counts(model: &Model) -> (Real, Real) {
         series += 5.0;
     }
     (charts, series)
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-    use crate::io::design::{DesignOverrides, load_design, load_design_with};
-    use std::path::Path;
-
-    fn design(name: &str) -> Design {
-        load_design(
-            &Path::new(env!("CARGO_MANIFEST_DIR"))
-                .join("designs")
-                .join(name),
-        )
-        .expect("valid design")
-    }
-
-    // Reference: the straight stent's run folder (designs/straight_stent.yaml, run with this version, with
-    // `--set 'output.snapshots.formats=[stl, obj]'`): 1301 steps, snapshots at the events t = 0, 1, 1.75, 1.7525,
-    // 3.25 and between them at 0.5, 2.2525, 2.7525 (8), each 100 368 triangles, so 5 018 484 bytes of STL
-    // (84 + 50 · 100 368) and 4.87 MB of OBJ on average; run.mcap 13.27 MB. The OBJ is estimated 5 % over
-    // (module docs); the recording must be estimated from above but not beyond 1.5 times.
-    #[test]
-    fn the_straight_stents_snapshots_are_counted_exactly_and_its_recording_from_above() {
-        let both = load_design_with(
-            &Path::new(env!("CARGO_MANIFEST_DIR")).join("designs/straight_stent.yaml"),
-            &DesignOverrides::sets(vec![
-                "output.snapshots.formats=[stl, obj]"
-                    .parse()
-                    .expect("override"),
-            ]),
-        )
-        .expect("valid design");
-        let estimate = estimated_disk(&both);
-        assert_eq!(estimate.snapshots, 8);
-        assert_eq!(estimate.snapshot_stl, 8 * 5_018_484);
-        let obj = estimate.snapshot_obj as Real / 8.0;
-        assert!((4.87e6..1.1 * 4.87e6).contains(&obj), "{obj}");
-        let mcap = estimate.recording as Real;
-        assert!((13.27e6..1.5 * 13.27e6).contains(&mcap), "{mcap}");
-        // By default only STL is written.
-        assert_eq!(
-            estimated_disk(&design("straight_stent.yaml")).snapshot_obj,
-            0
-        );
-    }
-
-    // Reference: docs/run-folder.md, the curved stent's recording is 31.9 MB (this version, 8 snapshots); from above, not
-    // beyond 1.5 times.
-    #[test]
-    fn the_curved_stents_recording_is_estimated_from_above() {
-        let mcap = estimated_disk(&design("curved_stent.yaml")).recording as Real;
-        assert!((31.9e6..1.5 * 31.9e6).contains(&mcap), "{mcap}");
-    }
 }

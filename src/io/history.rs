@@ -170,7 +170,7 @@ pub struct HistoryWriter {
 
 impl HistoryWriter {
     /// Creates (truncates) the file and writes the header for the model's probes; `strain_limits` (per material,
-    /// [`crate::io::design::OutputSettings::strain_limits`]) adds a peak column per material with a limit.
+    /// [`crate::design::OutputSettings::strain_limits`]) adds a peak column per material with a limit.
     pub fn create(
         path: &Path,
         sim: &Simulation<'_>,
@@ -179,7 +179,7 @@ impl HistoryWriter {
         let limits = limited_materials(strain_limits);
         let mut out = BufWriter::new(super::no_follow::create(path)?);
         let mut header = String::from("time");
-        if sim.model().solver.path.arc_length().is_some() {
+        if sim.model().solver().path.arc_length().is_some() {
             header.push_str(",load_factor");
         }
         for p in &sim.model().probes {
@@ -191,10 +191,10 @@ impl HistoryWriter {
         if sim.model().temperature_field.is_some() {
             header.push_str(",temperature_min,temperature_max");
         }
-        if sim.model().time.tolerance.is_some() {
+        if sim.model().time().tolerance.is_some() {
             header.push_str(",dt,error_estimate,rejected");
         }
-        if sim.model().solver.stabilisation.is_some() {
+        if sim.model().solver().stabilisation.is_some() {
             header
                 .push_str(",stabilisation_factor,strain_energy,dissipated_energy,dissipated_ratio");
             header.push_str(",damping_force_share");
@@ -315,7 +315,7 @@ impl HistoryWriter {
     fn row(&mut self, sim: &Simulation<'_>, report: Option<&StepReport>) -> ControlFlow<()> {
         let t = sim.time();
         let mut line = format!("{t:.10e}");
-        if sim.model().solver.path.arc_length().is_some() {
+        if sim.model().solver().path.arc_length().is_some() {
             line.push_str(&format!(",{:.12e}", sim.load_factor().unwrap_or(0.0)));
         }
         for p in &sim.model().probes {
@@ -337,13 +337,13 @@ impl HistoryWriter {
         if let Some((lo, hi)) = sim.temperature_extremes(sim.schedule_time()) {
             line.push_str(&format!(",{lo:.6},{hi:.6}"));
         }
-        if sim.model().time.tolerance.is_some() {
+        if sim.model().time().tolerance.is_some() {
             let (dt, estimate, rejected) = report.map_or((0.0, 0.0, 0), |r| {
                 (r.dt, r.error_estimate.unwrap_or(0.0), r.rejected)
             });
             line.push_str(&format!(",{dt:.6e},{estimate:.3e},{rejected}"));
         }
-        if sim.model().solver.stabilisation.is_some() {
+        if sim.model().solver().stabilisation.is_some() {
             let s = report.and_then(|r| r.stabilisation);
             let factor = s.map_or(0.0, |s| s.factor);
             let energy = s.map_or_else(|| sim.strain_energy(), |s| s.strain_energy);

@@ -1,13 +1,13 @@
-//! Files: YAML design files, STL and OBJ meshes, the run folder (history CSV, snapshots, MCAP recording,
-//! charts, summary), SVG charts. What the meshes and recorded centrelines show (the full device mirrored from a
-//! reduced model) is computed in [`crate::post`]; this layer writes it.
+//! Files: STL and OBJ meshes, the run folder (history CSV, snapshots, MCAP recording, charts, summary), SVG
+//! charts, centreline files. What the meshes and recorded centrelines show (the full device mirrored from a
+//! reduced model) is computed in [`crate::post`]; this layer writes it. The YAML design language is
+//! [`crate::design`], above this layer: the writers see a design through [`output::RunDesign`].
 
 pub mod atomic;
 pub mod centreline;
 pub mod chart;
 pub mod checkpoint;
 pub mod configurations;
-pub mod design;
 pub mod estimate;
 pub mod formats;
 pub mod history;
@@ -17,6 +17,7 @@ pub mod mcap_salvage;
 pub mod mesh_format;
 pub mod no_follow;
 pub mod obj;
+pub mod output;
 pub mod render;
 pub mod run_charts;
 pub mod run_folder;

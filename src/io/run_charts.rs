@@ -256,7 +256,7 @@ impl RunCharts {
         }
         charts.push(("newton.svg", newton));
 
-        if let Some(tolerance) = model.time.tolerance {
+        if let Some(tolerance) = model.time().tolerance {
             let mut steps = LineChart::new(
                 format!("{name}: error-controlled steps (tolerance {tolerance:e})"),
                 "time [s]",

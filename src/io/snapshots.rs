@@ -9,8 +9,8 @@
 
 use super::chart::ChartError;
 use super::configurations::{self, CENTRELINE_SAMPLES, Configuration};
-use super::design::SnapshotSettings;
 use super::mesh_format::{MeshFormat, SnapshotState};
+use super::output::SnapshotSettings;
 use super::run_folder::Manifest;
 use super::stl::MeshIoError;
 use super::{formats, render, stl, vtk};
@@ -44,18 +44,18 @@ pub struct SnapshotSchedule {
 impl SnapshotSchedule {
     /// The schedule of a design's snapshot settings for its model.
     pub fn new(settings: &SnapshotSettings, model: &Model) -> Self {
-        let snap = model.time.landing_tolerance();
+        let snap = model.time().landing_tolerance();
         let mut times = settings.times.clone();
         // An arc-length path's `time` is its path parameter, which passes `time.end` anywhere: its last state
         // is written by the writers' `finish`, and it has neither events nor times between them.
-        let end = match model.solver.path.arc_length() {
+        let end = match model.solver().path.arc_length() {
             None => {
                 let events: Vec<Real> = model.events().iter().map(|&(t, _)| t).collect();
                 if settings.events {
                     times.extend(&events);
                 }
                 times.extend(between_events(&events, settings.between));
-                model.time.end
+                model.time().end
             }
             Some(_) => Real::INFINITY,
         };
@@ -137,7 +137,7 @@ pub enum SnapshotAt {
 /// time with at least three decimals and its phase, `t1.750_fixed` (`t0.500` without a phase), or
 /// `step_00012` on an arc-length path, whose `time` is the path parameter.
 pub fn snapshot_name(model: &Model, step: usize, time: Real, phase: Option<Phase>) -> String {
-    if model.solver.path.arc_length().is_some() {
+    if model.solver().path.arc_length().is_some() {
         return format!("step_{step:05}");
     }
     // The fewest decimals, at least three, that write the time exactly (to 1e-9 of it): 1.750, 1.7525.

@@ -180,7 +180,7 @@ impl StateSample {
             residuals: report.map_or_else(Vec::new, |r| r.newton.residuals.clone()),
             cuts: report.map_or(0, |r| r.cuts),
             error_estimate: report.and_then(|r| r.error_estimate),
-            load_factor: model.solver.path.arc_length().map(|_| sim.load_scale()),
+            load_factor: model.solver().path.arc_length().map(|_| sim.load_scale()),
             probes: model
                 .probes
                 .iter()

@@ -464,7 +464,7 @@ impl RunSummaryFile {
             newton_iterations: 0,
             iterations_per_step: 0.0,
             step_cuts: 0,
-            time_error_control: model.time.tolerance.map(|tolerance| TimeErrorControl {
+            time_error_control: model.time().tolerance.map(|tolerance| TimeErrorControl {
                 tolerance,
                 accepted_steps: 0,
                 rejected_steps: 0,
@@ -472,7 +472,7 @@ impl RunSummaryFile {
                 smallest_step: 0.0,
                 largest_step: 0.0,
             }),
-            stabilisation: model.solver.stabilisation.map(|s| StabilisationSummary {
+            stabilisation: model.solver().stabilisation.map(|s| StabilisationSummary {
                 dissipated_fraction: s.dissipated_fraction,
                 limit: s.limit,
                 damped_steps: 0,
@@ -486,8 +486,8 @@ impl RunSummaryFile {
                 above_limit: false,
             }),
             final_time: 0.0,
-            end_time: model.time.end,
-            time_step: model.time.step,
+            end_time: model.time().end,
+            time_step: model.time().step,
             patches: model.patches.len(),
             collocation_points: model.num_collocation_points(),
             unknowns: model.num_unknowns(),

@@ -117,7 +117,7 @@ mod tests {
     };
     use crate::math::{Mat3, Vec3};
     use crate::model::builder::{ConditionSpec, ModelBuilder, PatchShape, ProbeAt, TimeSpec};
-    use crate::model::{Component, LinearMethod, TimeFunction};
+    use crate::model::{Component, LinearMethod, SolverSettings, TimeFunction, TimeSettings};
 
     /// A heated cantilever of a one-branch Maxwell/WLF material: one patch (p = 2, n = 4), clamped at its
     /// start, loaded at its end, with a temperature ramp and a probe — small enough to read its description.
@@ -189,6 +189,24 @@ mod tests {
         // each other.
         let up = |x: crate::math::Real| x.next_up();
         type Change = Box<dyn Fn(&mut Model)>;
+        // The time and Newton settings change as they do outside `model`: through the checked setters.
+        fn time(change: impl Fn(&mut TimeSettings) + 'static) -> Change {
+            Box::new(move |m| {
+                let mut time = m.time().clone();
+                change(&mut time);
+                *m = m.clone().with_time(time).expect("valid time settings");
+            })
+        }
+        fn solver(change: impl Fn(&mut SolverSettings) + 'static) -> Change {
+            Box::new(move |m| {
+                let mut solver = m.solver().clone();
+                change(&mut solver);
+                *m = m
+                    .clone()
+                    .with_solver(solver)
+                    .expect("valid Newton settings");
+            })
+        }
         let changes: Vec<(&str, Change)> = vec![
             (
                 "a branch modulus",
@@ -250,31 +268,28 @@ mod tests {
                         TimeFunction::try_table(vec![(0.0, 20.0), (1.0, up(90.0))]).expect("table")
                 }),
             ),
-            ("the end time", Box::new(move |m| m.time.end = up(1.0))),
-            ("the time step", Box::new(move |m| m.time.step = up(0.25))),
+            ("the end time", time(move |t| t.end = up(1.0))),
+            ("the time step", time(move |t| t.step = up(0.25))),
             (
                 "the smallest step",
-                Box::new(move |m| m.time.min_step = up(m.time.min_step)),
+                time(move |t| t.min_step = up(t.min_step)),
             ),
             (
                 "the release ramp",
-                Box::new(move |m| m.time.release_ramp = up(m.time.release_ramp)),
+                time(move |t| t.release_ramp = up(t.release_ramp)),
             ),
             (
                 "the Newton tolerance",
-                Box::new(move |m| m.solver.tolerance = up(m.solver.tolerance)),
+                solver(move |s| s.tolerance = up(s.tolerance)),
             ),
-            (
-                "the iterations allowed",
-                Box::new(|m| m.solver.max_iterations += 1),
-            ),
+            ("the iterations allowed", solver(|s| s.max_iterations += 1)),
             (
                 "the linear solver",
-                Box::new(|m| m.solver.linear = LinearMethod::SparseLu),
+                solver(|s| s.linear = LinearMethod::SparseLu),
             ),
             (
                 "stabilisation",
-                Box::new(|m| m.solver.stabilisation = Some(Default::default())),
+                solver(|s| s.stabilisation = Some(Default::default())),
             ),
             (
                 "a symmetry plane",

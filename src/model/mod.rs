@@ -501,10 +501,10 @@ pub struct Model {
     pub temperature: TimeFunction,
     /// A temperature that varies in space, which the material sees instead of `temperature` (`None`: uniform).
     pub temperature_field: Option<TemperatureField>,
-    /// Time stepping.
-    pub time: TimeSettings,
-    /// Newton settings.
-    pub solver: SolverSettings,
+    /// Time stepping ([`Model::time`]; changed through [`Model::with_time`], which checks it as the builder does).
+    time: TimeSettings,
+    /// Newton settings ([`Model::solver`]; changed through [`Model::with_solver`]).
+    solver: SolverSettings,
     /// Recorded points.
     pub probes: Vec<Probe>,
     /// Named node sets (indices into `nodes`), e.g. a generated stent's `all_joints`, `crown_1`, `symmetry`.
@@ -534,6 +534,16 @@ pub struct Vessel {
 }
 
 impl Model {
+    /// Time stepping.
+    pub fn time(&self) -> &TimeSettings {
+        &self.time
+    }
+
+    /// Newton settings.
+    pub fn solver(&self) -> &SolverSettings {
+        &self.solver
+    }
+
     /// The material regions of a device made of several materials: every material some patch uses, in material
     /// order; a region's nodes are those touching a patch of it ([`Model::node_touches_material`]: a node
     /// joining two materials belongs to both). Empty when every patch is of one material (no regions to compare).

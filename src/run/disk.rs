@@ -3,9 +3,9 @@
 //! file system, before anything is removed or written.
 
 use super::RunError;
-use crate::io::design::Design;
-use crate::io::design::locate::Locator;
-use crate::io::design::size::human_bytes;
+use crate::design::Design;
+use crate::design::locate::Locator;
+use crate::design::size::human_bytes;
 use crate::io::estimate::{DiskEstimate, estimated_disk};
 use crate::io::run_folder::FitFolder;
 use crate::math::Real;

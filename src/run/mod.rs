@@ -44,9 +44,9 @@ pub mod recorder;
 
 pub use recorder::{RECORDERS, Recorder, RecorderKind};
 
+use crate::design::Design;
+use crate::design::size::human_bytes;
 use crate::io::checkpoint::{self, OutputsCheckpoint, RunCheckpoint};
-use crate::io::design::Design;
-use crate::io::design::size::human_bytes;
 use crate::io::mcap::RunInfo;
 use crate::io::run_folder::{self, Manifest, RunFolder, RunFolderError};
 use crate::io::summary::{FailureReport, OutputState, RunStatus, RunSummaryFile, peak_memory_mib};
@@ -454,7 +454,7 @@ impl Outputs<'_> {
             control.rejected_steps = t.rejected;
         }
         if let (Some(summary), Some(settings)) =
-            (&mut s.stabilisation, &sim.model().solver.stabilisation)
+            (&mut s.stabilisation, &sim.model().solver().stabilisation)
         {
             let st = sim.stabilisation();
             summary.damped_steps = st.damped_steps;
@@ -656,12 +656,12 @@ fn setup<'m, 'c>(
         })?;
     }
     if !settings.quiet {
-        let plan = match model.solver.path {
+        let plan = match model.solver().path {
             crate::model::PathControl::Time => format!(
                 "{} steps of {} s to {} s",
                 design.steps.total(),
-                model.time.step,
-                model.time.end
+                model.time().step,
+                model.time().end
             ),
             crate::model::PathControl::ArcLength(a) => format!(
                 "arc-length path to load factor {} (at most {} increments)",
@@ -1026,7 +1026,7 @@ fn suggestions(model: &crate::model::Model, failure: &FailureReport) -> Vec<Stri
         return Vec::new();
     };
     let mut out = Vec::new();
-    let h = model.time.step;
+    let h = model.time().step;
     match model.phase_at(time) {
         Some(Phase::Programming) => out.push(match &model.programme {
             Some(p) => format!(
@@ -1042,12 +1042,12 @@ fn suggestions(model: &crate::model::Model, failure: &FailureReport) -> Vec<Stri
         }),
         Some(Phase::Releasing | Phase::Released) => out.push(format!(
             "a gentler release: a longer `time.release_ramp` (now {} s) lets the step cuts follow the springback",
-            short_time(model.time.release_ramp)
+            short_time(model.time().release_ramp)
         )),
         _ => out.push(format!(
             "a smaller `time.step` (now {} s) or a smaller `time.min_step` (now {} s)",
             short_time(h),
-            short_time(model.time.min_step)
+            short_time(model.time().min_step)
         )),
     }
     // The patch of the worst equation, as `describe_row` quotes it.
@@ -1081,7 +1081,7 @@ fn suggestions(model: &crate::model::Model, failure: &FailureReport) -> Vec<Stri
             ));
         }
     }
-    if model.solver.stabilisation.is_none() {
+    if model.solver().stabilisation.is_none() {
         out.push(
             "automatic stabilisation, `solver: {stabilisation: {}}`, carries a run through a buckle or a snap; summary.json then says how much energy it dissipated"
                 .to_string(),

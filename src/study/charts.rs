@@ -1,8 +1,8 @@
 //! The two log–log charts of an error study: error against the study's parameter (`n`, `h`) and error against
 //! wall time (work–precision), one series per curve (a degree, an integrator).
 
-use crate::io::chart::{LineChart, Scale, Series};
 use crate::math::Real;
+use crate::post::chart::{LineChart, Scale, Series};
 
 /// Wall times are charted on a log axis; a run faster than the clock resolves is drawn at this floor \[s\].
 pub const WALL_TIME_FLOOR: Real = 1e-6;

@@ -14,11 +14,10 @@ use super::StudyError;
 use super::charts::{ErrorChartLabels, ErrorCurve, error_charts};
 use super::fit::relative_error;
 use super::sample::{SampledRun, sample_run};
-use super::variant::{Remesh, TimeVariant, rebuild};
-use crate::io::chart::LineChart;
-use crate::io::design::Design;
+use super::variant::{Remesh, TimeVariant, VariedDesign};
 use crate::material::Integrator;
 use crate::math::Real;
+use crate::post::chart::LineChart;
 use std::fmt::Write as _;
 
 /// One run of a convergence study.
@@ -65,14 +64,14 @@ impl ConvergenceStudy {
     }
 }
 
-/// Runs the study on `design` (re-built for every `p` and `n`, [`rebuild`]) and returns its rows; `progress` is
+/// Runs the study on `design` (re-built for every `p` and `n`, [`VariedDesign::rebuild`]) and returns its rows; `progress` is
 /// told about each finished run.
 ///
 /// # Errors
 /// The first run that fails ([`StudyError::Run`] says which): every run must succeed for the rates to mean
 /// anything.
 pub fn convergence_study(
-    design: &Design,
+    design: &dyn VariedDesign,
     study: &ConvergenceStudy,
     mut progress: impl FnMut(&str),
 ) -> Result<Vec<ConvergencePoint>, StudyError> {
@@ -90,7 +89,7 @@ pub fn convergence_study(
             integrator: tolerance.map(|_| Integrator::Trapezoidal),
             ..TimeVariant::default()
         };
-        let model = until.of(&rebuild(design, &remesh)?)?;
+        let model = until.of(&design.rebuild(&remesh)?)?;
         Ok(sample_run(&model, study.samples)?)
     };
     let reference = run(rp, rn, None).map_err(|e| e.in_run("reference run"))?;

@@ -2,14 +2,14 @@
 //!
 //! This module owns the science above the solver — the scenarios, the exact references they are measured
 //! against, the error measure and fits, and the sweeps — and presents each study's result as CSV text, charts
-//! ([`crate::io::chart::LineChart`]) and prose. It writes no file and prints nothing: `stentkit study`
+//! ([`crate::post::chart::LineChart`]) and prose. It writes no file and prints nothing: `stentkit study`
 //! ([`crate::cli`]) parses the arguments, calls a study, writes what it returns and prints the progress lines it
 //! is handed.
 //!
 //! * [`fit`]: the relative error of a sampled displacement field and the least-squares slope of a log–log
 //!   relation (observed orders, growth exponents).
 //! * [`variant`]: the variants of a model a study runs — time stepping and integrator changed on the built
-//!   model, geometry (`p`, `n`, crowns) re-built from the design.
+//!   model, geometry (`p`, `n`, crowns) re-built by the design ([`variant::VariedDesign`]).
 //! * [`sample`]: one run of a model sampled on a grid of points per patch.
 //! * [`charts`]: the pair of log–log charts error-against-parameter and error-against-wall-time.
 //! * [`convergence`]: error against `p` and `n` (the paper's Fig. conv_circ) and work–precision.
@@ -20,12 +20,12 @@
 //!
 //! # Layer
 //!
-//! `study` sits above `io` and below `cli`: `… → solver → post → io → study → cli`. It needs `io` for two
-//! things only: re-building a design whose geometry a study varies (the mesh `p`, `n` or a stent's crowns go
-//! through [`crate::io::design`] in one function, [`variant::rebuild`]) and the chart type its results are drawn
-//! in. Everything else
-//! it takes from the layers below: a built [`crate::model::Model`], the [`crate::solver::Simulation`] that runs
-//! it and the material's point integrators.
+//! `study` sits above `post` and below `io`: `… → solver → post → study → io → design → …`. It takes a built
+//! [`crate::model::Model`], the [`crate::solver::Simulation`] that runs it and the material's point integrators
+//! from the layers below, and returns its charts as descriptions ([`crate::post::chart`]) that `cli` draws
+//! through `io`. A design whose geometry a study varies (the mesh `p`, `n` or a stent's crowns) is re-built by
+//! the design language above it, seen through [`variant::VariedDesign`]; the stability maps read their
+//! embedded designs through a [`stability::ReadDesign`] their caller hands in.
 
 pub mod charts;
 pub mod convergence;
@@ -38,19 +38,20 @@ pub mod variant;
 
 pub use fit::{fit_log_slope, relative_error};
 
-use crate::io::design::DesignError;
 use crate::material::MaterialError;
 use crate::math::Real;
 use crate::model::ScheduleError;
+use crate::model::builder::BuildError;
 use crate::solver::SolverError;
 
 /// Why a study could not be carried out. A run that fails inside a sweep meant to find failures (a time-step
 /// or stability study) is a result, not an error: it is recorded in the study's rows.
 #[derive(Debug, thiserror::Error)]
 pub enum StudyError {
-    /// The design, or a variant of it a study builds, was refused.
+    /// The design, or a variant of it a study builds, was refused (a [`crate::design::DesignError`]: the design
+    /// language sits above this layer).
     #[error("{0}")]
-    Design(#[source] DesignError),
+    Design(#[source] Box<dyn std::error::Error + Send + Sync>),
     /// A run failed where the study needs it to succeed (a reference run, a convergence run).
     #[error(transparent)]
     Solver(#[from] SolverError),
@@ -60,6 +61,10 @@ pub enum StudyError {
     /// A schedule a study sets (a temperature history) was refused.
     #[error(transparent)]
     Schedule(#[from] ScheduleError),
+    /// Settings a study gives a model (its time stepping, its Newton settings) were refused by the builder's
+    /// checks ([`crate::model::Model::with_settings`]).
+    #[error(transparent)]
+    Model(#[from] BuildError),
     /// A study setting is out of range.
     #[error("{setting} must be {expected}, got {value}")]
     InvalidSetting {
@@ -90,12 +95,6 @@ pub enum StudyError {
         #[source]
         source: Box<StudyError>,
     },
-}
-
-impl From<DesignError> for StudyError {
-    fn from(e: DesignError) -> Self {
-        StudyError::Design(e)
-    }
 }
 
 impl StudyError {

@@ -139,7 +139,7 @@ impl Watch<'_> {
     fn record(&mut self, sim: &Simulation<'_>) {
         let t = sim.time();
         // Runs land on record times; the tolerance only absorbs the rounding of the accumulated time.
-        let eps = 1e-9 * sim.model().time.end.max(1.0);
+        let eps = 1e-9 * sim.model().time().end.max(1.0);
         while let Some(&target) = self.times.get(self.states.len()) {
             if t + eps < target {
                 break;

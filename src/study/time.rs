@@ -18,10 +18,10 @@ use super::fit::{fit_log_slope, relative_error};
 use super::sample::{SampledRun, sample_run};
 use super::variant::TimeVariant;
 use super::{StudyError, error_chain};
-use crate::io::chart::LineChart;
 use crate::material::Integrator;
 use crate::math::Real;
 use crate::model::Model;
+use crate::post::chart::LineChart;
 use std::fmt::Write as _;
 
 /// Which run the errors of a time-step study are measured against.
@@ -145,7 +145,7 @@ pub fn time_study(
     });
     for variant in fixed.chain(controlled) {
         let integrator = variant.integrator.unwrap_or(Integrator::Trapezoidal);
-        let first = variant.step.unwrap_or(model.time.step);
+        let first = variant.step.unwrap_or(model.time().step);
         let mut row = TimePoint {
             integrator,
             step: first,

@@ -48,10 +48,9 @@
 
 use super::StudyError;
 use super::sample::{Watched, WatchedRun, watched_run};
-use super::variant::{Remesh, TimeVariant, rebuild};
-use crate::io::design::Design;
+use super::variant::{Remesh, TimeVariant, VariedDesign};
 use crate::math::{Real, Short, Vec3};
-use crate::model::{Model, ProbeLocation};
+use crate::model::{Model, ProbeLocation, TimeSettings};
 use std::fmt;
 
 /// Fixed steps over the screening horizon. With 20 (a step of 0.075 s on the curved stent's programming) the
@@ -213,7 +212,7 @@ impl fmt::Display for RunKey {
 
 /// Runs `tune`'s variants of one design, each once.
 struct Runner<'d> {
-    design: &'d Design,
+    design: &'d dyn VariedDesign,
     /// Names of the watched locations (`probe tip`, `node base`).
     names: Vec<String>,
     locations: Vec<ProbeLocation>,
@@ -241,19 +240,19 @@ impl Runner<'_> {
             points: Some(key.points),
             crowns: None,
         };
-        let mut model = rebuild(self.design, &remesh)?;
-        let whole = key.end >= model.time.end;
-        model.time.end = key.end;
+        let rebuilt = self.design.rebuild(&remesh)?;
+        let whole = key.end >= rebuilt.time().end;
         let (step, tolerance) = match key.stepping {
             Stepping::Fixed(h) => (Some(h), None),
             Stepping::Tolerance(tol) => (None, Some(tol)),
         };
-        TimeVariant {
+        let mut model = TimeVariant {
+            end: Some(key.end),
             step,
             tolerance,
             ..TimeVariant::default()
         }
-        .apply(&mut model)?;
+        .of(&rebuilt)?;
         // The whole schedule is compared at the comparison times, a screening run by its grid at its end.
         model.record_times = if whole {
             self.times.clone()
@@ -385,7 +384,7 @@ pub fn difference(run: &[Watched], finer: &[Watched], names: &[String]) -> Diffe
 
 /// The comparison times of `model` over its whole schedule (module docs).
 pub fn comparison_times(model: &Model) -> Vec<Real> {
-    let end = model.time.end;
+    let end = model.time().end;
     let mut times = model.condition_breakpoints();
     times.extend((1..=10).map(|k| end * k as Real / 10.0));
     times.sort_by(Real::total_cmp);
@@ -395,7 +394,7 @@ pub fn comparison_times(model: &Model) -> Vec<Real> {
 
 /// The screening horizon: the first schedule breakpoint at or after a quarter of the run.
 fn screening_horizon(model: &Model) -> Real {
-    let end = model.time.end;
+    let end = model.time().end;
     model
         .condition_breakpoints()
         .into_iter()
@@ -449,7 +448,7 @@ fn round_sig(x: Real) -> Real {
 /// estimate (not the trapezoidal one); [`StudyError::Run`] when no candidate's results settle in time or pass
 /// verification within [`MAX_ROUNDS`] rounds (each one's reason given).
 pub fn tune(
-    design: &Design,
+    design: &dyn VariedDesign,
     settings: &TuneSettings,
     mut progress: impl FnMut(&Trial),
 ) -> Result<Tuned, StudyError> {
@@ -461,8 +460,8 @@ pub fn tune(
             expected: "at least one",
         });
     }
-    let model = &design.model;
-    let end = model.time.end;
+    let model = design.model();
+    let end = model.time().end;
     // Every candidate controls its time error: refused at once for an update without an estimate.
     TimeVariant {
         tolerance: Some(tol),
@@ -589,7 +588,7 @@ fn time_ladder(
     mut tau: Real,
     tol: Real,
 ) -> Option<Real> {
-    let end = runner.design.model.time.end;
+    let end = runner.design.model().time().end;
     for _ in 0..MAX_TIME_RUNGS {
         let finer = round_sig(tau / 10.0);
         let key = |stepping| RunKey {
@@ -617,15 +616,18 @@ fn time_ladder(
 
 /// Wall time of the design's own settings \[s\]: fixed steps are timed over their first twentieth (at least 20
 /// steps) and extrapolated by the planned step count; error-controlled ones are run in full.
-fn design_cost(design: &Design) -> Result<Real, StudyError> {
-    let mut model = design.model.clone();
-    let planned = design.steps.total().max(1);
-    let fraction = if model.time.tolerance.is_some() {
+fn design_cost(design: &dyn VariedDesign) -> Result<Real, StudyError> {
+    let designed = design.model();
+    let planned = design.steps().total().max(1);
+    let fraction = if designed.time().tolerance.is_some() {
         1.0
     } else {
         (planned / 20).max(20).min(planned) as Real / planned as Real
     };
-    model.time.end *= fraction;
+    let model = designed.clone().with_time(TimeSettings {
+        end: designed.time().end * fraction,
+        ..designed.time().clone()
+    })?;
     let run = watched_run(&model, &[], None)?;
     Ok(if fraction < 1.0 {
         run.wall * planned as Real / run.summary.steps.max(1) as Real

@@ -3,14 +3,12 @@
 //! A variation of the time stepping, the release ramp or the internal-variable update changes settings of a
 //! built [`Model`] ([`TimeVariant`]): nothing is re-parsed. A variation of the geometry's discretisation (`p`,
 //! `n`) or of a generated stent's crowns changes the patches, nodes and conditions, so the design is re-built
-//! from its source ([`rebuild`]) — the one place a study goes back to the design file's layer, to be swapped
-//! for the model builder when it exists.
+//! ([`VariedDesign::rebuild`]): the design language ([`crate::design`], above this layer) implements it.
 
 use super::{StudyError, positive};
-use crate::io::design::{Design, DesignOverrides, parse_design_with};
 use crate::material::{Integrator, MaterialLaw, MaxwellLaw};
 use crate::math::Real;
-use crate::model::Model;
+use crate::model::{Model, StepPlan};
 
 /// Settings of the time stepping and the internal-variable update a study changes on a built model; `None`
 /// keeps the model's.
@@ -32,14 +30,15 @@ pub struct TimeVariant {
 }
 
 impl TimeVariant {
-    /// Changes `model` to this variant.
+    /// A copy of `model` changed to this variant: the time settings through [`Model::with_time`], which checks
+    /// them as the builder does.
     ///
     /// # Errors
     /// [`StudyError::InvalidSetting`] when a value is not positive and finite, [`StudyError::StepBeyondEnd`]
     /// when the step exceeds the end time, [`StudyError::Refused`] for error control with an internal-variable
-    /// update that has no estimate; `model` may then be partly changed.
-    pub fn apply(&self, model: &mut Model) -> Result<(), StudyError> {
-        let time = &mut model.time;
+    /// update that has no estimate, [`StudyError::Model`] for settings the builder refuses otherwise.
+    pub fn of(&self, model: &Model) -> Result<Model, StudyError> {
+        let mut time = model.time().clone();
         if let Some(end) = self.end {
             time.end = positive("the end time", end)?;
         }
@@ -67,6 +66,7 @@ impl TimeVariant {
                 end: time.end,
             });
         }
+        let mut model = model.clone();
         if let Some(integrator) = self.integrator {
             for law in &mut model.materials {
                 if let MaterialLaw::Maxwell(maxwell) = law {
@@ -75,24 +75,14 @@ impl TimeVariant {
             }
         }
         // As the builder does: error control only where its estimate holds (`Integrator::companion`).
-        if let Some(why) = model.time.error_control_refusal(&model.materials) {
+        if let Some(why) = time.error_control_refusal(&model.materials) {
             return Err(StudyError::Refused(why));
         }
-        Ok(())
-    }
-
-    /// A copy of `model` changed to this variant ([`TimeVariant::apply`]).
-    ///
-    /// # Errors
-    /// As [`TimeVariant::apply`].
-    pub fn of(&self, model: &Model) -> Result<Model, StudyError> {
-        let mut model = model.clone();
-        self.apply(&mut model)?;
-        Ok(model)
+        Ok(model.with_time(time)?)
     }
 }
 
-/// A geometry a study varies: the design is re-built ([`rebuild`]); `None` keeps the design's.
+/// A geometry a study varies: the design is re-built ([`VariedDesign::rebuild`]); `None` keeps the design's.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub struct Remesh {
     /// Degree `p` of every patch.
@@ -103,99 +93,20 @@ pub struct Remesh {
     pub crowns: Option<usize>,
 }
 
-/// The model of `design` re-built with the geometry `remesh`: today its YAML source parsed again with
-/// [`DesignOverrides`] (the design layer generates, fits and validates the patches, joints and conditions).
-///
-/// # Errors
-/// [`StudyError::Design`] when the variant is refused (e.g. `n ≤ p`, crowns for a design without a stent).
-pub fn rebuild(design: &Design, remesh: &Remesh) -> Result<Model, StudyError> {
-    let overrides = DesignOverrides {
-        degree: remesh.degree,
-        points: remesh.points,
-        crowns: remesh.crowns,
-        ..DesignOverrides::default()
-    };
-    Ok(parse_design_with(&design.source, &design.path, &overrides)?.model)
-}
+/// A design a study varies: the model as designed, and the model re-built with another geometry ([`Remesh`]),
+/// which only the design language can make (it generates, fits and validates the patches, joints and
+/// conditions). [`crate::design::Design`] is one; `study` sits below `design` and sees a design through this
+/// trait only.
+pub trait VariedDesign {
+    /// The model as designed.
+    fn model(&self) -> &Model;
 
-#[cfg(test)]
-mod tests {
-    use super::*;
-    use crate::io::design::parse_design;
-    use std::path::Path;
+    /// The steps a run of the model as designed takes when no step is cut (an arc-length path: its increments).
+    fn steps(&self) -> &StepPlan;
 
-    const BEND45: &str = include_str!("../../designs/bend45.yaml");
-
-    // The variant gives the model the design file would give with the same settings: on the viscoelastic arch
-    // (a Maxwell material), `time.end: 0.5`, `time.step: 0.25` and `material.integrator: exponential` make
-    // `min_step = 0.25/1024` and `release_ramp = 0.25` by the file's defaults and the exponential update, to the
-    // bit.
-    #[test]
-    fn a_time_variant_equals_the_file_with_the_same_settings() {
-        const ARCH: &str = include_str!("../../designs/circular_arch.yaml");
-        let path = Path::new("circular_arch.yaml");
-        let design = parse_design(ARCH, path).expect("the arch parses");
-        let varied = TimeVariant {
-            end: Some(0.5),
-            step: Some(0.25),
-            integrator: Some(Integrator::Exponential),
-            ..TimeVariant::default()
-        }
-        .of(&design.model)
-        .expect("a valid variant");
-        let overrides = DesignOverrides {
-            end_time: Some(0.5),
-            step: Some(0.25),
-            integrator: Some(crate::io::design::dto::IntegratorDto::Exponential),
-            ..DesignOverrides::default()
-        };
-        let file = parse_design_with(ARCH, path, &overrides).expect("overrides parse");
-        assert_ne!(varied, design.model);
-        assert_eq!(varied, file.model);
-    }
-
-    #[test]
-    fn a_step_beyond_the_end_is_refused() {
-        let design = parse_design(BEND45, Path::new("bend45.yaml")).expect("bend45 parses");
-        let too_long = TimeVariant {
-            step: Some(2.0),
-            ..TimeVariant::default()
-        };
-        assert!(matches!(
-            too_long.of(&design.model),
-            Err(StudyError::StepBeyondEnd {
-                step: 2.0,
-                end: 1.0
-            })
-        ));
-    }
-
-    // The crown count goes through the design layer: the same model as the design text with `stent.crowns: 2`
-    // written in (what the stability study did before, with a YAML edit). A design without a stent refuses a crown count.
-    #[test]
-    fn a_remeshed_stent_equals_the_edited_file() {
-        const STENT: &str = include_str!("../../designs/straight_stent.yaml");
-        let path = Path::new("straight_stent.yaml");
-        let design = parse_design(STENT, path).expect("the straight stent parses");
-        let remesh = Remesh {
-            degree: Some(5),
-            points: Some(14),
-            crowns: Some(2),
-        };
-        let rebuilt = rebuild(&design, &remesh).expect("two crowns");
-        assert_eq!(STENT.matches("\n  crowns: 6\n").count(), 1);
-        let edited = STENT.replace("\n  crowns: 6\n", "\n  crowns: 2\n");
-        let overrides = DesignOverrides {
-            degree: Some(5),
-            points: Some(14),
-            ..DesignOverrides::default()
-        };
-        let file = parse_design_with(&edited, path, &overrides).expect("parses");
-        assert_eq!(rebuilt, file.model);
-        let bend = parse_design(BEND45, Path::new("bend45.yaml")).expect("bend45 parses");
-        assert!(matches!(
-            rebuild(&bend, &remesh),
-            Err(StudyError::Design(_))
-        ));
-    }
+    /// The model re-built with the geometry `remesh`.
+    ///
+    /// # Errors
+    /// [`StudyError::Design`] when the variant is refused (e.g. `n ≤ p`, crowns for a design without a stent).
+    fn rebuild(&self, remesh: &Remesh) -> Result<Model, StudyError>;
 }

@@ -5,8 +5,8 @@
 
 use super::metrics::{Metrics, Release, run_metrics};
 use super::{Plan, SweepDir, SweepError, VariantState, short_name};
+use crate::design::load_design;
 use crate::io::chart::{LineChart, Series, write_svg};
-use crate::io::design::load_design;
 use crate::math::Real;
 use std::fmt::Write as _;
 use std::path::PathBuf;
@@ -106,7 +106,7 @@ pub fn collect(dir: &SweepDir, times: Option<&[Real]>) -> Result<Collected, Swee
     let times: Vec<Real> = match times {
         Some(t) => t.to_vec(),
         None => models.iter().flatten().next().map_or_else(Vec::new, |m| {
-            let end = m.time.end;
+            let end = m.time().end;
             match Release::of(m) {
                 Some(r) if r.time < end => vec![r.time + 0.5 * (end - r.time), end],
                 _ => vec![end],

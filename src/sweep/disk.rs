@@ -15,7 +15,7 @@
 //! one.
 
 use super::{Plan, Resolutions, resolve_design};
-use crate::io::design::set::{PathStep, SetOverride, apply, parse_path, resolved_text};
+use crate::design::set::{PathStep, SetOverride, apply, parse_path, resolved_text};
 use crate::io::estimate::{DiskEstimate, estimated_disk};
 use std::collections::HashMap;
 
@@ -169,7 +169,7 @@ fn member_source_len(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::io::design::{DesignOverrides, load_design, load_design_with};
+    use crate::design::{DesignOverrides, load_design, load_design_with};
     use crate::sweep::Parameter;
     use std::path::{Path, PathBuf};
 

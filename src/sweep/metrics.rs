@@ -146,7 +146,7 @@ impl Release {
         let time = model.programme.as_ref()?.release?;
         Some(Self {
             time,
-            ramp: model.time.release_ramp,
+            ramp: model.time().release_ramp,
         })
     }
 }

@@ -13,7 +13,7 @@
 //! only what it names.
 //!
 //! **Folder.** `DIR/sweep.json` (the plan: the design file, the parameters, the variants with their
-//! overrides), and per variant `DIR/variants/vNNN/`: `design.yaml` (the resolved design, [`crate::io::design::set`]),
+//! overrides), and per variant `DIR/variants/vNNN/`: `design.yaml` (the resolved design, [`crate::design::set`]),
 //! `run/` (its run folder), `log.txt` (what its run printed) or `error.txt` (why its design was refused: a
 //! variant the values make invalid is a failed row, not the end of the sweep). Nothing in DIR is removed by a
 //! sweep: a rerun skips completed variants, continues interrupted or killed ones from their checkpoint, starts
@@ -36,8 +36,8 @@ pub mod disk;
 pub mod metrics;
 pub mod slurm;
 
-use crate::io::design::set::{PathStep, parse_path, path_text};
-use crate::io::design::{Design, DesignError, DesignOverrides, SetOverride, load_design_with};
+use crate::design::set::{PathStep, parse_path, path_text};
+use crate::design::{Design, DesignError, DesignOverrides, SetOverride, load_design_with};
 use serde::{Deserialize, Serialize};
 use std::collections::HashMap;
 use std::io::Write as _;

@@ -1,7 +1,7 @@
 //! Models and designs for tests, built in code: [`bend45_builder`], the 45° bend as [`ModelBuilder`] calls;
 //! and the designs of `designs/` changed in code instead of by editing their YAML text
 //! (`fixtures::straight_stent().crowns(2).time(2.0, 0.01)`), each change a field path and a value applied to
-//! the design's tree exactly as `stentkit --set PATH=VALUE` applies it ([`stentkit::io::design::set`]). A
+//! the design's tree exactly as `stentkit --set PATH=VALUE` applies it ([`stentkit::design::set`]). A
 //! path that names no field of the design format is refused when the design is read (its fields are closed), so
 //! a change that no longer applies fails loudly instead of testing the unchanged design — where a text edit
 //! (`str::replace`) did nothing silently.
@@ -12,7 +12,7 @@
 //! itself (located errors, bad designs, `--set` paths) keep their YAML text.
 
 use std::path::{Path, PathBuf};
-use stentkit::io::design::{Design, DesignError, DesignOverrides, SetOverride, parse_design_with};
+use stentkit::design::{Design, DesignError, DesignOverrides, SetOverride, parse_design_with};
 use stentkit::material::{ElasticLaw, Section, SectionProperties};
 use stentkit::math::{Real, Vec3};
 use stentkit::model::builder::{

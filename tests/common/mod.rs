@@ -10,7 +10,7 @@ pub mod fixtures;
 use std::ops::ControlFlow;
 use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
-use stentkit::io::design::parse_design;
+use stentkit::design::parse_design;
 use stentkit::math::{Real, Vec3};
 use stentkit::model::{Model, ProbeLocation};
 use stentkit::solver::{Observer, Simulation, StepReport};

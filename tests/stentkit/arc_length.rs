@@ -307,6 +307,7 @@ fn a_coarse_roll_up_fails_by_load_steps_at_a_limit_point_of_its_own_path() {
     use stentkit::study::stability::scenarios::{CoarseDesign, coarse_map};
     let map = coarse_map(
         &[(CoarseDesign::Rollup, 4, 10), (CoarseDesign::Rollup, 6, 30)],
+        &stentkit::design::variants::read_varied,
         |_| {},
     )
     .expect("runs");

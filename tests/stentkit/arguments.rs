@@ -409,7 +409,7 @@ fn the_suggested_grid_fits_and_a_finer_one_does_not() {
 /// `stentkit::post::print`).
 #[test]
 fn the_print_estimate_counts_the_contour_triangles() {
-    use stentkit::io::design::load_design;
+    use stentkit::design::load_design;
     use stentkit::post::device::reference_patch_shapes;
     use stentkit::post::print::{
         PrintSettings, estimated_device_print, print_solid, thinnest_wire,
@@ -546,7 +546,7 @@ fn design_errors_print_huge_numbers_short() {
             for huge in ["1e308", "-1e308"] {
                 let changed = format!("{}{huge}{}", &text[..start], &text[end..]);
                 cases += 1;
-                if let Err(e) = stentkit::io::design::parse_design(&changed, &path) {
+                if let Err(e) = stentkit::design::parse_design(&changed, &path) {
                     let message = e.to_string();
                     if longest_digit_run(&message) > 20 {
                         long.push(message);

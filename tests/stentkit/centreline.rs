@@ -227,7 +227,7 @@ fn bad_centreline_files_are_refused_with_the_reason() {
 fn designs_on_file_centrelines_are_checked() {
     let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("designs/aorta_stent.yaml");
     let text = std::fs::read_to_string(&path).expect("design");
-    let design = stentkit::io::design::parse_design(&text, &path).expect("the aorta design reads");
+    let design = stentkit::design::parse_design(&text, &path).expect("the aorta design reads");
     assert!(
         design
             .notes
@@ -257,7 +257,7 @@ fn designs_on_file_centrelines_are_checked() {
         ),
     ] {
         assert!(text.contains(from), "{from}");
-        let error = stentkit::io::design::parse_design(&text.replace(from, to), &path)
+        let error = stentkit::design::parse_design(&text.replace(from, to), &path)
             .expect_err(to)
             .to_string();
         assert!(
@@ -290,7 +290,7 @@ fn the_aorta_stents_run_shows_the_vessel_lumen() {
     let stl = std::fs::read(dir.join("snapshots/vessel_lumen.stl")).expect("the lumen");
     let triangles = u32::from_le_bytes([stl[80], stl[81], stl[82], stl[83]]) as usize;
     assert_eq!(stl.len(), 84 + 50 * triangles);
-    let model = stentkit::io::design::load_design(&design)
+    let model = stentkit::design::load_design(&design)
         .expect("design")
         .model;
     let vessel = model.vessel.as_ref().expect("a vessel");
@@ -390,7 +390,7 @@ fn a_tapered_stent_follows_the_local_lumen() {
         "  oversize: 0.1 ",
         "  taper: true\n  radius: 6 #",
     );
-    let err = stentkit::io::design::parse_design(&refused, &path).expect_err("no oversize");
+    let err = stentkit::design::parse_design(&refused, &path).expect_err("no oversize");
     assert!(err.to_string().contains("stent.taper"), "{err}");
 }
 
@@ -739,7 +739,7 @@ fn a_smoothing_tighter_than_the_points_is_refused_in_words() {
     ] {
         let path = dir.join(format!("{name}.yaml"));
         let started = std::time::Instant::now();
-        let error = stentkit::io::design::parse_design(&text, &path)
+        let error = stentkit::design::parse_design(&text, &path)
             .expect_err("too tight")
             .to_string();
         eprintln!(
@@ -760,7 +760,7 @@ fn a_smoothing_tighter_than_the_points_is_refused_in_words() {
                 .expect("a smoothing line"),
             &format!("      smoothing: {enough}"),
         );
-        if let Err(e) = stentkit::io::design::parse_design(&retried, &path) {
+        if let Err(e) = stentkit::design::parse_design(&retried, &path) {
             assert!(!e.to_string().contains("too tight"), "{enough}: {e}");
         }
     }
@@ -790,18 +790,18 @@ fn a_dense_centrelines_lumen_is_bounded_and_counted() {
     std::fs::write(&dense, csv).expect("csv");
     let design = dir.join("dense.yaml");
     std::fs::write(&design, aorta_design_on(&dense, Some("0.01"), true)).expect("design");
-    let loaded = stentkit::io::design::load_design(&design).expect("the design reads");
+    let loaded = stentkit::design::load_design(&design).expect("the design reads");
     let rings = loaded.model.vessel.as_ref().expect("a vessel").points.len();
-    assert_eq!(rings, stentkit::io::design::vessel::MAX_LUMEN_RINGS);
+    assert_eq!(rings, stentkit::design::vessel::MAX_LUMEN_RINGS);
     let estimate = stentkit::io::estimate::estimated_disk(&loaded);
     let run = crate::materials::run(design.to_str().expect("UTF-8"), "dense_lumen", &BRIEF_RUN);
     let lumen = std::fs::metadata(run.join("snapshots/vessel_lumen.stl"))
         .expect("the lumen")
         .len();
     assert_eq!(lumen, 84 + 50 * 2 * 12 * rings as u64);
-    let ran = stentkit::io::design::load_design_with(
+    let ran = stentkit::design::load_design_with(
         &design,
-        &stentkit::io::design::DesignOverrides::sets(
+        &stentkit::design::DesignOverrides::sets(
             BRIEF_RUN
                 .iter()
                 .map(|set| set.parse().expect("override"))

@@ -14,7 +14,7 @@
 
 use crate::common::fixtures;
 use std::ops::ControlFlow;
-use stentkit::model::Model;
+use stentkit::model::{Model, SolverSettings, TimeSettings};
 use stentkit::solver::{CheckpointError, Observer, Simulation, StepOutcome, StepReport};
 
 /// Steps a simulation to the end, returning its reports.
@@ -50,8 +50,14 @@ fn cut_bend() -> Model {
 #[test]
 fn a_restored_simulation_continues_bit_for_bit() {
     // The bend again with the extrapolated start (`solver.extrapolate`), which reads the last step's increment.
-    let mut extrapolated = cut_bend();
-    extrapolated.solver.extrapolate = true;
+    let bend = cut_bend();
+    let mut extrapolated = bend
+        .clone()
+        .with_solver(SolverSettings {
+            extrapolate: true,
+            ..bend.solver().clone()
+        })
+        .expect("valid settings");
     extrapolated.name = "bend45_extrapolated".into();
     for model in [
         small_stent(),
@@ -62,7 +68,7 @@ fn a_restored_simulation_continues_bit_for_bit() {
         let mut full = Simulation::new(&model).expect("simulation");
         let reports = finish(&mut full);
         assert!(full.is_finished(), "{}", model.name);
-        if model.time.tolerance.is_some() {
+        if model.time().tolerance.is_some() {
             let rejected: usize = reports.iter().map(|r| r.rejected).sum();
             println!(
                 "{}: {} steps, {rejected} rejected",
@@ -145,8 +151,13 @@ fn a_checkpoint_of_another_model_is_refused() {
         "{error}"
     );
     // The same geometry with another load is another model too.
-    let mut heavier = bend.clone();
-    heavier.time.end *= 2.0;
+    let heavier = bend
+        .clone()
+        .with_time(TimeSettings {
+            end: 2.0 * bend.time().end,
+            ..bend.time().clone()
+        })
+        .expect("a longer run");
     let mut sim = Simulation::new(&heavier).expect("simulation");
     assert!(matches!(
         sim.restore(&checkpoint),

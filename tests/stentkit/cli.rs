@@ -4,7 +4,7 @@
 use crate::mesh::{TempDir, designs_and_good_small};
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
-use stentkit::io::design::load_design;
+use stentkit::design::load_design;
 
 /// Runs `stentkit` with `args`.
 fn stentkit(args: &[&str]) -> Output {
@@ -89,9 +89,9 @@ fn check_describes_every_design() {
         assert_eq!(count("nodes"), model.nodes.len());
         assert_eq!(count("collocation points"), model.num_collocation_points());
         assert_eq!(count("unknowns"), model.num_unknowns());
-        match model.solver.path {
+        match model.solver().path {
             // Error-controlled steps are not known before the run: `check` says so instead of a count.
-            stentkit::model::PathControl::Time if model.time.tolerance.is_some() => {
+            stentkit::model::PathControl::Time if model.time().tolerance.is_some() => {
                 assert_eq!(value_after(&stdout, "time steps"), "error-controlled");
             }
             stentkit::model::PathControl::Time => {
@@ -270,10 +270,10 @@ fn run_with_overrides_records_the_resolved_design() {
     let resolved = summary["resolved_design"]
         .as_str()
         .expect("resolved_design");
-    let model = stentkit::io::design::parse_design(resolved, Path::new("resolved.yaml"))
+    let model = stentkit::design::parse_design(resolved, Path::new("resolved.yaml"))
         .expect("the resolved design reads")
         .model;
-    assert_eq!(model.time.end, 0.1);
+    assert_eq!(model.time().end, 0.1);
     assert_eq!(summary["final_time"], serde_json::json!(0.1));
     let check = stentkit(&["check", path_str(&design), "--set", "material.wlf.Tg=61.5"]);
     assert!(

@@ -8,7 +8,7 @@
 
 use crate::common::edit;
 use std::path::{Path, PathBuf};
-use stentkit::io::design::{DesignError, load_design};
+use stentkit::design::{DesignError, load_design};
 
 fn data(name: &str) -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR"))
@@ -76,7 +76,7 @@ fn temperature_below_the_wlf_singularity_is_a_warning_with_the_freeze() {
         "temperature: [[0, 90], [1, 10]]",
     );
     let path = Path::new("wlf_freeze.yaml");
-    let design = stentkit::io::design::parse_design(&text, path).expect("accepted with a warning");
+    let design = stentkit::design::parse_design(&text, path).expect("accepted with a warning");
     let warning = design
         .warnings
         .iter()
@@ -109,7 +109,7 @@ fn temperature_below_the_wlf_singularity_is_a_warning_with_the_freeze() {
         "time: {",
         "temperature: [[0, 90], [1, 10]]\ntime: {",
     );
-    let design = stentkit::io::design::parse_design(&bend, path).expect("cooled bend");
+    let design = stentkit::design::parse_design(&bend, path).expect("cooled bend");
     assert!(
         design
             .warnings
@@ -333,7 +333,7 @@ fn generated_hostile_designs_are_refused_quickly_with_located_errors() {
     let mut failures = Vec::new();
     for case in generated_corpus() {
         let started = std::time::Instant::now();
-        let result = stentkit::io::design::parse_design(&case.text, path);
+        let result = stentkit::design::parse_design(&case.text, path);
         let elapsed = started.elapsed();
         eprintln!(
             "{}: {} bytes, refused in {elapsed:?}",
@@ -434,7 +434,7 @@ fn long_values_are_quoted_shortened_in_errors() {
     ];
     for (field, text) in cases {
         let error =
-            stentkit::io::design::parse_design(&text, Path::new("long.yaml")).expect_err("refused");
+            stentkit::design::parse_design(&text, Path::new("long.yaml")).expect_err("refused");
         let message = error.to_string();
         assert!(
             message.chars().count() < 400 && message.contains(&cut),
@@ -451,8 +451,7 @@ fn long_values_are_quoted_shortened_in_errors() {
     // are shortened (the path without backticks).
     let key = "k".repeat(1000);
     let text = edit(&base, "units: SI", &format!("units: SI\n{key}: 1"));
-    let error =
-        stentkit::io::design::parse_design(&text, Path::new("long.yaml")).expect_err("refused");
+    let error = stentkit::design::parse_design(&text, Path::new("long.yaml")).expect_err("refused");
     let message = error.to_string();
     assert!(
         message.chars().count() < 600
@@ -475,7 +474,7 @@ fn a_design_name_is_one_folder_name() {
     // the file stem is the name, and `..yaml` has the stem `.` (Rust's `file_stem` keeps everything before the
     // last dot): refused too, pointing at the design's first line (there is no `name` to point at).
     let base = std::fs::read_to_string(data("good_small.yaml")).expect("base");
-    let error = stentkit::io::design::parse_design(&base, Path::new("..yaml"))
+    let error = stentkit::design::parse_design(&base, Path::new("..yaml"))
         .expect_err("the stem `.` is not a folder name");
     let message = error.to_string();
     assert!(
@@ -490,7 +489,7 @@ fn a_design_name_is_one_folder_name() {
             "version: 1\n",
             &format!("version: 1\nname: {name}\n"),
         );
-        let design = stentkit::io::design::parse_design(&text, Path::new("named.yaml"))
+        let design = stentkit::design::parse_design(&text, Path::new("named.yaml"))
             .unwrap_or_else(|e| panic!("{name}: {e}"));
         assert_eq!(design.model.name, name);
     }
@@ -503,10 +502,10 @@ fn a_design_name_is_one_folder_name() {
 fn a_temperature_schedule_that_ends_early_is_a_warning() {
     let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("designs/straight_stent.yaml");
     let text = std::fs::read_to_string(&path).expect("design");
-    let short = stentkit::io::design::parse_design_with(
+    let short = stentkit::design::parse_design_with(
         &text,
         &path,
-        &stentkit::io::design::DesignOverrides::sets(vec![
+        &stentkit::design::DesignOverrides::sets(vec![
             "temperature=[[0, 90], [1, 90], [1.75, 45]]"
                 .parse()
                 .expect("set"),
@@ -520,7 +519,7 @@ fn a_temperature_schedule_that_ends_early_is_a_warning() {
         "{:?}",
         short.warnings
     );
-    let full = stentkit::io::design::parse_design(&text, &path).expect("design");
+    let full = stentkit::design::parse_design(&text, &path).expect("design");
     assert!(
         !full
             .warnings
@@ -539,10 +538,10 @@ fn a_temperature_schedule_that_ends_early_is_a_warning() {
 fn a_release_above_the_glass_transition_is_a_warning() {
     let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("designs/straight_stent.yaml");
     let text = std::fs::read_to_string(&path).expect("design");
-    let hot = stentkit::io::design::parse_design_with(
+    let hot = stentkit::design::parse_design_with(
         &text,
         &path,
-        &stentkit::io::design::DesignOverrides::sets(vec![
+        &stentkit::design::DesignOverrides::sets(vec![
             "temperature=[[0, 90], [3.25, 90]]".parse().expect("set"),
         ]),
     )
@@ -556,7 +555,7 @@ fn a_release_above_the_glass_transition_is_a_warning() {
         warning.contains("t = 1.75 at 90 °C") && warning.contains("Tg = 70 °C"),
         "{warning}"
     );
-    let paper = stentkit::io::design::parse_design(&text, &path).expect("design");
+    let paper = stentkit::design::parse_design(&text, &path).expect("design");
     assert!(
         paper
             .warnings
@@ -576,10 +575,10 @@ fn a_wire_thicker_than_the_gap_between_crowns_is_a_warning() {
     let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("designs/straight_stent.yaml");
     let text = std::fs::read_to_string(&path).expect("design");
     let with = |diameter: &str| {
-        stentkit::io::design::parse_design_with(
+        stentkit::design::parse_design_with(
             &text,
             &path,
-            &stentkit::io::design::DesignOverrides::sets(
+            &stentkit::design::DesignOverrides::sets(
                 [
                     "stent.amplitude=2".to_string(),
                     "stent.spacing=9".to_string(),

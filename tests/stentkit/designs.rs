@@ -1,7 +1,7 @@
 //! Every design in `designs/` loads, and `check` describes it.
 
 use std::path::{Path, PathBuf};
-use stentkit::io::design::load_design;
+use stentkit::design::load_design;
 
 /// All YAML files in `designs/`.
 pub fn all_designs() -> Vec<PathBuf> {

@@ -4,11 +4,11 @@
 
 use crate::outputs::{design, path_str, stentkit, test_outputs, text};
 use std::sync::Arc;
+use stentkit::design::load_design;
 use stentkit::geometry::stent::{
     BridgeShape, BridgeSpec, CentrelineSpec, CrownSpec, DiamondSpec, StentFamily, StentSpec,
     Symmetry,
 };
-use stentkit::io::design::load_design;
 use stentkit::material::{CircularSection, ElasticLaw};
 use stentkit::math::{Real, Vec3};
 use stentkit::model::Model;

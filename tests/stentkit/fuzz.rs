@@ -17,7 +17,7 @@ use proptest::prelude::*;
 use proptest::test_runner::{Config, RngSeed};
 use std::panic::{AssertUnwindSafe, catch_unwind};
 use std::path::{Path, PathBuf};
-use stentkit::io::design::{DesignError, parse_design};
+use stentkit::design::{DesignError, parse_design};
 use stentkit::solver::Simulation;
 
 /// Cases per run of the test.

@@ -11,6 +11,7 @@ mod cli;
 mod design_errors;
 mod designs;
 mod diamond;
+mod estimate;
 mod export;
 mod fields;
 mod fuzz;

@@ -22,11 +22,11 @@
 
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicUsize, Ordering};
+use stentkit::design::load_design;
 use stentkit::geometry::analytic::ArcLengthTable;
 use stentkit::geometry::frame::{FrameField, FrameSettings};
 use stentkit::geometry::mesh::TriangleMesh;
 use stentkit::geometry::tube::{TubeSettings, sweep_curve};
-use stentkit::io::design::load_design;
 use stentkit::io::{obj, stl};
 use stentkit::math::{Real, Vec3};
 use stentkit::model::Model;
@@ -361,9 +361,9 @@ fn the_temporary_shape_is_the_device_where_its_programme_takes_it() {
         mesh.check_closed().expect("closed");
         // The wires are the generated curves as fitted: their centrelines stray from the bound's cylinder by
         // up to the fit's deviation.
-        let fit = stentkit::io::design::load_design_with(
+        let fit = stentkit::design::load_design_with(
             &crate::outputs::design(name),
-            &stentkit::io::design::DesignOverrides {
+            &stentkit::design::DesignOverrides {
                 temporary_shape: true,
                 ..Default::default()
             },

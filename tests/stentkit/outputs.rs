@@ -13,7 +13,7 @@ use serde_json::Value;
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
-use stentkit::io::design::{DesignOverrides, parse_design_with};
+use stentkit::design::{DesignOverrides, parse_design_with};
 use stentkit::io::snapshots::SnapshotWriter;
 use stentkit::io::stl::read_stl;
 use stentkit::math::Real;
@@ -482,9 +482,7 @@ fn straight_stent_run_writes_closed_full_device_snapshots() {
     );
 
     let rec = check_recording(&dir, &file);
-    let model = stentkit::io::design::load_design(&file)
-        .expect("design")
-        .model;
+    let model = stentkit::design::load_design(&file).expect("design").model;
     let rods: usize = (0..model.patches.len())
         .map(|k| patch_copies(&model, k).len())
         .sum();
@@ -511,7 +509,7 @@ fn straight_stent_run_writes_closed_full_device_snapshots() {
 /// Runs `model` for its (shortened) time with a snapshot writer into `dir`; returns the writer.
 fn snapshots_of(
     model: &Model,
-    settings: &stentkit::io::design::SnapshotSettings,
+    settings: &stentkit::design::SnapshotSettings,
     dir: &Path,
 ) -> Vec<stentkit::io::snapshots::Snapshot> {
     let mut sim = Simulation::new(model).expect("simulation");
@@ -535,7 +533,7 @@ fn curved_stent_half_model_snapshots_are_closed() {
     let design = parse_design_with(&text, &file, &overrides).expect("valid design");
     let dir = test_outputs("curved_stent_snapshots");
     // A coarse drawing (8 segments, 21 rings per patch) keeps the files small; the welds are the same.
-    let settings = stentkit::io::design::SnapshotSettings {
+    let settings = stentkit::design::SnapshotSettings {
         segments: 8,
         rings: 21,
         ..design.output.snapshots.clone()

@@ -4,7 +4,7 @@
 
 use crate::common::edit;
 use std::path::{Path, PathBuf};
-use stentkit::io::design::{
+use stentkit::design::{
     DesignError, DesignOverrides, SetOverride, load_design, load_design_with, parse_design,
 };
 

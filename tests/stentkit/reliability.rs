@@ -16,7 +16,7 @@ use std::cell::{Cell, RefCell};
 use std::ops::ControlFlow;
 use std::path::Path;
 use std::process::Command;
-use stentkit::io::design::parse_design;
+use stentkit::design::parse_design;
 use stentkit::io::snapshots::SnapshotSchedule;
 use stentkit::math::Real;
 use stentkit::model::Model;
@@ -375,7 +375,7 @@ fn failing_at_the_smallest_step_at_a_large_time_ends_the_run() {
     let SolverError::StepFailed { time, dt, step, .. } = error else {
         panic!("expected StepFailed, got {error}");
     };
-    let min_step = model.time.min_step;
+    let min_step = model.time().min_step;
     let ulp = time.next_up() - time;
     assert!(
         (dt - min_step).abs() <= STEP_ROUND_OFF_ULPS * ulp,
@@ -432,12 +432,12 @@ fn the_uncooled_straight_stent_fails_at_the_release_with_a_report() {
     match result {
         Ok(summary) => {
             assert!(!summary.stopped, "the guard stopped the run");
-            assert_eq!(sim.time(), model.time.end);
+            assert_eq!(sim.time(), model.time().end);
         }
         Err(SolverError::StepFailed { time, dt, .. }) => {
             let ulp = time.next_up() - time;
             assert!(
-                (dt - model.time.min_step).abs() <= STEP_ROUND_OFF_ULPS * ulp,
+                (dt - model.time().min_step).abs() <= STEP_ROUND_OFF_ULPS * ulp,
                 "dt = {dt:e}"
             );
             assert!(time > 1.75, "fails after the release, at {time}");
@@ -681,7 +681,7 @@ fn the_disk_estimate_bounds_a_run_folder_from_above() {
         .time(1.0, 1.0e-3)
         .set("output.configurations.render", "false")
         .write(&dir.join("bend_fine.yaml"));
-    let design = stentkit::io::design::load_design(&file).expect("valid");
+    let design = stentkit::design::load_design(&file).expect("valid");
     let estimate = stentkit::io::estimate::estimated_disk(&design);
     let run = dir.join("run");
     completed_in_process(&file, &run, &[]);

@@ -295,7 +295,7 @@ impl stentkit::run::Console for StopAt<'_> {
 fn an_in_process_run_stopped_by_its_interrupt_resumes_to_the_uninterrupted_result() {
     use stentkit::run::{Folder, Interrupt, Lines, RunError, RunSettings, run};
     let root = scratch("in_process");
-    let design = stentkit::io::design::load_design(&two_crown_stent(&root)).expect("design");
+    let design = stentkit::design::load_design(&two_crown_stent(&root)).expect("design");
     let full = root.join("full");
     let settings = RunSettings::new("in-process test");
     let new = |dir: &Path| Folder::New {

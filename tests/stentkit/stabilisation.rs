@@ -5,7 +5,7 @@
 
 use crate::common::{fixtures, model_from_text, node_displacement, solve};
 use stentkit::math::Real;
-use stentkit::model::StabilisationSettings;
+use stentkit::model::{SolverSettings, StabilisationSettings};
 use stentkit::solver::Simulation;
 
 /// A straight cantilever of length 1 (E = 1e7, d = 0.01, ν = 0.3) bent by an end couple `moment` about z.
@@ -123,8 +123,13 @@ fn the_coarse_stent_whose_release_folds_completes_with_stabilisation() {
         .expect_err("Newton alone stalls at the release");
     println!("p = 5, n = 14 without stabilisation: {failure}");
     assert!(sim.time() >= 1.75 && sim.time() < 1.76, "{}", sim.time());
-    let mut stabilised = plain.clone();
-    stabilised.solver.stabilisation = Some(StabilisationSettings::default());
+    let stabilised = plain
+        .clone()
+        .with_solver(SolverSettings {
+            stabilisation: Some(StabilisationSettings::default()),
+            ..plain.solver().clone()
+        })
+        .expect("stabilisation at its defaults");
     let (sim, _) = solve(&stabilised);
     let s = *sim.stabilisation();
     println!(

@@ -6,7 +6,7 @@ use crate::common::fixtures;
 use std::ops::ControlFlow;
 use std::path::Path;
 use stentkit::geometry::frame::{FrameField, FrameSettings};
-use stentkit::io::design::parse_design;
+use stentkit::design::parse_design;
 use stentkit::io::stl::{read_stl, write_stl};
 use stentkit::math::{Real, Vec3};
 use stentkit::model::{Model, ProbeLocation};
@@ -311,7 +311,7 @@ time: {{end: 1, step: 0.25}}
 fn solve(model: &Model) -> Vec<(String, Vec3, Vec3)> {
     let mut sim = Simulation::new(model).unwrap_or_else(|e| panic!("{e}"));
     let summary = sim.run(&mut []).unwrap_or_else(|e| panic!("{e}"));
-    assert!((summary.time - model.time.end).abs() < 1e-12);
+    assert!((summary.time - model.time().end).abs() < 1e-12);
     let mut out = Vec::new();
     for (k, n) in model.nodes.iter().enumerate() {
         out.push((
@@ -521,7 +521,7 @@ time: {end: 2, step: 0.5}
 // path and a message containing the fragment.
 #[test]
 fn stent_block_errors_are_located() {
-    use stentkit::io::design::DesignError;
+    use stentkit::design::DesignError;
     let base = parse_design(BASE, Path::new("base.yaml")).unwrap_or_else(|e| panic!("{e}"));
     assert_eq!(base.model.programme.as_ref().unwrap().nodes.len(), 4);
     // (text replaced, replacement, (line, column), field path, message fragment)
@@ -710,8 +710,13 @@ fn block_solver_matches_the_sparse_lu() {
     let programme =
         "{kind: radial_contraction, nodes: crown_1, delta_r: 0.6, ramp: [0, 0.5], release: 0.75}";
     let block = small_stent(layout, "symmetry: quarter", programme);
-    let mut sparse = block.clone();
-    sparse.solver.linear = stentkit::model::LinearMethod::SparseLu;
+    let sparse = block
+        .clone()
+        .with_solver(stentkit::model::SolverSettings {
+            linear: stentkit::model::LinearMethod::SparseLu,
+            ..block.solver().clone()
+        })
+        .expect("valid settings");
     /// Every node's displacement after every step, up to a given time.
     struct Histories(Vec<Vec3>, Real);
     impl Observer for Histories {

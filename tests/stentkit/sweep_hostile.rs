@@ -12,7 +12,7 @@ use crate::outputs::{design, path_str, stentkit, test_outputs, text, wait_at_mos
 use std::path::{Path, PathBuf};
 use std::process::{Child, Command, Output, Stdio};
 use std::time::{Duration, Instant};
-use stentkit::io::design::{DesignOverrides, load_design_with};
+use stentkit::design::{DesignOverrides, load_design_with};
 use stentkit::io::estimate::estimated_disk;
 
 /// 5000 values of the Poisson ratio of the bend (`0, 0.0001, …, 0.4999`): the sweep size, each value

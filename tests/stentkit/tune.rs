@@ -4,7 +4,7 @@
 use crate::mesh::TempDir;
 use std::path::Path;
 use std::process::Command;
-use stentkit::io::design::load_design;
+use stentkit::design::load_design;
 use stentkit::math::Real;
 use stentkit::model::ProbeLocation;
 use stentkit::study::sample::watched_run;
@@ -56,7 +56,7 @@ fn a_tuned_arch_stays_within_its_tolerance_of_the_paper_settings() {
         "{text}"
     );
     let tuned = load_design(&tuned_path).expect("the tuned design reads");
-    let tau = tuned.model.time.tolerance.expect("a time tolerance");
+    let tau = tuned.model.time().tolerance.expect("a time tolerance");
     assert!(text.contains("\nmesh: {p: "), "{text}");
 
     let paper = load_design(&design).expect("the paper design reads");

@@ -237,7 +237,7 @@ impl Observer for TipHistory {
 #[test]
 fn the_cantilever_is_programmed_holds_its_temporary_shape_and_recovers() {
     let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("designs/cantilever_morphing.yaml");
-    let design = stentkit::io::design::load_design(&path).expect("design loads");
+    let design = stentkit::design::load_design(&path).expect("design loads");
     let mut sim = Simulation::new(&design.model).expect("simulation");
     let mut tip = TipHistory(Vec::new());
     let summary = sim.run(&mut [&mut tip]).expect("run completes");
@@ -349,7 +349,7 @@ fn error_control_catches_the_trapezoidal_ringing_after_a_jump() {
 // were held to, 1/4 to 1/8); the section-stress part of the estimate is what catches it.
 #[test]
 fn error_control_sees_the_errors_made_while_nodes_are_held() {
-    use stentkit::io::design::load_design;
+    use stentkit::design::load_design;
     use stentkit::model::ProbeLocation;
     use stentkit::study::sample::{node_lengths, watched_run};
     use stentkit::study::tune::comparison_times;

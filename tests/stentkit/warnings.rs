@@ -7,7 +7,7 @@ use crate::common::{design_text, fixtures, replace_line};
 use crate::outputs::{design, path_str, run_in_process, stentkit, test_outputs, text};
 use crate::stabilisation::warning_said;
 use std::path::{Path, PathBuf};
-use stentkit::io::design::{DesignOverrides, load_design, load_design_with};
+use stentkit::design::{DesignOverrides, load_design, load_design_with};
 use stentkit::math::Real;
 
 /// The straight stent (designs/straight_stent.yaml) with two crowns and error-controlled steps (tolerance
@@ -172,7 +172,7 @@ fn check_of_an_error_controlled_design_says_what_error_control_does() {
     let model = load_design(&design("aorta_stent.yaml"))
         .expect("valid")
         .model;
-    let bound = model.planned_steps_at(model.time.min_step).total()
+    let bound = model.planned_steps_at(model.time().min_step).total()
         + model.schedule_breakpoints().len()
         + 1;
     assert!(steps.contains(&format!("at most {bound}")), "{steps}");

@@ -29,7 +29,7 @@ mod schema;
 pub use format::{FRAME_ID, coordinate_decimals, path_key};
 pub use schema::scene_update_schema;
 
-use super::design::{Design, RecordingSettings, SnapshotSettings};
+use super::output::{RecordingSettings, RunDesign, SnapshotSettings};
 use super::snapshots::SnapshotSchedule;
 use super::state::{LoadChannel, StateSample, load_channels};
 use crate::math::Real;
@@ -162,12 +162,12 @@ impl McapRecorder {
     /// [`McapError`] when the file cannot be created or written.
     pub fn create(
         path: &Path,
-        design: &Design,
+        design: &impl RunDesign,
         info: &RunInfo,
         snapshots: &SnapshotSettings,
     ) -> Result<Self, McapError> {
-        let model = &design.model;
-        let settings = design.output.recording.clone();
+        let model = design.model();
+        let settings = design.output().recording.clone();
         let file = super::no_follow::create(path).map_err(|source| McapError::Create {
             path: path.to_path_buf(),
             source,
@@ -193,7 +193,7 @@ impl McapRecorder {
             ("stentkit_version", info.version.clone()),
             ("command_line", info.command_line.clone()),
             ("design", model.name.clone()),
-            ("design_file", design.path.display().to_string()),
+            ("design_file", design.path().display().to_string()),
             ("units", units.name().to_string()),
             ("length_unit", units.length().to_string()),
             ("force_unit", units.force().to_string()),
@@ -215,7 +215,7 @@ impl McapRecorder {
                 metadata,
             })
             .map_err(write_error)?;
-        let name = design.path.file_name().map_or_else(
+        let name = design.path().file_name().map_or_else(
             || "design.yaml".to_string(),
             |n| n.to_string_lossy().into_owned(),
         );
@@ -225,7 +225,7 @@ impl McapRecorder {
                 create_time: 0,
                 name,
                 media_type: "application/yaml".into(),
-                data: Cow::Borrowed(design.source.as_bytes()),
+                data: Cow::Borrowed(design.source().as_bytes()),
             })
             .map_err(write_error)?;
         let channels = load_channels(model);

@@ -2,7 +2,7 @@
 //! (by end or by coincidence), conditions, loads, temperature, material, time and solver settings, probes.
 //! [`ModelBuilder::build`] makes and checks the model; every check that involves more than one value is made
 //! here, and a failed one is a [`BuildError`] naming the input [`Field`]. The design-file layer
-//! ([`crate::io::design`]) is a translation of YAML into builder calls that maps fields back to lines.
+//! ([`crate::design`]) is a translation of YAML into builder calls that maps fields back to lines.
 //!
 //! ```
 //! use stentkit::material::{CircularSection, ElasticLaw};
@@ -386,6 +386,68 @@ impl TimeSpec {
             tolerance: self.tolerance,
             max_step: self.max_step,
         })
+    }
+}
+
+impl From<&TimeSettings> for TimeSpec {
+    /// The spec whose [`TimeSpec::settings`] are `time` again, every default spelled out.
+    fn from(time: &TimeSettings) -> Self {
+        Self {
+            end: time.end,
+            step: time.step,
+            min_step: Some(time.min_step),
+            release_ramp: Some(time.release_ramp),
+            tolerance: time.tolerance,
+            max_step: time.max_step,
+        }
+    }
+}
+
+impl Model {
+    /// This model with the time stepping `time`, checked as [`ModelBuilder::build`] checks it
+    /// ([`Model::with_settings`]).
+    ///
+    /// # Errors
+    /// As [`Model::with_settings`].
+    pub fn with_time(self, time: TimeSettings) -> Result<Model> {
+        let solver = self.solver.clone();
+        self.with_settings(time, solver)
+    }
+
+    /// This model with the Newton settings `solver`, checked as [`ModelBuilder::build`] checks them
+    /// ([`Model::with_settings`]).
+    ///
+    /// # Errors
+    /// As [`Model::with_settings`].
+    pub fn with_solver(self, solver: SolverSettings) -> Result<Model> {
+        let time = self.time.clone();
+        self.with_settings(time, solver)
+    }
+
+    /// This model with the time stepping `time` and the Newton settings `solver`, after the checks
+    /// [`ModelBuilder::build`] runs on them: the time spec's ([`TimeSpec::settings`]), error control only where
+    /// every material's estimate holds, the solver's tolerances and stabilisation, and an arc-length path only
+    /// for an elastic model without programme, error control or releases. What the builder made from the old
+    /// settings stays as it was (a programme's times, the record times).
+    ///
+    /// # Errors
+    /// The [`BuildError`] of the first check that fails, at the field the builder would name.
+    pub fn with_settings(mut self, time: TimeSettings, solver: SolverSettings) -> Result<Model> {
+        let time = TimeSpec::from(&time).settings()?;
+        if let Some(why) = time.error_control_refusal(&self.materials) {
+            return Err(BuildError::new(Field::Time(TimeField::Tolerance), why));
+        }
+        check_solver(&solver)?;
+        check_path(
+            &solver,
+            &self.materials,
+            &self.material_names,
+            self.programme.is_some() || time.tolerance.is_some(),
+            &self.nodes,
+        )?;
+        self.time = time;
+        self.solver = solver;
+        Ok(self)
     }
 }
 
@@ -1179,6 +1241,50 @@ mod tests {
         assert_eq!(model.nodes[0].name, "knee");
         assert_eq!(model.nodes[0].ends.len(), 2);
         assert!(b.validate().is_ok());
+    }
+
+    // A built model's settings change only through the checked setters, which refuse what the builder refuses
+    // at the field the builder names (the reference: the builder given the same settings, `field_of`) and take
+    // valid settings as given.
+    #[test]
+    fn changed_settings_are_checked_as_the_builder_checks_them() {
+        let model = elastic().build().expect("valid").model;
+        let beyond = TimeSettings {
+            step: 2.0 * model.time().end,
+            ..model.time().clone()
+        };
+        let mut b = elastic();
+        b.time(TimeSpec::from(&beyond));
+        let refused = model
+            .clone()
+            .with_time(beyond)
+            .expect_err("a step beyond the end");
+        assert_eq!(refused.field, Field::Time(TimeField::Step));
+        assert_eq!(refused.field, field_of(&b));
+
+        let no_iterations = SolverSettings {
+            max_iterations: 0,
+            ..model.solver().clone()
+        };
+        let mut b = elastic();
+        b.solver(no_iterations.clone());
+        let refused = model
+            .clone()
+            .with_solver(no_iterations)
+            .expect_err("no Newton iteration");
+        assert_eq!(refused.field, Field::Solver(SolverField::MaxIterations));
+        assert_eq!(refused.field, field_of(&b));
+
+        let longer = TimeSettings {
+            end: 2.0 * model.time().end,
+            ..model.time().clone()
+        };
+        let changed = model
+            .clone()
+            .with_time(longer.clone())
+            .expect("a longer run");
+        assert_eq!(changed.time(), &longer);
+        assert_eq!(changed.solver(), model.solver());
     }
 
     #[test]

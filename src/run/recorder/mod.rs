@@ -20,8 +20,8 @@ mod recording;
 mod snapshots;
 
 use super::{Console, RunError};
+use crate::design::Design;
 use crate::io::checkpoint::Problem;
-use crate::io::design::Design;
 use crate::io::mcap::RunInfo;
 use crate::io::run_folder::{Manifest, RunFolder};
 use crate::io::summary::{OutputState, RunSummaryFile};

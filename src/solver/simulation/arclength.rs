@@ -97,7 +97,7 @@ fn constraint_root(a: Real, b: Real, c: Real, better: impl Fn(Real) -> Real) -> 
 impl Simulation<'_> {
     /// The arc-length settings, when the path is driven by arc length.
     pub(super) fn arc_length_settings(&self) -> Option<ArcLengthSettings> {
-        self.model.solver.path.arc_length()
+        self.model.solver().path.arc_length()
     }
 
     /// The load factor of the current state (arc-length runs; `None` for time-driven ones).
@@ -108,16 +108,16 @@ impl Simulation<'_> {
     /// The time at which the model's schedules are read for the current state: its time, or `time.end` on an
     /// arc-length path (whose loads are those at `time.end` scaled by the load factor, [`Self::load_scale`]).
     pub fn schedule_time(&self) -> Real {
-        match self.model.solver.path {
+        match self.model.solver().path {
             PathControl::Time => self.time,
-            PathControl::ArcLength(_) => self.model.time.end,
+            PathControl::ArcLength(_) => self.model.time().end,
         }
     }
 
     /// The factor on the loads the schedules give at [`Self::schedule_time`]: 1, or an arc-length path's load
     /// factor (0 before its first increment).
     pub fn load_scale(&self) -> Real {
-        match self.model.solver.path {
+        match self.model.solver().path {
             PathControl::Time => 1.0,
             PathControl::ArcLength(_) => self.load_factor().unwrap_or(0.0),
         }
@@ -170,8 +170,8 @@ impl Simulation<'_> {
         settings: &ArcLengthSettings,
         state: &mut ArcState,
     ) -> Result<StepOutcome, SolverError> {
-        let end_time = self.model.time.end;
-        let min_ratio = self.model.time.min_step / self.model.time.step;
+        let end_time = self.model.time().end;
+        let min_ratio = self.model.time().min_step / self.model.time().step;
         let reference = Actions::at(self.model, end_time, &self.ramps);
         loop {
             if observer.interrupted() {
@@ -283,8 +283,8 @@ impl Simulation<'_> {
             ArcConstraint::Cylindrical => 0.0,
             ArcConstraint::Spherical => 1.0,
         };
-        let tol = self.model.solver.tolerance;
-        let residual_tol = self.model.solver.residual_factor * tol;
+        let tol = self.model.solver().tolerance;
+        let residual_tol = self.model.solver().residual_factor * tol;
         let lambda0 = state.load_factor;
         let mut lambda = lambda0;
         let mut dx = vec![0.0; n];
@@ -312,7 +312,7 @@ impl Simulation<'_> {
                     corrections,
                 });
             }
-            if corrections >= self.model.solver.max_iterations {
+            if corrections >= self.model.solver().max_iterations {
                 return Err(NewtonFailure::NotConverged(report));
             }
             // q = ∂R/∂λ, then the residual and tangent at λ (kept in `self.lin`).
@@ -343,8 +343,8 @@ impl Simulation<'_> {
                             arc
                         } else {
                             // The first increment: `time.step / time.end` of the end load factor.
-                            let dl0 = settings.end_load_factor * self.model.time.step
-                                / self.model.time.end;
+                            let dl0 = settings.end_load_factor * self.model.time().step
+                                / self.model.time().end;
                             let first = dl0.abs() * (qq + psi2).sqrt();
                             state.arc = first;
                             state.first_arc = first;

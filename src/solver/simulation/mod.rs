@@ -228,7 +228,7 @@ impl<'m> Simulation<'m> {
             disc.num_unknowns(),
             &pattern,
             &patch_ranges(&disc),
-            model.solver.linear,
+            model.solver().linear,
         )?;
         let values = vec![0.0; pattern.len()];
         let control_length = disc
@@ -267,7 +267,7 @@ impl<'m> Simulation<'m> {
             last_increment: None,
             round_off_reported: false,
             breakpoints: model.schedule_breakpoints(),
-            step_size: model.time.step,
+            step_size: model.time().step,
             step_cuts: 0,
             tangent: checkpoint::TangentRecord::default(),
             control: adaptive::StepControl::default(),

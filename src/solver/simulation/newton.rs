@@ -78,7 +78,7 @@ impl Simulation<'_> {
         observer: &dyn Observer,
     ) -> Result<NewtonReport, NewtonFailure> {
         let actions = Actions::at(self.model, t, &self.ramps);
-        let settings = &self.model.solver;
+        let settings = &self.model.solver();
         let (tol, max_iterations, ratio) = (
             self.newton_tolerance(),
             settings.max_iterations,
@@ -112,7 +112,7 @@ impl Simulation<'_> {
                 let n = report.residuals.len();
                 let stagnant = n >= 3 && r > STAGNATION_RATIO * report.residuals[n - 2];
                 let meets = |tol: Real| {
-                    let small = r <= self.model.solver.residual_factor * tol;
+                    let small = r <= self.model.solver().residual_factor * tol;
                     (small && remaining_error(&report.increments, stale_first) <= tol)
                         || (r <= tol && stagnant)
                 };
@@ -151,13 +151,13 @@ impl Simulation<'_> {
             fresh_last = fresh_tangent;
             if report.iterations == 0 {
                 stale_first = !fresh_tangent;
-                if self.model.solver.stabilisation.is_some() {
+                if self.model.solver().stabilisation.is_some() {
                     self.first_increment.clone_from(&self.delta);
                 }
             }
             self.record_increment(&mut report)?;
             self.state.apply_increment(&self.disc, &self.delta);
-            if self.model.solver.extrapolate {
+            if self.model.solver().extrapolate {
                 self.step_increment.resize(self.delta.len(), 0.0);
                 for (a, d) in self.step_increment.iter_mut().zip(&self.delta) {
                     *a += d;
@@ -189,8 +189,8 @@ impl Simulation<'_> {
     /// [`NEWTON_SHARE`] of the share of the time tolerance each step is held to
     /// ([`super::adaptive::LOCAL_FRACTION`]).
     pub(super) fn newton_tolerance(&self) -> Real {
-        let tolerance = self.model.solver.tolerance;
-        self.model.time.tolerance.map_or(tolerance, |tau| {
+        let tolerance = self.model.solver().tolerance;
+        self.model.time().tolerance.map_or(tolerance, |tau| {
             tolerance.max(NEWTON_SHARE * super::adaptive::LOCAL_FRACTION * tau)
         })
     }

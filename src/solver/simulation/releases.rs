@@ -54,7 +54,7 @@ impl Simulation<'_> {
                 self.ramps[k][i] = Some(ReleaseRamp {
                     reaction,
                     start,
-                    duration: self.model.time.release_ramp,
+                    duration: self.model.time().release_ramp,
                 });
                 captured.push((k, i));
             }
@@ -121,7 +121,7 @@ impl Simulation<'_> {
             self.disc.num_unknowns() + gauge.len(),
             &pattern,
             &patch_ranges(&self.disc),
-            self.model.solver.linear,
+            self.model.solver().linear,
         )?;
         let values = vec![0.0; pattern.len()];
         self.gauge = Some((gauge, system, values));

@@ -211,7 +211,7 @@ impl Simulation<'_> {
     /// `solver.stabilisation`.
     pub fn stabilisation_warnings(&self) -> Vec<String> {
         self.model
-            .solver
+            .solver()
             .stabilisation
             .map_or_else(Vec::new, |settings| self.stabiliser.warnings(&settings))
     }
@@ -293,7 +293,7 @@ impl Simulation<'_> {
     /// raises it) for a retry at the same size, and says whether to retry. `false`: stabilisation is off,
     /// exhausted for this step, or cannot be scaled; the step is then cut.
     pub(super) fn stabilise_retry(&mut self, dt: Real, target: Real) -> bool {
-        let Some(settings) = self.model.solver.stabilisation else {
+        let Some(settings) = self.model.solver().stabilisation else {
             return false;
         };
         match self.stabiliser.factor {
@@ -335,7 +335,7 @@ impl Simulation<'_> {
     /// runs with stabilisation), the damping switched off when the step dissipated no more than the fraction
     /// aimed at, a damped tangent forgotten, and when the run went above the limit remembered.
     pub(super) fn account_stabilisation(&mut self, t: Real) -> Option<StepStabilisation> {
-        let settings = self.model.solver.stabilisation?;
+        let settings = self.model.solver().stabilisation?;
         let energy = self.strain_energy();
         let damping = self.damping.take();
         let factor = self

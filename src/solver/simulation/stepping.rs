@@ -85,14 +85,14 @@ impl Simulation<'_> {
     pub fn is_finished(&self) -> bool {
         match self.arc_length_settings() {
             Some(settings) => self.arc_length_finished(&settings),
-            None => self.time >= self.model.time.end - self.landing_tolerance(),
+            None => self.time >= self.model.time().end - self.landing_tolerance(),
         }
     }
 
     /// Times closer than this to a breakpoint or the end are that breakpoint: the model's landing tolerance
     /// ([`crate::model::LANDING_TOLERANCE`] of the nominal step) \[time\].
     fn landing_tolerance(&self) -> Real {
-        self.model.time.landing_tolerance()
+        self.model.time().landing_tolerance()
     }
 
     /// Takes one step — the next converged one, with the retries and cuts it needed — and returns its report,
@@ -124,9 +124,9 @@ impl Simulation<'_> {
         if self.is_finished() {
             return Ok(StepOutcome::Finished);
         }
-        let end = self.model.time.end;
-        let nominal = self.model.time.step;
-        let min_step = self.model.time.min_step;
+        let end = self.model.time().end;
+        let nominal = self.model.time().step;
+        let min_step = self.model.time().min_step;
         let snap = self.landing_tolerance();
         loop {
             // Before every attempt: the first of a step, and each cut.
@@ -160,10 +160,10 @@ impl Simulation<'_> {
                 self.roll_back(start, &captured, Abandon::Failed);
                 return Err(e);
             }
-            if self.model.solver.extrapolate {
+            if self.model.solver().extrapolate {
                 self.predict(dt);
             }
-            let reuse = self.model.solver.reuse_factorisation;
+            let reuse = self.model.solver().reuse_factorisation;
             let mut attempt = self.newton(target, reuse, &*observer);
             if reuse && let Err(NewtonFailure::NotConverged(failed)) = &attempt {
                 // A reused factorisation may be what failed: retry the same step with Newton's method proper
@@ -184,7 +184,7 @@ impl Simulation<'_> {
             // Error control: a converged step whose time-error estimate exceeds the tolerance is rejected and
             // retried shorter (module `adaptive`), unless it is already the smallest step.
             let mut estimate = None;
-            if let (Ok(_), Some(tolerance)) = (&attempt, self.model.time.tolerance) {
+            if let (Ok(_), Some(tolerance)) = (&attempt, self.model.time().tolerance) {
                 estimate = match self.time_error_estimate(self.time, target) {
                     Ok(e) => e,
                     Err(e) => {
@@ -229,7 +229,7 @@ impl Simulation<'_> {
                         self.notices.push(round_off_notice(
                             target,
                             &newton,
-                            self.model.solver.tolerance,
+                            self.model.solver().tolerance,
                         ));
                     }
                     let report = StepReport {
@@ -244,7 +244,7 @@ impl Simulation<'_> {
                         load_factor: None,
                         stabilisation,
                     };
-                    match self.model.time.tolerance {
+                    match self.model.time().tolerance {
                         Some(tolerance) => {
                             let ratio = error_ratio(estimate, tolerance);
                             let mut next = self.control.accepted(dt, ratio);
@@ -252,7 +252,7 @@ impl Simulation<'_> {
                             if dt < self.step_size && report.cuts == 0 {
                                 next = next.max(self.step_size);
                             }
-                            let largest = self.model.time.max_step.unwrap_or(Real::INFINITY);
+                            let largest = self.model.time().max_step.unwrap_or(Real::INFINITY);
                             self.step_size = next.clamp(min_step, largest.max(min_step));
                         }
                         None if self.step_size < nominal => {

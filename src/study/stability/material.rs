@@ -13,12 +13,12 @@
 //! computed branch stress (ringing: the trapezoidal rule is A- but not L-stable).
 
 use super::INTEGRATORS;
-use crate::io::chart::{LineChart, Scale, Series};
 use crate::material::{
     Integrator, Material, Prony, PronyBranch, ReducedTimeQuadrature, Wlf, reduced_time_increment,
     simulate_strain_history,
 };
 use crate::math::Real;
+use crate::post::chart::{LineChart, Scale, Series};
 use crate::study::StudyError;
 use std::fmt::Write as _;
 use std::num::NonZeroUsize;

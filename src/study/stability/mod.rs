@@ -25,9 +25,11 @@ pub mod newton;
 pub mod scenarios;
 
 use super::StudyError;
-use crate::io::chart::LineChart;
+use super::variant::VariedDesign;
 use crate::material::Integrator;
 use crate::math::Real;
+use crate::post::chart::LineChart;
+use std::path::Path;
 
 /// The three integrators, in the order of the maps.
 pub const INTEGRATORS: [Integrator; 3] = [
@@ -125,14 +127,21 @@ impl Default for StabilityStudy {
     }
 }
 
+/// Reads a design's text (named by the path in errors and as its default name) into a design a study can vary:
+/// the design language's parser ([`crate::design::variants::read_varied`]), handed in by the caller because
+/// `study` sits below `design`.
+pub type ReadDesign = dyn Fn(&str, &Path) -> Result<Box<dyn VariedDesign>, StudyError>;
+
 /// Runs every map of `study` whose list is not empty, in the order material, bend45, heating, release, coarse. Each
 /// finished map is handed to `done` (which writes it), so the maps finished before a failure are kept; the text
-/// of `stability.md` (a title and every map's paragraph) is returned. `progress` is told about each run.
+/// of `stability.md` (a title and every map's paragraph) is returned. `read` reads the embedded designs the maps
+/// vary; `progress` is told about each run.
 ///
 /// # Errors
 /// The first error of a map (an out-of-range setting, a refused design) or of `done`.
 pub fn stability<E: From<StudyError>>(
     study: &StabilityStudy,
+    read: &ReadDesign,
     mut done: impl FnMut(&MapReport) -> Result<(), E>,
     mut progress: impl FnMut(&str),
 ) -> Result<String, E> {
@@ -152,25 +161,25 @@ pub fn stability<E: From<StudyError>>(
         progress("material map done");
     }
     if !study.load_steps.is_empty() {
-        let map = scenarios::bend45_map(&study.load_steps, &mut progress)?;
+        let map = scenarios::bend45_map(&study.load_steps, read, &mut progress)?;
         let report = scenarios::bend45_report(&map);
         done(&report)?;
         summary.push_str(&report.summary);
     }
     if !study.heating.is_empty() {
-        let map = scenarios::heating_map(&study.heating, &mut progress)?;
+        let map = scenarios::heating_map(&study.heating, read, &mut progress)?;
         let report = scenarios::heating_report(&map);
         done(&report)?;
         summary.push_str(&report.summary);
     }
     if !study.release.is_empty() {
-        let map = scenarios::release_map(&study.release, &mut progress)?;
+        let map = scenarios::release_map(&study.release, read, &mut progress)?;
         let report = scenarios::release_report(&map);
         done(&report)?;
         summary.push_str(&report.summary);
     }
     if !study.coarse.is_empty() {
-        let map = scenarios::coarse_map(&study.coarse, &mut progress)?;
+        let map = scenarios::coarse_map(&study.coarse, read, &mut progress)?;
         let report = scenarios::coarse_report(&map);
         done(&report)?;
         summary.push_str(&report.summary);

@@ -2,9 +2,9 @@
 //! converges without cuts, how many iterations a step takes, where steps are cut or the run fails. The
 //! scenarios that make the maps are in [`super::scenarios`].
 
-use crate::io::chart::{LineChart, Scale, Series};
 use crate::math::Real;
 use crate::model::Model;
+use crate::post::chart::{LineChart, Scale, Series};
 use crate::solver::{NewtonReport, Observer, Simulation, SolverError, StepReport};
 use std::fmt::Write as _;
 use std::ops::ControlFlow;
@@ -109,7 +109,7 @@ pub fn newton_run(model: &Model) -> Result<NewtonRun, SolverError> {
     run.wall = started.elapsed().as_secs_f64();
     run.notices = sim.notices().to_vec();
     run.notices.extend(sim.stabilisation_warnings());
-    run.stabilisation = model.solver.stabilisation.map(|_| *sim.stabilisation());
+    run.stabilisation = model.solver().stabilisation.map(|_| *sim.stabilisation());
     run.final_probe = model
         .probes
         .first()
@@ -118,7 +118,7 @@ pub fn newton_run(model: &Model) -> Result<NewtonRun, SolverError> {
         Ok(summary) => {
             // An arc-length path that used its increments allowed before the end load factor did not complete.
             let short = model
-                .solver
+                .solver()
                 .path
                 .arc_length()
                 .is_some_and(|a| sim.load_factor() != Some(a.end_load_factor));

@@ -1,17 +1,19 @@
 //! The scenarios of the solver maps: the elastic 45° bend in fewer and fewer load steps, the loaded arch heated
 //! faster and faster, and the release snap of a two-crown stent with several steps and release ramps. Each
-//! varies the model of an embedded design ([`designs`]) — its time stepping ([`TimeVariant`]), its temperature
-//! schedule, and for the stent its crowns and mesh ([`rebuild`]) — runs it through [`newton_run`] and presents
-//! its map ([`MapReport`]).
+//! varies the model of an embedded design ([`designs`], read by the caller's [`ReadDesign`]) — its time stepping
+//! ([`TimeVariant`]), its temperature schedule, and for the stent its crowns and mesh
+//! ([`VariedDesign::rebuild`]) — runs it through [`newton_run`] and presents its map ([`MapReport`]).
 
-use super::MapReport;
 use super::newton::{
     SolverMap, SolverPoint, describe, newton_run, solver_chart, solver_csv, solver_summary,
 };
-use crate::io::design::{Design, parse_design};
+use super::{MapReport, ReadDesign};
 use crate::math::Real;
-use crate::model::TimeFunction;
-use crate::study::variant::{Remesh, TimeVariant, rebuild};
+use crate::model::{
+    ArcLengthSettings, Model, PathControl, SolverSettings, StabilisationSettings, TimeFunction,
+    TimeSettings,
+};
+use crate::study::variant::{Remesh, TimeVariant, VariedDesign};
 use crate::study::{StudyError, positive};
 use std::fmt::Write as _;
 use std::path::Path;
@@ -31,9 +33,12 @@ pub mod designs {
 /// The 45° bend with each number of equal load steps.
 pub fn bend45_map(
     load_steps: &[usize],
+    read: &ReadDesign,
     mut progress: impl FnMut(&str),
 ) -> Result<SolverMap, StudyError> {
-    let bend = embedded(designs::BEND45, "bend45.yaml")?.model;
+    let bend = embedded(read, designs::BEND45, "bend45.yaml")?
+        .model()
+        .clone();
     let mut points = Vec::new();
     for &n in load_steps {
         if n == 0 {
@@ -72,9 +77,12 @@ const ARCH_END: Real = 5.0;
 /// The arch heated over `duration` (loads still ramp over 5 s) with step `h`: `(duration [s], h [s])` pairs.
 pub fn heating_map(
     cases: &[(Real, Real)],
+    read: &ReadDesign,
     mut progress: impl FnMut(&str),
 ) -> Result<SolverMap, StudyError> {
-    let arch = embedded(designs::ARCH, "circular_arch.yaml")?.model;
+    let arch = embedded(read, designs::ARCH, "circular_arch.yaml")?
+        .model()
+        .clone();
     let mut points = Vec::new();
     for &(duration, h) in cases {
         if !(duration > 0.0 && duration <= ARCH_END) {
@@ -167,9 +175,10 @@ const HOT: Real = 90.0;
 /// release as designed or held hot.
 pub fn release_map(
     cases: &[ReleaseCase],
+    read: &ReadDesign,
     mut progress: impl FnMut(&str),
 ) -> Result<SolverMap, StudyError> {
-    let stent = embedded(designs::STRAIGHT_STENT, "straight_stent.yaml")?;
+    let stent = embedded(read, designs::STRAIGHT_STENT, "straight_stent.yaml")?;
     let mut points = Vec::new();
     for &ReleaseCase {
         h,
@@ -192,9 +201,9 @@ pub fn release_map(
             release_ramp: Some(ramp),
             ..TimeVariant::default()
         }
-        .of(&rebuild(&stent, &remesh)?)?;
+        .of(&stent.rebuild(&remesh)?)?;
         if stabilised {
-            model.solver.stabilisation = Some(crate::model::StabilisationSettings::default());
+            model = stabilised_model(model)?;
         }
         if hot {
             model.temperature = TimeFunction::constant(HOT);
@@ -262,29 +271,37 @@ impl CoarseDesign {
 /// bend45, 1 rollup), `p`, `n` and `route` ([`route_name`]).
 pub fn coarse_map(
     cases: &[(CoarseDesign, usize, usize)],
+    read: &ReadDesign,
     mut progress: impl FnMut(&str),
 ) -> Result<SolverMap, StudyError> {
     let mut points = Vec::new();
     for &(design, p, n) in cases {
         let (name, text) = design.source();
-        let parsed = embedded(text, &format!("{name}.yaml"))?;
+        let parsed = embedded(read, text, &format!("{name}.yaml"))?;
         let remesh = Remesh {
             degree: Some(p),
             points: Some(n),
             crowns: None,
         };
-        let stepped = rebuild(&parsed, &remesh)?;
+        let stepped = parsed.rebuild(&remesh)?;
         // Short arcs (the first 1 % of the load, growing at most fourfold) sample the path densely enough to
         // locate its limit points to about 1e-3.
-        let mut arc = stepped.clone();
-        arc.time.step = arc.time.end / 100.0;
-        arc.time.min_step = arc.time.step / 1024.0;
-        arc.solver.path = crate::model::PathControl::ArcLength(crate::model::ArcLengthSettings {
-            max_growth: 4.0,
-            ..crate::model::ArcLengthSettings::default()
-        });
-        let mut stabilised = stepped.clone();
-        stabilised.solver.stabilisation = Some(crate::model::StabilisationSettings::default());
+        let step = stepped.time().end / 100.0;
+        let arc = stepped.clone().with_settings(
+            TimeSettings {
+                step,
+                min_step: step / 1024.0,
+                ..stepped.time().clone()
+            },
+            SolverSettings {
+                path: PathControl::ArcLength(ArcLengthSettings {
+                    max_growth: 4.0,
+                    ..ArcLengthSettings::default()
+                }),
+                ..stepped.solver().clone()
+            },
+        )?;
+        let stabilised = stabilised_model(stepped.clone())?;
         for (route, model) in [(0.0, &stepped), (1.0, &arc), (2.0, &stabilised)] {
             let run = newton_run(model)?;
             progress(&format!(
@@ -478,7 +495,20 @@ pub fn release_report(map: &SolverMap) -> MapReport {
     }
 }
 
+/// `model` with automatic stabilisation at its defaults (`solver.stabilisation`).
+fn stabilised_model(model: Model) -> Result<Model, StudyError> {
+    let solver = SolverSettings {
+        stabilisation: Some(StabilisationSettings::default()),
+        ..model.solver().clone()
+    };
+    Ok(model.with_solver(solver)?)
+}
+
 /// The embedded design `text`, named `file` in errors and as its default name.
-fn embedded(text: &str, file: &str) -> Result<Design, StudyError> {
-    Ok(parse_design(text, Path::new(file))?)
+fn embedded(
+    read: &ReadDesign,
+    text: &str,
+    file: &str,
+) -> Result<Box<dyn VariedDesign>, StudyError> {
+    read(text, Path::new(file))
 }

@@ -144,7 +144,7 @@ fn replace_entry(text: &str, key: &str, line: &str) -> Option<String> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::io::design::{DesignOverrides, parse_design, parse_design_with};
+    use crate::design::{DesignOverrides, parse_design, parse_design_with};
     use std::path::Path;
 
     fn choice() -> TunedChoice {
@@ -177,13 +177,13 @@ mod tests {
         for (name, source) in [
             (
                 "curved_stent.yaml",
-                include_str!("../../../designs/curved_stent.yaml"),
+                include_str!("../../designs/curved_stent.yaml"),
             ),
             (
                 "circular_arch.yaml",
-                include_str!("../../../designs/circular_arch.yaml"),
+                include_str!("../../designs/circular_arch.yaml"),
             ),
-            ("bend45.yaml", include_str!("../../../designs/bend45.yaml")),
+            ("bend45.yaml", include_str!("../../designs/bend45.yaml")),
         ] {
             let text = check(name, source);
             // Every comment line of the source is still there.
@@ -196,7 +196,7 @@ mod tests {
 
     #[test]
     fn a_block_style_time_and_per_patch_meshes_are_replaced() {
-        let arch = include_str!("../../../designs/circular_arch.yaml");
+        let arch = include_str!("../../designs/circular_arch.yaml");
         // Each edit below must find its text (a silent no-op would test the unedited design).
         for from in [
             "time: {end: 5.0, step: 1.0e-3}",

@@ -169,7 +169,7 @@ pub fn build(dto: &DesignDto, default_name: &str, temporary_shape: bool) -> Resu
     // path takes at most its increments allowed, and has no times to place snapshots at: by default about
     // DEFAULT_COUNT of them over its increments.
     let snapshots = dto.output.as_ref().and_then(|o| o.snapshots.as_ref());
-    let plan = match model.solver.path {
+    let plan = match model.solver().path {
         PathControl::ArcLength(a) => {
             if snapshots.is_some_and(|s| s.times.is_some()) {
                 return Err(issue(
@@ -197,7 +197,7 @@ pub fn build(dto: &DesignDto, default_name: &str, temporary_shape: bool) -> Resu
             model.planned_steps()
         }
     };
-    let memory = check_size(dto, &StepCount::planned(&plan, model.time.step, dto))?;
+    let memory = check_size(dto, &StepCount::planned(&plan, model.time().step, dto))?;
     // A part no condition holds can move as a rigid body: `run` refuses it (the solver's check), `check` warns.
     // Not of a temporary shape, which is built without its programme (the programme is what takes the nodes
     // there): `run` solves the permanent design, whose programme holds them (issue 31: `mesh --state temporary`
@@ -919,10 +919,10 @@ fn solver_settings(s: Option<&SolverDto>) -> SolverSettings {
 fn short_schedule_warning(model: &crate::model::Model) -> Option<String> {
     let schedule = &model.temperature;
     let &(last, value) = schedule.points().last()?;
-    let end = model.time.end;
-    (model.solver.path.arc_length().is_none()
+    let end = model.time().end;
+    (model.solver().path.arc_length().is_none()
         && !schedule.is_constant()
-        && last < end - model.time.landing_tolerance())
+        && last < end - model.time().landing_tolerance())
         .then(|| {
             format!(
                 "the temperature schedule ends at t = {last}, before the run does ({end}): the temperature is held at its last value, {value} °C, from there (extend the table to the end if that is not meant)"
@@ -938,7 +938,7 @@ fn hot_release_warnings(model: &crate::model::Model) -> Vec<String> {
         .programme
         .as_ref()
         .and_then(|p| p.release)
-        .filter(|&r| r < model.time.end)
+        .filter(|&r| r < model.time().end)
     else {
         return Vec::new();
     };
@@ -952,7 +952,7 @@ fn hot_release_warnings(model: &crate::model::Model) -> Vec<String> {
             (temperature > tg).then(|| {
                 format!(
                     "the programme releases its nodes at t = {release} at {temperature} °C, above the glass transition of material `{name}` (Tg = {tg} °C): the device is rubbery there and springs back, so no temporary shape is fixed; cool it below Tg before the release{}",
-                    if model.solver.stabilisation.is_some() {
+                    if model.solver().stabilisation.is_some() {
                         ""
                     } else {
                         " (to simulate the snap-back anyway, add `solver: {stabilisation: {}}`: Newton alone meets it with step cuts and may stall)"

@@ -7,6 +7,10 @@
 //! wrong and what is allowed. Before any of this, [`guard`] refuses text too large, too deeply nested or with
 //! aliases, which would make the parsers slow or the design enormous. [`tuned_text`] writes a design's text
 //! with the discretisation `stentkit tune` chose.
+//!
+//! Layer: above `io` (it reads centreline files and names output formats through it) and `study` (a
+//! [`Design`] is the [`crate::study::variant::VariedDesign`] a study re-builds, [`variants`]); `io`'s writers
+//! see it as an [`crate::io::output::RunDesign`].
 
 pub mod build;
 mod diamond;
@@ -21,105 +25,18 @@ pub mod size;
 
 pub mod stent;
 mod tuned;
+pub mod variants;
 pub mod vessel;
 
+pub use crate::io::output::{OutputSettings, RecordingSettings, SnapshotSettings};
 pub use set::SetOverride;
 pub use tuned::{TunedChoice, TunedTextError, tuned_text};
 
-use crate::math::Real;
+use crate::io::output::RunDesign;
 use crate::math::quote;
 use crate::model::Model;
 use std::fmt;
 use std::path::{Path, PathBuf};
-
-/// Which tube meshes of the full device a run writes (the design's `output.snapshots`).
-#[derive(Debug, Clone, PartialEq, serde::Serialize)]
-pub struct SnapshotSettings {
-    /// Requested snapshot times \[time\], sorted, within `[0, end]` (the model's record times: steps land on
-    /// them).
-    pub times: Vec<Real>,
-    /// A snapshot every this many converged steps; 0 for none.
-    pub every: usize,
-    /// A snapshot at each event of the model's cycle ([`crate::model::cycle`]: programmed, fixed, released)
-    /// besides the initial and final states (`output.snapshots.events`, default true).
-    pub events: bool,
-    /// Snapshots between the events: the run, cut at its events, is divided into about this many equal pieces
-    /// ([`crate::io::snapshots::SnapshotSchedule`]); 0 for none. Default [`Self::DEFAULT_BETWEEN`] when the
-    /// design sets neither `every` nor `times`.
-    pub between: usize,
-    /// The file formats, by extension, in the registry's order ([`crate::io::formats`]; default STL only).
-    pub formats: Vec<&'static str>,
-    /// Vertices around each tube section.
-    pub segments: usize,
-    /// Rings (sections) along each patch, about: every k-th of the samples taken at a whole number of samples
-    /// per control point, the ends always included ([`crate::post::device::current_device_shapes`]).
-    pub rings: usize,
-    /// With every snapshot, the fields along the rods for ParaView (`output.vtk`, default true;
-    /// [`crate::io::vtk`]).
-    pub vtk: bool,
-    /// The views of the configuration figures (`output.configurations.views`); `None`: the defaults
-    /// ([`crate::io::configurations::default_views`]).
-    pub views: Option<Vec<crate::io::configurations::View>>,
-    /// A shaded picture of the configuration figures' states (`output.configurations.render`, default true;
-    /// [`crate::io::render`]).
-    pub render: bool,
-}
-
-impl SnapshotSettings {
-    /// Default number of periodic snapshots over an arc-length path, which has no times to place them at:
-    /// `every = ⌈increments / 20⌉`.
-    pub const DEFAULT_COUNT: usize = 20;
-    /// Default pieces between the events ([`Self::between`]): 6. With the events this gives the straight stent 8
-    /// snapshots (t = 0, 0.5, 1 programmed, 1.75 fixed, 1.7525 released, 2.2525, 2.7525, 3.25 final), a
-    /// 58 MB folder with the recording, which holds every step besides.
-    pub const DEFAULT_BETWEEN: usize = 6;
-    /// Default vertices around a section: 12, the section polygon has 95.5 % of the circle's area (16 would
-    /// have 97.4 %, in files a third larger). A snapshot is a preview: `stentkit mesh` writes finer ones.
-    pub const DEFAULT_SEGMENTS: usize = 12;
-    /// Default rings per patch: 41, about one per wire diameter along a crown wire of the paper's stents
-    /// (the full straight stent at 12 segments: 100 000 triangles, 5 MB of binary STL), whatever the patch's
-    /// `n`.
-    pub const DEFAULT_RINGS: usize = 41;
-}
-
-/// What `run.mcap` records (the design's `output.recording`).
-#[derive(Debug, Clone, PartialEq, serde::Serialize)]
-pub struct RecordingSettings {
-    /// Whether `run.mcap` is written at all.
-    pub enabled: bool,
-    /// Points per patch of the centrelines recorded every step (about: every k-th point of one sample per
-    /// control point, the ends always included).
-    pub centreline_points: usize,
-    /// Whether the tube meshes are recorded at snapshot steps.
-    pub meshes: bool,
-    /// Vertices around each section of a recorded mesh.
-    pub mesh_segments: usize,
-    /// Rings per patch of a recorded mesh, about.
-    pub mesh_rings: usize,
-}
-
-impl RecordingSettings {
-    /// Default centreline points per patch: 21 (one per control point of the paper's n = 20 patches). The
-    /// centrelines are recorded at every step, so they dominate the file size: the straight stent's run gives
-    /// a recording of about 20 MB.
-    pub const DEFAULT_CENTRELINE_POINTS: usize = 21;
-    /// Default vertices around a recorded section: 8, enough to see a round wire in Foxglove.
-    pub const DEFAULT_MESH_SEGMENTS: usize = 8;
-    /// Default rings per patch of a recorded mesh: 21.
-    pub const DEFAULT_MESH_RINGS: usize = 21;
-}
-
-/// The validated `output:` block besides the probes (which are part of the model).
-#[derive(Debug, Clone, PartialEq, serde::Serialize)]
-pub struct OutputSettings {
-    /// Snapshot meshes.
-    pub snapshots: SnapshotSettings,
-    /// The MCAP recording.
-    pub recording: RecordingSettings,
-    /// Per material of the model (`material` first, then `materials`), the surface strain it survives
-    /// (`strain_limit`), which `run` warns above.
-    pub strain_limits: Vec<Option<Real>>,
-}
 
 /// A design read from a file.
 #[derive(Debug, Clone)]
@@ -144,6 +61,24 @@ pub struct Design {
     pub overrides: Vec<String>,
     /// Where it was read from.
     pub path: PathBuf,
+}
+
+impl RunDesign for Design {
+    fn model(&self) -> &Model {
+        &self.model
+    }
+    fn output(&self) -> &OutputSettings {
+        &self.output
+    }
+    fn steps(&self) -> &crate::model::StepPlan {
+        &self.steps
+    }
+    fn source(&self) -> &str {
+        &self.source
+    }
+    fn path(&self) -> &Path {
+        &self.path
+    }
 }
 
 /// Why a design could not be read.
