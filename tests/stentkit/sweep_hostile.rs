@@ -13,7 +13,7 @@ use std::path::{Path, PathBuf};
 use std::process::{Child, Command, Output, Stdio};
 use std::time::{Duration, Instant};
 use stentkit::io::design::{DesignOverrides, load_design_with};
-use stentkit::io::estimate::estimated_disk;
+use stentkit::run::estimate::estimated_disk;
 
 /// 5000 values of the Poisson ratio of the bend (`0, 0.0001, …, 0.4999`): the sweep size, each value
 /// valid, none changing what a run writes.
