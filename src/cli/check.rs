@@ -2,9 +2,9 @@
 
 use crate::design::size::{MEMORY_LIMIT_BYTES, human_bytes};
 use crate::design::{Design, DesignOverrides, SetOverride, load_design_with};
-use crate::io::estimate::estimated_disk;
 use crate::material::{ConstitutiveLaw, MaterialLaw};
 use crate::model::Component;
+use crate::run::estimate::estimated_disk;
 use std::fmt::Write as _;
 use std::path::Path;
 
@@ -190,22 +190,6 @@ pub fn describe(design: &Design, file: &str) -> String {
     let _ = writeln!(s);
     let disk = estimated_disk(design);
     let mb = |bytes: u64| format!("{:.1} MB", bytes as f64 / 1e6);
-    // Only the parts the design writes.
-    let parts: Vec<String> = [
-        ("STL", disk.snapshot_stl),
-        ("OBJ", disk.snapshot_obj),
-        ("fields", disk.snapshot_vtp),
-        ("vessel lumen", disk.vessel_lumen),
-    ]
-    .into_iter()
-    .filter(|&(_, bytes)| bytes > 0)
-    .map(|(name, bytes)| format!("{name} {}", mb(bytes)))
-    .collect();
-    let recording = if design.output.recording.enabled {
-        format!("run.mcap {}", mb(disk.recording))
-    } else {
-        "no recording".to_string()
-    };
     // An error-controlled run's steps are known only as it runs: the estimate at h, and the most it can write.
     let (basis, most) = match bound {
         Some(steps) => (
@@ -224,16 +208,12 @@ pub fn describe(design: &Design, file: &str) -> String {
         ),
         None => (String::new(), String::new()),
     };
+    // Each part with its kinds of file that the design writes.
     let _ = writeln!(
         s,
-        "disk                run folder about {}{basis}: {} snapshots {} ({}), {recording}, history.csv {}, charts {}, summary.json {}{most}",
+        "disk                run folder about {}{basis}: {}{most}",
         mb(disk.total()),
-        disk.snapshots,
-        mb(disk.snapshots_bytes()),
-        parts.join(" + "),
-        mb(disk.history),
-        mb(disk.charts),
-        mb(disk.summary)
+        disk.describe(&mb, true)
     );
     let worst = model
         .patches

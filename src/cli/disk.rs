@@ -28,13 +28,13 @@ pub fn check_sweep_space(
 ) -> anyhow::Result<Option<u64>> {
     let needed = sweep_bytes(estimate, concurrent);
     let free = free_space(dir);
-    let (Some(free_bytes), Some((index, largest))) = (free, estimate.largest) else {
+    let (Some(free_bytes), Some((index, largest))) = (free, &estimate.largest) else {
         return Ok(free);
     };
     if needed <= free_bytes {
         return Ok(free);
     }
-    let (field, advice) = largest_part(&largest);
+    let (field, advice) = largest_part(largest);
     let source = std::fs::read_to_string(&plan.design).unwrap_or_default();
     Err(BadInput(format!(
         "{}{}: {field}: this sweep would write about {} ({} variants to run; the largest, {} [{}], about {}: {}) into {}, whose file system has {} free: {advice}, sweep fewer variants, or choose a folder on a larger disk with -o",
@@ -42,10 +42,10 @@ pub fn check_sweep_space(
         position(&source, field),
         human_bytes(needed as Real),
         estimate.variants,
-        plan.variants.get(index).map_or("?", |v| v.id.as_str()),
-        plan.label(index),
+        plan.variants.get(*index).map_or("?", |v| v.id.as_str()),
+        plan.label(*index),
         human_bytes(largest.total() as Real),
-        parts(&largest),
+        parts(largest),
         dir.display(),
         human_bytes(free_bytes as Real),
     ))

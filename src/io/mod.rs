@@ -8,7 +8,6 @@ pub mod centreline;
 pub mod chart;
 pub mod checkpoint;
 pub mod configurations;
-pub mod estimate;
 pub mod formats;
 pub mod history;
 pub mod input;

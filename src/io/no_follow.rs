@@ -13,9 +13,9 @@
 //!   link at the moment of the removal, whatever happens to the paths meanwhile;
 //! - a folder that holds links where stentkit writes is refused before anything is changed, naming them
 //!   ([`links_inside`]; [`crate::io::run_folder::classify`] refuses a run folder that holds any);
-//! - a sweep folder's own files (`sweep.sbatch`, `slurm.json`, a variant's `log.txt` and `task_error.txt`, the
-//!   table's temporary) are written with [`write()`] or [`open`], so a link in their place is an error, not a
-//!   way into a user's file.
+//! - a sweep folder's own files that are not written atomically (`sweep.sbatch`, `slurm.json`, a variant's
+//!   `log.txt` and `task_error.txt`) are written with [`write()`] or [`open`], so a link in their place is an
+//!   error, not a way into a user's file.
 //!
 //! The folder the user names (`-o DIR`, `RUN_DIR`) may itself be a link: the user chose that place, as they
 //! choose any path they type. Only what lies inside it is held to the rule. A file written atomically (a

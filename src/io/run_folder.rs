@@ -20,7 +20,7 @@
 //!   every removal, truncation and rewrite below opens its file or folder without following a link. The
 //!   folder itself may be a link (the user chose it).
 
-use super::no_follow;
+use super::{atomic, no_follow};
 use serde::Deserialize;
 use std::collections::BTreeSet;
 use std::fs::{self, File, OpenOptions};
@@ -579,8 +579,9 @@ impl Drop for Reserve {
     }
 }
 
-/// Removes the hidden temporaries `.<name>.<pid>.<n>.tmp` (see [`crate::io::stl`]'s atomic writes) of the
-/// listed files `owned`, in their folders: what a run killed during an atomic write leaves.
+/// Removes the hidden temporaries of the listed files `owned` in their folders
+/// ([`atomic::remove_stale_temporaries`]): what a run killed during an atomic write leaves. Returns them,
+/// relative to `dir`.
 ///
 /// # Errors
 /// [`RunFolderError::Io`] naming the file that could not be removed.
@@ -588,41 +589,23 @@ pub fn remove_stale_temporaries(
     dir: &Path,
     owned: &BTreeSet<PathBuf>,
 ) -> Result<Vec<PathBuf>, RunFolderError> {
-    let folders: BTreeSet<PathBuf> = owned
+    let folders: BTreeSet<&Path> = owned
         .iter()
-        .map(|p| p.parent().map(Path::to_path_buf).unwrap_or_default())
+        .map(|p| p.parent().unwrap_or(Path::new("")))
         .collect();
     let mut removed = Vec::new();
     for folder in folders {
-        // A folder that is missing (or, raced in since `classify`, a link) holds no temporary of ours.
-        let Ok(opened) = no_follow::folder_inside(dir, &folder) else {
-            continue;
-        };
-        let Ok(names) = opened.names() else {
-            continue;
-        };
-        for name in names {
-            let Some(target) = name.to_str().and_then(temporary_target) else {
-                continue;
-            };
-            if owned.contains(&folder.join(target)) {
-                let path = dir.join(&folder).join(&name);
-                if opened.remove(&name).map_err(io_error(&path))? {
-                    removed.push(folder.join(&name));
+        let owns = |target: &str| owned.contains(&folder.join(target));
+        removed.extend(
+            atomic::remove_stale_temporaries(dir, folder, &owns).map_err(|e| {
+                RunFolderError::Io {
+                    path: e.path,
+                    source: e.source,
                 }
-            }
-        }
+            })?,
+        );
     }
     Ok(removed)
-}
-
-/// The file a temporary `.<name>.<pid>.<n>.tmp` was to become (`<name>`), if `name` is one.
-fn temporary_target(name: &str) -> Option<&str> {
-    let rest = name.strip_prefix('.')?.strip_suffix(".tmp")?;
-    let (rest, counter) = rest.rsplit_once('.')?;
-    let (target, pid) = rest.rsplit_once('.')?;
-    let digits = |s: &str| !s.is_empty() && s.bytes().all(|b| b.is_ascii_digit());
-    (digits(counter) && digits(pid) && !target.is_empty()).then_some(target)
 }
 
 /// Takes the lock of `dir` and writes who holds it.
@@ -718,21 +701,6 @@ mod tests {
         assert_eq!(at(0), "1970-01-01T00:00:00Z");
         assert_eq!(at(951_782_400), "2000-02-29T00:00:00Z");
         assert_eq!(at(1_795_471_563), "2026-11-23T22:06:03Z");
-    }
-
-    #[test]
-    fn temporaries_are_recognised_by_their_whole_pattern() {
-        assert_eq!(
-            temporary_target(".summary.json.123.4.tmp"),
-            Some("summary.json")
-        );
-        assert_eq!(
-            temporary_target(".step_00001.stl.9.0.tmp"),
-            Some("step_00001.stl")
-        );
-        assert_eq!(temporary_target("summary.json.123.4.tmp"), None);
-        assert_eq!(temporary_target(".notes.tmp"), None);
-        assert_eq!(temporary_target(".a.b.c.tmp"), None);
     }
 
     #[test]

@@ -1,14 +1,14 @@
-//! Refusing a run that the disk cannot hold: the run's estimated output ([`estimated_disk`]: snapshots,
-//! recording, history, charts, summary) and the finishing reserve against the free space of the run folder's
-//! file system, before anything is removed or written.
+//! Refusing a run that the disk cannot hold: the run's estimated output ([`estimated_disk`]: each recorder's
+//! part and the summary) and the finishing reserve against the free space of the run folder's file system,
+//! before anything is removed or written.
 
 use super::RunError;
 use crate::design::Design;
 use crate::design::locate::Locator;
 use crate::design::size::human_bytes;
-use crate::io::estimate::{DiskEstimate, estimated_disk};
 use crate::io::run_folder::FitFolder;
 use crate::math::Real;
+use crate::run::estimate::{DiskEstimate, estimated_disk};
 use std::path::Path;
 
 /// Room a run keeps free for finishing \[bytes\]: the summary (a few kB) and the charts (tens of kB each), written
@@ -64,32 +64,18 @@ pub fn position(source: &str, field: &str) -> String {
         .unwrap_or_default()
 }
 
-/// `8 snapshots 42.0 MB, run.mcap 19.0 MB, history.csv 203 kB, charts and summary 3.0 MB`.
+/// `history.csv 203 kB, run.mcap 19.0 MB, 8 snapshots 42.0 MB, charts 3.0 MB, summary.json 10 kB`: the parts in
+/// the registry's order ([`DiskEstimate::describe`]).
 pub fn parts(estimate: &DiskEstimate) -> String {
-    format!(
-        "{} snapshots {}, run.mcap {}, history.csv {}, charts and summary {}",
-        estimate.snapshots,
-        human_bytes(estimate.snapshots_bytes() as Real),
-        human_bytes(estimate.recording as Real),
-        human_bytes(estimate.history as Real),
-        human_bytes((estimate.charts + estimate.summary) as Real),
-    )
+    estimate.describe(&|bytes| human_bytes(bytes as Real), false)
 }
 
-/// The field that sizes the largest part of `estimate`, and what to do with it.
+/// The field that sizes the largest part of `estimate` that has one ([`DiskEstimate::largest`]), and what to
+/// do with it (`output`, in general terms, for an estimate without advice: never met, as `history.csv`'s part
+/// has some).
 pub fn largest_part(estimate: &DiskEstimate) -> (&'static str, &'static str) {
-    let snapshots = estimate.snapshots_bytes();
-    if snapshots >= estimate.recording && snapshots >= estimate.history {
-        (
-            "output.snapshots",
-            "take fewer snapshots (fewer `between` or `times`, a larger `every`) or smaller ones (fewer `rings`, `segments`, one of the `formats`)",
-        )
-    } else if estimate.recording >= estimate.history {
-        (
-            "output.recording.centreline_points",
-            "record fewer centreline points per patch, or set `meshes: false`",
-        )
-    } else {
-        ("time.step", "take larger time steps")
-    }
+    estimate
+        .largest()
+        .and_then(|p| p.advice)
+        .unwrap_or(("output", "write fewer outputs"))
 }

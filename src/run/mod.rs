@@ -36,10 +36,11 @@
 //! continues; the charts and the summary's counts go on from the checkpoint's. The result is the uninterrupted
 //! run's: the same history.csv byte for byte.
 //!
-//! **Disk.** A new run is refused when its estimated output ([`crate::io::estimate`], part by part) and
-//! [`disk::FINISHING_RESERVE`] exceed the free space ([`disk::check_space`]).
+//! **Disk.** A new run is refused when its estimated output ([`estimate`]: each recorder's part and the
+//! summary) and [`disk::FINISHING_RESERVE`] exceed the free space ([`disk::check_space`]).
 
 pub mod disk;
+pub mod estimate;
 pub mod recorder;
 
 pub use recorder::{RECORDERS, Recorder, RecorderKind};

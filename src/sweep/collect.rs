@@ -1,15 +1,24 @@
 //! `sweep.csv` and the charts of a sweep folder: one row per variant (its parameters, state, wall time and
 //! [`super::metrics`]), and each metric against each numeric parameter, one line per combination of the other
 //! parameters. Collecting reads only the folder's files, so it gives the same table whether the variants ran
-//! here or on a cluster, and it can run while variants are still running (their rows say so).
+//! here or on a cluster, and it can run while variants are still running (their rows say so). The table and
+//! the charts are written atomically ([`crate::io::atomic`]), after removing the temporaries a collection
+//! killed outright left of them (module docs of [`super`]).
 
 use super::metrics::{Metrics, Release, run_metrics};
 use super::{Plan, SweepDir, SweepError, VariantState, short_name};
 use crate::design::load_design;
+use crate::io::atomic::{Durability, remove_stale_temporaries, write_file_atomically};
 use crate::io::chart::{LineChart, Series, write_svg};
 use crate::math::Real;
 use std::fmt::Write as _;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
+
+/// The table's file in a sweep folder.
+pub(super) const TABLE_FILE: &str = "sweep.csv";
+
+/// The charts' folder in a sweep folder.
+const CHARTS_FOLDER: &str = "charts";
 
 /// One variant's row.
 #[derive(Debug, Clone, PartialEq)]
@@ -189,10 +198,17 @@ pub fn collect(dir: &SweepDir, times: Option<&[Real]>) -> Result<Collected, Swee
         }
         csv.push('\n');
     }
-    let csv_path = dir.dir.join("sweep.csv");
-    write_replacing(&csv_path, &csv)?;
-    // The charts.
-    let charts_dir = dir.dir.join("charts");
+    let csv_path = dir.dir.join(TABLE_FILE);
+    remove_stale_temporaries(&dir.dir, Path::new(""), &|t| t == TABLE_FILE)?;
+    write_file_atomically(&csv_path, &csv, Durability::Unsynced).map_err(|source| {
+        SweepError::Io {
+            path: csv_path.clone(),
+            source,
+        }
+    })?;
+    // The charts, every one an SVG of this collection.
+    remove_stale_temporaries(&dir.dir, Path::new(CHARTS_FOLDER), &|t| t.ends_with(".svg"))?;
+    let charts_dir = dir.dir.join(CHARTS_FOLDER);
     let mut charts = Vec::new();
     // A parameter with one value is the same in every variant: no chart against it, no line per its value.
     let varied: Vec<bool> = plan.parameters.iter().map(|p| p.values.len() > 1).collect();
@@ -280,15 +296,4 @@ fn field(text: &str) -> String {
     } else {
         text.to_string()
     }
-}
-
-/// Writes `text` to `path` through a temporary file renamed over it (a reader never sees half a table).
-fn write_replacing(path: &std::path::Path, text: &str) -> Result<(), SweepError> {
-    let temporary = path.with_extension("csv.partial");
-    crate::io::no_follow::write(&temporary, text.as_bytes())
-        .and_then(|()| std::fs::rename(&temporary, path))
-        .map_err(|source| SweepError::Io {
-            path: path.to_path_buf(),
-            source,
-        })
 }

@@ -23,9 +23,19 @@
 //! its sweep (edited by hand: [`SweepDir::read_plan`]).
 //!
 //! **Preparation** ([`SweepDir::prepare`]) writes `sweep.json` first, then the variants' designs, every file
-//! through a temporary renamed into place: a preparation stopped by a signal (between two variants) or killed
-//! outright leaves a folder the same command continues — it checks the designs already written and writes the
-//! rest — and never half a file.
+//! through a temporary renamed into place ([`crate::io::atomic`]; `sweep.json` synced to disk, the designs
+//! not: a design a power loss left empty is written again): a preparation stopped by a signal (between two
+//! variants) or killed outright leaves a folder the same command continues — it checks the designs already
+//! written and writes the rest — and never half a file.
+//!
+//! **Stale temporaries.** A writer killed outright leaves its temporary, `.<name>.<pid>.<n>.tmp` beside the file
+//! it was writing (io::atomic's name). A folder holding only temporaries of `sweep.json` is as good as empty
+//! ([`SweepDir::check`]); the preparation removes the temporaries of the files it writes — `sweep.json` and
+//! `sweep.csv` in the folder, `design.yaml` and `error.txt` in each variant's — and the collection those of
+//! `sweep.csv` and of the charts ([`collect::collect`]); a variant's `run/` is a run folder, whose own
+//! temporaries its run removes ([`crate::io::run_folder`]). Nothing else is removed, and a sweep folder has no
+//! lock: one command at a time prepares or collects it (two at once could remove each other's temporary in
+//! progress, and the later rename fails with an error naming the file).
 //!
 //! **State** of a variant ([`VariantState`]) is read from its files: `summary.json`'s status, or `error.txt`
 //! (its design was refused), or `task_error.txt` (its run was refused before it wrote a summary), or nothing
@@ -38,13 +48,21 @@ pub mod slurm;
 
 use crate::design::set::{PathStep, parse_path, path_text};
 use crate::design::{Design, DesignError, DesignOverrides, SetOverride, load_design_with};
+use crate::io::atomic::{
+    Durability, RemoveError, remove_stale_temporaries, temporary_target, write_file_atomically,
+};
 use serde::{Deserialize, Serialize};
 use std::collections::HashMap;
-use std::io::Write as _;
 use std::path::{Path, PathBuf};
 
 /// The plan file in a sweep folder.
 pub const PLAN_FILE: &str = "sweep.json";
+
+/// A variant's resolved design, in its folder.
+const DESIGN_FILE: &str = "design.yaml";
+
+/// Why a variant's design was refused, in its folder.
+const ERROR_FILE: &str = "error.txt";
 
 /// One swept parameter: a field path and its values.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -410,7 +428,7 @@ impl SweepDir {
 
     /// The resolved design of variant `id`.
     pub fn design(&self, id: &str) -> PathBuf {
-        self.variant(id).join("design.yaml")
+        self.variant(id).join(DESIGN_FILE)
     }
 
     /// The run folder of variant `id`.
@@ -420,7 +438,7 @@ impl SweepDir {
 
     /// Why variant `id`'s design was refused, if it was.
     pub fn error(&self, id: &str) -> PathBuf {
-        self.variant(id).join("error.txt")
+        self.variant(id).join(ERROR_FILE)
     }
 
     /// What variant `id`'s runs printed (appended by every attempt, here or on the cluster).
@@ -484,10 +502,11 @@ impl SweepDir {
             }
             return Ok(());
         }
-        // A preparation killed while it wrote the plan leaves only the plan's temporary: as good as empty.
-        let temporary = temporary(&self.plan_file());
+        // A preparation killed while it wrote the plan leaves only the plan's temporaries: as good as empty.
+        let plan_temporary =
+            |name: &std::ffi::OsStr| name.to_str().and_then(temporary_target) == Some(PLAN_FILE);
         let mut entries = match self.dir.read_dir() {
-            Ok(d) => d.flatten().map(|e| e.path()).filter(|p| *p != temporary),
+            Ok(d) => d.flatten().filter(|e| !plan_temporary(&e.file_name())),
             Err(_) => return Ok(()),
         };
         match entries.next() {
@@ -505,9 +524,9 @@ impl SweepDir {
     /// Writes `plan` into the folder ([`SweepDir::check`] must accept it) and then each variant's resolved
     /// design, or the reason it was refused, checking those an earlier preparation wrote. The plan comes
     /// first and every file is written through a temporary renamed into place, so a preparation killed at any
-    /// moment leaves a folder this continues (module docs). `known` holds resolutions already made
-    /// ([`disk::SweepEstimate::resolved`]); `stop` is asked before each variant, and when it says so the
-    /// preparation ends there.
+    /// moment leaves a folder this continues; the temporaries a killed one left are removed (module docs).
+    /// `known` holds resolutions already made ([`disk::SweepEstimate::resolved`]); `stop` is asked before each
+    /// variant, and when it says so the preparation ends there.
     ///
     /// # Errors
     /// [`SweepError::Folder`] for a folder [`SweepDir::check`] refuses or a variant whose design changed;
@@ -524,9 +543,13 @@ impl SweepDir {
             move |source| SweepError::Io { path, source }
         };
         std::fs::create_dir_all(&self.dir).map_err(io(&self.dir))?;
+        remove_stale_temporaries(&self.dir, Path::new(""), &|t| {
+            t == PLAN_FILE || t == collect::TABLE_FILE
+        })?;
         if !self.plan_file().exists() {
             let text = serde_json::to_string_pretty(plan).unwrap_or_default();
-            write_atomically(&self.plan_file(), &text, true).map_err(io(&self.plan_file()))?;
+            write_file_atomically(&self.plan_file(), text, Durability::Synced)
+                .map_err(io(&self.plan_file()))?;
         }
         for (index, v) in plan.variants.iter().enumerate() {
             if stop() {
@@ -534,6 +557,9 @@ impl SweepDir {
             }
             let dir = self.variant(&v.id);
             std::fs::create_dir_all(&dir).map_err(io(&dir))?;
+            remove_stale_temporaries(&dir, Path::new(""), &|t| {
+                t == DESIGN_FILE || t == ERROR_FILE
+            })?;
             let resolved = known
                 .get(&index)
                 .cloned()
@@ -546,10 +572,10 @@ impl SweepDir {
                 Ok(existing) if existing == *text => {}
                 // Empty: written but not yet flushed when the machine stopped (the text is never empty).
                 Ok(existing) if existing.is_empty() => {
-                    write_atomically(&path, text, false).map_err(io(&path))?;
+                    write_file_atomically(&path, text, Durability::Unsynced).map_err(io(&path))?;
                 }
                 Err(e) if e.kind() == std::io::ErrorKind::NotFound => {
-                    write_atomically(&path, text, false).map_err(io(&path))?;
+                    write_file_atomically(&path, text, Durability::Unsynced).map_err(io(&path))?;
                 }
                 Err(e) if e.kind() != std::io::ErrorKind::InvalidData => {
                     return Err(io(&path)(e));
@@ -615,25 +641,13 @@ pub enum Prepared {
     },
 }
 
-/// `path` with `.partial` appended: where [`write_atomically`] writes first.
-fn temporary(path: &Path) -> PathBuf {
-    let mut name = path.as_os_str().to_owned();
-    name.push(".partial");
-    PathBuf::from(name)
-}
-
-/// Writes `text` to `path` through a temporary renamed over it (a reader, or a rerun after SIGKILL, never sees
-/// half a file; a stale temporary of a killed writer is replaced), flushed to the disk first when `sync`.
-/// `path` itself is one this sweep writes and checks before it writes: nothing the user wrote is replaced.
-fn write_atomically(path: &Path, text: &str, sync: bool) -> std::io::Result<()> {
-    let partial = temporary(path);
-    let mut file = std::fs::File::create(&partial)?;
-    file.write_all(text.as_bytes())?;
-    if sync {
-        file.sync_all()?;
+impl From<RemoveError> for SweepError {
+    fn from(e: RemoveError) -> Self {
+        Self::Io {
+            path: e.path,
+            source: e.source,
+        }
     }
-    drop(file);
-    std::fs::rename(&partial, path)
 }
 
 /// The resolved design text of variant `index`, or the design error its overrides give.

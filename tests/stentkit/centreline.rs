@@ -773,7 +773,7 @@ fn a_smoothing_tighter_than_the_points_is_refused_in_words() {
 /// `vessel_lumen.stl`) and the disk estimate (45.7 MB) did not count it. Now the rings are at most
 /// `MAX_LUMEN_RINGS` (1000; 12 segments around, so at most 24 000 triangles), and the disk estimate counts the
 /// lumen to the byte (84 + 50 bytes per triangle) and, as for every run it is made for, covers every byte
-/// written (module docs of `io::estimate`: it has not underestimated a run).
+/// written (module docs of `run::estimate`: it has not underestimated a run).
 #[test]
 fn a_dense_centrelines_lumen_is_bounded_and_counted() {
     let dir = scratch("dense-lumen");
@@ -793,7 +793,7 @@ fn a_dense_centrelines_lumen_is_bounded_and_counted() {
     let loaded = stentkit::design::load_design(&design).expect("the design reads");
     let rings = loaded.model.vessel.as_ref().expect("a vessel").points.len();
     assert_eq!(rings, stentkit::design::vessel::MAX_LUMEN_RINGS);
-    let estimate = stentkit::io::estimate::estimated_disk(&loaded);
+    let estimate = stentkit::run::estimate::estimated_disk(&loaded);
     let run = crate::materials::run(design.to_str().expect("UTF-8"), "dense_lumen", &BRIEF_RUN);
     let lumen = std::fs::metadata(run.join("snapshots/vessel_lumen.stl"))
         .expect("the lumen")
@@ -809,8 +809,14 @@ fn a_dense_centrelines_lumen_is_bounded_and_counted() {
         ),
     )
     .expect("the design reads");
-    let estimate_ran = stentkit::io::estimate::estimated_disk(&ran);
-    assert_eq!(estimate_ran.vessel_lumen, lumen);
+    let estimate_ran = stentkit::run::estimate::estimated_disk(&ran);
+    assert_eq!(
+        estimate_ran
+            .part("snapshots")
+            .expect("the snapshots' part")
+            .file("vessel lumen"),
+        lumen
+    );
     let files = walk(&run);
     let written: u64 = files.iter().map(|f| f.1).sum();
     eprintln!(

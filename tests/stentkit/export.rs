@@ -60,9 +60,9 @@ fn the_flagship_run_folder_is_lean_and_its_snapshots_are_named_by_phase_and_expo
     let bytes = folder_bytes(&dir);
     assert!(bytes < 60_000_000, "run folder {bytes} bytes");
     // `check`'s estimate of the folder bounds it from above, within 1.3 times (58.1 MB written, 64.3 MB
-    // estimated: the recording is charged for a device that moves every step, io::estimate).
+    // estimated: the recording is charged for a device that moves every step, run::estimate).
     let design = stentkit::design::load_design(&file).expect("design");
-    let estimate = stentkit::io::estimate::estimated_disk(&design).total() as f64;
+    let estimate = stentkit::run::estimate::estimated_disk(&design).total() as f64;
     let ratio = estimate / bytes as f64;
     assert!(
         (1.0..1.3).contains(&ratio),

@@ -11,7 +11,6 @@ mod cli;
 mod design_errors;
 mod designs;
 mod diamond;
-mod estimate;
 mod export;
 mod fields;
 mod fuzz;

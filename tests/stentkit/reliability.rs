@@ -671,7 +671,7 @@ pub(crate) fn folder_bytes(dir: &Path) -> u64 {
 fn the_disk_estimate_bounds_a_run_folder_from_above() {
     // Reference: the run folder itself. The 45° bend at h = 1e-3 (1000 steps, every output written but the
     // shaded picture; about 0.3 s) wrote 3.29 MB against an estimate of 3.46 MB when the estimate was
-    // calibrated with 21 snapshots of STL and OBJ (io::estimate's table). The estimate must not be below what
+    // calibrated with 21 snapshots of STL and OBJ (run::estimate's table). The estimate must not be below what
     // is written, nor more than 1.3 times it: a writer that grows (or an estimate that drifts) fails here. The
     // picture is left out: it is charged at the stents' 0.5 bytes a pixel, and the bend's thin line compresses
     // 20 times better (25 kB against 0.8 MB charged), which with 7 small default snapshots would be most of the
@@ -682,7 +682,7 @@ fn the_disk_estimate_bounds_a_run_folder_from_above() {
         .set("output.configurations.render", "false")
         .write(&dir.join("bend_fine.yaml"));
     let design = stentkit::design::load_design(&file).expect("valid");
-    let estimate = stentkit::io::estimate::estimated_disk(&design);
+    let estimate = stentkit::run::estimate::estimated_disk(&design);
     let run = dir.join("run");
     completed_in_process(&file, &run, &[]);
     let written = folder_bytes(&run) as f64;

@@ -5,8 +5,8 @@
 use crate::common::fixtures;
 use std::ops::ControlFlow;
 use std::path::Path;
-use stentkit::geometry::frame::{FrameField, FrameSettings};
 use stentkit::design::parse_design;
+use stentkit::geometry::frame::{FrameField, FrameSettings};
 use stentkit::io::stl::{read_stl, write_stl};
 use stentkit::math::{Real, Vec3};
 use stentkit::model::{Model, ProbeLocation};

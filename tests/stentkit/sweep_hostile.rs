@@ -13,7 +13,7 @@ use std::path::{Path, PathBuf};
 use std::process::{Child, Command, Output, Stdio};
 use std::time::{Duration, Instant};
 use stentkit::design::{DesignOverrides, load_design_with};
-use stentkit::io::estimate::estimated_disk;
+use stentkit::run::estimate::estimated_disk;
 
 /// 5000 values of the Poisson ratio of the bend (`0, 0.0001, …, 0.4999`): the issue's sweep size, each value
 /// valid, none changing what a run writes.
@@ -77,7 +77,8 @@ fn prepared(dir: &Path) -> usize {
     })
 }
 
-/// Every file under `dir` whose name ends in `.partial` (a temporary a writer left behind).
+/// Every file under `dir` that is a writer's temporary: io::atomic's hidden `.<name>.<pid>.<n>.tmp`, or the
+/// `.partial` of the sweep's earlier writer.
 fn partial_files(dir: &Path) -> Vec<PathBuf> {
     let mut found = Vec::new();
     let mut stack = vec![dir.to_path_buf()];
@@ -86,12 +87,17 @@ fn partial_files(dir: &Path) -> Vec<PathBuf> {
             let p = e.path();
             if p.is_dir() {
                 stack.push(p);
-            } else if p.to_string_lossy().ends_with(".partial") {
+            } else if is_temporary(&e.file_name().to_string_lossy()) {
                 found.push(p);
             }
         }
     }
     found
+}
+
+/// Whether `name` is a writer's temporary (see [`partial_files`]).
+fn is_temporary(name: &str) -> bool {
+    name.ends_with(".partial") || (name.starts_with('.') && name.ends_with(".tmp"))
 }
 
 /// `32 TB`, `6.5 GB`, `740 kB` (as stentkit prints sizes) in bytes.
@@ -252,6 +258,79 @@ fn a_preparation_killed_outright_is_continued_by_the_same_command() {
     );
     assert_eq!(prepared(&dir), 5000);
     assert!(partial_files(&dir).is_empty(), "{:?}", partial_files(&dir));
+}
+
+// Issue 32, item 3: stale temporaries in a sweep folder. The sweep's files are written through io::atomic,
+// whose temporaries are `.<name>.<pid>.<n>.tmp` (unique per write, so a killed writer's is not overwritten by
+// the next one, as the earlier `<name>.partial` was). Planted here as a writer killed outright leaves them: a
+// folder holding only a temporary of `sweep.json` is accepted as empty and prepared; a rerun of the
+// preparation removes the temporaries of `sweep.json`, `sweep.csv` and each variant's `design.yaml` and
+// `error.txt`, a collection those of `sweep.csv` and the charts; a hidden file of the same pattern whose
+// target is not the sweep's (a user's `.notes.txt.1.2.tmp`) is left. Reference: the folder's listing, and the
+// prepared designs, which must be those of a folder prepared without temporaries (the bend over two Poisson
+// ratios, one refused: nu = 0.6 > 0.5).
+#[test]
+fn stale_temporaries_in_a_sweep_folder_are_removed_and_nothing_else() {
+    use stentkit::sweep::collect::collect;
+    use stentkit::sweep::{Parameter, Plan, Prepared, Resolutions, SweepDir};
+    let parameters = vec![Parameter::parse("material.nu=0.3,0.6").expect("parameter")];
+    let plan = Plan::new(&design("bend45.yaml"), parameters, false).expect("plan");
+    let stale = ".sweep.json.999999.0.tmp";
+    let prepare = |dir: &SweepDir| {
+        let prepared = dir.prepare(&plan, &Resolutions::new(), &|| false);
+        assert_eq!(prepared.expect("prepared"), Prepared::All);
+    };
+    // The reference: a folder prepared without temporaries.
+    let clean = SweepDir {
+        dir: test_outputs("sweep_stale_clean"),
+    };
+    prepare(&clean);
+    // A folder a preparation was killed in while writing the plan.
+    let dir = SweepDir {
+        dir: test_outputs("sweep_stale"),
+    };
+    std::fs::create_dir_all(&dir.dir).expect("folder");
+    std::fs::write(dir.dir.join(stale), "{\"design\": ").expect("stale plan");
+    dir.check(&plan)
+        .expect("a folder holding only the plan's temporary is empty");
+    prepare(&dir);
+    assert!(
+        partial_files(&dir.dir).is_empty(),
+        "{:?}",
+        partial_files(&dir.dir)
+    );
+    // Killed writers of every kind, and a user's hidden file of the same pattern.
+    let planted = [
+        stale,
+        ".sweep.csv.999999.1.tmp",
+        "variants/v000/.design.yaml.999999.2.tmp",
+        "variants/v001/.error.txt.999999.3.tmp",
+        "charts/.fixity_vs_nu.svg.999999.4.tmp",
+    ];
+    std::fs::create_dir_all(dir.dir.join("charts")).expect("charts");
+    for name in planted {
+        std::fs::write(dir.dir.join(name), "stale").expect("planted");
+    }
+    let users = dir.dir.join("variants/v000/.notes.txt.1.2.tmp");
+    std::fs::write(&users, "the user's").expect("user's file");
+    prepare(&dir);
+    let mut left = partial_files(&dir.dir);
+    left.sort();
+    let chart = dir.dir.join("charts/.fixity_vs_nu.svg.999999.4.tmp");
+    assert_eq!(left, [chart, users.clone()], "after the preparation");
+    collect(&dir, None).expect("collected");
+    assert_eq!(partial_files(&dir.dir), [users], "after the collection");
+    for file in [
+        "sweep.json",
+        "variants/v000/design.yaml",
+        "variants/v001/error.txt",
+    ] {
+        assert_eq!(
+            std::fs::read_to_string(dir.dir.join(file)).expect("written"),
+            std::fs::read_to_string(clean.dir.join(file)).expect("reference"),
+            "{file}"
+        );
+    }
 }
 
 // Item 13. Reproduces: `sweep collect` panicked (index out of bounds, src/sweep/collect.rs:201) on a sweep.json

@@ -1,13 +1,19 @@
-//! The charts as a recorder: [`crate::io::run_charts`]' histories of the states collected (its position).
+//! The charts as a recorder: [`crate::io::run_charts`]' histories of the states collected (its position); its
+//! estimate the charts' points and the snapshots' configuration figures.
 
 use super::{Finishing, Recorder, RecorderKind, damaged};
 use crate::io::checkpoint::{Decoder, Encoder, Problem};
+use crate::io::configurations::{CENTRELINE_SAMPLES, MAX_ROWS};
+use crate::io::render::PANEL_WIDTH;
 use crate::io::run_charts::RunCharts;
-use crate::io::state::StateSample;
+use crate::io::state::{StateSample, load_channels};
 use crate::io::summary::{FinalState, RunSummaryFile};
 use crate::math::Real;
+use crate::model::Model;
+use crate::post::device::{device_sample_counts, patch_copies};
 use crate::post::recovery::Recovery;
 use crate::run::RunError;
+use crate::run::estimate::{DiskPart, Sizing};
 use crate::solver::Simulation;
 
 /// The charts of the run's histories ([`crate::io::run_charts`]), with the snapshots' configuration figures.
@@ -22,7 +28,65 @@ pub(super) const CHARTS: RecorderKind = RecorderKind {
         let samples = decode_samples(position).map_err(|p| damaged("charts/", p))?;
         Ok(Box::new(RunCharts::new(sim.model()).resumed(samples)))
     },
+    estimate: |s| DiskPart::new("charts", estimated_bytes(s) as u64),
 };
+
+/// Bytes of a chart besides its points: axes, labels, legend (22 kB measured for the straight stent's
+/// temperature chart).
+const CHART_FIXED_BYTES: Real = 30_000.0;
+
+/// Bytes per plotted point of a chart series: 8.2 measured (the bend's temperature chart at 10⁵ steps).
+const CHART_POINT_BYTES: Real = 10.0;
+
+/// Bytes per point of a polyline in an SVG figure (`x,y ` with plotters' coordinates: 8–9 measured).
+const SVG_POINT_BYTES: Real = 10.0;
+
+/// Bytes per pixel of the shaded picture's PNG: 0.33 measured (the straight stent's, 485 kB for 1.47 million
+/// pixels, mostly white).
+const PNG_PIXEL_BYTES: Real = 0.5;
+
+/// `charts/`: the charts' fixed parts and a point per state and series, and the configuration figures.
+fn estimated_bytes(s: &Sizing<'_>) -> Real {
+    let model = s.model();
+    let count = s.snapshots as Real;
+    let device_points: Real = device_sample_counts(model, CENTRELINE_SAMPLES)
+        .iter()
+        .enumerate()
+        .map(|(k, &n)| (patch_copies(model, k).len() * n) as Real)
+        .sum();
+    let (charts, series) = chart_counts(model);
+    // The configuration figures: up to MAX_ROWS rows and one figure per row, each panel the initial and the
+    // current centrelines of the full device in two views.
+    let figure_rows = (count - 1.0).clamp(0.0, MAX_ROWS as Real);
+    let figures = 2.0 * figure_rows * 2.0 * 2.0 * device_points * SVG_POINT_BYTES;
+    // Their shaded picture: the initial state and each row, a square panel each (the straight stent's are
+    // 2:3) of PANEL_WIDTH² pixels.
+    let picture = if s.design.output.snapshots.render {
+        (figure_rows + 1.0) * Real::from(PANEL_WIDTH).powi(2) * PNG_PIXEL_BYTES
+    } else {
+        0.0
+    };
+    let figures = figures + picture;
+    charts * CHART_FIXED_BYTES + s.states * series * CHART_POINT_BYTES + figures
+}
+
+/// The charts a run draws and the number of series in them (io::run_charts): temperature (1), probe
+/// displacements (3 per probe) and their normalised overlay (3 per probe, a load per channel, the
+/// temperature), recovery (4) and Δr (1) with a programme, Newton iterations (1).
+fn chart_counts(model: &Model) -> (Real, Real) {
+    let probes = model.probes.len() as Real;
+    let mut charts = 2.0;
+    let mut series = 2.0;
+    if probes > 0.0 {
+        charts += 2.0;
+        series += 6.0 * probes + load_channels(model).len() as Real + 1.0;
+    }
+    if model.programme.is_some() {
+        charts += 2.0;
+        series += 5.0;
+    }
+    (charts, series)
+}
 
 pub(super) fn encode_sample(e: &mut Encoder, s: &StateSample) {
     e.usize(s.step);

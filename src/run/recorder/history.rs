@@ -1,10 +1,14 @@
-//! `history.csv` as a recorder: the rows of [`crate::io::history`], its position the file's length and rows.
+//! `history.csv` as a recorder: the rows of [`crate::io::history`], its position the file's length and rows,
+//! its estimate a row per state at its longest.
 
 use super::{Finishing, Recorder, RecorderKind, damaged, upto};
 use crate::io::checkpoint::{Decoder, Encoder, Problem};
 use crate::io::history::{HistoryPosition, HistoryWriter};
 use crate::io::summary::RunSummaryFile;
+use crate::math::Real;
+use crate::model::Model;
 use crate::run::RunError;
+use crate::run::estimate::DiskPart;
 use crate::solver::Simulation;
 use std::path::Path;
 
@@ -39,10 +43,48 @@ pub(super) const HISTORY: RecorderKind = RecorderKind {
             .map_err(|e| RunError::context(format!("cannot continue {}", path.display()), e))?;
         Ok(Box::new(writer))
     },
+    estimate: |s| {
+        let design = s.design;
+        let rows = s.states + 1.0;
+        let bytes = rows * row_bytes(&design.model, &design.output.strain_limits);
+        DiskPart {
+            advice: Some(("time.step", "take larger time steps")),
+            ..DiskPart::new(HISTORY_FILE, bytes as u64)
+        }
+    },
 };
 
 /// The history's file name in the run folder.
 const HISTORY_FILE: &str = "history.csv";
+
+/// Bytes of a `history.csv` row (io::history's formats at their longest): time (17), three displacements per
+/// probe (20 each), temperature (11), iterations (3), residual (10), cuts (3), the recovery ratios (18 each)
+/// and Δr (17) of a programme, the largest node displacement (16), the peak surface strain (16), its patch
+/// (the longest name) and arc length (16), one peak per material with a strain limit (16), the line end.
+fn row_bytes(model: &Model, strain_limits: &[Option<Real>]) -> Real {
+    let name = model
+        .patches
+        .iter()
+        .map(|p| p.name.len())
+        .max()
+        .unwrap_or(0) as Real;
+    let limits = strain_limits.iter().flatten().count() as Real;
+    let peaks = 16.0 + 17.0 + name + 1.0 + 17.0 + 17.0 * limits;
+    let recovery = match &model.programme {
+        Some(p) => {
+            36.0 + if matches!(
+                p.kind,
+                crate::model::ProgrammeKind::RadialContraction { .. }
+            ) {
+                18.0
+            } else {
+                0.0
+            }
+        }
+        None => 0.0,
+    };
+    17.0 + 60.0 * model.probes.len() as Real + 11.0 + 3.0 + 11.0 + 3.0 + recovery + peaks + 1.0
+}
 
 pub(super) fn decode_history(bytes: &[u8]) -> Result<HistoryPosition, Problem> {
     let mut d = Decoder::new(bytes);

@@ -5,20 +5,22 @@
 //! checkpoint (the bytes [`Recorder::position`] encodes and its kind's `resume` decodes, with
 //! [`crate::io::checkpoint::Encoder`] and [`crate::io::checkpoint::Decoder`]), its resume (its kind's
 //! `check_resume` before anything is written, then `resume`), its part of `summary.json`
-//! ([`Recorder::summarise`]) and how it is finished whatever happened ([`Recorder::finish`]: the state of its
-//! files and its problem, if any). The run ([`super`]) knows none of them by name: it makes them from the list,
-//! observes the simulation through them, times each (`summary.json`'s `timing.recording`, by name), saves and
-//! restores their positions by name and finishes them in the list's order.
+//! ([`Recorder::summarise`]), how it is finished whatever happened ([`Recorder::finish`]: the state of its
+//! files and its problem, if any) and what it will write, estimated before the run starts (its kind's
+//! `estimate`, a [`DiskPart`] of [`super::estimate`]). The run ([`super`]) knows none of them by name: it makes
+//! them from the list, observes the simulation through them, times each (`summary.json`'s `timing.recording`,
+//! by name), saves and restores their positions by name and finishes them in the list's order; the disk
+//! estimate (`check`, the run's and the sweep's refusals) adds up their parts in the list's order.
 //!
 //! A new recorder is one module here with its [`RecorderKind`] and [`Recorder`] (and, for a new file format, its
 //! writer in [`crate::io`]), its `mod` line and one line in [`RECORDERS`].
-//! The disk estimate of a run is still [`crate::io::estimate`]'s, part by part (module docs of [`super`]).
 
 mod charts;
 mod history;
 mod recording;
 mod snapshots;
 
+use super::estimate::{DiskPart, Sizing};
 use super::{Console, RunError};
 use crate::design::Design;
 use crate::io::checkpoint::Problem;
@@ -80,7 +82,7 @@ pub struct Setup<'a> {
 /// A recorder made, or the reason it could not be.
 pub type Made = Result<Box<dyn Recorder>, RunError>;
 
-/// A kind of recorder: its name and how it is made, continued and checked (module docs).
+/// A kind of recorder: its name, how it is made, continued and checked, and what it will write (module docs).
 #[derive(Clone, Copy)]
 pub struct RecorderKind {
     /// Its name in `summary.json`'s `timing.recording` and in checkpoints.
@@ -92,6 +94,9 @@ pub struct RecorderKind {
     pub check_resume: fn(dir: &Path, position: &[u8], step: usize) -> Result<(), RunError>,
     /// Continues it from `position` (a checkpoint's).
     pub resume: fn(&Setup<'_>, &Simulation<'_>, &[u8]) -> Made,
+    /// What it will write in a run of the design, estimated before the run (a part of no bytes when the design
+    /// turns it off).
+    pub estimate: fn(&Sizing<'_>) -> DiskPart,
 }
 
 /// The recorders of a run, in the order they observe each step and are finished (the recording before the

@@ -1,12 +1,16 @@
 //! `run.mcap` as a recorder: [`crate::io::mcap`]'s recording, its position the last message; resumed by copying
-//! the old recording up to it.
+//! the old recording up to it; its estimate the compressed messages of every state and snapshot.
 
 use super::{Finishing, Recorder, RecorderKind, Setup, damaged, upto};
 use crate::io::checkpoint::{Decoder, Encoder, Problem};
 use crate::io::mcap::{McapRecorder, RecordingPosition};
 use crate::io::mcap_salvage::{Salvage, salvage};
+use crate::io::state::load_channels;
 use crate::math::Real;
+use crate::model::Model;
+use crate::post::device::{device_sample_counts, patch_copies};
 use crate::run::RunError;
+use crate::run::estimate::{DiskPart, Sizing, digits};
 use crate::solver::Simulation;
 use std::path::Path;
 
@@ -43,7 +47,114 @@ pub(super) const RECORDING: RecorderKind = RecorderKind {
         let position = decode_recording(position).map_err(|p| damaged(MCAP_FILE, p))?;
         Ok(Box::new(Some(resume_recording(setup, &position)?)))
     },
+    estimate: |s| {
+        if !s.design.output.recording.enabled {
+            return DiskPart::new("no recording", 0);
+        }
+        DiskPart {
+            holds_design_text: true,
+            advice: Some((
+                "output.recording.centreline_points",
+                "record fewer centreline points per patch, or set `meshes: false`",
+            )),
+            ..DiskPart::new(MCAP_FILE, estimated_bytes(s) as u64)
+        }
+    },
 };
+
+/// Compressed bytes of a recorded centreline point whose coordinates change from step to step: 10.5, measured
+/// on the 45° bend at 1000 steps (21 points per step, 234 kB of zstd-1 chunks for 1001 steps, besides the
+/// message headers). Points that barely move compress to 4–5 bytes (the straight stent's 5.3).
+const CENTRELINE_POINT_BYTES: Real = 10.5;
+
+/// Compressed bytes of a point of a mirrored copy of a rod: 4, measured on the straight stent (the three
+/// mirrored copies of each rod added 7.25 MB to 4.03 MB of unique centrelines, 3.6 bytes a point).
+const MIRRORED_POINT_BYTES: Real = 4.0;
+
+/// Compressed bytes of a recorded line's header (pose, colour, thickness: the same text every step): 2.
+const LINE_BYTES: Real = 2.0;
+
+/// Bytes per recorded message besides its content: the MCAP record header (31 bytes, compressed with its
+/// chunk), the message index entry (16 bytes, uncompressed) and the compressed scene-update wrapper.
+const MESSAGE_BYTES: Real = 40.0;
+
+/// Compression of the `/state` messages (full-precision numbers): 4.7 measured on the bend, 5.7 on the straight
+/// stent; 4 charged.
+const STATE_COMPRESSION: Real = 4.0;
+
+/// Compression of the recorded tube meshes (points at fixed decimals, sequential indices): 4.9 measured on the
+/// bend, 5.5 on the straight stent; 4.5 charged.
+const MESH_COMPRESSION: Real = 4.5;
+
+/// Bytes of a recording besides the messages and the design attached: schemas, metadata, chunk and summary
+/// indexes (about 12 kB for the straight stent).
+const RECORDING_FIXED_BYTES: Real = 20_000.0;
+
+/// `run.mcap` of a recording the design turns on: a state and the centrelines at every state, a mesh at every
+/// snapshot, the vessel once, the fixed records and the design's text.
+fn estimated_bytes(s: &Sizing<'_>) -> Real {
+    let design = s.design;
+    let model = s.model();
+    let recording = &design.output.recording;
+    let count = s.snapshots as Real;
+    let point_counts = device_sample_counts(model, recording.centreline_points);
+    let (mut unique, mut mirrored, mut lines) = (0.0, 0.0, 0.0);
+    for (k, &points) in point_counts.iter().enumerate() {
+        let copies = patch_copies(model, k).len() as Real;
+        unique += points as Real;
+        mirrored += (copies - 1.0) * points as Real;
+        lines += copies;
+    }
+    let centrelines = unique * CENTRELINE_POINT_BYTES
+        + mirrored * MIRRORED_POINT_BYTES
+        + lines * LINE_BYTES
+        + MESSAGE_BYTES;
+    let state = state_message_bytes(model) / STATE_COMPRESSION + MESSAGE_BYTES;
+    let meshes = if recording.meshes {
+        let (v, t) = s.tube_mesh(recording.mesh_rings, recording.mesh_segments);
+        let raw = 400.0 + v * s.point_bytes() + 3.0 * t * (digits(v) + 1.0);
+        count * (raw / MESH_COMPRESSION + MESSAGE_BYTES)
+    } else {
+        0.0
+    };
+    // The vessel, recorded once: its centreline and, with a radius, its lumen at the recording's segments.
+    let vessel = match &model.vessel {
+        Some(vessel) => {
+            let rings = vessel.points.len() as Real;
+            let mesh = match vessel.radius {
+                Some(_) => {
+                    let m = recording.mesh_segments as Real;
+                    let (v, t) = (rings * m + 2.0, 2.0 * m * rings);
+                    v * s.point_bytes() + 3.0 * t * (digits(v) + 1.0)
+                }
+                None => 0.0,
+            };
+            let raw = 400.0 + rings * s.point_bytes() + mesh;
+            raw / MESH_COMPRESSION + MESSAGE_BYTES
+        }
+        None => 0.0,
+    };
+    s.states * (centrelines + state)
+        + meshes
+        + vessel
+        + RECORDING_FIXED_BYTES
+        + design.source.len() as Real
+}
+
+/// Bytes of a `/state` message before compression: the fixed fields, a load per channel, about six Newton
+/// residuals, a probe's displacement and magnitude, the recovery measures of a programme (398 bytes measured
+/// for the straight stent, 412 for the bend; 472 and 462 here).
+fn state_message_bytes(model: &Model) -> Real {
+    200.0
+        + 30.0 * load_channels(model).len() as Real
+        + 22.0 * 6.0
+        + 100.0 * model.probes.len() as Real
+        + if model.programme.is_some() {
+            110.0
+        } else {
+            0.0
+        }
+}
 
 /// The recording's file name in the run folder.
 const MCAP_FILE: &str = "run.mcap";

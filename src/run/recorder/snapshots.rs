@@ -1,5 +1,5 @@
 //! The snapshots as a recorder: [`crate::io::snapshots`]' tube meshes and fields, with the configuration figures
-//! drawn when the run ends; its position the snapshots written.
+//! drawn when the run ends; its position the snapshots written; its estimate the files of each snapshot by kind.
 
 use super::{Finishing, Recorder, RecorderKind, damaged};
 use crate::io::checkpoint::{Decoder, Encoder, Problem};
@@ -9,6 +9,7 @@ use crate::math::Real;
 use crate::math::quote::short_time;
 use crate::model::cycle::Phase;
 use crate::run::RunError;
+use crate::run::estimate::{DiskPart, Sizing, digits};
 use crate::solver::Simulation;
 use std::path::{Path, PathBuf};
 
@@ -48,7 +49,81 @@ pub(super) const SNAPSHOTS: RecorderKind = RecorderKind {
             .resumed(written, last);
         Ok(Box::new(writer))
     },
+    estimate: |s| {
+        let files = estimated_files(s);
+        DiskPart {
+            files: files.to_vec(),
+            advice: Some((
+                "output.snapshots",
+                "take fewer snapshots (fewer `between` or `times`, a larger `every`) or smaller ones (fewer `rings`, `segments`, one of the `formats`)",
+            )),
+            ..DiskPart::new(
+                format!("{} snapshots", s.snapshots),
+                files.iter().map(|&(_, bytes)| bytes).sum(),
+            )
+        }
+    },
 };
+
+/// Bytes of an OBJ `v x y z` line: three coordinates in Rust's shortest round-trip form, each with a sign,
+/// two integer digits and up to 16 decimals, 62 in all. Measured on the straight stent: 57 on average, 67
+/// at most.
+const OBJ_VERTEX_LINE_BYTES: Real = 62.0;
+
+/// Bytes of an OBJ file's comment lines besides the design name: about 150 (144 for the straight stent).
+const OBJ_HEADER_BYTES: Real = 200.0;
+
+/// Bytes of a field file besides its arrays: the XML of 18 arrays with their units (4.1 kB measured).
+const VTP_FIXED_BYTES: Real = 6_000.0;
+
+/// Bytes of a `run.pvd` line (about 100 measured).
+const PVD_LINE_BYTES: Real = 120.0;
+
+/// The snapshots' files by kind \[bytes\]: the binary STL and OBJ files of all snapshots, their field files and
+/// `run.pvd` ([`crate::io::vtk`]), and the vessel's lumen, `snapshots/vessel_lumen.stl`, for a stent on a file
+/// centreline with a lumen radius ([`crate::io::snapshots::VESSEL_FILE`]).
+fn estimated_files(s: &Sizing<'_>) -> [(&'static str, u64); 4] {
+    let model = s.model();
+    let snapshot = &s.design.output.snapshots;
+    let count = s.snapshots as Real;
+    let (vertices, triangles) = s.tube_mesh(snapshot.rings, snapshot.segments);
+    let written = |extension: &str| {
+        if snapshot.formats.contains(&extension) {
+            count
+        } else {
+            0.0
+        }
+    };
+    let stl = written("stl") * (84.0 + 50.0 * triangles);
+    let obj = written("obj")
+        * (OBJ_HEADER_BYTES
+            + model.name.len() as Real
+            + vertices * OBJ_VERTEX_LINE_BYTES
+            + triangles * (3.0 * digits(vertices) + 5.0));
+    // The field files: per collocation point three coordinates, 34 field values and a connectivity entry,
+    // 8 bytes each in base64 (4/3), plus the XML; run.pvd a line per snapshot.
+    let vtp = if snapshot.vtk {
+        let points: usize = model.patches.iter().map(|p| p.curve.num_points()).sum();
+        count * (VTP_FIXED_BYTES + points as Real * 38.0 * 8.0 * 4.0 / 3.0 + PVD_LINE_BYTES)
+    } else {
+        0.0
+    };
+    // The vessel's lumen, written once with the first snapshot: a closed tube of the vessel's rings.
+    let lumen = match &model.vessel {
+        Some(vessel) if vessel.radius.is_some() => {
+            let rings = vessel.points.len() as Real;
+            let m = snapshot.segments as Real;
+            84.0 + 50.0 * (2.0 * m * rings)
+        }
+        _ => 0.0,
+    };
+    [
+        ("STL", stl as u64),
+        ("OBJ", obj as u64),
+        ("fields", vtp as u64),
+        ("vessel lumen", lumen as u64),
+    ]
+}
 
 type SnapshotsPosition = (Vec<Snapshot>, Option<(usize, Real)>);
 
