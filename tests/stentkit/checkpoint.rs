@@ -91,7 +91,7 @@ fn a_restored_simulation_continues_bit_for_bit() {
                 first.step().expect("steps").expect("not at the end");
             }
             let checkpoint = first.checkpoint();
-            assert_eq!(checkpoint.step, at);
+            assert_eq!(checkpoint.snapshot.clock.step, at);
             // The original goes on (its factorisation, state and history change), then is rewound.
             let ahead = finish(&mut first);
             assert_eq!(
@@ -112,7 +112,7 @@ fn a_restored_simulation_continues_bit_for_bit() {
             // A new simulation of the same model.
             let mut second = Simulation::new(&model).expect("simulation");
             second.restore(&checkpoint).expect("same model");
-            assert_eq!(second.time(), checkpoint.time);
+            assert_eq!(second.time(), checkpoint.snapshot.clock.time);
             assert_eq!(second.checkpoint(), checkpoint, "restoring changes nothing");
             let resumed = finish(&mut second);
             assert_eq!(
@@ -130,7 +130,7 @@ fn a_restored_simulation_continues_bit_for_bit() {
             println!(
                 "{}: restored at step {at} (t = {}, factorisation {}), {} more steps bit for bit",
                 model.name,
-                checkpoint.time,
+                checkpoint.snapshot.clock.time,
                 if checkpoint.tangent.is_some() {
                     "rebuilt"
                 } else {
