@@ -29,8 +29,8 @@
 //! (`io::checkpoint`); this module owns no format.
 
 use super::Simulation;
-use super::snapshot::{Restorable, StepSnapshot};
 use super::timing::SolverTiming;
+use super::{Restorable, StepSnapshot};
 use crate::material::{ConstitutiveLaw, LAW_NUMBERS, MaterialError, MaterialState, SectionLaw};
 use crate::math::{Real, Vec3};
 use crate::model::Model;
@@ -440,7 +440,7 @@ impl Simulation<'_> {
     /// Puts the states `values` (one per term, saved by [`PointTerm::save`] from these very terms or checked
     /// when a checkpoint was restored) into the terms.
     fn swap_term_states(&mut self, values: &[Vec<Real>]) {
-        let restored = super::snapshot::restore_terms(&mut self.terms, values);
+        let restored = super::restore_terms(&mut self.terms, values);
         assert!(
             restored.is_ok(),
             "a state a term saved or that a restore checked is refused: {restored:?}"

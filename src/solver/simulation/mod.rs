@@ -119,6 +119,7 @@ use super::terms::{Constraint, PointTerm, Terms};
 use crate::math::{Real, Vec3};
 use crate::model::{Model, ProbeLocation};
 use constitutive::PointMaterials;
+use snapshot::{Restorable, restore_terms};
 
 /// A running simulation of one model: a composition of parts (module docs), each in its own module.
 pub struct Simulation<'m> {

@@ -1,8 +1,7 @@
 //! Release ramps (a released component's reaction, captured before the step that releases it) and the gauge
 //! constraints switched on by a programme's release.
 
-use super::snapshot::Restorable;
-use super::{CheckpointError, Simulation, patch_ranges};
+use super::{CheckpointError, Restorable, Simulation, patch_ranges};
 use crate::math::{Real, Vec3};
 use crate::solver::SolverError;
 use crate::solver::assembly::{

@@ -17,11 +17,7 @@
 //! calls, costs no copy per attempt), and a checkpoint saves them through the same interface
 //! ([`crate::material::ConstitutiveLaw::save_state`]).
 
-use super::arclength::ArcState;
-use super::clock::Clock;
-use super::releases::ReleaseSnapshot;
-use super::solution::SolutionSnapshot;
-use super::{CheckpointError, Simulation};
+use super::{ArcState, CheckpointError, Clock, ReleaseSnapshot, Simulation, SolutionSnapshot};
 use crate::math::Real;
 use crate::solver::terms::PointTerm;
 

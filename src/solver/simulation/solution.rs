@@ -1,8 +1,7 @@
 //! The solution of a simulation: the last converged configuration and the increments that predict the next
 //! step's.
 
-use super::CheckpointError;
-use super::snapshot::Restorable;
+use super::{CheckpointError, Restorable};
 use crate::math::Real;
 use crate::solver::discretisation::Discretisation;
 use crate::solver::state::State;
