@@ -392,10 +392,7 @@ impl Simulation<'_> {
             self.refactor_recorded()?;
         }
         self.releases.gauge_active &= self.releases.gauge.is_some();
-        let multipliers = match (&self.releases.gauge, self.releases.gauge_active) {
-            (Some((g, _, _)), true) => g.len(),
-            _ => 0,
-        };
+        let multipliers = self.releases.active_gauge().map_or(0, |g| g.len());
         if self.solution.state.multipliers.len() != multipliers {
             return Err(CheckpointError::Size {
                 what: "gauge multipliers",
