@@ -10,7 +10,8 @@
 //!
 //! A new part that a step changes is one more field here and one more `impl Restorable`; [`Simulation::snapshot`]
 //! builds the struct and [`Simulation::put_back`] takes it apart field by field (a pattern without `..`), so
-//! the compiler asks for the new field on both paths at once.
+//! the compiler asks for the new field on both paths at once. The checkpoint file (`io::checkpoint`) then
+//! encodes and decodes the new field, under a new format version.
 //!
 //! The materials' internal variables are the one thing a step changes that is not here: a material keeps the
 //! data of its last converged step itself ([`crate::material::ConstitutiveLaw::roll_back`], which a roll-back
