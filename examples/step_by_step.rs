@@ -58,8 +58,8 @@ fn main() -> Result<(), Box<dyn Error>> {
     let checkpoint = sim.checkpoint();
     println!(
         "checkpoint at step {} (t = {} s): {} materials' states, factorisation {}",
-        checkpoint.step,
-        checkpoint.time,
+        checkpoint.snapshot.clock.step,
+        checkpoint.snapshot.clock.time,
         checkpoint.materials.len(),
         if checkpoint.tangent.is_some() {
             "to rebuild"

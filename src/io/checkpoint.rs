@@ -35,7 +35,10 @@ use crate::material::LAW_NUMBERS;
 use crate::math::{Mat3, Real, Vec3};
 use crate::solver::assembly::{Actions, ReleaseRamp};
 use crate::solver::simulation::adaptive::StepControl;
-use crate::solver::simulation::{ArcState, StabiliserState, TangentOrigin};
+use crate::solver::simulation::{
+    ArcState, Clock, ReleaseSnapshot, SolutionSnapshot, StabiliserState, StepSnapshot,
+    TangentOrigin,
+};
 use crate::solver::state::State;
 use crate::solver::{Checkpoint, RunSummary, SolverTiming};
 use std::path::{Path, PathBuf};
@@ -548,15 +551,16 @@ fn decode_timing(d: &mut Decoder<'_>) -> Result<SolverTiming, Problem> {
 }
 
 fn encode_solver(e: &mut Encoder, c: &Checkpoint) {
+    let step = &c.snapshot;
     e.u64(c.model);
-    e.f64(c.time);
-    e.usize(c.step);
-    e.f64(c.step_size);
-    e.usize(c.step_cuts);
-    e.option(c.control.previous_ratio.as_ref(), |e, r| e.f64(*r));
-    e.usize(c.control.rejections);
-    e.bool(c.control.above_tolerance_reported);
-    encode_state(e, &c.state);
+    e.f64(step.clock.time);
+    e.usize(step.clock.step);
+    e.f64(step.clock.step_size);
+    e.usize(step.clock.step_cuts);
+    e.option(step.clock.control.previous_ratio.as_ref(), |e, r| e.f64(*r));
+    e.usize(step.clock.control.rejections);
+    e.bool(step.clock.control.above_tolerance_reported);
+    encode_state(e, &step.solution.state);
     e.list(&c.materials, |e, (material, values)| {
         e.usize(*material);
         e.f64s(values);
@@ -567,18 +571,21 @@ fn encode_solver(e: &mut Encoder, c: &Checkpoint) {
     });
     e.list(&c.notices, |e, n| e.str(n));
     e.bool(c.round_off_reported);
-    encode_ramps(e, &c.ramps);
+    encode_ramps(e, &step.releases.ramps);
     e.option(c.gauge.as_ref(), |e, frozen| {
         e.list(frozen, |e, (node, x)| {
             e.usize(*node);
             e.vec3(x);
         });
     });
-    e.bool(c.gauge_active);
-    e.option(c.last_increment.as_ref(), |e, (increment, h)| {
-        e.f64s(increment);
-        e.f64(*h);
-    });
+    e.bool(step.releases.gauge_active);
+    e.option(
+        step.solution.last_increment.as_ref(),
+        |e, (increment, h)| {
+            e.f64s(increment);
+            e.f64(*h);
+        },
+    );
     e.option(c.tangent.as_ref(), |e, t| {
         encode_state(e, &t.state);
         e.list(&t.laws, |e, law| {
@@ -591,7 +598,7 @@ fn encode_solver(e: &mut Encoder, c: &Checkpoint) {
         e.list(&t.terms, |e, v| e.f64s(v));
     });
     encode_timing(e, &c.timing);
-    e.option(c.arc.as_ref(), |e, a| {
+    e.option(step.arc.as_ref(), |e, a| {
         e.f64(a.load_factor);
         e.f64(a.arc);
         e.f64(a.first_arc);
@@ -615,12 +622,13 @@ fn encode_solver(e: &mut Encoder, c: &Checkpoint) {
     e.usize(s.steps_above_force_limit);
     e.usize(s.unscaled_stalls);
     e.f64(s.first_unscaled_time);
-    e.list(&c.terms, |e, t| e.f64s(t));
+    e.list(&step.terms, |e, t| e.f64s(t));
 }
 
 fn decode_solver(d: &mut Decoder<'_>) -> Result<Checkpoint, Problem> {
-    Ok(Checkpoint {
-        model: d.u64()?,
+    // In the order of the file (`encode_solver`), then put together.
+    let model = d.u64()?;
+    let clock = Clock {
         time: d.f64()?,
         step: d.usize()?,
         step_size: d.f64()?,
@@ -630,56 +638,80 @@ fn decode_solver(d: &mut Decoder<'_>) -> Result<Checkpoint, Problem> {
             rejections: d.usize()?,
             above_tolerance_reported: d.bool()?,
         },
-        state: decode_state(d)?,
-        materials: d.list(16, |d| Ok((d.usize()?, d.f64s()?)))?,
-        material_notices: d.list(16, |d| Ok((d.usize()?, d.str()?)))?,
-        notices: d.list(8, |d| d.str())?,
-        round_off_reported: d.bool()?,
-        ramps: decode_ramps(d)?,
-        gauge: d.option(|d| d.list(32, |d| Ok((d.usize()?, d.vec3()?))))?,
-        gauge_active: d.bool()?,
-        last_increment: d.option(|d| Ok((d.f64s()?, d.f64()?)))?,
-        tangent: d.option(|d| {
-            Ok(TangentOrigin {
-                state: decode_state(d)?,
-                laws: d.list(8 * LAW_NUMBERS, |d| {
-                    let mut law = [0.0; LAW_NUMBERS];
-                    for x in &mut law {
-                        *x = d.f64()?;
-                    }
-                    Ok(law)
-                })?,
-                actions: decode_actions(d)?,
-                gauge_active: d.bool()?,
-                terms: d.list(8, |d| d.f64s())?,
-            })
-        })?,
-        timing: decode_timing(d)?,
-        arc: d.option(|d| {
-            Ok(ArcState {
-                load_factor: d.f64()?,
-                arc: d.f64()?,
-                first_arc: d.f64()?,
-                previous: d.option(|d| Ok((d.f64s()?, d.f64()?)))?,
-                reached_end: d.bool()?,
-            })
-        })?,
-        stabiliser: StabiliserState {
-            factor: d.option(|d| d.f64())?,
-            escalations: d.usize()?,
-            base_factor: d.f64()?,
-            dissipated: d.f64()?,
-            peak_strain_energy: d.f64()?,
-            largest_step_ratio: d.f64()?,
-            damped_steps: d.usize()?,
-            energy_limit_time: d.option(|d| d.f64())?,
-            largest_force_share: d.f64()?,
-            largest_force_share_time: d.f64()?,
-            steps_above_force_limit: d.usize()?,
-            unscaled_stalls: d.usize()?,
-            first_unscaled_time: d.f64()?,
+    };
+    let state = decode_state(d)?;
+    let materials = d.list(16, |d| Ok((d.usize()?, d.f64s()?)))?;
+    let material_notices = d.list(16, |d| Ok((d.usize()?, d.str()?)))?;
+    let notices = d.list(8, |d| d.str())?;
+    let round_off_reported = d.bool()?;
+    let ramps = decode_ramps(d)?;
+    let gauge = d.option(|d| d.list(32, |d| Ok((d.usize()?, d.vec3()?))))?;
+    let gauge_active = d.bool()?;
+    let last_increment = d.option(|d| Ok((d.f64s()?, d.f64()?)))?;
+    let tangent = d.option(|d| {
+        Ok(TangentOrigin {
+            state: decode_state(d)?,
+            laws: d.list(8 * LAW_NUMBERS, |d| {
+                let mut law = [0.0; LAW_NUMBERS];
+                for x in &mut law {
+                    *x = d.f64()?;
+                }
+                Ok(law)
+            })?,
+            actions: decode_actions(d)?,
+            gauge_active: d.bool()?,
+            terms: d.list(8, |d| d.f64s())?,
+        })
+    })?;
+    let timing = decode_timing(d)?;
+    let arc = d.option(|d| {
+        Ok(ArcState {
+            load_factor: d.f64()?,
+            arc: d.f64()?,
+            first_arc: d.f64()?,
+            previous: d.option(|d| Ok((d.f64s()?, d.f64()?)))?,
+            reached_end: d.bool()?,
+        })
+    })?;
+    let stabiliser = StabiliserState {
+        factor: d.option(|d| d.f64())?,
+        escalations: d.usize()?,
+        base_factor: d.f64()?,
+        dissipated: d.f64()?,
+        peak_strain_energy: d.f64()?,
+        largest_step_ratio: d.f64()?,
+        damped_steps: d.usize()?,
+        energy_limit_time: d.option(|d| d.f64())?,
+        largest_force_share: d.f64()?,
+        largest_force_share_time: d.f64()?,
+        steps_above_force_limit: d.usize()?,
+        unscaled_stalls: d.usize()?,
+        first_unscaled_time: d.f64()?,
+    };
+    let terms = d.list(8, |d| d.f64s())?;
+    Ok(Checkpoint {
+        model,
+        snapshot: StepSnapshot {
+            clock,
+            solution: SolutionSnapshot {
+                state,
+                last_increment,
+            },
+            releases: ReleaseSnapshot {
+                ramps,
+                gauge_active,
+            },
+            arc,
+            terms,
         },
-        terms: d.list(8, |d| d.f64s())?,
+        materials,
+        material_notices,
+        notices,
+        round_off_reported,
+        gauge,
+        tangent,
+        timing,
+        stabiliser,
     })
 }
 
@@ -745,38 +777,54 @@ mod tests {
         };
         let solver = Checkpoint {
             model: 0x0123_4567_89ab_cdef,
-            time: 1.75,
-            step: 700,
-            step_size: 2.5e-3 / 4.0,
-            step_cuts: 0,
-            control: StepControl {
-                previous_ratio: Some(0.25),
-                rejections: 2,
-                above_tolerance_reported: true,
+            snapshot: StepSnapshot {
+                clock: Clock {
+                    time: 1.75,
+                    step: 700,
+                    step_size: 2.5e-3 / 4.0,
+                    step_cuts: 0,
+                    control: StepControl {
+                        previous_ratio: Some(0.25),
+                        rejections: 2,
+                        above_tolerance_reported: true,
+                    },
+                },
+                solution: SolutionSnapshot {
+                    state: state.clone(),
+                    last_increment: Some((vec![0.5; 12], 2.5e-3)),
+                },
+                releases: ReleaseSnapshot {
+                    ramps: vec![
+                        [
+                            None,
+                            Some(ReleaseRamp {
+                                reaction: 3.0,
+                                start: 1.75,
+                                duration: 2.5e-3
+                            }),
+                            None,
+                            None,
+                            None,
+                            None
+                        ];
+                        2
+                    ],
+                    gauge_active: true,
+                },
+                arc: Some(ArcState {
+                    load_factor: -0.25,
+                    arc: 0.125,
+                    first_arc: 0.0625,
+                    previous: Some((vec![1.5; 12], -0.5)),
+                    reached_end: false,
+                }),
+                terms: vec![Vec::new(), vec![1.5, -0.0, f64::MIN_POSITIVE]],
             },
-            state: state.clone(),
             materials: vec![(0, vec![1.0, 2.0, Real::NAN]), (2, vec![])],
             material_notices: vec![(0, "relaxation_frozen".into())],
             notices: vec!["at t = 1 …".into()],
             round_off_reported: true,
-            ramps: vec![
-                [
-                    None,
-                    Some(ReleaseRamp {
-                        reaction: 3.0,
-                        start: 1.75,
-                        duration: 2.5e-3
-                    }),
-                    None,
-                    None,
-                    None,
-                    None
-                ];
-                2
-            ],
             gauge: Some(vec![(1, Vec3::new(1.0, 2.0, 3.0))]),
-            gauge_active: true,
-            last_increment: Some((vec![0.5; 12], 2.5e-3)),
             tangent: Some(TangentOrigin {
                 state,
                 laws: vec![[0.25; LAW_NUMBERS]; 2],
@@ -794,13 +842,6 @@ mod tests {
                 residual: (3, 0.5),
                 ..SolverTiming::default()
             },
-            arc: Some(ArcState {
-                load_factor: -0.25,
-                arc: 0.125,
-                first_arc: 0.0625,
-                previous: Some((vec![1.5; 12], -0.5)),
-                reached_end: false,
-            }),
             stabiliser: StabiliserState {
                 factor: Some(2.5e-6),
                 escalations: 2,
@@ -816,7 +857,6 @@ mod tests {
                 unscaled_stalls: 2,
                 first_unscaled_time: 0.5,
             },
-            terms: vec![Vec::new(), vec![1.5, -0.0, f64::MIN_POSITIVE]],
         };
         let outputs = OutputsCheckpoint {
             settings: 42,
@@ -866,7 +906,7 @@ mod tests {
         b.solver.materials.clear();
         assert_eq!(a, b);
         assert_eq!(
-            back.solver.state.control[0].y.to_bits(),
+            back.solver.snapshot.solution.state.control[0].y.to_bits(),
             (-0.0 as Real).to_bits()
         );
     }

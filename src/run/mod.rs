@@ -338,7 +338,7 @@ fn resume(
     }
     for kind in RECORDERS {
         let position = saved_position(&saved.outputs, kind)?;
-        (kind.check_resume)(dir, position, saved.solver.step)?;
+        (kind.check_resume)(dir, position, saved.solver.snapshot.clock.step)?;
     }
     // Every check passed: only now is anything written (the lock, stale temporaries removed).
     let folder = fit.open().map_err(refused)?;
@@ -346,8 +346,8 @@ fn resume(
         console.say(&format!(
             "stentkit run: resuming {} from its checkpoint at step {} (t = {} s)",
             dir.display(),
-            saved.solver.step,
-            short_time(saved.solver.time)
+            saved.solver.snapshot.clock.step,
+            short_time(saved.solver.snapshot.clock.time)
         ));
     }
     run_in(design, &folder, settings, interrupt, console, Some(saved))

@@ -88,7 +88,7 @@ fn a_restored_simulation_continues_bit_for_bit() {
                 first.step().expect("steps").expect("not at the end");
             }
             let checkpoint = first.checkpoint();
-            assert_eq!(checkpoint.step, at);
+            assert_eq!(checkpoint.snapshot.clock.step, at);
             // The original goes on (its factorisation, state and history change), then is rewound.
             let ahead = finish(&mut first);
             assert_eq!(
@@ -109,7 +109,7 @@ fn a_restored_simulation_continues_bit_for_bit() {
             // A new simulation of the same model.
             let mut second = Simulation::new(&model).expect("simulation");
             second.restore(&checkpoint).expect("same model");
-            assert_eq!(second.time(), checkpoint.time);
+            assert_eq!(second.time(), checkpoint.snapshot.clock.time);
             assert_eq!(second.checkpoint(), checkpoint, "restoring changes nothing");
             let resumed = finish(&mut second);
             assert_eq!(
@@ -127,7 +127,7 @@ fn a_restored_simulation_continues_bit_for_bit() {
             println!(
                 "{}: restored at step {at} (t = {}, factorisation {}), {} more steps bit for bit",
                 model.name,
-                checkpoint.time,
+                checkpoint.snapshot.clock.time,
                 if checkpoint.tangent.is_some() {
                     "rebuilt"
                 } else {
@@ -236,5 +236,53 @@ fn an_interrupted_simulation_continues_bit_for_bit() {
     }
     println!(
         "12 interruptions, {kept} with a factorisation to keep or make again, all continued bit for bit"
+    );
+}
+
+/// An abandoned attempt puts back everything a step changes: interrupted within the first step of the stent's
+/// release snap (step 176, 1.75 → 1.76 s: the captured reactions start to fall, Newton iterates the rods and the
+/// gauge constraints' multipliers), the simulation's [`stentkit::solver::StepSnapshot`] — clock, configuration
+/// with its multipliers, last increment, ramps, gauge activity, arc-length and terms' states — equals the one
+/// before the step. The step taken afterwards changes the configuration, multipliers included, so the
+/// comparison is not of parts the step leaves alone.
+/// Source: the roll-back's contract (`solver::simulation::snapshot`); exact comparison, no tolerance.
+#[test]
+fn an_abandoned_attempt_puts_back_everything_a_step_changes() {
+    let model = small_stent();
+    let mut sim = Simulation::new(&model).expect("simulation");
+    for _ in 0..175 {
+        sim.step().expect("steps").expect("not at the end");
+    }
+    let before = sim.checkpoint();
+    assert_eq!(before.snapshot.clock.time, 1.75);
+    assert!(before.gauge.is_some() && before.snapshot.releases.gauge_active);
+    let ramps = |c: &stentkit::solver::Checkpoint| {
+        c.snapshot.releases.ramps.iter().flatten().flatten().count()
+    };
+    assert!(ramps(&before) > 0, "the release reactions are captured");
+    // Poll 1 is before the attempt; polls 2 and 3 come before Newton iterations within it.
+    for at in [2, 3] {
+        let mut observer = InterruptAt {
+            polls: std::cell::Cell::new(0),
+            at,
+        };
+        let outcome = sim.step_with(&mut observer).expect("steps");
+        assert_eq!(outcome, StepOutcome::Interrupted, "poll {at}");
+        assert_eq!(
+            sim.checkpoint().snapshot,
+            before.snapshot,
+            "interrupted at poll {at}"
+        );
+    }
+    let report = sim.step().expect("steps").expect("not at the end");
+    assert!(report.newton.iterations >= 2, "{report:?}");
+    let stepped = sim.checkpoint().snapshot.solution;
+    assert_ne!(
+        stepped.state.control,
+        before.snapshot.solution.state.control
+    );
+    assert_ne!(
+        stepped.state.multipliers,
+        before.snapshot.solution.state.multipliers
     );
 }

@@ -137,21 +137,18 @@ impl Simulation<'_> {
         if !any {
             return Ok(None);
         }
-        let actions = Actions::at(model, t_np1, &self.ramps);
+        let actions = Actions::at(model, t_np1, &self.releases.ramps);
         if !self.active_system().0.is_factored() {
             self.linearise(&actions, true)?;
             self.factor_tangent()?;
         }
-        let gauge = match (&self.gauge, self.gauge_active) {
-            (Some((g, _, _)), true) => Some(g),
-            _ => None,
-        };
-        let damping = super::stabilisation::view(&self.damping);
+        let gauge = self.releases.active_gauge();
+        let damping = super::stabilisation::view(&self.stabiliser.damping);
         let (point, constraints) = super::assembly_terms(&self.terms, damping.as_ref(), gauge);
         self.assembler.assemble(
             &Assembly {
                 disc: &self.disc,
-                state: &self.state,
+                state: &self.solution.state,
                 material: StepMaterial { laws: &laws },
                 actions: &actions,
                 terms: Terms {
@@ -159,7 +156,7 @@ impl Simulation<'_> {
                     constraints: &constraints,
                 },
             },
-            &mut self.lin,
+            &mut self.work.lin,
             &mut Sink::Discard,
         );
         self.solve_increment();
@@ -172,7 +169,7 @@ impl Simulation<'_> {
     /// the strain that carries it (`ΔN/C̄_N`, `ΔM/C̄_M` times the patch length: a rotation), largest over the
     /// points (module docs, *Estimate*: where nodes are held it is what the configuration cannot show).
     fn held_stress_error(&self, companion: &[SectionLaw]) -> Real {
-        let (disc, state) = (&self.disc, &self.state);
+        let (disc, state) = (&self.disc, &self.solution.state);
         let mut largest: Real = 0.0;
         for (g, (law, other)) in self.materials.laws.iter().zip(companion).enumerate() {
             if law == other {
@@ -181,7 +178,7 @@ impl Simulation<'_> {
             let strain = point_strains(disc, state, g);
             let (a, b) = (law.stress(&strain), other.stress(&strain));
             let (c_n, c_m) = law.stiffness();
-            let length = self.control_length[disc.patches[disc.points[g].patch].offset];
+            let length = self.measures.control_length[disc.patches[disc.points[g].patch].offset];
             for i in 0..3 {
                 largest = largest
                     .max(((a.force[i] - b.force[i]) / c_n[i]).abs())

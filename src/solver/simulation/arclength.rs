@@ -34,13 +34,12 @@
 
 use super::newton::NewtonFailure;
 use super::report::NewtonReport;
-use super::stepping::StepOutcome;
+use super::stepping::{Abandon, StepOutcome};
 use super::{Observer, Simulation, StepReport};
 use crate::math::Real;
 use crate::model::{ArcConstraint, ArcLengthSettings, PathControl};
 use crate::solver::SolverError;
 use crate::solver::assembly::Actions;
-use crate::solver::state::State;
 
 /// Where an arc-length run is on its path.
 #[derive(Debug, Clone, PartialEq, Default)]
@@ -109,7 +108,7 @@ impl Simulation<'_> {
     /// arc-length path (whose loads are those at `time.end` scaled by the load factor, [`Self::load_scale`]).
     pub fn schedule_time(&self) -> Real {
         match self.model.solver().path {
-            PathControl::Time => self.time,
+            PathControl::Time => self.clock.time,
             PathControl::ArcLength(_) => self.model.time().end,
         }
     }
@@ -125,7 +124,8 @@ impl Simulation<'_> {
 
     /// Whether an arc-length run is over: the end load factor reached, or the increments allowed taken.
     pub(super) fn arc_length_finished(&self, settings: &ArcLengthSettings) -> bool {
-        self.arc.as_ref().is_some_and(|a| a.reached_end) || self.step >= settings.max_increments
+        self.arc.as_ref().is_some_and(|a| a.reached_end)
+            || self.clock.step >= settings.max_increments
     }
 
     /// The weighted inner product of two vectors of unknowns: translations over their patch's length,
@@ -139,7 +139,7 @@ impl Simulation<'_> {
             .zip(b[..n].chunks_exact(6))
             .enumerate()
         {
-            let w = 1.0 / (self.control_length[j] * self.control_length[j]);
+            let w = 1.0 / (self.measures.control_length[j] * self.measures.control_length[j]);
             for i in 0..3 {
                 sum += w * x[i] * y[i] + x[i + 3] * y[i + 3];
             }
@@ -172,13 +172,13 @@ impl Simulation<'_> {
     ) -> Result<StepOutcome, SolverError> {
         let end_time = self.model.time().end;
         let min_ratio = self.model.time().min_step / self.model.time().step;
-        let reference = Actions::at(self.model, end_time, &self.ramps);
+        let reference = Actions::at(self.model, end_time, &self.releases.ramps);
         loop {
             if observer.interrupted() {
                 return Ok(StepOutcome::Interrupted);
             }
             let (lambda0, ds) = (state.load_factor, state.arc);
-            let start = self.state.clone();
+            let start = self.begin_attempt();
             self.prepare_step(end_time, end_time)?;
             let attempt = self
                 .arc_increment(&reference, settings, state, Constraint::Arc(ds), observer)
@@ -187,7 +187,7 @@ impl Simulation<'_> {
                     let end = settings.end_load_factor;
                     let lambda = lambda0 + inc.dlambda;
                     if (lambda0 - end) * (lambda - end) <= 0.0 {
-                        self.state = start.clone();
+                        self.solution.state = start.solution.state.clone();
                         self.arc_increment(
                             &reference,
                             settings,
@@ -202,10 +202,11 @@ impl Simulation<'_> {
                 });
             match attempt {
                 Ok((inc, landed)) => {
+                    self.work.tangent.end_attempt();
                     self.commit_step();
-                    self.step += 1;
+                    self.clock.step += 1;
                     let ds = self.arc_dot(&inc.dx, &inc.dx).sqrt();
-                    self.time += ds;
+                    self.clock.time += ds;
                     state.load_factor += inc.dlambda;
                     state.reached_end = landed;
                     let growth = (settings.target_iterations as Real
@@ -215,19 +216,19 @@ impl Simulation<'_> {
                     state.arc = (state.arc * growth).min(settings.max_growth * state.first_arc);
                     state.previous = Some((inc.dx, inc.dlambda));
                     let report = StepReport {
-                        step: self.step,
-                        time: self.time,
+                        step: self.clock.step,
+                        time: self.clock.time,
                         dt: ds,
                         temperature: self.model.temperature.value(end_time),
                         newton: inc.newton,
-                        cuts: std::mem::take(&mut self.step_cuts),
+                        cuts: std::mem::take(&mut self.clock.step_cuts),
                         error_estimate: None,
                         rejected: 0,
                         load_factor: Some(state.load_factor),
                         stabilisation: None,
                     };
-                    if !landed && self.step >= settings.max_increments {
-                        self.notices.push(format!(
+                    if !landed && self.clock.step >= settings.max_increments {
+                        self.record.notices.push(format!(
                             "the arc-length path stopped after its {} increments allowed at load factor {:.6} without reaching the end load factor {} (raise `solver.arc_length.max_increments`)",
                             settings.max_increments, state.load_factor, settings.end_load_factor
                         ));
@@ -235,21 +236,21 @@ impl Simulation<'_> {
                     return Ok(StepOutcome::Stepped(Box::new(report)));
                 }
                 Err(NewtonFailure::Fatal(e)) => {
-                    self.abandon_increment(start);
+                    self.roll_back(&start, Abandon::Failed);
                     return Err(e);
                 }
                 Err(NewtonFailure::Interrupted) => {
-                    self.abandon_increment(start);
+                    self.roll_back(&start, Abandon::Failed);
                     return Ok(StepOutcome::Interrupted);
                 }
                 Err(NewtonFailure::NotConverged(mut newton)) => {
                     newton.worst_equation = self.worst_equation();
-                    self.abandon_increment(start);
-                    observer.step_failed(self.time + state.arc, state.arc, &newton);
+                    self.roll_back(&start, Abandon::Failed);
+                    observer.step_failed(self.clock.time + state.arc, state.arc, &newton);
                     if state.arc <= state.first_arc * min_ratio * (1.0 + 1e-12) {
                         return Err(SolverError::StepFailed {
-                            time: self.time + state.arc,
-                            step: self.step + 1,
+                            time: self.clock.time + state.arc,
+                            step: self.clock.step + 1,
                             dt: state.arc,
                             iterations: newton.iterations,
                             residuals: newton.residuals,
@@ -263,7 +264,7 @@ impl Simulation<'_> {
                         });
                     }
                     state.arc = (0.5 * state.arc).max(state.first_arc * min_ratio);
-                    self.step_cuts += 1;
+                    self.clock.step_cuts += 1;
                 }
             }
         }
@@ -315,17 +316,17 @@ impl Simulation<'_> {
             if corrections >= self.model.solver().max_iterations {
                 return Err(NewtonFailure::NotConverged(report));
             }
-            // q = ∂R/∂λ, then the residual and tangent at λ (kept in `self.lin`).
+            // q = ∂R/∂λ, then the residual and tangent at λ (kept in `self.work.lin`).
             self.linearise(&reference.scaled(lambda + 1.0), false)
                 .map_err(NewtonFailure::Fatal)?;
-            let shifted = self.lin.residual.clone();
+            let shifted = self.work.lin.residual.clone();
             self.linearise(&reference.scaled(lambda), true)
                 .map_err(NewtonFailure::Fatal)?;
             self.factor_tangent().map_err(NewtonFailure::Fatal)?;
             report.factorisations += 1;
             let mut dx_q: Vec<Real> = shifted
                 .iter()
-                .zip(&self.lin.residual)
+                .zip(&self.work.lin.residual)
                 .map(|(s, r)| -(s - r))
                 .collect();
             self.solve_in_place(&mut dx_q);
@@ -359,12 +360,12 @@ impl Simulation<'_> {
                     }
                 }
             } else {
-                // δx_R = −K⁻¹ R, the residual kept in `self.lin`.
+                // δx_R = −K⁻¹ R, the residual kept in `self.work.lin`.
                 self.solve_increment();
                 match constraint {
                     Constraint::Load(_) => 0.0,
                     Constraint::Arc(arc) => {
-                        let dx_r = &self.delta[..n];
+                        let dx_r = &self.work.delta[..n];
                         let base: Vec<Real> = dx.iter().zip(dx_r).map(|(a, b)| a + b).collect();
                         let a = self.arc_dot(&dx_q, &dx_q) + psi2;
                         let b = 2.0 * (self.arc_dot(&base, &dx_q) + psi2 * dlambda);
@@ -388,10 +389,10 @@ impl Simulation<'_> {
             };
             // The increment: the tangent direction scaled by δλ, plus (in corrections) δx_R.
             if predictor {
-                self.delta.clear();
-                self.delta.extend(dx_q.iter().map(|d| d * dl));
+                self.work.delta.clear();
+                self.work.delta.extend(dx_q.iter().map(|d| d * dl));
             } else {
-                for (d, q) in self.delta.iter_mut().zip(&dx_q) {
+                for (d, q) in self.work.delta.iter_mut().zip(&dx_q) {
                     *d += dl * q;
                 }
             }
@@ -399,21 +400,15 @@ impl Simulation<'_> {
             if !predictor {
                 corrections += 1;
             }
-            self.state.apply_increment(&self.disc, &self.delta);
-            for (a, d) in dx.iter_mut().zip(&self.delta) {
+            self.solution
+                .state
+                .apply_increment(&self.disc, &self.work.delta);
+            for (a, d) in dx.iter_mut().zip(&self.work.delta) {
                 *a += d;
             }
             dlambda += dl;
             lambda = lambda0 + dlambda;
         }
-    }
-
-    /// Undoes an abandoned increment: back to its start state `start`, the materials' step rolled back and the
-    /// factorisations forgotten (they belong to its iterates).
-    fn abandon_increment(&mut self, start: State) {
-        self.state = start;
-        self.materials.roll_back(&self.model.materials);
-        self.forget_factorisation();
     }
 }
 

@@ -1,11 +1,13 @@
 //! Checkpoints: the whole state of a simulation at a converged step as a plain value ([`Checkpoint`]), and
 //! the restore that continues from it **bit for bit** as the uninterrupted simulation would.
 //!
-//! What "the whole state" is, beyond the configuration (control points, rotations, curvatures, multipliers)
-//! and the materials' internal variables: the time, step count, step size and cuts of the step in progress;
-//! the release ramps captured and the gauge constraints (their frozen positions) with whether they are active;
-//! the point terms' states ([`crate::solver::terms`]);
-//! the last step's increment (for extrapolation); the notices said and their flags; the solver's timing; and
+//! What "the whole state" is: what a step changes, as the [`StepSnapshot`] that a roll-back also puts back
+//! (the clock — time, step count, step size and cuts of the step in progress, error control —, the
+//! configuration (control points, rotations, curvatures, multipliers) and the last step's increment, the release
+//! ramps captured and whether the gauge constraints are active, the arc-length state, the point terms' states
+//! ([`crate::solver::terms`])); the materials' internal variables; and the records an abandoned attempt does not
+//! undo: the gauge constraints once built (their frozen positions), the notices said and their flags, the
+//! stabiliser's memory, the solver's timing; and
 //! — because Newton reuses a factorisation of the tangent across iterations and steps while it contracts
 //! (`solver.reuse_factorisation`) — what the current factorisation was computed from: the state, the section
 //! laws, the loads, the gauge activity and the terms' states at the iterate where that tangent was assembled
@@ -28,32 +30,25 @@
 
 use super::Simulation;
 use super::timing::SolverTiming;
+use super::{Restorable, StepSnapshot};
 use crate::material::{ConstitutiveLaw, LAW_NUMBERS, MaterialError, MaterialState, SectionLaw};
 use crate::math::{Real, Vec3};
 use crate::model::Model;
 use crate::solver::SolverError;
-use crate::solver::assembly::{Actions, ReleaseRamp};
+use crate::solver::assembly::Actions;
 use crate::solver::state::State;
 use crate::solver::terms::{Constraint, PointTerm};
 
-/// Everything a simulation needs to continue exactly from where it was ([`Simulation::checkpoint`]); plain
-/// data (numbers, vectors, strings), so that any format can store it.
+/// Everything a simulation needs to continue exactly from where it was ([`Simulation::checkpoint`]): what a
+/// step changes ([`StepSnapshot`], the value a roll-back puts back too) and the run's records that an
+/// abandoned attempt does not undo. Plain data (numbers, vectors, strings), so that any format can store it.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Checkpoint {
     /// [`model_fingerprint`] of the model simulated.
     pub model: u64,
-    /// Time reached \[time\].
-    pub time: Real,
-    /// Converged steps.
-    pub step: usize,
-    /// Size of the next step's first attempt \[time\].
-    pub step_size: Real,
-    /// Cuts of the step in progress (0 at a step boundary).
-    pub step_cuts: usize,
-    /// The memory of error-controlled stepping.
-    pub control: super::adaptive::StepControl,
-    /// The configuration.
-    pub state: State,
+    /// What a step changes: clock, configuration, last increment, release ramps and gauge activity,
+    /// arc-length state, point terms' states.
+    pub snapshot: StepSnapshot,
     /// Per material that some patch uses: its index in `Model::materials` and its saved state
     /// ([`ConstitutiveLaw::save_state`]).
     pub materials: Vec<(usize, Vec<Real>)>,
@@ -63,25 +58,14 @@ pub struct Checkpoint {
     pub notices: Vec<String>,
     /// Whether a step accepted at the round-off floor has been reported.
     pub round_off_reported: bool,
-    /// Per node and local component: the release ramp captured, if any.
-    pub ramps: Vec<[Option<ReleaseRamp>; 6]>,
     /// The gauge constraints, if built: the positions they freeze, by node.
     pub gauge: Option<Vec<(usize, Vec3)>>,
-    /// Whether the gauge constraints apply to the step being solved.
-    pub gauge_active: bool,
-    /// The last converged step's total increment and its size \[time\].
-    pub last_increment: Option<(Vec<Real>, Real)>,
     /// What the current factorisation was computed from; `None` when there is none.
     pub tangent: Option<TangentOrigin>,
     /// Where the solver's time went so far.
     pub timing: SolverTiming,
-    /// Where an arc-length run is on its path (`None` for time-driven runs and before the first increment).
-    pub arc: Option<super::ArcState>,
     /// The stabiliser's memory ([`super::stabilisation`]).
     pub stabiliser: super::StabiliserState,
-    /// Per point term of the simulation's list, in its order: the numbers it keeps between steps
-    /// ([`crate::solver::terms::PointTerm::save`]).
-    pub terms: Vec<Vec<Real>>,
 }
 
 /// The iterate at which the current factorisation's tangent was assembled (module docs).
@@ -294,14 +278,16 @@ impl Simulation<'_> {
                 (g.material, values)
             })
             .collect();
-        let active_factored = match (&self.gauge, self.gauge_active) {
+        let active_factored = match (&self.releases.gauge, self.releases.gauge_active) {
             (Some((_, system, _)), true) => system.is_factored(),
-            _ => self.system.is_factored(),
+            _ => self.work.system.is_factored(),
         };
-        let record = &self.tangent.current;
+        let record = &self.work.tangent.current;
         let tangent = match (&record.state, &record.actions) {
             (Some(state), Some(actions))
-                if record.valid && active_factored && record.gauge_active == self.gauge_active =>
+                if record.valid
+                    && active_factored
+                    && record.gauge_active == self.releases.gauge_active =>
             {
                 Some(TangentOrigin {
                     state: state.clone(),
@@ -315,25 +301,19 @@ impl Simulation<'_> {
         };
         Checkpoint {
             model: model_fingerprint(self.model),
-            time: self.time,
-            step: self.step,
-            step_size: self.step_size,
-            step_cuts: self.step_cuts,
-            control: self.control,
-            state: self.state.clone(),
+            snapshot: self.snapshot(),
             materials,
             material_notices: self.materials.said.clone(),
-            notices: self.notices.clone(),
-            round_off_reported: self.round_off_reported,
-            ramps: self.ramps.clone(),
-            gauge: self.gauge.as_ref().map(|(g, _, _)| g.frozen.clone()),
-            gauge_active: self.gauge_active,
-            last_increment: self.last_increment.clone(),
+            notices: self.record.notices.clone(),
+            round_off_reported: self.record.round_off_reported,
+            gauge: self
+                .releases
+                .gauge
+                .as_ref()
+                .map(|(g, _, _)| g.frozen.clone()),
             tangent,
-            timing: self.timing.clone(),
-            arc: self.arc.clone(),
-            stabiliser: self.stabiliser,
-            terms: term_states(&self.terms),
+            timing: self.record.timing.clone(),
+            stabiliser: self.stabiliser.memory,
         }
     }
 
@@ -379,47 +359,29 @@ impl Simulation<'_> {
         }
         self.materials.refresh_laws(&self.model.materials);
         // Each term's state at the tangent's origin is checked by restoring it first (module docs of
-        // `crate::solver::terms`), then the checkpoint's own.
-        let no_origin = Vec::new();
-        let origin_terms = checkpoint.tangent.as_ref().map_or(&no_origin, |t| &t.terms);
-        for (k, (term, values)) in self.terms.iter_mut().zip(&checkpoint.terms).enumerate() {
-            for values in origin_terms.get(k).into_iter().chain([values]) {
-                term.restore(values)
-                    .map_err(|expected| CheckpointError::Term {
-                        term: term.name(),
-                        expected,
-                        found: values.len(),
-                    })?;
-            }
+        // `crate::solver::terms`), then the snapshot's own with every other part a step changes.
+        if let Some(origin) = &checkpoint.tangent {
+            self.terms.restore(&origin.terms)?;
         }
+        self.put_back(&checkpoint.snapshot)?;
         self.materials.said.clone_from(&checkpoint.material_notices);
-        self.time = checkpoint.time;
-        self.step = checkpoint.step;
-        self.step_size = checkpoint.step_size;
-        self.step_cuts = checkpoint.step_cuts;
-        self.control = checkpoint.control;
-        self.notices.clone_from(&checkpoint.notices);
-        self.round_off_reported = checkpoint.round_off_reported;
-        self.ramps.clone_from(&checkpoint.ramps);
-        self.last_increment.clone_from(&checkpoint.last_increment);
-        self.arc.clone_from(&checkpoint.arc);
-        self.stabiliser = checkpoint.stabiliser;
-        self.damping = None;
-        self.step_increment.clear();
-        self.system.invalidate();
-        self.tangent.invalidate();
-        self.gauge = None;
+        self.record.notices.clone_from(&checkpoint.notices);
+        self.record.round_off_reported = checkpoint.round_off_reported;
+        self.stabiliser.memory = checkpoint.stabiliser;
+        self.stabiliser.damping = None;
+        self.work.system.invalidate();
+        self.work.tangent.invalidate();
+        self.releases.gauge = None;
         if let Some(frozen) = &checkpoint.gauge {
             let mut positions = vec![Vec3::zeros(); self.model.nodes.len()];
             for &(k, x) in frozen {
                 positions[k] = x;
             }
-            self.build_gauge(&positions, checkpoint.time)?;
+            self.build_gauge(&positions, checkpoint.snapshot.clock.time)?;
         }
-        self.state.copy_from(&checkpoint.state);
         if let Some(origin) = &checkpoint.tangent {
             // The tangent of the current factorisation, assembled and factorised again at its iterate.
-            self.tangent.current = Origin {
+            self.work.tangent.current = Origin {
                 valid: true,
                 state: Some(origin.state.clone()),
                 laws: origin.laws.iter().map(SectionLaw::from_numbers).collect(),
@@ -429,19 +391,16 @@ impl Simulation<'_> {
             };
             self.refactor_recorded()?;
         }
-        self.gauge_active = checkpoint.gauge_active && self.gauge.is_some();
-        let multipliers = match (&self.gauge, self.gauge_active) {
-            (Some((g, _, _)), true) => g.len(),
-            _ => 0,
-        };
-        if self.state.multipliers.len() != multipliers {
+        self.releases.gauge_active &= self.releases.gauge.is_some();
+        let multipliers = self.releases.active_gauge().map_or(0, |g| g.len());
+        if self.solution.state.multipliers.len() != multipliers {
             return Err(CheckpointError::Size {
                 what: "gauge multipliers",
                 expected: multipliers,
-                found: self.state.multipliers.len(),
+                found: self.solution.state.multipliers.len(),
             });
         }
-        self.timing = checkpoint.timing.clone();
+        self.record.timing = checkpoint.timing.clone();
         Ok(())
     }
 
@@ -449,30 +408,40 @@ impl Simulation<'_> {
     /// activity and terms' states): the factorisation it had, bit for bit. The simulation's own state, laws,
     /// gauge activity and terms' states are left as they were.
     pub(super) fn refactor_recorded(&mut self) -> Result<(), SolverError> {
-        let origin = std::mem::take(&mut self.tangent.current);
+        let origin = std::mem::take(&mut self.work.tangent.current);
         let (Some(state), Some(actions)) = (&origin.state, &origin.actions) else {
             return Ok(());
         };
-        let own_state = std::mem::replace(&mut self.state, state.clone());
+        let own_state = std::mem::replace(&mut self.solution.state, state.clone());
         let own_laws = std::mem::replace(&mut self.materials.laws, origin.laws.clone());
         let own_gauge = std::mem::replace(
-            &mut self.gauge_active,
-            origin.gauge_active && self.gauge.is_some(),
+            &mut self.releases.gauge_active,
+            origin.gauge_active && self.releases.gauge.is_some(),
         );
-        let own_terms = term_states(&self.terms);
-        swap_term_states(&mut self.terms, &origin.terms);
-        self.system.invalidate();
-        if let Some((_, system, _)) = &mut self.gauge {
+        let own_terms = self.terms.save();
+        self.swap_term_states(&origin.terms);
+        self.work.system.invalidate();
+        if let Some((_, system, _)) = &mut self.releases.gauge {
             system.invalidate();
         }
         let result = self
             .linearise(actions, true)
             .and_then(|_| self.factor_tangent());
-        self.state = own_state;
+        self.solution.state = own_state;
         self.materials.laws = own_laws;
-        self.gauge_active = own_gauge;
-        swap_term_states(&mut self.terms, &own_terms);
+        self.releases.gauge_active = own_gauge;
+        self.swap_term_states(&own_terms);
         result
+    }
+
+    /// Puts the states `values` (one per term, saved by [`PointTerm::save`] from these very terms or checked
+    /// when a checkpoint was restored) into the terms.
+    fn swap_term_states(&mut self, values: &[Vec<Real>]) {
+        let restored = super::restore_terms(&mut self.terms, values);
+        assert!(
+            restored.is_ok(),
+            "a state a term saved or that a restore checked is refused: {restored:?}"
+        );
     }
 
     /// The checkpoint's sizes against this model's (the terms' states are checked as they are restored).
@@ -480,20 +449,44 @@ impl Simulation<'_> {
         let points = self.disc.points.len();
         let controls = self.disc.control0.len();
         let mut checks = vec![
-            ("control points", controls, c.state.control.len()),
-            ("rotations", points, c.state.rotation.len()),
-            ("curvatures", points, c.state.kappa.len()),
-            ("curvature derivatives", points, c.state.kappa_s.len()),
-            ("release ramps", self.model.nodes.len(), c.ramps.len()),
-            ("list of point terms", self.terms.len(), c.terms.len()),
+            (
+                "control points",
+                controls,
+                c.snapshot.solution.state.control.len(),
+            ),
+            (
+                "rotations",
+                points,
+                c.snapshot.solution.state.rotation.len(),
+            ),
+            ("curvatures", points, c.snapshot.solution.state.kappa.len()),
+            (
+                "curvature derivatives",
+                points,
+                c.snapshot.solution.state.kappa_s.len(),
+            ),
+            (
+                "release ramps",
+                self.model.nodes.len(),
+                c.snapshot.releases.ramps.len(),
+            ),
+            (
+                "list of point terms",
+                self.terms.len(),
+                c.snapshot.terms.len(),
+            ),
             (
                 "list of materials",
                 self.materials.groups.len(),
                 c.materials.len(),
             ),
         ];
-        if !c.gauge_active {
-            checks.push(("gauge multipliers", 0, c.state.multipliers.len()));
+        if !c.snapshot.releases.gauge_active {
+            checks.push((
+                "gauge multipliers",
+                0,
+                c.snapshot.solution.state.multipliers.len(),
+            ));
         }
         if let Some(origin) = &c.tangent {
             let tangent = [
@@ -542,30 +535,5 @@ impl Simulation<'_> {
             });
         }
         Ok(())
-    }
-}
-
-/// Every term's state ([`PointTerm::save`]), in the order of the list.
-fn term_states(terms: &[Box<dyn PointTerm + Send>]) -> Vec<Vec<Real>> {
-    terms
-        .iter()
-        .map(|t| {
-            let mut values = Vec::new();
-            t.save(&mut values);
-            values
-        })
-        .collect()
-}
-
-/// Puts the states `values` (one per term, saved by [`PointTerm::save`] from these very terms or checked when a
-/// checkpoint was restored) into the terms.
-fn swap_term_states(terms: &mut [Box<dyn PointTerm + Send>], values: &[Vec<Real>]) {
-    for (term, values) in terms.iter_mut().zip(values) {
-        let restored = term.restore(values);
-        assert!(
-            restored.is_ok(),
-            "term `{}`: a state it saved or that a restore checked is refused",
-            term.name()
-        );
     }
 }

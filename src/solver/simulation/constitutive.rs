@@ -187,12 +187,12 @@ impl Simulation<'_> {
                 let key = (group.material, notice.kind().to_string());
                 if !materials.said.contains(&key) {
                     materials.said.push(key);
-                    self.notices.push(notice.to_string());
+                    self.record.notices.push(notice.to_string());
                 }
             }
         }
         materials.refresh_laws(&model.materials);
-        SolverTiming::add(&mut self.timing.material, start);
+        SolverTiming::add(&mut self.record.timing.material, start);
         Ok(())
     }
 
@@ -200,7 +200,7 @@ impl Simulation<'_> {
     /// its points.
     pub(super) fn commit_step(&mut self) {
         let start = Instant::now();
-        let (disc, state) = (&self.disc, &self.state);
+        let (disc, state) = (&self.disc, &self.solution.state);
         for group in &mut self.materials.groups {
             let points = &group.points;
             let strains = |i: usize| point_strains(disc, state, points[i]);
@@ -211,7 +211,7 @@ impl Simulation<'_> {
             term.commit(disc, state);
         }
         // Counted with the step's preparation.
-        self.timing.material.1 += start.elapsed().as_secs_f64();
+        self.record.timing.material.1 += start.elapsed().as_secs_f64();
     }
 
     /// With a temperature field: the lowest and highest temperature over the collocation points at time `t`

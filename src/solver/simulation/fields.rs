@@ -202,7 +202,7 @@ impl Simulation<'_> {
     /// The fields at every collocation point in the current state, in the global numbering (patch by patch,
     /// along each patch).
     pub fn point_fields(&self) -> Vec<PointFields> {
-        let (model, disc, state) = (self.model, &self.disc, &self.state);
+        let (model, disc, state) = (self.model, &self.disc, &self.solution.state);
         let t = self.schedule_time();
         (0..disc.points.len())
             .map(|g| {
@@ -308,7 +308,7 @@ impl Simulation<'_> {
     /// The strains of collocation point `g` and its section's fibre stretches around the circle of its
     /// section's radius (half the wire's diameter, or of the drawing diameter of a section given by properties).
     fn stretch_at(&self, g: usize) -> (crate::material::SectionStrains, SectionStretch) {
-        let (model, disc, state) = (self.model, &self.disc, &self.state);
+        let (model, disc, state) = (self.model, &self.disc, &self.solution.state);
         let point = &disc.points[g];
         let strain = point_strains(disc, state, g);
         let radius = model.wire_radius(point.patch);
@@ -322,16 +322,16 @@ impl Simulation<'_> {
         (strain, stretch)
     }
 
-    /// The reference arc length of every collocation point from its patch's start ([`arc_lengths`], once).
+    /// The reference arc length of every collocation point from its patch's start (computed once,
+    /// [`super::measures::Measures::arc_lengths`]).
     pub(super) fn arc_lengths(&self) -> &[Real] {
-        self.arc_length
-            .get_or_init(|| arc_lengths(self.model, &self.disc))
+        self.measures.arc_lengths(self.model, &self.disc)
     }
 }
 
 /// The reference arc length of every collocation point from its patch's start (Gauss–Legendre between
-/// successive points, [`ARC_LENGTH_PARTS`] parts each), computed once per simulation.
-fn arc_lengths(
+/// successive points, [`ARC_LENGTH_PARTS`] parts each).
+pub(super) fn arc_lengths(
     model: &crate::model::Model,
     disc: &crate::solver::discretisation::Discretisation,
 ) -> Vec<Real> {

@@ -55,39 +55,59 @@
 //! factorisation back to the one its attempt started with (kept, or made again from its recorded origin), so a
 //! later `step` or `run` — or a checkpoint taken now — continues bit for bit as the uninterrupted run.
 //!
+//! **Parts.** A [`Simulation`] is the model, its discretisation, assembler, point terms and materials, and a
+//! few parts, each a struct in its own module owning its fields: the [`Clock`] (time, steps, step size, cuts,
+//! error control; `clock`), the solution (the configuration and the steps' increments; `solution`), the
+//! releases (ramps and gauge constraints; `releases`), the arc-length path's state (`arclength`), the
+//! stabiliser (its memory and the attempt's damping; [`stabilisation`]), the workspace (linear system,
+//! assembly, increment, factorisation record; `workspace`), the run's record (notices, timing; `record`) and
+//! fixed measures of the model (`measures`). What a step changes — clock, solution, releases, arc-length
+//! state, the terms' states — is saved by one value, the [`StepSnapshot`] (`snapshot`): roll-back puts back
+//! the snapshot taken at the start of an attempt, and a [`Checkpoint`] is that snapshot between steps plus the
+//! run's records.
+//!
 //! The concepts live in their own files: [`report`] (what a step and a run report), [`observer`] (who is told),
 //! [`adaptive`] (the time-error estimate and the step-size controller), `arclength` (arc-length continuation),
-//! [`timing`] (where the wall time went), `stepping` (the step loop, step-size control and roll-back), `newton`
+//! [`timing`] (where the wall time went), `stepping` (the step loop and roll-back), `newton`
 //! (Newton's method on normalised norms and its diagnostics), `releases` (release ramps and gauge constraints),
-//! `constitutive` (the materials at the points: step preparation, commit, roll-back) and [`checkpoint`] (the
-//! whole state as a value, and its restore).
-
+//! `constitutive` (the materials at the points: step preparation, commit, roll-back), `snapshot` (what a step
+//! changes, taken and put back) and [`checkpoint`] (the whole state as a value, and its restore).
 pub mod adaptive;
 mod arclength;
 pub mod checkpoint;
+mod clock;
 mod constitutive;
 pub mod fields;
+mod measures;
 mod newton;
 pub mod observer;
+mod record;
 mod releases;
 pub mod report;
+mod snapshot;
+mod solution;
 pub mod stabilisation;
 mod stepping;
 pub mod timing;
+mod workspace;
 
 pub use arclength::ArcState;
 pub use checkpoint::{Checkpoint, CheckpointError, TangentOrigin, model_fingerprint};
+pub use clock::Clock;
 pub use fields::{PeakSurfaceStrain, PointFields, peak_surface_strain};
 pub use newton::ROUND_OFF_TOLERANCE;
 pub use observer::{NoObserver, Observer, Observers};
+pub use releases::ReleaseSnapshot;
 pub use report::{NewtonReport, RunSummary, StepReport};
+pub use snapshot::StepSnapshot;
+pub use solution::SolutionSnapshot;
 pub use stabilisation::{StabiliserState, StepStabilisation};
 pub use stepping::{STEP_FACTOR, STEP_ROUND_OFF_ULPS, StepOutcome};
 pub use timing::SolverTiming;
 
 use super::SolverError;
 use super::assembly::{
-    Actions, Assembler, Assembly, Linearisation, ReleaseRamp, Sink, StepMaterial, point_position,
+    Actions, Assembler, Assembly, Linearisation, Sink, StepMaterial, point_position,
 };
 use super::discretisation::Discretisation;
 use super::gauge::Gauge;
@@ -99,13 +119,9 @@ use super::terms::{Constraint, PointTerm, Terms};
 use crate::math::{Real, Vec3};
 use crate::model::{Model, ProbeLocation};
 use constitutive::PointMaterials;
+use snapshot::{Restorable, restore_terms};
 
-/// The increment norm's length of a patch whose ends coincide (a closed loop) is its chord floored at this
-/// fraction of the model size: a translation increment is measured against a length of the order of the
-/// patch, never against zero.
-const CLOSED_PATCH_LENGTH_FRACTION: Real = 1e-3;
-
-/// A running simulation of one model.
+/// A running simulation of one model: a composition of parts (module docs), each in its own module.
 pub struct Simulation<'m> {
     model: &'m Model,
     disc: Discretisation,
@@ -113,59 +129,24 @@ pub struct Simulation<'m> {
     /// The point terms every assembly includes, in the order they add up (before the damping of
     /// stabilisation): [`registered_terms`] and those added by [`Simulation::add_term`].
     terms: Vec<Box<dyn PointTerm + Send>>,
-    system: LinearSystem,
-    state: State,
-    time: Real,
-    step: usize,
-    lin: Linearisation,
-    values: Vec<Real>,
-    delta: Vec<Real>,
-    /// Length of the patch of each control point, for increment norms.
-    control_length: Vec<Real>,
     /// Every material's points and internal variables, and every point's section law for the step being solved.
     materials: PointMaterials,
-    /// Messages for the user, each said once (e.g. the WLF freeze).
-    notices: Vec<String>,
-    /// Per node and local component: the release ramp, once the component has been released.
-    ramps: Vec<[Option<ReleaseRamp>; 6]>,
-    /// Gauge constraints after a programme's release, with their extended system and entry values.
-    gauge: Option<(Gauge, LinearSystem, Vec<Real>)>,
-    /// Whether the gauge constraints apply to the step being solved.
-    gauge_active: bool,
-    /// Where the time went so far.
-    timing: SolverTiming,
-    /// Sum of the increments applied in the step being solved (prediction and Newton corrections).
-    step_increment: Vec<Real>,
-    /// The last converged step's total increment and its size, for the next step's prediction.
-    last_increment: Option<(Vec<Real>, Real)>,
-    /// Whether a step accepted at the round-off floor has been reported.
-    round_off_reported: bool,
-    /// The schedule breakpoints the steps land on ([`Model::schedule_breakpoints`]), sorted.
-    breakpoints: Vec<Real>,
-    /// The size of the next step's first attempt \[time\]: the nominal step, or less after a cut (doubled back
-    /// by converged steps).
-    step_size: Real,
-    /// Cuts of the step in progress (0 between steps; kept over an interruption, so that the continued step
-    /// reports them all).
-    step_cuts: usize,
-    /// What the current factorisation was computed from, for checkpoints ([`checkpoint`]).
-    tangent: checkpoint::TangentRecord,
-    /// The memory of error-controlled stepping ([`adaptive`]).
-    control: adaptive::StepControl,
-    /// Reference arc length of every collocation point from its patch's start, for the fields ([`fields`]):
-    /// computed at the first use (a run without field outputs never needs it).
-    arc_length: std::sync::OnceLock<Vec<Real>>,
+    /// Time, steps, the next step's size and the error controller's memory ([`Clock`]).
+    clock: Clock,
+    /// The configuration and the increments of the steps.
+    solution: solution::Solution,
+    /// Release ramps and gauge constraints.
+    releases: releases::Releases,
     /// Where an arc-length run is on its path (`None` for time-driven runs, and before the first increment).
     arc: Option<arclength::ArcState>,
-    /// The stabiliser's memory ([`stabilisation`]).
-    stabiliser: StabiliserState,
-    /// The damping of the attempt in progress: the last converged state and `c/h` (`None`: undamped).
-    damping: Option<(State, Real)>,
-    /// The first Newton increment of the last attempt (runs with stabilisation: the estimate of a stalled
-    /// step's motion, [`stabilisation`]).
-    first_increment: Vec<Real>,
-    /// Trapezoidal weights of the collocation points in the reference arc length (computed at the first use).
-    point_weights: std::sync::OnceLock<Vec<Real>>,
+    /// The stabiliser's memory and the damping of the attempt in progress ([`stabilisation`]).
+    stabiliser: stabilisation::Stabiliser,
+    /// The linear system, the last assembly and increment, and the factorisation's origin.
+    work: workspace::Workspace,
+    /// What the run has said and spent.
+    record: record::RunRecord,
+    /// Fixed measures of the model: increment lengths, breakpoints, arc lengths and weights.
+    measures: measures::Measures,
 }
 
 impl<'m> Simulation<'m> {
@@ -231,52 +212,27 @@ impl<'m> Simulation<'m> {
             model.solver().linear,
         )?;
         let values = vec![0.0; pattern.len()];
-        let control_length = disc
-            .patches
-            .iter()
-            .flat_map(|r| {
-                let length = (disc.control0[r.offset + r.n - 1] - disc.control0[r.offset]).norm();
-                // Chord length, floored by the model size for closed patches.
-                std::iter::repeat_n(
-                    length.max(CLOSED_PATCH_LENGTH_FRACTION * disc.length_scale),
-                    r.n,
-                )
-            })
-            .collect();
         let n = disc.num_unknowns();
         Ok(Self {
             model,
+            measures: measures::Measures::new(model, &disc),
+            solution: solution::Solution::starting_at(state),
             disc,
             assembler,
             terms,
-            system,
-            state,
-            time: 0.0,
-            step: 0,
-            lin,
-            values,
-            delta: vec![0.0; n],
-            control_length,
             materials,
-            notices: Vec::new(),
-            ramps: vec![[None; 6]; model.nodes.len()],
-            gauge: None,
-            gauge_active: false,
-            timing: SolverTiming::default(),
-            step_increment: Vec::new(),
-            last_increment: None,
-            round_off_reported: false,
-            breakpoints: model.schedule_breakpoints(),
-            step_size: model.time().step,
-            step_cuts: 0,
-            tangent: checkpoint::TangentRecord::default(),
-            control: adaptive::StepControl::default(),
-            arc_length: std::sync::OnceLock::new(),
+            clock: Clock::start(model.time()),
+            releases: releases::Releases::new(model.nodes.len()),
             arc: None,
-            stabiliser: StabiliserState::default(),
-            damping: None,
-            first_increment: Vec::new(),
-            point_weights: std::sync::OnceLock::new(),
+            stabiliser: stabilisation::Stabiliser::default(),
+            work: workspace::Workspace {
+                system,
+                lin,
+                values,
+                delta: vec![0.0; n],
+                tangent: checkpoint::TangentRecord::default(),
+            },
+            record: record::RunRecord::default(),
         })
     }
 }
@@ -293,13 +249,13 @@ impl Simulation<'_> {
     /// Messages worth telling the user, each added once (e.g. that relaxation froze below `Tg − C2`), in the
     /// order they arose.
     pub fn notices(&self) -> &[String] {
-        &self.notices
+        &self.record.notices
     }
 
     /// Assembles the residual (and with `with_tangent` the tangent) at the current state for time `t` and
     /// returns the normalised residual norm: one piece of a Newton iteration, for benchmarks and diagnostics.
     pub fn assemble(&mut self, t: Real, with_tangent: bool) -> Result<Real, SolverError> {
-        let actions = Actions::at(self.model, t, &self.ramps);
+        let actions = Actions::at(self.model, t, &self.releases.ramps);
         self.linearise(&actions, with_tangent)
     }
 
@@ -309,12 +265,12 @@ impl Simulation<'_> {
     pub fn factor_and_solve(&mut self) -> Result<&[Real], SolverError> {
         self.factor_tangent()?;
         self.solve_increment();
-        Ok(&self.delta)
+        Ok(&self.work.delta)
     }
 
     /// Where the solver's time went so far.
     pub fn timing(&self) -> &SolverTiming {
-        &self.timing
+        &self.record.timing
     }
 
     /// The model.
@@ -329,28 +285,28 @@ impl Simulation<'_> {
 
     /// The current (last converged) state.
     pub fn state(&self) -> &State {
-        &self.state
+        &self.solution.state
     }
 
     /// Time of the current state.
     pub fn time(&self) -> Real {
-        self.time
+        self.clock.time
     }
 
     /// Converged steps so far (0: the initial state).
     pub fn step_count(&self) -> usize {
-        self.step
+        self.clock.step
     }
 
     /// The size of the next step's first attempt \[time\]: the nominal `time.step`, or less while a cut step
     /// size grows back ([`STEP_FACTOR`]).
     pub fn step_size(&self) -> Real {
-        self.step_size
+        self.clock.step_size
     }
 
     /// The linear system (solver, size, pattern).
     pub fn system(&self) -> &LinearSystem {
-        &self.system
+        &self.work.system
     }
 
     /// Displacement of a probe in the current state.
@@ -358,7 +314,7 @@ impl Simulation<'_> {
         match *location {
             ProbeLocation::Node(k) => {
                 let g = self.disc.end_point(self.model.nodes[k].ends[0]);
-                point_position(&self.disc, &self.state.control, g)
+                point_position(&self.disc, &self.solution.state.control, g)
                     - point_position(&self.disc, &self.disc.control0, g)
             }
             ProbeLocation::Patch { patch, u } => {
@@ -370,7 +326,7 @@ impl Simulation<'_> {
                     .enumerate()
                     .map(|(a, n)| {
                         let j = range.offset + table.first + a;
-                        (self.state.control[j] - self.disc.control0[j]) * *n
+                        (self.solution.state.control[j] - self.disc.control0[j]) * *n
                     })
                     .sum()
             }
@@ -381,8 +337,12 @@ impl Simulation<'_> {
     /// `(σ R N, σ R M)` (spatial force and moment, outward sign σ), in the order of the node's ends. At
     /// equilibrium their sums equal the node's applied load (or its reaction, at prescribed components).
     pub fn node_end_resultants(&self, k: usize) -> Vec<(Vec3, Vec3)> {
-        self.assembler
-            .node_end_resultants(&self.disc, &self.state, self.step_material(), k)
+        self.assembler.node_end_resultants(
+            &self.disc,
+            &self.solution.state,
+            self.step_material(),
+            k,
+        )
     }
 }
 

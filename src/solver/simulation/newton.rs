@@ -77,8 +77,8 @@ impl Simulation<'_> {
         reuse: bool,
         observer: &dyn Observer,
     ) -> Result<NewtonReport, NewtonFailure> {
-        let actions = Actions::at(self.model, t, &self.ramps);
-        let settings = &self.model.solver();
+        let actions = Actions::at(self.model, t, &self.releases.ramps);
+        let settings = self.model.solver();
         let (tol, max_iterations, ratio) = (
             self.newton_tolerance(),
             settings.max_iterations,
@@ -152,14 +152,23 @@ impl Simulation<'_> {
             if report.iterations == 0 {
                 stale_first = !fresh_tangent;
                 if self.model.solver().stabilisation.is_some() {
-                    self.first_increment.clone_from(&self.delta);
+                    self.stabiliser.first_increment.clone_from(&self.work.delta);
                 }
             }
             self.record_increment(&mut report)?;
-            self.state.apply_increment(&self.disc, &self.delta);
+            self.solution
+                .state
+                .apply_increment(&self.disc, &self.work.delta);
             if self.model.solver().extrapolate {
-                self.step_increment.resize(self.delta.len(), 0.0);
-                for (a, d) in self.step_increment.iter_mut().zip(&self.delta) {
+                self.solution
+                    .step_increment
+                    .resize(self.work.delta.len(), 0.0);
+                for (a, d) in self
+                    .solution
+                    .step_increment
+                    .iter_mut()
+                    .zip(&self.work.delta)
+                {
                     *a += d;
                 }
             }
@@ -167,7 +176,7 @@ impl Simulation<'_> {
         }
     }
 
-    /// Counts the increment in `self.delta` as one more iteration of `report` with its normalised norm, or
+    /// Counts the increment in `self.work.delta` as one more iteration of `report` with its normalised norm, or
     /// abandons the iteration where it is not finite or so large that the tangent must be (nearly) singular
     /// ([`SINGULAR_INCREMENT`]), saying where.
     pub(super) fn record_increment(&self, report: &mut NewtonReport) -> Result<(), NewtonFailure> {
@@ -195,24 +204,6 @@ impl Simulation<'_> {
         })
     }
 
-    /// Predicts the state at `t` by extrapolating the last step's increment linearly in time (scaled by `dt`
-    /// over its size; the rotation part applied as one more multiplicative increment). Schedules are piecewise
-    /// linear, so the last step's rate is a good guess except across a breakpoint, after which there is no
-    /// prediction (see `run`).
-    pub(super) fn predict(&mut self, dt: Real) {
-        self.step_increment.clear();
-        let n = self.disc.num_unknowns();
-        // (A step that needed no iteration left an empty increment: nothing to extrapolate.)
-        let Some((increment, h)) = self.last_increment.as_ref().filter(|(i, _)| i.len() >= n)
-        else {
-            return;
-        };
-        let scale = dt / h;
-        self.step_increment
-            .extend(increment[..n].iter().map(|d| d * scale));
-        self.state.apply_increment(&self.disc, &self.step_increment);
-    }
-
     /// Assembles residual and tangent at the current state for time `t` and returns the normalised residual
     /// norm (largest over fields).
     pub(super) fn linearise(
@@ -224,21 +215,21 @@ impl Simulation<'_> {
         let material = StepMaterial {
             laws: &self.materials.laws,
         };
-        let (gauge, values) = match (&mut self.gauge, self.gauge_active) {
+        let (gauge, values) = match (&mut self.releases.gauge, self.releases.gauge_active) {
             (Some((g, _, v)), true) => (Some(&*g), v),
-            _ => (None, &mut self.values),
+            _ => (None, &mut self.work.values),
         };
         let mut sink = if with_tangent {
             Sink::Values { values, next: 0 }
         } else {
             Sink::Discard
         };
-        let damping = super::stabilisation::view(&self.damping);
+        let damping = super::stabilisation::view(&self.stabiliser.damping);
         let (point, constraints) = super::assembly_terms(&self.terms, damping.as_ref(), gauge);
         self.assembler.assemble(
             &Assembly {
                 disc: &self.disc,
-                state: &self.state,
+                state: &self.solution.state,
                 material,
                 actions,
                 terms: Terms {
@@ -246,20 +237,20 @@ impl Simulation<'_> {
                     constraints: &constraints,
                 },
             },
-            &mut self.lin,
+            &mut self.work.lin,
             &mut sink,
         );
         let slot = if with_tangent {
-            &mut self.timing.tangent
+            &mut self.record.timing.tangent
         } else {
-            &mut self.timing.residual
+            &mut self.record.timing.residual
         };
         SolverTiming::add(slot, start);
         if with_tangent {
-            self.tangent.assembled(actions);
+            self.work.tangent.assembled(actions);
         }
         let mut norm: Real = 0.0;
-        for (r, s) in self.lin.residual.iter().zip(&self.lin.row_scale) {
+        for (r, s) in self.work.lin.residual.iter().zip(&self.work.lin.row_scale) {
             let x = (r / s).abs();
             if !x.is_finite() {
                 return Ok(Real::INFINITY);
@@ -269,13 +260,13 @@ impl Simulation<'_> {
         Ok(norm)
     }
 
-    /// Normalised norm of the increment in `self.delta`: translations over the patch length, rotations in
+    /// Normalised norm of the increment in `self.work.delta`: translations over the patch length, rotations in
     /// radians.
     pub(super) fn increment_norm(&self) -> Real {
         let mut norm: Real = 0.0;
         let n = self.disc.num_unknowns();
-        for (j, d) in self.delta[..n].chunks_exact(6).enumerate() {
-            let l = self.control_length[j];
+        for (j, d) in self.work.delta[..n].chunks_exact(6).enumerate() {
+            let l = self.measures.control_length[j];
             for i in 0..3 {
                 norm = norm.max((d[i] / l).abs()).max(d[i + 3].abs());
             }
@@ -289,9 +280,9 @@ impl Simulation<'_> {
 
     /// The system that the step being solved uses (with the gauge constraints or without) and its entries.
     pub(super) fn active_system(&mut self) -> (&mut LinearSystem, &[Real]) {
-        match (&mut self.gauge, self.gauge_active) {
+        match (&mut self.releases.gauge, self.releases.gauge_active) {
             (Some((_, s, v)), true) => (s, &*v),
-            _ => (&mut self.system, &self.values),
+            _ => (&mut self.work.system, &self.work.values),
         }
     }
 
@@ -306,24 +297,24 @@ impl Simulation<'_> {
             },
             e => e,
         })?;
-        self.tangent.factorised(
-            &self.state,
+        self.work.tangent.factorised(
+            &self.solution.state,
             &self.materials.laws,
-            self.gauge_active,
+            self.releases.gauge_active,
             &self.terms,
         );
-        SolverTiming::add(&mut self.timing.factorisation, start);
+        SolverTiming::add(&mut self.record.timing.factorisation, start);
         Ok(())
     }
 
     /// Solves for the Newton increment `δ = −K⁻¹ r` of the last assembled residual with the last factorisation,
-    /// into `self.delta`.
+    /// into `self.work.delta`.
     pub(super) fn solve_increment(&mut self) {
-        let mut delta = std::mem::take(&mut self.delta);
+        let mut delta = std::mem::take(&mut self.work.delta);
         delta.clear();
-        delta.extend(self.lin.residual.iter().map(|r| -r));
+        delta.extend(self.work.lin.residual.iter().map(|r| -r));
         self.solve_in_place(&mut delta);
-        self.delta = delta;
+        self.work.delta = delta;
     }
 
     /// Solves the last factorised system for the right-hand side in `rhs`, in place (counted in
@@ -331,19 +322,20 @@ impl Simulation<'_> {
     pub(super) fn solve_in_place(&mut self, rhs: &mut [Real]) {
         let start = Instant::now();
         self.active_system().0.solve_in_place(rhs);
-        SolverTiming::add(&mut self.timing.solve, start);
+        SolverTiming::add(&mut self.record.timing.solve, start);
     }
 
-    /// Where the residual in `self.lin` is not finite, after `iteration` Newton iterations: its first such
+    /// Where the residual in `self.work.lin` is not finite, after `iteration` Newton iterations: its first such
     /// equation, and how many there are.
     pub(super) fn worst_equation(&self) -> Option<String> {
         // The first of the largest, a NaN counting as infinite: where a non-finite residual appeared first.
         let mut worst: Option<(usize, Real)> = None;
         for (row, (r, s)) in self
+            .work
             .lin
             .residual
             .iter()
-            .zip(&self.lin.row_scale)
+            .zip(&self.work.lin.row_scale)
             .enumerate()
         {
             let v = (r / s).abs();
@@ -361,10 +353,11 @@ impl Simulation<'_> {
     /// Names the equations whose residual is not finite after `iteration` iterations.
     pub(super) fn non_finite_residual(&self, iteration: usize) -> String {
         let bad: Vec<usize> = self
+            .work
             .lin
             .residual
             .iter()
-            .zip(&self.lin.row_scale)
+            .zip(&self.work.lin.row_scale)
             .enumerate()
             .filter(|(_, (r, s))| !(*r / *s).is_finite())
             .map(|(i, _)| i)
@@ -379,12 +372,13 @@ impl Simulation<'_> {
         }
     }
 
-    /// Where the Newton increment in `self.delta` is not finite (at iteration `iteration`, 1-based): the patches
+    /// Where the Newton increment in `self.work.delta` is not finite (at iteration `iteration`, 1-based): the patches
     /// and the first unknown. A singular tangent (a part free to move as a rigid body) gives this.
     pub(super) fn non_finite_increment(&self, iteration: usize) -> String {
         let patches =
-            crate::solver::diagnose::non_finite_patches(self.model, &self.disc, &self.delta);
+            crate::solver::diagnose::non_finite_patches(self.model, &self.disc, &self.work.delta);
         let first = self
+            .work
             .delta
             .iter()
             .position(|d| !d.is_finite())
@@ -400,15 +394,15 @@ impl Simulation<'_> {
         )
     }
 
-    /// Where the (finite) Newton increment in `self.delta`, of normalised size `norm`, is largest.
+    /// Where the (finite) Newton increment in `self.work.delta`, of normalised size `norm`, is largest.
     pub(super) fn huge_increment(&self, iteration: usize, norm: Real) -> String {
         let n = self.disc.num_unknowns();
-        let largest = self.delta[..n]
+        let largest = self.work.delta[..n]
             .iter()
             .enumerate()
             .map(|(c, d)| {
                 let scale = if c % 6 < 3 {
-                    self.control_length[c / 6]
+                    self.measures.control_length[c / 6]
                 } else {
                     1.0
                 };

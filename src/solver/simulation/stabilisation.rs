@@ -180,6 +180,21 @@ pub struct StepStabilisation {
     pub force_share: Real,
 }
 
+/// The stabilisation's part of a simulation: its memory over the run and the damping of the attempt in
+/// progress.
+#[derive(Debug, Default)]
+pub(super) struct Stabiliser {
+    /// The stabiliser's memory: kept over an abandoned attempt (a failed attempt is what switches the damping
+    /// on or raises it) and saved by a checkpoint ([`super::Checkpoint::stabiliser`]).
+    pub(super) memory: StabiliserState,
+    /// The damping of the attempt in progress: the last converged state and `c/h` (`None`: undamped); dropped
+    /// when the attempt ends, either way.
+    pub(super) damping: Option<(State, Real)>,
+    /// The first Newton increment of the last attempt (runs with stabilisation: the estimate of a stalled
+    /// step's motion, module docs).
+    pub(super) first_increment: Vec<Real>,
+}
+
 /// The damping of the attempt in progress as the assembly sees it.
 pub(super) fn view(damping: &Option<(State, Real)>) -> Option<Damping<'_>> {
     damping.as_ref().map(|(previous, rate)| Damping {
@@ -194,7 +209,7 @@ impl Simulation<'_> {
         let weights = self.point_weights();
         (0..self.disc.points.len())
             .map(|g| {
-                let strain = point_strains(&self.disc, &self.state, g);
+                let strain = point_strains(&self.disc, &self.solution.state, g);
                 let stress = self.materials.laws[g].stress(&strain);
                 0.5 * weights[g]
                     * (strain.force.dot(&stress.force) + strain.moment.dot(&stress.moment))
@@ -204,7 +219,7 @@ impl Simulation<'_> {
 
     /// The stabiliser's memory: the damping factor, if on, and the dissipated and strain energies so far.
     pub fn stabilisation(&self) -> &StabiliserState {
-        &self.stabiliser
+        &self.stabiliser.memory
     }
 
     /// What the run must say about its stabilisation so far ([`StabiliserState::warnings`]); none without
@@ -213,7 +228,9 @@ impl Simulation<'_> {
         self.model
             .solver()
             .stabilisation
-            .map_or_else(Vec::new, |settings| self.stabiliser.warnings(&settings))
+            .map_or_else(Vec::new, |settings| {
+                self.stabiliser.memory.warnings(&settings)
+            })
     }
 
     /// The damping force's share `D / max(D, E)` of the forces on the device in the current state, under the
@@ -222,7 +239,7 @@ impl Simulation<'_> {
         let disc = &self.disc;
         let weights = self.point_weights();
         let lever = disc.length_scale;
-        let actions = Actions::at(self.model, t, &self.ramps);
+        let actions = Actions::at(self.model, t, &self.releases.ramps);
         let (mut damping, mut external) = (0.0, 0.0);
         for (g, point) in disc.points.iter().enumerate() {
             let w = weights[g];
@@ -230,7 +247,7 @@ impl Simulation<'_> {
                 * (actions.dist_force[point.patch].norm()
                     + actions.dist_couple[point.patch].norm() / lever);
             let (area, inertia) = Damping::masses(&disc.shapes[point.shape]);
-            let (dx, theta) = d.motion(disc, &self.state, g);
+            let (dx, theta) = d.motion(disc, &self.solution.state, g);
             damping +=
                 w * d.rate * (area * dx.norm() + inertia.component_mul(&theta).norm() / lever);
         }
@@ -267,26 +284,7 @@ impl Simulation<'_> {
 
     /// Trapezoidal weights of the collocation points in the reference arc length, patch by patch.
     fn point_weights(&self) -> &[Real] {
-        self.point_weights.get_or_init(|| {
-            let s = self.arc_lengths();
-            let mut w = vec![0.0; s.len()];
-            for range in &self.disc.patches {
-                for g in range.offset..range.offset + range.n {
-                    let before = if g > range.offset {
-                        s[g] - s[g - 1]
-                    } else {
-                        0.0
-                    };
-                    let after = if g + 1 < range.offset + range.n {
-                        s[g + 1] - s[g]
-                    } else {
-                        0.0
-                    };
-                    w[g] = 0.5 * (before + after);
-                }
-            }
-            w
-        })
+        self.measures.point_weights(self.model, &self.disc)
     }
 
     /// Called after a step of size `dt` to `target` failed and was rolled back: switches the damping on (or
@@ -296,18 +294,20 @@ impl Simulation<'_> {
         let Some(settings) = self.model.solver().stabilisation else {
             return false;
         };
-        match self.stabiliser.factor {
-            Some(c) if self.stabiliser.escalations < MAX_ESCALATIONS => {
-                self.stabiliser.factor = Some(c * ESCALATION);
-                self.stabiliser.escalations += 1;
+        match self.stabiliser.memory.factor {
+            Some(c) if self.stabiliser.memory.escalations < MAX_ESCALATIONS => {
+                self.stabiliser.memory.factor = Some(c * ESCALATION);
+                self.stabiliser.memory.escalations += 1;
                 true
             }
             Some(_) => false,
             None => {
                 let c = settings.factor.unwrap_or_else(|| {
-                    let energy = self.strain_energy().max(self.stabiliser.peak_strain_energy);
+                    let energy = self
+                        .strain_energy()
+                        .max(self.stabiliser.memory.peak_strain_energy);
                     let n = self.disc.num_unknowns();
-                    let first = &self.first_increment;
+                    let first = &self.stabiliser.first_increment;
                     let motion = if first.len() >= n {
                         self.motion_measure(|g| interpolate(&self.disc, first, g))
                     } else {
@@ -316,16 +316,16 @@ impl Simulation<'_> {
                     settings.dissipated_fraction * energy * dt / motion
                 });
                 if !(c.is_finite() && c > 0.0) {
-                    let s = &mut self.stabiliser;
+                    let s = &mut self.stabiliser.memory;
                     if s.unscaled_stalls == 0 {
                         s.first_unscaled_time = target;
                     }
                     s.unscaled_stalls += 1;
                     return false;
                 }
-                self.stabiliser.factor = Some(c);
-                self.stabiliser.base_factor = c;
-                self.stabiliser.escalations = 0;
+                self.stabiliser.memory.factor = Some(c);
+                self.stabiliser.memory.base_factor = c;
+                self.stabiliser.memory.escalations = 0;
                 true
             }
         }
@@ -337,17 +337,18 @@ impl Simulation<'_> {
     pub(super) fn account_stabilisation(&mut self, t: Real) -> Option<StepStabilisation> {
         let settings = self.model.solver().stabilisation?;
         let energy = self.strain_energy();
-        let damping = self.damping.take();
+        let damping = self.stabiliser.damping.take();
         let factor = self
             .stabiliser
+            .memory
             .factor
             .filter(|_| damping.is_some())
             .unwrap_or(0.0);
         let dissipated = view(&damping).map_or(0.0, |d| {
-            d.rate * self.motion_measure(|g| d.motion(&self.disc, &self.state, g))
+            d.rate * self.motion_measure(|g| d.motion(&self.disc, &self.solution.state, g))
         });
         let force_share = view(&damping).map_or(0.0, |d| self.damping_force_share(t, d));
-        let s = &mut self.stabiliser;
+        let s = &mut self.stabiliser.memory;
         s.escalations = 0;
         s.peak_strain_energy = s.peak_strain_energy.max(energy);
         if damping.is_some() {
@@ -374,7 +375,7 @@ impl Simulation<'_> {
             });
             self.forget_factorisation();
         }
-        let s = &mut self.stabiliser;
+        let s = &mut self.stabiliser.memory;
         if s.energy_limit_time.is_none() && s.ratio() > settings.limit {
             s.energy_limit_time = Some(t);
         }

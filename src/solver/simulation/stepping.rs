@@ -5,10 +5,10 @@ use super::adaptive::{LOCAL_FRACTION, error_ratio};
 use super::checkpoint::Revert;
 use super::newton::{NewtonFailure, round_off_notice};
 use super::observer::Observers;
+use super::snapshot::StepSnapshot;
 use super::{NoObserver, Observer, RunSummary, Simulation, StepReport};
 use crate::math::Real;
 use crate::solver::SolverError;
-use crate::solver::state::State;
 
 /// Allowance, in units in the last place of the time reached, when a step size computed as `(t + h) − t` is
 /// compared with `time.min_step` or halved to it. `t + h` rounds to within half an ulp and the difference is
@@ -46,18 +46,9 @@ fn halved_step(dt: Real, min_step: Real, target: Real) -> Real {
     }
 }
 
-/// What a step changes before it converges, saved at its start so that a failed or interrupted attempt can be
-/// undone exactly.
-struct StepStart {
-    /// The last converged state.
-    state: State,
-    /// Whether the gauge constraints were active.
-    gauge_active: bool,
-}
-
 /// Why an attempt of a step is abandoned ([`Simulation::roll_back`]).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
-enum Abandon {
+pub(super) enum Abandon {
     /// Newton failed, or a fatal error: the factorisations are forgotten.
     Failed,
     /// It converged but error control rejected it: the factorisation is kept.
@@ -85,7 +76,7 @@ impl Simulation<'_> {
     pub fn is_finished(&self) -> bool {
         match self.arc_length_settings() {
             Some(settings) => self.arc_length_finished(&settings),
-            None => self.time >= self.model.time().end - self.landing_tolerance(),
+            None => self.clock.time >= self.model.time().end - self.landing_tolerance(),
         }
     }
 
@@ -125,7 +116,6 @@ impl Simulation<'_> {
             return Ok(StepOutcome::Finished);
         }
         let end = self.model.time().end;
-        let nominal = self.model.time().step;
         let min_step = self.model.time().min_step;
         let snap = self.landing_tolerance();
         loop {
@@ -135,33 +125,34 @@ impl Simulation<'_> {
             }
             // Breakpoints are sorted: a binary search keeps a step's cost independent of their number (a table of
             // 10⁵ breakpoints made every step scan it).
-            let breakpoints = &self.breakpoints;
+            let breakpoints = &self.measures.breakpoints;
             let next_break = breakpoints
-                .get(breakpoints.partition_point(|&b| b <= self.time + snap))
+                .get(breakpoints.partition_point(|&b| b <= self.clock.time + snap))
                 .copied()
                 .unwrap_or(end)
                 .min(end);
-            let mut target = self.time + self.step_size;
+            let mut target = self.clock.time + self.clock.step_size;
             if target > next_break - snap {
                 target = next_break;
             }
-            let dt = target - self.time;
-            let start = self.step_start();
+            let dt = target - self.clock.time;
+            let start = self.begin_attempt();
             // Damping, while the stabiliser has it on: measured from the last converged state over this step.
-            self.damping = self
+            self.stabiliser.damping = self
                 .stabiliser
+                .memory
                 .factor
-                .map(|c| (start.state.clone(), c / dt));
-            let captured = self.capture_releases(target);
+                .map(|c| (start.solution.state.clone(), c / dt));
+            self.capture_releases(target);
             let prepared = self
                 .set_gauge(target)
-                .and_then(|()| self.prepare_step(self.time, target));
+                .and_then(|()| self.prepare_step(self.clock.time, target));
             if let Err(e) = prepared {
-                self.roll_back(start, &captured, Abandon::Failed);
+                self.roll_back(&start, Abandon::Failed);
                 return Err(e);
             }
             if self.model.solver().extrapolate {
-                self.predict(dt);
+                self.solution.predict(&self.disc, dt);
             }
             let reuse = self.model.solver().reuse_factorisation;
             let mut attempt = self.newton(target, reuse, &*observer);
@@ -170,8 +161,8 @@ impl Simulation<'_> {
                 // before cutting it.
                 observer.step_failed(target, dt, failed);
                 let factorisations = failed.factorisations;
-                self.state = start.state.clone();
-                self.step_increment.clear();
+                self.solution.state = start.solution.state.clone();
+                self.solution.step_increment.clear();
                 attempt = if observer.interrupted() {
                     Err(NewtonFailure::Interrupted)
                 } else {
@@ -185,24 +176,24 @@ impl Simulation<'_> {
             // retried shorter (module `adaptive`), unless it is already the smallest step.
             let mut estimate = None;
             if let (Ok(_), Some(tolerance)) = (&attempt, self.model.time().tolerance) {
-                estimate = match self.time_error_estimate(self.time, target) {
+                estimate = match self.time_error_estimate(self.clock.time, target) {
                     Ok(e) => e,
                     Err(e) => {
-                        self.roll_back(start, &captured, Abandon::Failed);
+                        self.roll_back(&start, Abandon::Failed);
                         return Err(e);
                     }
                 };
                 let ratio = error_ratio(estimate, tolerance);
                 if ratio > 1.0 {
                     if !is_smallest_step(dt, min_step, target) {
-                        self.roll_back(start, &captured, Abandon::Rejected);
+                        self.roll_back(&start, Abandon::Rejected);
                         observer.step_rejected(target, dt, estimate.unwrap_or(0.0));
-                        self.step_size = self.control.rejected(dt, ratio).max(min_step);
+                        self.clock.step_size = self.clock.control.rejected(dt, ratio).max(min_step);
                         continue;
                     }
-                    if !self.control.above_tolerance_reported {
-                        self.control.above_tolerance_reported = true;
-                        self.notices.push(format!(
+                    if !self.clock.control.above_tolerance_reported {
+                        self.clock.control.above_tolerance_reported = true;
+                        self.record.notices.push(format!(
                             "at t = {target} the time-error estimate {:.3e} exceeds its share {LOCAL_FRACTION} of the tolerance {tolerance:e} at the smallest step {min_step:e}: this step and any other like it are accepted (said once; the trapezoidal rule ringing after a jump of strain at a high temperature does this)",
                             estimate.unwrap_or(0.0)
                         ));
@@ -211,68 +202,53 @@ impl Simulation<'_> {
             }
             match attempt {
                 Ok(newton) => {
-                    self.tangent.end_attempt();
+                    self.work.tangent.end_attempt();
                     self.commit_step();
                     let stabilisation = self.account_stabilisation(target);
                     // A schedule's rate changes at its breakpoints: no extrapolation across them.
-                    let breakpoints = &self.breakpoints;
+                    let breakpoints = &self.measures.breakpoints;
                     let nearest = breakpoints.partition_point(|&b| b < target - snap);
                     let at_break = breakpoints
                         .get(nearest)
                         .is_some_and(|&b| (b - target).abs() <= snap);
-                    let increment = std::mem::take(&mut self.step_increment);
-                    self.last_increment = (!at_break).then_some((increment, dt));
-                    self.time = target;
-                    self.step += 1;
-                    if newton.at_round_off && !self.round_off_reported {
-                        self.round_off_reported = true;
-                        self.notices.push(round_off_notice(
+                    let increment = std::mem::take(&mut self.solution.step_increment);
+                    self.solution.last_increment = (!at_break).then_some((increment, dt));
+                    let cuts = std::mem::take(&mut self.clock.step_cuts);
+                    self.clock
+                        .advance(self.model.time(), target, dt, cuts, estimate);
+                    if newton.at_round_off && !self.record.round_off_reported {
+                        self.record.round_off_reported = true;
+                        self.record.notices.push(round_off_notice(
                             target,
                             &newton,
                             self.model.solver().tolerance,
                         ));
                     }
                     let report = StepReport {
-                        step: self.step,
+                        step: self.clock.step,
                         time: target,
                         dt,
                         temperature: self.model.temperature.value(target),
                         newton,
-                        cuts: std::mem::take(&mut self.step_cuts),
+                        cuts,
                         error_estimate: estimate,
-                        rejected: std::mem::take(&mut self.control.rejections),
+                        rejected: std::mem::take(&mut self.clock.control.rejections),
                         load_factor: None,
                         stabilisation,
                     };
-                    match self.model.time().tolerance {
-                        Some(tolerance) => {
-                            let ratio = error_ratio(estimate, tolerance);
-                            let mut next = self.control.accepted(dt, ratio);
-                            // A step shortened to land on a breakpoint does not shrink the next below the plan.
-                            if dt < self.step_size && report.cuts == 0 {
-                                next = next.max(self.step_size);
-                            }
-                            let largest = self.model.time().max_step.unwrap_or(Real::INFINITY);
-                            self.step_size = next.clamp(min_step, largest.max(min_step));
-                        }
-                        None if self.step_size < nominal => {
-                            self.step_size = (STEP_FACTOR * self.step_size).min(nominal);
-                        }
-                        None => {}
-                    }
                     return Ok(StepOutcome::Stepped(Box::new(report)));
                 }
                 Err(NewtonFailure::Fatal(e)) => {
-                    self.roll_back(start, &captured, Abandon::Failed);
+                    self.roll_back(&start, Abandon::Failed);
                     return Err(e);
                 }
                 Err(NewtonFailure::Interrupted) => {
-                    self.roll_back(start, &captured, Abandon::Interrupted);
+                    self.roll_back(&start, Abandon::Interrupted);
                     return Ok(StepOutcome::Interrupted);
                 }
                 Err(NewtonFailure::NotConverged(mut newton)) => {
                     newton.worst_equation = self.worst_equation();
-                    self.roll_back(start, &captured, Abandon::Failed);
+                    self.roll_back(&start, Abandon::Failed);
                     observer.step_failed(target, dt, &newton);
                     // Stabilisation: the same step again with the damping switched on or raised.
                     if self.stabilise_retry(dt, target) {
@@ -281,7 +257,7 @@ impl Simulation<'_> {
                     if is_smallest_step(dt, min_step, target) {
                         return Err(SolverError::StepFailed {
                             time: target,
-                            step: self.step + 1,
+                            step: self.clock.step + 1,
                             dt,
                             iterations: newton.iterations,
                             residuals: newton.residuals,
@@ -289,8 +265,7 @@ impl Simulation<'_> {
                             worst_equation: newton.worst_equation,
                         });
                     }
-                    self.step_size = halved_step(dt, min_step, target);
-                    self.step_cuts += 1;
+                    self.clock.cut(halved_step(dt, min_step, target));
                 }
             }
         }
@@ -308,17 +283,17 @@ impl Simulation<'_> {
     pub fn run(&mut self, observers: &mut [&mut dyn Observer]) -> Result<RunSummary, SolverError> {
         let mut observers = Observers::new(observers);
         let mut summary = RunSummary {
-            time: self.time,
+            time: self.clock.time,
             ..RunSummary::default()
         };
-        if self.step == 0 && observers.start(self).is_break() {
+        if self.clock.step == 0 && observers.start(self).is_break() {
             summary.stopped = true;
             return Ok(summary);
         }
         loop {
             let outcome = self.step_with(&mut observers);
             // Cuts of an attempt that failed for good or was abandoned count too.
-            let pending = self.step_cuts;
+            let pending = self.clock.step_cuts;
             match outcome {
                 Ok(StepOutcome::Stepped(report)) => {
                     summary.steps += 1;
@@ -343,19 +318,19 @@ impl Simulation<'_> {
         }
     }
 
-    /// What a step is about to change, saved before it starts (see [`Self::roll_back`]).
-    fn step_start(&mut self) -> StepStart {
-        self.tangent.begin_attempt();
-        StepStart {
-            state: self.state.clone(),
-            gauge_active: self.gauge_active,
-        }
+    /// An attempt of a step starts: what it may change is saved ([`StepSnapshot`]), and the factorisation it
+    /// starts with is marked (see [`Self::roll_back`]).
+    pub(super) fn begin_attempt(&mut self) -> StepSnapshot {
+        self.work.tangent.begin_attempt();
+        self.snapshot()
     }
 
-    /// Undoes an attempt that failed or was interrupted: restores the last converged state, the materials' data
-    /// of the last converged step ([`crate::material::ConstitutiveLaw::roll_back`]) and the gauge activation,
-    /// and forgets the release reactions `captured` for it. (The internal variables are only advanced by a
-    /// converged step, in `commit_step`.)
+    /// Undoes an attempt that failed, was rejected or was interrupted: every part a step changes goes back to
+    /// `start`, the snapshot taken when the attempt began ([`Self::begin_attempt`]; a release reaction captured
+    /// for it is forgotten with it), the materials to the data of their last converged step
+    /// ([`crate::material::ConstitutiveLaw::roll_back`]), and the attempt's damping is dropped. (The internal
+    /// variables are only advanced by a converged step, in `commit_step`.) What the run said and spent, the
+    /// stabiliser's memory and the gauge constraints once built are kept.
     ///
     /// After a failure the factorisations are invalidated: they belong to the abandoned iterates, and the next
     /// attempt starts with a fresh tangent. After a rejection by error control the attempt converged: its last
@@ -363,19 +338,18 @@ impl Simulation<'_> {
     /// After an interruption the factorisation goes back to the one the attempt started with — kept if the
     /// attempt made none, made again from its recorded origin otherwise — so that continuing (a later `step`, or
     /// a restored checkpoint taken now) repeats the uninterrupted run exactly.
-    fn roll_back(&mut self, start: StepStart, captured: &[(usize, usize)], why: Abandon) {
-        self.state = start.state;
-        self.damping = None;
+    pub(super) fn roll_back(&mut self, start: &StepSnapshot, why: Abandon) {
+        let restored = self.put_back(start);
+        assert!(
+            restored.is_ok(),
+            "a part refused the snapshot it saved itself: {restored:?}"
+        );
+        self.stabiliser.damping = None;
         self.materials.roll_back(&self.model.materials);
-        self.gauge_active = start.gauge_active;
-        for &(k, i) in captured {
-            self.ramps[k][i] = None;
-        }
-        self.step_increment.clear();
         let revert = match why {
-            Abandon::Interrupted => self.tangent.revert_attempt(),
+            Abandon::Interrupted => self.work.tangent.revert_attempt(),
             Abandon::Rejected => {
-                self.tangent.end_attempt();
+                self.work.tangent.end_attempt();
                 Revert::Keep
             }
             Abandon::Failed => Revert::Forget,
@@ -393,11 +367,11 @@ impl Simulation<'_> {
 
     /// Forgets every factorisation (the next Newton iteration assembles and factorises afresh).
     pub(super) fn forget_factorisation(&mut self) {
-        self.system.invalidate();
-        if let Some((_, system, _)) = &mut self.gauge {
+        self.work.system.invalidate();
+        if let Some((_, system, _)) = &mut self.releases.gauge {
             system.invalidate();
         }
-        self.tangent.invalidate();
+        self.work.tangent.invalidate();
     }
 }
 

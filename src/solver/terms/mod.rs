@@ -27,10 +27,10 @@
 //! - *Its state*: what a term keeps between steps (an anchor, a slip, a history) changes only when a step
 //!   converges ([`PointTerm::commit`], called with the converged state after the materials' commit); during
 //!   the attempts of a step the term is read-only (`&self`), so an attempt that fails, is rejected or is
-//!   interrupted leaves the term as the last converged step left it — the roll-back of a term is to do
-//!   nothing, and no snapshot is needed for it. A checkpoint keeps each term's numbers
-//!   ([`PointTerm::save`], [`PointTerm::restore`]; the simulation's `Checkpoint::terms`, in the order of the
-//!   list), so a restored run continues bit for bit. A stateless term (today's three) keeps the defaults. The
+//!   interrupted leaves the term as the last converged step left it. Its numbers ([`PointTerm::save`],
+//!   [`PointTerm::restore`]) are part of what a step changes, the simulation's `StepSnapshot::terms` (in the
+//!   order of the list): a roll-back puts them back (which changes nothing for a term that attempts only read)
+//!   and a checkpoint keeps them, so a restored run continues bit for bit. A stateless term (today's three) keeps the defaults. The
 //!   damping of stabilisation is the one term built per attempt from the simulation's own memory (the last
 //!   converged state and `c/h`), which drops it when the attempt ends either way.
 //!
