@@ -22,7 +22,7 @@ static TEMPORARY_COUNTER: AtomicU64 = AtomicU64::new(0);
 ///
 /// # Errors
 /// The I/O error of creating, writing, syncing or renaming the temporary file; the target is then unchanged.
-pub fn write_bytes_atomically(path: &Path, bytes: &[u8]) -> io::Result<()> {
+pub(crate) fn write_bytes_atomically(path: &Path, bytes: &[u8]) -> io::Result<()> {
     write_atomically(path, |w| w.write_all(bytes)).map_err(|e| match e {
         MeshIoError::Write { source, .. } | MeshIoError::Read { source, .. } => source,
     })

@@ -2,27 +2,27 @@
 //! charts, summary), SVG charts. What the meshes and recorded centrelines show (the full device mirrored from a
 //! reduced model) is computed in [`crate::post`]; this layer writes it.
 
-pub mod atomic;
+pub(crate) mod atomic;
 pub mod centreline;
 pub mod chart;
-pub mod checkpoint;
-pub mod configurations;
+pub(crate) mod checkpoint;
+pub(crate) mod configurations;
 pub mod design;
 pub mod estimate;
-pub mod formats;
+pub(crate) mod formats;
 pub mod history;
-pub mod input;
-pub mod mcap;
-pub mod mcap_salvage;
-pub mod mesh_format;
-pub mod no_follow;
+pub(crate) mod input;
+pub(crate) mod mcap;
+pub(crate) mod mcap_salvage;
+pub(crate) mod mesh_format;
+pub(crate) mod no_follow;
 pub mod obj;
-pub mod render;
-pub mod run_charts;
-pub mod run_folder;
+pub(crate) mod render;
+pub(crate) mod run_charts;
+pub(crate) mod run_folder;
 pub mod snapshots;
-pub mod state;
+pub(crate) mod state;
 pub mod stl;
-pub mod summary;
+pub(crate) mod summary;
 pub mod threemf;
 pub mod vtk;

@@ -23,7 +23,7 @@ use std::fmt::Write as _;
 
 /// One run of a convergence study.
 #[derive(Debug, Clone, PartialEq)]
-pub struct ConvergencePoint {
+pub(crate) struct ConvergencePoint {
     /// Degree.
     pub degree: usize,
     /// Control points per patch.
@@ -42,7 +42,7 @@ pub struct ConvergencePoint {
 
 /// Settings of a convergence study.
 #[derive(Debug, Clone, PartialEq)]
-pub struct ConvergenceStudy {
+pub(crate) struct ConvergenceStudy {
     /// Degrees to run.
     pub degrees: Vec<usize>,
     /// Control points per patch to run (values `≤ p` are skipped for that `p`).
@@ -71,7 +71,7 @@ impl ConvergenceStudy {
 /// # Errors
 /// The first run that fails ([`StudyError::Run`] says which): every run must succeed for the rates to mean
 /// anything.
-pub fn convergence_study(
+pub(crate) fn convergence_study(
     design: &Design,
     study: &ConvergenceStudy,
     mut progress: impl FnMut(&str),
@@ -131,7 +131,7 @@ pub fn convergence_study(
 }
 
 /// The rows as CSV, with a comment header saying what the error is measured against.
-pub fn convergence_csv(
+pub(crate) fn convergence_csv(
     rows: &[ConvergencePoint],
     study: &ConvergenceStudy,
     design: &str,
@@ -164,7 +164,7 @@ pub fn convergence_csv(
 
 /// The two charts of a convergence study: error against `n` and error against wall time (work–precision),
 /// one series per degree, on log–log axes.
-pub fn convergence_charts(
+pub(crate) fn convergence_charts(
     rows: &[ConvergencePoint],
     study: &ConvergenceStudy,
     design: &str,

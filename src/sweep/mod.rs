@@ -31,10 +31,10 @@
 //! (its design was refused), or `task_error.txt` (its run was refused before it wrote a summary), or nothing
 //! yet.
 
-pub mod collect;
-pub mod disk;
-pub mod metrics;
-pub mod slurm;
+pub(crate) mod collect;
+pub(crate) mod disk;
+pub(crate) mod metrics;
+pub(crate) mod slurm;
 
 use crate::io::design::set::{PathStep, parse_path, path_text};
 use crate::io::design::{Design, DesignError, DesignOverrides, SetOverride, load_design_with};
@@ -506,7 +506,7 @@ impl SweepDir {
     /// design, or the reason it was refused, checking those an earlier preparation wrote. The plan comes
     /// first and every file is written through a temporary renamed into place, so a preparation killed at any
     /// moment leaves a folder this continues (module docs). `known` holds resolutions already made
-    /// ([`disk::SweepEstimate::resolved`]); `stop` is asked before each variant, and when it says so the
+    /// (`disk::SweepEstimate::resolved`); `stop` is asked before each variant, and when it says so the
     /// preparation ends there.
     ///
     /// # Errors

@@ -77,7 +77,7 @@ pub struct Checkpoint {
     pub timing: SolverTiming,
     /// Where an arc-length run is on its path (`None` for time-driven runs and before the first increment).
     pub arc: Option<super::ArcState>,
-    /// The stabiliser's memory ([`super::stabilisation`]).
+    /// The stabiliser's memory (`super::stabilisation`).
     pub stabiliser: super::StabiliserState,
     /// Per point term of the simulation's list, in its order: the numbers it keeps between steps
     /// ([`crate::solver::terms::PointTerm::save`]).
