@@ -47,6 +47,9 @@
 
 // Checks such as `!(x > 0.0)` are deliberate: they reject NaN along with the out-of-range values.
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
+// The public API is curated: an item is `pub` only where a program using the crate can reach it (the modules
+// below and the re-exports after them); everything else is `pub(crate)`. Every public item has a doc comment.
+#![warn(missing_docs, unreachable_pub)]
 
 pub mod cli;
 pub mod design;
@@ -60,3 +63,10 @@ pub mod run;
 pub mod solver;
 pub mod study;
 pub mod sweep;
+
+// The entry points most programs need, at the crate root: build a model in code or read a design file, and
+// simulate it step by step (a run into a run folder, as the command line does, is [`run::run`]).
+pub use io::design::{Design, load_design, parse_design};
+pub use model::Model;
+pub use model::builder::ModelBuilder;
+pub use solver::{Observer, Simulation, SolverError, StepReport};

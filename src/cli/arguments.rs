@@ -27,7 +27,7 @@ use std::ffi::OsStr;
 
 /// A value parser that turns an argument's text into its value or says what is wrong with it.
 #[derive(Debug, Clone, Copy)]
-pub struct Checked<T> {
+pub(crate) struct Checked<T> {
     parse: fn(&str) -> Result<T, String>,
     /// Characters of the value shown in a refusal: [`QUOTED_CHARS`], or a path's whole length.
     shown: usize,
@@ -49,7 +49,7 @@ impl<T: Clone + Send + Sync + 'static> TypedValueParser for Checked<T> {
 
 /// A value parser for one of a fixed list of words (listed in `--help` and in the refusal).
 #[derive(Debug, Clone, Copy)]
-pub struct OneOf(&'static [&'static str]);
+pub(crate) struct OneOf(&'static [&'static str]);
 
 impl TypedValueParser for OneOf {
     type Value = String;
@@ -101,7 +101,7 @@ fn refusal(
 }
 
 /// A finite number > 0 (a tolerance, a time step, a grid spacing).
-pub fn positive() -> Checked<Real> {
+pub(crate) fn positive() -> Checked<Real> {
     Checked {
         shown: QUOTED_CHARS,
         parse: |text| number(text).and_then(|x| check(x, x > 0.0, "a finite number > 0")),
@@ -109,7 +109,7 @@ pub fn positive() -> Checked<Real> {
 }
 
 /// A finite number ≥ 0 (a time, a distance that may be zero).
-pub fn non_negative() -> Checked<Real> {
+pub(crate) fn non_negative() -> Checked<Real> {
     Checked {
         shown: QUOTED_CHARS,
         parse: |text| number(text).and_then(|x| check(x, x >= 0.0, "a finite number ≥ 0")),
@@ -117,7 +117,7 @@ pub fn non_negative() -> Checked<Real> {
 }
 
 /// A whole number ≥ `MIN` (a count of samples, segments, rings).
-pub fn at_least<const MIN: usize>() -> Checked<usize> {
+pub(crate) fn at_least<const MIN: usize>() -> Checked<usize> {
     Checked {
         shown: QUOTED_CHARS,
         parse: |text| match text.trim().parse::<usize>() {
@@ -128,12 +128,12 @@ pub fn at_least<const MIN: usize>() -> Checked<usize> {
 }
 
 /// One of `words`.
-pub fn one_of(words: &'static [&'static str]) -> OneOf {
+pub(crate) fn one_of(words: &'static [&'static str]) -> OneOf {
     OneOf(words)
 }
 
 /// A value parser from a parse function (`--set`, `--reference`, an integrator's name).
-pub fn parsed_by<T>(parse: fn(&str) -> Result<T, String>) -> Checked<T> {
+pub(crate) fn parsed_by<T>(parse: fn(&str) -> Result<T, String>) -> Checked<T> {
     Checked {
         parse,
         shown: QUOTED_CHARS,
@@ -141,7 +141,7 @@ pub fn parsed_by<T>(parse: fn(&str) -> Result<T, String>) -> Checked<T> {
 }
 
 /// A finite number > 0, or `none` (a tolerance that can be turned off).
-pub fn positive_or_none() -> Checked<super::MaybeTolerance> {
+pub(crate) fn positive_or_none() -> Checked<super::MaybeTolerance> {
     Checked {
         shown: QUOTED_CHARS,
         parse: |text| match text.trim() {
@@ -154,7 +154,7 @@ pub fn positive_or_none() -> Checked<super::MaybeTolerance> {
 }
 
 /// A `--set PATH=VALUE` override ([`SetOverride`]); its refusal quotes the argument once, shortened.
-pub fn set_override() -> Checked<SetOverride> {
+pub(crate) fn set_override() -> Checked<SetOverride> {
     Checked {
         shown: QUOTED_CHARS,
         parse: |text| text.parse::<SetOverride>().map_err(|e| e.message),
@@ -163,7 +163,7 @@ pub fn set_override() -> Checked<SetOverride> {
 
 /// The extensions `mesh -o` and `export -o` write: the snapshot formats ([`crate::io::formats`]) and `csv`
 /// for the centrelines.
-pub fn device_file() -> Checked<std::path::PathBuf> {
+pub(crate) fn device_file() -> Checked<std::path::PathBuf> {
     Checked {
         // A path is shown whole (the longest a path can be is 4096 bytes).
         shown: 4096,
@@ -210,7 +210,7 @@ fn check(x: Real, ok: bool, what: &str) -> Result<Real, String> {
 /// [`TIME_LIMIT_SECONDS`]: `--grid 0.0001: the print solid would need about 2.8e16 bytes of memory (…), more
 /// than stentkit's limit of 8.0 GB: give a --grid of at least 0.0277 mm`. `argument` is the flag and its
 /// value as typed, `task` what it is for, `what` the estimate's parts in words, `instead` the value that fits.
-pub fn too_costly(
+pub(crate) fn too_costly(
     argument: &str,
     task: &str,
     bytes: Real,
@@ -249,7 +249,7 @@ fn duration(seconds: Real) -> String {
 }
 
 /// A count for a message: whole below a million, `2.03e12` above.
-pub fn count(x: Real) -> String {
+pub(crate) fn count(x: Real) -> String {
     if x < 1e6 {
         format!("{x:.0}")
     } else {
@@ -259,12 +259,12 @@ pub fn count(x: Real) -> String {
 
 /// `x` > 0 rounded up to three significant digits, for a least value to suggest (`2.02e-7` for
 /// `2.0101451485608872e-7`).
-pub fn rounded_up(x: Real) -> Short {
+pub(crate) fn rounded_up(x: Real) -> Short {
     let scale = Real::powi(10.0, x.log10().floor() as i32 - 2);
     Short::rounded((x / scale).ceil() * scale, 3)
 }
 
 /// A number for a message: shortest round trip, in exponent form far from 1 ([`Short`]).
-pub fn short(x: Real) -> String {
+pub(crate) fn short(x: Real) -> String {
     Short(x).to_string()
 }

@@ -9,7 +9,7 @@ use std::fmt::Write as _;
 use std::path::Path;
 
 /// Loads the design with the `--set` overrides `sets` and prints its description.
-pub fn run(path: &Path, sets: Vec<SetOverride>) -> anyhow::Result<()> {
+pub(crate) fn run(path: &Path, sets: Vec<SetOverride>) -> anyhow::Result<()> {
     let design = load_design_with(path, &DesignOverrides::sets(sets))?;
     print!("{}", describe(&design, &path.display().to_string()));
     Ok(())

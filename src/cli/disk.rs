@@ -10,7 +10,7 @@ use crate::sweep::Plan;
 use crate::sweep::disk::SweepEstimate;
 use std::path::Path;
 
-pub use crate::run::disk::FINISHING_RESERVE;
+pub(crate) use crate::run::disk::FINISHING_RESERVE;
 
 /// Refuses (with [`BadInput`]) a sweep into `dir` whose estimated output ([`SweepEstimate`]: what the runs of its
 /// variants still to run write, and their design files) plus [`FINISHING_RESERVE`] for each of the
@@ -20,7 +20,7 @@ pub use crate::run::disk::FINISHING_RESERVE;
 /// # Errors
 /// [`BadInput`] naming the design file, the field that sizes the largest part of the largest variant, the
 /// total, that variant's estimate by part, and the free space.
-pub fn check_sweep_space(
+pub(crate) fn check_sweep_space(
     plan: &Plan,
     dir: &Path,
     estimate: &SweepEstimate,
@@ -53,6 +53,6 @@ pub fn check_sweep_space(
 }
 
 /// What a sweep needs free: its estimate and [`FINISHING_RESERVE`] for each of the `concurrent` runs \[bytes\].
-pub fn sweep_bytes(estimate: &SweepEstimate, concurrent: usize) -> u64 {
+pub(crate) fn sweep_bytes(estimate: &SweepEstimate, concurrent: usize) -> u64 {
     estimate.total + (concurrent.min(estimate.variants) * FINISHING_RESERVE) as u64
 }

@@ -19,15 +19,15 @@ use crate::post::print::{
 };
 
 /// The default vertices around a tube of `mesh` and `export` (`--segments`).
-pub const DEFAULT_SEGMENTS: usize = 16;
+pub(crate) const DEFAULT_SEGMENTS: usize = 16;
 /// The default samples per control point of `mesh` (`--samples`).
-pub const DEFAULT_SAMPLES: usize = 4;
+pub(crate) const DEFAULT_SAMPLES: usize = 4;
 /// The default rings per patch of `export` (`--rings`).
-pub const DEFAULT_RINGS: usize = 41;
+pub(crate) const DEFAULT_RINGS: usize = 41;
 
 /// How a command samples the device's patches.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub enum Sampling {
+pub(crate) enum Sampling {
     /// `mesh --samples`: this many samples per control point of every patch.
     PerPoint(usize),
     /// `export --rings`: about this many samples per patch, taken at a whole number per control point (the
@@ -99,7 +99,7 @@ impl Sampling {
 
 /// What `mesh` or `export` is asked to draw.
 #[derive(Debug, Clone, Copy)]
-pub struct Drawing {
+pub(crate) struct Drawing {
     /// How the patches are sampled.
     pub sampling: Sampling,
     /// Vertices around each tube (`--segments`).
@@ -114,7 +114,7 @@ pub struct Drawing {
 /// settings out of range ([`PrintSettings::resolved`]), or an estimated cost (`DrawingCost`) above the
 /// memory limit designs get ([`MEMORY_LIMIT_BYTES`]) or, for a print solid, above [`TIME_LIMIT_SECONDS`];
 /// naming the argument to change and the value that fits.
-pub fn check_drawing(model: &Model, drawing: &Drawing) -> anyhow::Result<()> {
+pub(crate) fn check_drawing(model: &Model, drawing: &Drawing) -> anyhow::Result<()> {
     let thinnest = thinnest_wire(model);
     let spacing = match &drawing.print {
         Some(settings) => {

@@ -30,7 +30,7 @@ use std::path::{Path, PathBuf};
 
 /// Which state of the run to export.
 #[derive(Debug, Clone, PartialEq)]
-pub enum Which {
+pub(crate) enum Which {
     /// The first step at or after this time.
     Time(Real),
     /// An event of the cycle: `initial`, `programmed`, `fixed`, `released`, `final`.
@@ -39,7 +39,7 @@ pub enum Which {
 
 /// What to export and how finely.
 #[derive(Debug, Clone)]
-pub struct ExportOptions {
+pub(crate) struct ExportOptions {
     /// The state.
     pub which: Which,
     /// The mesh file (`.stl`, `.obj`, `.3mf`), or `.csv` for the centrelines.
@@ -61,7 +61,7 @@ pub struct ExportOptions {
 /// # Errors
 /// [`BadInput`] for an output that exists (without `force`), a folder that is not a run folder, a design that
 /// is not the one that ran, a phase the model does not have or a time outside what the run reached; the design's errors; a step that fails.
-pub fn run(run_dir: &Path, options: &ExportOptions) -> anyhow::Result<()> {
+pub(crate) fn run(run_dir: &Path, options: &ExportOptions) -> anyhow::Result<()> {
     let extension = options
         .output
         .extension()

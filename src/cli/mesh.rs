@@ -27,7 +27,7 @@ use std::path::Path;
 
 /// Which shape `mesh` writes.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
-pub enum State {
+pub(crate) enum State {
     /// The shape the device is made in (and recovers to).
     Permanent,
     /// The shape the programme drives it to, before it is released.
@@ -36,7 +36,7 @@ pub enum State {
 
 /// How finely `mesh` draws the device.
 #[derive(Debug, Clone, Copy)]
-pub struct Resolution {
+pub(crate) struct Resolution {
     /// Vertices around each tube.
     pub segments: usize,
     /// Samples along each patch per control point.
@@ -47,7 +47,7 @@ pub struct Resolution {
 
 /// Writes the shape `state` of the design (with the `--set` overrides `sets`) to `output` (`.stl`, `.obj`,
 /// `.3mf` or `.csv`; an existing file only with `--force`).
-pub fn run(
+pub(crate) fn run(
     design: &Path,
     output: super::Target<'_>,
     state: State,

@@ -2,19 +2,19 @@
 //! shape as a closed tube surface), `run` (simulate and write the run folder), `study` (accuracy against cost)
 //! and `schema` (the JSON Schema of the design format). The only module that uses `anyhow` and prints.
 
-pub mod arguments;
+pub(crate) mod arguments;
 pub mod check;
-pub mod disk;
-pub mod drawing;
-pub mod export;
-pub mod mesh;
-pub mod render;
-pub mod repair;
+pub(crate) mod disk;
+pub(crate) mod drawing;
+pub(crate) mod export;
+pub(crate) mod mesh;
+pub(crate) mod render;
+pub(crate) mod repair;
 pub mod run;
-pub mod signals;
-pub mod study;
-pub mod sweep;
-pub mod tune;
+pub(crate) mod signals;
+pub(crate) mod study;
+pub(crate) mod sweep;
+pub(crate) mod tune;
 
 use crate::design::SetOverride;
 use clap::{Parser, Subcommand};
@@ -31,7 +31,7 @@ use std::process::ExitCode;
     after_help = "Exit status: 0 completed, 1 failed (solver, output, folder in use), 2 bad input (design, \
                   arguments, folder, existing output or size refused; nothing ran), 130 interrupted by SIGINT, SIGTERM or SIGHUP."
 )]
-pub struct Cli {
+pub(crate) struct Cli {
     /// What to do.
     #[command(subcommand)]
     pub command: Command,
@@ -39,7 +39,7 @@ pub struct Cli {
 
 /// The subcommands.
 #[derive(Debug, Subcommand)]
-pub enum Command {
+pub(crate) enum Command {
     /// Validate a design and print its patches, nodes, collocation points, unknowns, time steps, geometry fit
     /// error and warnings.
     ///
@@ -264,7 +264,7 @@ pub enum Command {
 
 /// The print-solid options of `mesh` and `export`.
 #[derive(Debug, Clone, Copy, clap::Args)]
-pub struct PrintArgs {
+pub(crate) struct PrintArgs {
     /// Write one closed, manifold solid for a printer (the union of the wires, joints filled, simplified,
     /// standing on its axis on z = 0) instead of one tube per rod.
     #[arg(long)]
@@ -281,7 +281,7 @@ pub struct PrintArgs {
 
 impl PrintArgs {
     /// The print settings, if `--print` was given.
-    pub fn settings(self) -> Option<crate::post::print::PrintSettings> {
+    pub(crate) fn settings(self) -> Option<crate::post::print::PrintSettings> {
         self.print.then_some(crate::post::print::PrintSettings {
             spacing: self.grid,
             tolerance: self.deviation,
@@ -292,7 +292,7 @@ impl PrintArgs {
 /// `stentkit sweep`: a sweep to run, or one of its subcommands.
 #[derive(Debug, clap::Args)]
 #[command(args_conflicts_with_subcommands = true, subcommand_negates_reqs = true)]
-pub struct SweepCli {
+pub(crate) struct SweepCli {
     /// collect, status or task.
     #[command(subcommand)]
     pub command: Option<SweepCommand>,
@@ -345,7 +345,7 @@ pub struct SweepCli {
 
 /// The subcommands of `stentkit sweep`.
 #[derive(Debug, Subcommand)]
-pub enum SweepCommand {
+pub(crate) enum SweepCommand {
     /// Write DIR/sweep.csv (a row per variant: parameters, status, wall time, programmed displacement, snap at
     /// release, fixity, recovery ratios, times to 50 % and 90 % recovery, final residual shape) and
     /// DIR/charts/ (each metric against each numeric parameter), from the variants' run folders.
@@ -380,7 +380,7 @@ pub enum SweepCommand {
 
 /// The studies.
 #[derive(Debug, Subcommand)]
-pub enum StudyCommand {
+pub(crate) enum StudyCommand {
     /// p × n sweep: displacement error against a self-converged run, and wall time, per run (CSV).
     ///
     /// Example: stentkit study convergence designs/circular_arch.yaml --time 3 -o runs/arch_convergence
@@ -495,12 +495,12 @@ pub const EXIT_INTERRUPTED: u8 = 130;
 /// Input refused before anything ran (exit status [`EXIT_BAD_INPUT`]).
 #[derive(Debug, thiserror::Error)]
 #[error("{0}")]
-pub struct BadInput(pub String);
+pub(crate) struct BadInput(pub String);
 
 /// A file or folder the user named for a command's output (`-o`), and whether what is there may be replaced
 /// (`--force`).
 #[derive(Debug, Clone, Copy)]
-pub struct Target<'a> {
+pub(crate) struct Target<'a> {
     /// The file or folder.
     pub path: &'a std::path::Path,
     /// Replace what exists.
@@ -515,7 +515,7 @@ pub struct Target<'a> {
 ///
 /// # Errors
 /// [`BadInput`] (exit status 2) naming every target that exists.
-pub fn refuse_existing<'a>(
+pub(crate) fn refuse_existing<'a>(
     targets: impl IntoIterator<Item = &'a std::path::Path>,
     force: bool,
 ) -> Result<(), BadInput> {
@@ -542,7 +542,7 @@ pub fn refuse_existing<'a>(
 /// A run stopped by a signal (exit status [`EXIT_INTERRUPTED`]).
 #[derive(Debug, thiserror::Error)]
 #[error("{0}")]
-pub struct Interrupted(pub String);
+pub(crate) struct Interrupted(pub String);
 
 /// The exit status of a command that ended with `error`.
 pub fn exit_code(error: &anyhow::Error) -> u8 {
@@ -583,7 +583,7 @@ pub fn error_text(error: &anyhow::Error) -> String {
     crate::math::quote::shortened_numbers(&text).into_owned()
 }
 
-pub use crate::math::quote::short_time;
+pub(crate) use crate::math::quote::short_time;
 
 /// Runs the command line and returns the process exit code.
 pub fn main() -> ExitCode {
@@ -765,7 +765,7 @@ pub fn main() -> ExitCode {
 /// A tolerance argument that may be `none` (a type of its own: clap would take an `Option` field for an
 /// optional argument).
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub struct MaybeTolerance(pub Option<f64>);
+pub(crate) struct MaybeTolerance(pub Option<f64>);
 
 /// `stentkit sweep …`.
 fn sweep(cli: SweepCli) -> anyhow::Result<()> {

@@ -9,7 +9,7 @@ use crate::io::snapshots::{SnapshotWriter, VESSEL_FILE};
 use std::path::{Path, PathBuf};
 
 /// `text` when it names a view ([`View::parse`]; `--view` is checked with it as it is read).
-pub fn view_name(text: &str) -> Result<String, String> {
+pub(crate) fn view_name(text: &str) -> Result<String, String> {
     View::parse(text)
         .map(|_| text.to_string())
         .ok_or_else(|| "must be axonometric, x1-x2, x1-x3 or x2-x3".to_string())
@@ -21,7 +21,7 @@ pub fn view_name(text: &str) -> Result<String, String> {
 /// # Errors
 /// [`BadInput`] for an unknown view, an output that is not `.png` or exists (without `--force`), or a folder
 /// without summary or snapshots; the error of a mesh that cannot be read or a picture that cannot be written.
-pub fn run(
+pub(crate) fn run(
     dir: &Path,
     output: super::Target<'_>,
     times: &[f64],

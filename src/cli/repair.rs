@@ -23,7 +23,7 @@ use std::path::{Path, PathBuf};
 ///
 /// # Errors
 /// [`BadInput`] for a folder that is not a run folder; the I/O error of a file that cannot be repaired.
-pub fn run(dir: &Path) -> anyhow::Result<()> {
+pub(crate) fn run(dir: &Path) -> anyhow::Result<()> {
     let listed = match classify(dir)? {
         FolderKind::Run(files) => files,
         FolderKind::Empty => {

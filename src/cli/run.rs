@@ -1,7 +1,7 @@
 //! `stentkit run`: simulates a design and writes the run folder through [`crate::run`] (the folder's layout,
 //! heartbeat, checkpoints and `--resume` are described there). This command reads the design with its
 //! `--set` and `--tol` overrides, maps SIGINT, SIGTERM and SIGHUP onto the run's interruption
-//! ([`super::signals`]: the step in progress is abandoned at its next Newton iteration), shows a progress bar
+//! (`super::signals`: the step in progress is abandoned at its next Newton iteration), shows a progress bar
 //! (indicatif, on stderr, hidden when stderr is not a terminal or with `--quiet`) and prints the run's
 //! messages, and turns the run's errors into exit statuses: a refusal is bad input (2), an interruption 130,
 //! anything else a failed run (1).
@@ -136,13 +136,13 @@ impl Observer for Progress {
 }
 
 /// The command line as typed, arguments with spaces quoted.
-pub fn command_line() -> String {
+pub(crate) fn command_line() -> String {
     quoted_command_line(std::env::args())
 }
 
 /// `args` as one line, arguments that are empty or hold spaces quoted (what `summary.json` and `run.mcap`
 /// record as the command line).
-pub fn quoted_command_line(args: impl IntoIterator<Item = String>) -> String {
+pub(crate) fn quoted_command_line(args: impl IntoIterator<Item = String>) -> String {
     args.into_iter()
         .map(|a| {
             if a.is_empty() || a.contains(char::is_whitespace) {
@@ -245,7 +245,7 @@ pub fn run_with(
 
 /// The command's error for a run's: a refusal is [`BadInput`], an interruption [`Interrupted`], the rest keeps
 /// its message and causes as they were.
-pub fn command_error(e: RunError) -> anyhow::Error {
+pub(crate) fn command_error(e: RunError) -> anyhow::Error {
     match e {
         RunError::Refused(message) => BadInput(message).into(),
         RunError::Interrupted(message) => Interrupted(message).into(),
@@ -269,13 +269,13 @@ fn run_dir(output: Option<PathBuf>, name: &str) -> PathBuf {
 /// Where a console's lines go: stderr (around the progress bar), or a log file (a sweep's variant run in
 /// process, whose lines a worker process wrote to its log before).
 #[derive(Debug, Default)]
-pub struct Out {
+pub(crate) struct Out {
     log: Option<Mutex<std::fs::File>>,
 }
 
 impl Out {
     /// Lines appended to `log`.
-    pub fn log(log: std::fs::File) -> Self {
+    pub(crate) fn log(log: std::fs::File) -> Self {
         Self {
             log: Some(Mutex::new(log)),
         }
@@ -295,7 +295,7 @@ impl Out {
 }
 
 /// The terminal (or a log) as a run's console: the progress bar, from the run's start, and the messages.
-pub struct Terminal {
+pub(crate) struct Terminal {
     quiet: bool,
     verbose: bool,
     out: Arc<Out>,
@@ -307,7 +307,7 @@ pub struct Terminal {
 impl Terminal {
     /// A console with a progress bar unless `quiet` (a log has none), every failed Newton attempt reported with
     /// `verbose`, its lines going to `out`.
-    pub fn new(quiet: bool, verbose: bool, out: Out) -> Self {
+    pub(crate) fn new(quiet: bool, verbose: bool, out: Out) -> Self {
         let quiet = quiet || out.log.is_some();
         Self {
             quiet,

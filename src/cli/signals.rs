@@ -18,12 +18,12 @@ use signal_hook::consts::{SIGHUP, SIGINT, SIGTERM};
 use std::sync::Once;
 
 /// The signals received, as requests to stop: what `stentkit run` and the sweep's workers are given.
-pub static INTERRUPT: Interrupt = Interrupt::new();
+pub(crate) static INTERRUPT: Interrupt = Interrupt::new();
 static INSTALL: Once = Once::new();
 
 /// What the first and second signal make the process do, said when they arrive.
 #[derive(Debug, Clone, Copy)]
-pub struct Messages {
+pub(crate) struct Messages {
     /// After the first signal.
     pub first: &'static str,
     /// After the second.
@@ -31,13 +31,13 @@ pub struct Messages {
 }
 
 /// A run's messages (module docs).
-pub const RUN: Messages = Messages {
+pub(crate) const RUN: Messages = Messages {
     first: "stopping at the next Newton iteration and finishing every file (send it again to skip the final snapshot)",
     second: "finishing run.mcap and summary.json, then exiting (a third signal quits at once)",
 };
 
 /// A sweep's messages (`cli::sweep`).
-pub const SWEEP: Messages = Messages {
+pub(crate) const SWEEP: Messages = Messages {
     first: "no new variant is prepared or started; the running ones finish their files and stop (the same command continues the sweep)",
     second: "still waiting for the running variants (a third signal quits the sweep and them; the same command continues them)",
 };
@@ -45,12 +45,12 @@ pub const SWEEP: Messages = Messages {
 /// Starts the thread that receives SIGINT, SIGTERM and SIGHUP for the rest of the process, with a run's
 /// messages. Later calls do nothing. If the handlers cannot be installed the default actions stay (the process
 /// is killed) and a warning says so.
-pub fn install() {
+pub(crate) fn install() {
     install_with(RUN);
 }
 
 /// [`install`] with `messages`.
-pub fn install_with(messages: Messages) {
+pub(crate) fn install_with(messages: Messages) {
     INSTALL.call_once(|| {
         let mut signals = match signal_hook::iterator::Signals::new([SIGINT, SIGTERM, SIGHUP]) {
             Ok(s) => s,
@@ -86,12 +86,12 @@ pub fn install_with(messages: Messages) {
 }
 
 /// Whether a run was asked to stop (any handled signal received).
-pub fn stop_requested() -> bool {
+pub(crate) fn stop_requested() -> bool {
     INTERRUPT.requested()
 }
 
 /// The name of the first signal received (`SIGINT`, `SIGTERM`, `SIGHUP`), if any.
-pub fn first() -> Option<&'static str> {
+pub(crate) fn first() -> Option<&'static str> {
     INTERRUPT.cause()
 }
 

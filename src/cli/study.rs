@@ -27,7 +27,7 @@ const STABILITY_SUMMARY: &str = "stability.md";
 /// When and where a study measures its error: at `time` (default: the design's end time), on `samples` points
 /// per patch.
 #[derive(Debug, Clone, Copy)]
-pub struct Sampling {
+pub(crate) struct Sampling {
     /// Time of the measurement.
     pub time: Option<f64>,
     /// Sampling points per patch.
@@ -36,7 +36,7 @@ pub struct Sampling {
 
 /// `stentkit study convergence`: the `p × n` sweep of `design` against the reference `P,N`, measured at `time`
 /// (default: the design's end time), written into the folder `output` (its files replaced only with `--force`).
-pub fn convergence(
+pub(crate) fn convergence(
     design: &Path,
     output: Target<'_>,
     degrees: Vec<usize>,
@@ -86,7 +86,7 @@ pub fn convergence(
 }
 
 /// Parses an integrator's design-file name (`trapezoidal`, `backward-euler`, `exponential`).
-pub fn parse_integrator(name: &str) -> Result<Integrator, String> {
+pub(crate) fn parse_integrator(name: &str) -> Result<Integrator, String> {
     [
         Integrator::Trapezoidal,
         Integrator::BackwardEuler,
@@ -98,7 +98,7 @@ pub fn parse_integrator(name: &str) -> Result<Integrator, String> {
 }
 
 /// Parses `study time --reference`: `auto`, `design` or a time step > 0.
-pub fn parse_reference(text: &str) -> Result<TimeReference, String> {
+pub(crate) fn parse_reference(text: &str) -> Result<TimeReference, String> {
     match text {
         "auto" => Ok(TimeReference::Auto),
         "design" => Ok(TimeReference::Design),
@@ -110,7 +110,7 @@ pub fn parse_reference(text: &str) -> Result<TimeReference, String> {
 }
 
 /// Parses `study convergence --reference P,N`: a degree ≥ 2 and more control points than that.
-pub fn degree_and_points(text: &str) -> Result<(usize, usize), String> {
+pub(crate) fn degree_and_points(text: &str) -> Result<(usize, usize), String> {
     text.split_once(',')
         .and_then(|(p, n)| Some((p.trim().parse().ok()?, n.trim().parse().ok()?)))
         .filter(|&(p, n)| p >= 2 && n > p)
@@ -118,7 +118,7 @@ pub fn degree_and_points(text: &str) -> Result<(usize, usize), String> {
 }
 
 /// The maps `study stability --maps` draws.
-pub const MAPS: &[&str] = &["material", "bend45", "heating", "release", "coarse"];
+pub(crate) const MAPS: &[&str] = &["material", "bend45", "heating", "release", "coarse"];
 
 /// Refuses (exit status 2, naming `argument`) a study run of `design` changed by `variant` whose time steps
 /// would need more memory than a design may ([`crate::design::size::MemoryEstimate::with_steps`]: the
@@ -162,7 +162,7 @@ fn check_steps(
 /// `stentkit study time`: the time-step sweep of `design` per integrator, measured at `time` (default: the
 /// design's end time) against `reference` (`auto`, `design` or a step), written into the folder `output` (its
 /// files replaced only with `--force`).
-pub fn time(
+pub(crate) fn time(
     design: &Path,
     output: Target<'_>,
     steps: Vec<f64>,
@@ -250,7 +250,7 @@ pub fn time(
 /// `stentkit study stability`: the maps named in `maps` (any of material, bend45, heating, release, coarse), each
 /// written as `<map>.csv` and `<map>.svg` as soon as it is done, then `stability.md`, into the folder `output`
 /// (its files replaced only with `--force`).
-pub fn stability_maps(output: Target<'_>, maps: &[String]) -> anyhow::Result<()> {
+pub(crate) fn stability_maps(output: Target<'_>, maps: &[String]) -> anyhow::Result<()> {
     let Target {
         path: output,
         force,

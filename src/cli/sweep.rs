@@ -24,7 +24,7 @@ use std::time::{Duration, Instant};
 
 /// What `stentkit sweep DESIGN …` was asked.
 #[derive(Debug, Clone, PartialEq)]
-pub struct SweepOptions {
+pub(crate) struct SweepOptions {
     /// The swept `--set` arguments (`PATH=V1,V2,…` or `PATH=START:STOP:STEP`).
     pub sets: Vec<String>,
     /// Pair the k-th values instead of the cartesian product.
@@ -53,7 +53,7 @@ pub struct SweepOptions {
 /// # Errors
 /// [`BadInput`] for arguments, a folder or a disk refused, [`Interrupted`] when stopped by a signal, an error
 /// when variants failed (after the table is written) or Slurm refused the job.
-pub fn run(design: &Path, options: SweepOptions) -> anyhow::Result<()> {
+pub(crate) fn run(design: &Path, options: SweepOptions) -> anyhow::Result<()> {
     signals::install_with(signals::SWEEP);
     let parameters = options
         .sets
@@ -394,7 +394,7 @@ fn submit(
 /// # Errors
 /// [`BadInput`] for an unknown index, a refused design or a failed variant without `retry_failed`; the run's
 /// own errors.
-pub fn task(dir: &Path, index: usize, retry_failed: bool) -> anyhow::Result<()> {
+pub(crate) fn task(dir: &Path, index: usize, retry_failed: bool) -> anyhow::Result<()> {
     signals::install();
     let mut console = super::run::Terminal::new(true, false, super::run::Out::default());
     let started = (Instant::now(), super::run::command_line());
@@ -491,7 +491,7 @@ fn task_with(
 ///
 /// # Errors
 /// When DIR holds no sweep or the table cannot be written.
-pub fn collect_command(dir: &Path, at: Option<Vec<Real>>) -> anyhow::Result<()> {
+pub(crate) fn collect_command(dir: &Path, at: Option<Vec<Real>>) -> anyhow::Result<()> {
     let sweep = SweepDir {
         dir: dir.to_path_buf(),
     };
@@ -525,7 +525,7 @@ fn report(collected: &Collected) {
 ///
 /// # Errors
 /// When DIR holds no sweep.
-pub fn status(dir: &Path) -> anyhow::Result<()> {
+pub(crate) fn status(dir: &Path) -> anyhow::Result<()> {
     let sweep = SweepDir {
         dir: dir.to_path_buf(),
     };

@@ -14,7 +14,7 @@ use std::path::Path;
 /// Tunes `design` to `tolerance`, trying `degrees` and at most `max_points` points per patch; writes the tuned
 /// design to `output` when given (over an existing file only with `--force`). `sets` are `--set` overrides of
 /// the design.
-pub fn run(
+pub(crate) fn run(
     design_path: &Path,
     tolerance: f64,
     output: Option<super::Target<'_>>,

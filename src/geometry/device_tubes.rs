@@ -11,7 +11,7 @@ use crate::math::{Mat3, Real, Vec3};
 
 /// One rod of a device, sampled for drawing as a tube.
 #[derive(Debug, Clone, Copy)]
-pub struct RodTube<'a> {
+pub(crate) struct RodTube<'a> {
     /// Centreline samples \[length\].
     pub centre: &'a [Vec3],
     /// Section frames at the samples (columns `d1, d2, d3`).
@@ -43,13 +43,13 @@ const PHASE_STEP: Real = 0.618_033_988_749_894_9;
 /// The section phase of the `k`-th rod of a device, a fraction of a segment in `[0, 1)`: `k φ mod 1` with
 /// `φ` the golden-ratio conjugate. Sweeping each rod with its own phase keeps the end rings of rods meeting at
 /// a joint from coinciding vertex for vertex (see [`super::tube::sweep_curve`]).
-pub fn section_phase(k: usize) -> Real {
+pub(crate) fn section_phase(k: usize) -> Real {
     (k as Real * PHASE_STEP).fract()
 }
 
 /// The rotation about the rod axis `d1` that turns a section polygon of `segments` vertices by `phase`
 /// segments: multiply a frame by it on the right.
-pub fn phase_turn(phase: Real, segments: usize) -> Mat3 {
+pub(crate) fn phase_turn(phase: Real, segments: usize) -> Mat3 {
     *crate::math::so3::exp(&(Vec3::x() * (2.0 * PI * phase / segments.max(1) as Real))).matrix()
 }
 
@@ -59,7 +59,7 @@ pub fn phase_turn(phase: Real, segments: usize) -> Mat3 {
 /// compared on the side most of the rod's sections face (`d2 × d3` along or against the samples' order; along when
 /// undecided), so a ring facing the wrong way is turned too. Frames the sweep would reject (too few samples,
 /// coincident samples, non-finite or degenerate frames) are returned unchanged, for the sweep to report.
-pub fn limited_tilt(centre: &[Vec3], frames: &[Mat3], max_tilt: Real) -> Vec<Mat3> {
+pub(crate) fn limited_tilt(centre: &[Vec3], frames: &[Mat3], max_tilt: Real) -> Vec<Mat3> {
     let Ok(tangents) = centreline_tangents(centre) else {
         return frames.to_vec();
     };
@@ -116,7 +116,7 @@ pub fn limited_tilt(centre: &[Vec3], frames: &[Mat3], max_tilt: Real) -> Vec<Mat
 ///
 /// # Errors
 /// [`DeviceMeshError`] naming the rod whose tube cannot be swept.
-pub fn device_mesh(
+pub(crate) fn device_mesh(
     rods: &[RodTube<'_>],
     planes: &[(Vec3, Vec3)],
     settings: &TubeSettings,

@@ -402,12 +402,12 @@ pub struct SmoothFit {
 /// "singular system"). With it the search makes at most about `3 log2(1000) = 30` fits, each `O(points)`.
 pub const MAX_SMOOTHING_CONTROL_POINTS: usize = 1000;
 
-/// The cubic with the fewest control points whose least-squares fit ([`crate::math::approx::approximate`],
+/// The cubic with the fewest control points whose least-squares fit (`crate::math::approx::approximate`,
 /// through the first and last point) stays within `tolerance` of every point of `points`: the count doubles
 /// from 4 until the fit is close enough, then bisection finds the smallest (the deviation falls with the count;
 /// with as many control points as points the fit interpolates). The count is at most the number of points and
 /// [`MAX_SMOOTHING_CONTROL_POINTS`]; a count whose least-squares system is singular (spans of too few points,
-/// [`crate::math::approx::MIN_RELATIVE_PIVOT`]) lowers that ceiling, and the search goes on below it.
+/// `crate::math::approx::MIN_RELATIVE_PIVOT`) lowers that ceiling, and the search goes on below it.
 ///
 /// # Errors
 /// [`GeometryError::InvalidParameter`] for fewer than two points, two consecutive points that coincide, or a

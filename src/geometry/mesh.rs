@@ -5,7 +5,7 @@
 //! [`TriangleMesh::mirrored_welded`]).
 //!
 //! The generators that produce closed shells live beside it: tubes in [`super::tube`], spheres in
-//! [`super::sphere`], whole devices in [`super::device_tubes`]. Nothing here writes files: the `io` layer
+//! `super::sphere`, whole devices in `super::device_tubes`. Nothing here writes files: the `io` layer
 //! turns a [`TriangleMesh`] into STL or OBJ.
 
 use std::collections::HashMap;

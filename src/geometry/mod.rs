@@ -5,15 +5,17 @@
 //! is the `io` layer's job.
 
 pub mod analytic;
-pub mod device_tubes;
+pub(crate) mod device_tubes;
 pub mod fit;
 pub mod frame;
 pub mod mesh;
-pub mod polyline;
+#[cfg(test)]
+pub(crate) mod polyline;
 pub mod primitives;
-pub mod simplify;
+pub(crate) mod simplify;
 pub mod solid;
-pub mod sphere;
+#[cfg(test)]
+pub(crate) mod sphere;
 pub mod stent;
 #[cfg(test)]
 mod test_shapes;

@@ -32,7 +32,7 @@ use crate::math::{Mat3, Vec3};
 /// # Errors
 /// [`TubeError::TooFewSamples`], [`TubeError::NonFinite`], [`TubeError::CoincidentSamples`] or
 /// [`TubeError::ZeroTangent`] when the polyline cannot define tangents.
-pub fn parallel_transport_frames(centre: &[Vec3]) -> Result<Vec<Mat3>, TubeError> {
+pub(crate) fn parallel_transport_frames(centre: &[Vec3]) -> Result<Vec<Mat3>, TubeError> {
     let tangents = centreline_tangents(centre)?;
     let t0 = tangents[0];
     // The coordinate axis least aligned with t0 is at least 54.7° away from it, so r0 is well conditioned.

@@ -29,7 +29,7 @@ use crate::math::{Mat3, Real, Vec3};
 
 /// The least cosine between a triangle's normal before and after a collapse (about 72°): a larger turn is a
 /// fold in the making and the collapse is refused.
-pub const MAX_TURN_COS: Real = 0.3;
+pub(crate) const MAX_TURN_COS: Real = 0.3;
 
 /// The area-weighted quadric `Σ wᵢ (nᵢ·x + dᵢ)² = xᵀ A x + 2 bᵀ x + c` of a set of planes, and the weights'
 /// sum `w`: `Q(x) / w` is the mean squared distance from `x` to the planes.
@@ -320,7 +320,7 @@ impl Collapser {
 
 /// `mesh` (closed, 2-manifold, consistently oriented) with edges collapsed while every merged vertex stays
 /// within `tolerance` of the input planes it replaces (see the module documentation), and a report.
-pub fn simplify(mesh: &TriangleMesh, tolerance: Real) -> (TriangleMesh, SimplifyReport) {
+pub(crate) fn simplify(mesh: &TriangleMesh, tolerance: Real) -> (TriangleMesh, SimplifyReport) {
     let n = mesh.vertices.len();
     let mut quadrics = vec![Quadric::zero(); n];
     let mut around = vec![Vec::new(); n];

@@ -26,7 +26,7 @@
 //!
 //! **Size.** The triangles grow as the surface over `h²`: the straight stent's full device (4080 capsules of
 //! its centrelines sampled twice per control point) gives 2.0 million triangles at h = r/3 (about 4 s) and
-//! 5.6 million at r/5 (16 s), against 100 000 for its snapshot's swept tubes; [`super::simplify`] reduces them.
+//! 5.6 million at r/5 (16 s), against 100 000 for its snapshot's swept tubes; `super::simplify` reduces them.
 
 use super::mesh::TriangleMesh;
 use crate::math::{Real, Vec3};

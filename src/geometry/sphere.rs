@@ -15,7 +15,7 @@ use crate::math::{Real, Vec3};
 /// # Errors
 /// [`TubeError::InvalidRadius`], [`TubeError::TooFewSegments`] or [`TubeError::NonFinite`]
 /// (`what = "sphere centre"`) for unusable input.
-pub fn sphere(
+pub(crate) fn sphere(
     center: &Vec3,
     radius: Real,
     settings: &TubeSettings,

@@ -1,8 +1,8 @@
 //! Closed tube surfaces swept along centrelines: a circular section swept along sampled centre points with
 //! given section frames, closed at both ends by flat caps ([`sweep_tube`], [`sweep_tube_with_caps`]), or
 //! along a spline curve with its rotation-minimising frames ([`sweep_curve`]). [`TubeSettings`] hold the
-//! resolution and tolerances of these and of the other shell generators ([`super::sphere`],
-//! [`super::device_tubes`]), and [`TubeError`] says why a tube, sphere or frame set cannot be built.
+//! resolution and tolerances of these and of the other shell generators (`super::sphere`,
+//! `super::device_tubes`), and [`TubeError`] says why a tube, sphere or frame set cannot be built.
 //!
 //! ## Several tubes make one device
 //!
@@ -42,7 +42,7 @@ pub struct TubeSettings {
     /// elliptic or skewed section and indicates a bug or unnormalised input.
     pub frame_tolerance: Real,
     /// Largest angle \[rad\] between a ring's section normal (`d2 × d3`) and the sampled centreline direction
-    /// that [`super::device_tubes::device_mesh`] draws as given. Coarse samples of a bent rod tilt the sections against the polyline
+    /// that `super::device_tubes::device_mesh` draws as given. Coarse samples of a bent rod tilt the sections against the polyline
     /// that joins them (by half the angle the rod turns between two samples): two rings on a patch bent into a
     /// half circle put both sections edge-on to the chord, which no tube can be swept through. A ring tilted
     /// further is turned, about the axis normal to both directions, until its tilt is this angle. Default
@@ -50,7 +50,7 @@ pub struct TubeSettings {
     /// rings per patch never come close.
     pub max_section_tilt: Real,
     /// Largest distance of an end ring from a symmetry plane, as a fraction of the tube radius, for
-    /// [`super::device_tubes::device_mesh`] to treat the ring as lying in the plane (left open and welded to its mirror image).
+    /// `super::device_tubes::device_mesh` to treat the ring as lying in the plane (left open and welded to its mirror image).
     /// Default `1e-6`: a rod end held by symmetry conditions lies in the plane to the solver's round-off
     /// (~1e-12 of the radius), while any end not on a plane is at least a fraction of a radius away.
     pub seam_tolerance: Real,
@@ -230,7 +230,7 @@ impl TubeSettings {
 /// triangles along the same diagonal; each end gets a centre vertex and a fan of `m` triangles.
 ///
 /// **Orientation.** Every ring is traversed counter-clockwise about the local marching direction
-/// (the centreline tangent estimated from the samples, see [`super::polyline::parallel_transport_frames`]): when
+/// (the centreline tangent estimated from the samples, see `super::polyline::parallel_transport_frames`): when
 /// `d2 × d3` points backwards at a sample, that ring is drawn with `−φ`. The result is a closed surface
 /// with outward normals and positive [`TriangleMesh::volume`] whichever way the frames are handed, and
 /// even if their handedness changes along the centreline. Vertex `k` of one ring is joined to vertex `k`
@@ -259,7 +259,7 @@ pub fn sweep_tube(
 
 /// [`sweep_tube`] with a choice of caps. An uncapped end leaves its ring as a boundary: the surface is open
 /// there, meant to be welded to another surface sharing the same ring (the mirror image of a rod ending on a
-/// symmetry plane, see [`super::device_tubes::device_mesh`]).
+/// symmetry plane, see `super::device_tubes::device_mesh`).
 ///
 /// **Layout.** As [`sweep_tube`]: vertex `i·m + k` is point `k` of ring `i`; then the centre of the start cap
 /// (if capped), then that of the end cap (if capped). The start ring is vertices `0 … m−1`, the end ring

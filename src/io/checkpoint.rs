@@ -44,20 +44,20 @@ use crate::solver::{Checkpoint, RunSummary, SolverTiming};
 use std::path::{Path, PathBuf};
 
 /// The checkpoint's file name inside a run folder.
-pub const FILE_NAME: &str = crate::io::run_folder::CHECKPOINT_FILE;
+pub(crate) const FILE_NAME: &str = crate::io::run_folder::CHECKPOINT_FILE;
 
 /// The format's first eight bytes.
 const MAGIC: &[u8; 8] = b"STKCKPT\0";
 
 /// The format version this build writes and reads.
-pub const VERSION: u32 = 9;
+pub(crate) const VERSION: u32 = 9;
 
 /// Bytes before the payload: magic, version, length.
 const HEADER: usize = 8 + 4 + 8;
 
 /// What a run checkpoint holds: the simulation and its outputs at one converged step.
 #[derive(Debug, Clone, PartialEq)]
-pub struct RunCheckpoint {
+pub(crate) struct RunCheckpoint {
     /// The simulation ([`crate::solver::Simulation::checkpoint`]).
     pub solver: Checkpoint,
     /// The outputs.
@@ -66,7 +66,7 @@ pub struct RunCheckpoint {
 
 /// Where the outputs of a run stood at a checkpoint: enough to continue each as if never interrupted.
 #[derive(Debug, Clone, PartialEq)]
-pub struct OutputsCheckpoint {
+pub(crate) struct OutputsCheckpoint {
     /// Fingerprint of the design's output settings (snapshots, recording): a resumed run must write the same.
     pub settings: u64,
     /// Each recorder's position, by its name, in the recorder's own encoding (`crate::run::recorder`: each
@@ -82,7 +82,7 @@ pub struct OutputsCheckpoint {
 
 impl OutputsCheckpoint {
     /// The position saved by the recorder named `name`.
-    pub fn position(&self, name: &str) -> Option<&[u8]> {
+    pub(crate) fn position(&self, name: &str) -> Option<&[u8]> {
         self.positions
             .iter()
             .find(|(n, _)| n == name)
@@ -92,7 +92,7 @@ impl OutputsCheckpoint {
 
 /// Why a checkpoint file cannot be read.
 #[derive(Debug, thiserror::Error)]
-pub enum CheckpointFileError {
+pub(crate) enum CheckpointFileError {
     /// Reading the file failed.
     #[error("{path}: {source}")]
     Io {
@@ -129,7 +129,7 @@ pub enum CheckpointFileError {
 
 /// The version of the output settings' description hashed by [`settings_fingerprint`]: raised when its form
 /// changes (as [`crate::model::fingerprint::VERSION`] is for the model's).
-pub const SETTINGS_DESCRIPTION_VERSION: u32 = 1;
+pub(crate) const SETTINGS_DESCRIPTION_VERSION: u32 = 1;
 
 /// The fingerprint of the outputs' settings of a design: as the model's ([`crate::model::fingerprint`]), a
 /// hash of their serialised, versioned description (every field of [`super::output::OutputSettings`]).
@@ -145,7 +145,7 @@ pub fn settings_fingerprint(settings: &super::output::OutputSettings) -> u64 {
 ///
 /// # Errors
 /// The I/O error; `path` is then unchanged.
-pub fn write(path: &Path, checkpoint: &RunCheckpoint) -> std::io::Result<()> {
+pub(crate) fn write(path: &Path, checkpoint: &RunCheckpoint) -> std::io::Result<()> {
     let mut e = Encoder(Vec::with_capacity(1 << 16));
     e.0.extend_from_slice(MAGIC);
     e.u32(VERSION);
@@ -163,7 +163,7 @@ pub fn write(path: &Path, checkpoint: &RunCheckpoint) -> std::io::Result<()> {
 ///
 /// # Errors
 /// [`CheckpointFileError`]: not readable, not a checkpoint, another version, or damaged.
-pub fn read(path: &Path) -> Result<RunCheckpoint, CheckpointFileError> {
+pub(crate) fn read(path: &Path) -> Result<RunCheckpoint, CheckpointFileError> {
     let bytes = std::fs::read(path).map_err(|source| CheckpointFileError::Io {
         path: path.to_path_buf(),
         source,
@@ -217,7 +217,7 @@ fn decode(bytes: &[u8]) -> Result<RunCheckpoint, Problem> {
 
 /// A decoding problem, before the path is known.
 #[derive(Debug, Clone, PartialEq)]
-pub enum Problem {
+pub(crate) enum Problem {
     /// No magic at the file's start.
     NotACheckpoint,
     /// Another version of the format.
@@ -249,60 +249,60 @@ impl Problem {
 
 /// Appends little-endian fields to a byte buffer (the format's encoding, module docs).
 #[derive(Debug, Default)]
-pub struct Encoder(pub Vec<u8>);
+pub(crate) struct Encoder(pub Vec<u8>);
 
 impl Encoder {
     /// A byte.
-    pub fn u8(&mut self, v: u8) {
+    pub(crate) fn u8(&mut self, v: u8) {
         self.0.push(v);
     }
     /// A `u32`.
-    pub fn u32(&mut self, v: u32) {
+    pub(crate) fn u32(&mut self, v: u32) {
         self.0.extend_from_slice(&v.to_le_bytes());
     }
     /// A `u64`.
-    pub fn u64(&mut self, v: u64) {
+    pub(crate) fn u64(&mut self, v: u64) {
         self.0.extend_from_slice(&v.to_le_bytes());
     }
     /// A `usize`, as a `u64`.
-    pub fn usize(&mut self, v: usize) {
+    pub(crate) fn usize(&mut self, v: usize) {
         self.u64(v as u64);
     }
     /// A flag, as a byte 0/1.
-    pub fn bool(&mut self, v: bool) {
+    pub(crate) fn bool(&mut self, v: bool) {
         self.u8(u8::from(v));
     }
     /// A float, by its bits.
-    pub fn f64(&mut self, v: Real) {
+    pub(crate) fn f64(&mut self, v: Real) {
         self.u64(v.to_bits());
     }
     /// A list of floats.
-    pub fn f64s(&mut self, v: &[Real]) {
+    pub(crate) fn f64s(&mut self, v: &[Real]) {
         self.usize(v.len());
         for &x in v {
             self.f64(x);
         }
     }
     /// A vector's three components.
-    pub fn vec3(&mut self, v: &Vec3) {
+    pub(crate) fn vec3(&mut self, v: &Vec3) {
         for &x in v.iter() {
             self.f64(x);
         }
     }
     /// A list of vectors.
-    pub fn vec3s(&mut self, v: &[Vec3]) {
+    pub(crate) fn vec3s(&mut self, v: &[Vec3]) {
         self.usize(v.len());
         for x in v {
             self.vec3(x);
         }
     }
     /// A string: its length, then its UTF-8 bytes.
-    pub fn str(&mut self, s: &str) {
+    pub(crate) fn str(&mut self, s: &str) {
         self.usize(s.len());
         self.0.extend_from_slice(s.as_bytes());
     }
     /// An option: a flag, then the value written by `f`.
-    pub fn option<T>(&mut self, v: Option<&T>, mut f: impl FnMut(&mut Self, &T)) {
+    pub(crate) fn option<T>(&mut self, v: Option<&T>, mut f: impl FnMut(&mut Self, &T)) {
         match v {
             None => self.bool(false),
             Some(x) => {
@@ -312,7 +312,7 @@ impl Encoder {
         }
     }
     /// A list: its length, then each item written by `f`.
-    pub fn list<T>(&mut self, v: &[T], mut f: impl FnMut(&mut Self, &T)) {
+    pub(crate) fn list<T>(&mut self, v: &[T], mut f: impl FnMut(&mut Self, &T)) {
         self.usize(v.len());
         for x in v {
             f(self, x);
@@ -322,14 +322,14 @@ impl Encoder {
 
 /// Reads little-endian fields from a byte buffer; every read checks the bytes are there.
 #[derive(Debug)]
-pub struct Decoder<'a> {
+pub(crate) struct Decoder<'a> {
     bytes: &'a [u8],
     at: usize,
 }
 
 impl<'a> Decoder<'a> {
     /// Reads `bytes` from their start.
-    pub fn new(bytes: &'a [u8]) -> Self {
+    pub(crate) fn new(bytes: &'a [u8]) -> Self {
         Self { bytes, at: 0 }
     }
 
@@ -337,7 +337,7 @@ impl<'a> Decoder<'a> {
     ///
     /// # Errors
     /// [`Problem::Damaged`] naming how many are left.
-    pub fn finish(&self) -> Result<(), Problem> {
+    pub(crate) fn finish(&self) -> Result<(), Problem> {
         if self.at == self.bytes.len() {
             Ok(())
         } else {
@@ -349,7 +349,7 @@ impl<'a> Decoder<'a> {
     }
 
     /// The next `n` bytes.
-    pub fn take(&mut self, n: usize) -> Result<&[u8], Problem> {
+    pub(crate) fn take(&mut self, n: usize) -> Result<&[u8], Problem> {
         let end = self
             .at
             .checked_add(n)
@@ -362,29 +362,29 @@ impl<'a> Decoder<'a> {
         Ok(out)
     }
     /// A byte.
-    pub fn u8(&mut self) -> Result<u8, Problem> {
+    pub(crate) fn u8(&mut self) -> Result<u8, Problem> {
         Ok(self.take(1)?[0])
     }
     /// A `u32`.
-    pub fn u32(&mut self) -> Result<u32, Problem> {
+    pub(crate) fn u32(&mut self) -> Result<u32, Problem> {
         let b = self.take(4)?;
         Ok(u32::from_le_bytes([b[0], b[1], b[2], b[3]]))
     }
     /// A `u64`.
-    pub fn u64(&mut self) -> Result<u64, Problem> {
+    pub(crate) fn u64(&mut self) -> Result<u64, Problem> {
         let b = self.take(8)?;
         let mut a = [0u8; 8];
         a.copy_from_slice(b);
         Ok(u64::from_le_bytes(a))
     }
     /// A `usize` (written as a `u64`).
-    pub fn usize(&mut self) -> Result<usize, Problem> {
+    pub(crate) fn usize(&mut self) -> Result<usize, Problem> {
         let v = self.u64()?;
         usize::try_from(v).map_err(|_| Problem::Damaged(format!("a count of {v}")))
     }
     /// A count of items of at least `item_bytes` each: refused when the rest of the file cannot hold them (so a
     /// damaged count never allocates absurdly).
-    pub fn count(&mut self, item_bytes: usize) -> Result<usize, Problem> {
+    pub(crate) fn count(&mut self, item_bytes: usize) -> Result<usize, Problem> {
         let n = self.usize()?;
         let left = self.bytes.len() - self.at;
         if n.saturating_mul(item_bytes.max(1)) > left {
@@ -395,7 +395,7 @@ impl<'a> Decoder<'a> {
         Ok(n)
     }
     /// A flag.
-    pub fn bool(&mut self) -> Result<bool, Problem> {
+    pub(crate) fn bool(&mut self) -> Result<bool, Problem> {
         match self.u8()? {
             0 => Ok(false),
             1 => Ok(true),
@@ -403,31 +403,31 @@ impl<'a> Decoder<'a> {
         }
     }
     /// A float.
-    pub fn f64(&mut self) -> Result<Real, Problem> {
+    pub(crate) fn f64(&mut self) -> Result<Real, Problem> {
         Ok(Real::from_bits(self.u64()?))
     }
     /// A list of floats.
-    pub fn f64s(&mut self) -> Result<Vec<Real>, Problem> {
+    pub(crate) fn f64s(&mut self) -> Result<Vec<Real>, Problem> {
         let n = self.count(8)?;
         (0..n).map(|_| self.f64()).collect()
     }
     /// A vector.
-    pub fn vec3(&mut self) -> Result<Vec3, Problem> {
+    pub(crate) fn vec3(&mut self) -> Result<Vec3, Problem> {
         Ok(Vec3::new(self.f64()?, self.f64()?, self.f64()?))
     }
     /// A list of vectors.
-    pub fn vec3s(&mut self) -> Result<Vec<Vec3>, Problem> {
+    pub(crate) fn vec3s(&mut self) -> Result<Vec<Vec3>, Problem> {
         let n = self.count(24)?;
         (0..n).map(|_| self.vec3()).collect()
     }
     /// A string.
-    pub fn str(&mut self) -> Result<String, Problem> {
+    pub(crate) fn str(&mut self) -> Result<String, Problem> {
         let n = self.count(1)?;
         String::from_utf8(self.take(n)?.to_vec())
             .map_err(|_| Problem::Damaged("a text that is not UTF-8".into()))
     }
     /// An option, its value read by `f`.
-    pub fn option<T>(
+    pub(crate) fn option<T>(
         &mut self,
         mut f: impl FnMut(&mut Self) -> Result<T, Problem>,
     ) -> Result<Option<T>, Problem> {
@@ -438,7 +438,7 @@ impl<'a> Decoder<'a> {
         }
     }
     /// A list of items of at least `item_bytes` each, read by `f`.
-    pub fn list<T>(
+    pub(crate) fn list<T>(
         &mut self,
         item_bytes: usize,
         mut f: impl FnMut(&mut Self) -> Result<T, Problem>,

@@ -21,14 +21,14 @@ use plotters::prelude::*;
 use std::path::{Path, PathBuf};
 
 /// Most rows (times) in `configurations.svg`.
-pub const MAX_ROWS: usize = 6;
+pub(crate) const MAX_ROWS: usize = 6;
 
 /// Samples per patch of the centrelines kept for the figures.
-pub const CENTRELINE_SAMPLES: usize = 41;
+pub(crate) const CENTRELINE_SAMPLES: usize = 41;
 
 /// One state of the device for the figures: its time, temperature and the full device's centrelines.
 #[derive(Debug, Clone, PartialEq)]
-pub struct Configuration {
+pub(crate) struct Configuration {
     /// Time \[s\].
     pub time: Real,
     /// Temperature \[°C\].
@@ -100,7 +100,7 @@ impl View {
 }
 
 /// The default views of a device whose initial centrelines are `lines` (module docs).
-pub fn default_views(lines: &[Vec<Vec3>]) -> Vec<View> {
+pub(crate) fn default_views(lines: &[Vec<Vec3>]) -> Vec<View> {
     let (mut lo, mut hi) = (
         Vec3::repeat(Real::INFINITY),
         Vec3::repeat(Real::NEG_INFINITY),
@@ -125,8 +125,10 @@ pub fn default_views(lines: &[Vec<Vec3>]) -> Vec<View> {
 }
 
 /// The states shown: those at `requested` times (to `snap`) when any is requested, otherwise up to
-/// [`MAX_ROWS`] spread evenly over `states` after the first (the initial state), the last always.
-pub fn chosen<'a>(
+/// [`MAX_ROWS`] spread evenly over `states` after the first (the initial state), the last always (the tests'
+/// view of [`chosen_indices`]).
+#[cfg(test)]
+fn chosen<'a>(
     states: &'a [Configuration],
     requested: &[Real],
     snap: Real,
@@ -138,8 +140,10 @@ pub fn chosen<'a>(
         .collect()
 }
 
-/// The indices into `times` (the states' times, the first the initial state) of the states [`chosen`] shows.
-pub fn chosen_indices(times: &[Real], requested: &[Real], snap: Real) -> Vec<usize> {
+/// The indices into `times` (the states' times, the first the initial state) of the states shown: those at
+/// `requested` times (to `snap`) when any is requested, otherwise up to [`MAX_ROWS`] spread evenly after the
+/// first, the last always.
+pub(crate) fn chosen_indices(times: &[Real], requested: &[Real], snap: Real) -> Vec<usize> {
     let later = 1..times.len().max(1);
     if !requested.is_empty() {
         let picked: Vec<usize> = later
@@ -167,7 +171,7 @@ const PANEL: (u32, u32) = (480, 360);
 ///
 /// # Errors
 /// [`ChartError::Drawing`] when plotters fails, [`ChartError::Empty`] without a point to draw.
-pub fn render(
+pub(crate) fn render(
     title: &str,
     length: &str,
     initial: &Configuration,
@@ -284,7 +288,7 @@ fn draw_panel<DB: DrawingBackend>(
 }
 
 /// File name of the per-time figure of a state at `time`.
-pub fn per_time_file(time: Real) -> String {
+pub(crate) fn per_time_file(time: Real) -> String {
     format!("configuration_t{time:.4}.svg")
 }
 
@@ -293,7 +297,7 @@ pub fn per_time_file(time: Real) -> String {
 ///
 /// # Errors
 /// As [`render`], and [`ChartError::Io`] when a file cannot be claimed or written.
-pub fn write(
+pub(crate) fn write(
     folder: &Path,
     relative: &Path,
     titles: (&str, &str),

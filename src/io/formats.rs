@@ -11,20 +11,20 @@ use super::mesh_format::MeshFormat;
 use super::{obj, stl, threemf};
 
 /// Every snapshot format, in the order a snapshot writes them.
-pub const FORMATS: &[&dyn MeshFormat] = &[&stl::Stl, &obj::Obj, &threemf::ThreeMf];
+pub(crate) const FORMATS: &[&dyn MeshFormat] = &[&stl::Stl, &obj::Obj, &threemf::ThreeMf];
 
 /// The formats a run writes by default: binary STL only. STL is what slicers, mesh repair tools and
 /// `stentkit`'s own picture read; OBJ holds the same triangles (with shared vertices, about as large: 6.2 MB
 /// against STL's 6.4 MB per snapshot of the straight stent) and is written when a design asks for it.
-pub const DEFAULT_FORMATS: &[&str] = &["stl"];
+pub(crate) const DEFAULT_FORMATS: &[&str] = &["stl"];
 
 /// The format of an extension (`stl`, `obj`), if registered.
-pub fn format(extension: &str) -> Option<&'static dyn MeshFormat> {
+pub(crate) fn format(extension: &str) -> Option<&'static dyn MeshFormat> {
     FORMATS.iter().copied().find(|f| f.extension() == extension)
 }
 
 /// The registered extensions, for messages (`stl, obj`).
-pub fn extensions() -> String {
+pub(crate) fn extensions() -> String {
     FORMATS
         .iter()
         .map(|f| f.extension())

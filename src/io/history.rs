@@ -10,7 +10,7 @@
 //! of the step, 0 when undamped), `strain_energy` (at the step's end), `dissipated_energy` (by the damping since
 //! the start), `dissipated_ratio` (that over the largest strain energy so far) and `damping_force_share` (the
 //! damping force's share of the forces on the device at the step's end, 0 when undamped;
-//! [`crate::solver::simulation::stabilisation`]).
+//! `crate::solver::simulation::stabilisation`).
 //! A design with a programme (stents) adds `recovery_ratio_mean` and `recovery_ratio_max`, the mean (weighted
 //! over the full device) and largest `‖η_l‖ / ‖η_temp,l‖` over the driven nodes — 1 at the temporary shape, 0 at
 //! the permanent one — and, for a radial contraction, `delta_r`: the mean radial contraction of the driven
@@ -21,7 +21,7 @@
 //! extremes over the collocation points. Then `max_displacement`, the largest
 //! displacement of any node from the reference shape (length unit): the size of the programmed shape, of the
 //! snap at a release and of what is left at the end (`stentkit sweep`'s metrics). The last three columns say
-//! where the surface strain of the wire peaks ([`crate::solver::simulation::fields`]): `surface_strain_peak`
+//! where the surface strain of the wire peaks (`crate::solver::simulation::fields`): `surface_strain_peak`
 //! (the largest fibre stretch `λ − 1` over the collocation points),
 //! `surface_strain_patch` (the patch's name) and `surface_strain_s` (the reference arc length from the patch's
 //! start, length unit).

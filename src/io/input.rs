@@ -15,7 +15,7 @@ use std::path::Path;
 
 /// Why [`read_regular_file`] returned no bytes.
 #[derive(Debug)]
-pub enum InputError {
+pub(crate) enum InputError {
     /// The operating system's error (missing file, no permission …).
     Io(std::io::Error),
     /// Not a regular file: what it is, in words ("a FIFO (named pipe)", "a character device", "a folder" …).
@@ -29,7 +29,7 @@ pub enum InputError {
 /// # Errors
 /// [`InputError::NotRegular`] for a device, FIFO, socket or folder, [`InputError::TooLarge`] for more than
 /// `limit` bytes, [`InputError::Io`] when the operating system refuses.
-pub fn read_regular_file(path: &Path, limit: u64) -> Result<Vec<u8>, InputError> {
+pub(crate) fn read_regular_file(path: &Path, limit: u64) -> Result<Vec<u8>, InputError> {
     let metadata = std::fs::metadata(path).map_err(InputError::Io)?;
     if !metadata.is_file() {
         return Err(InputError::NotRegular(kind(metadata.file_type())));
@@ -76,7 +76,7 @@ fn kind(file_type: FileType) -> &'static str {
 /// Largest `summary.json` stentkit reads back \[bytes\]: 16 MiB. A summary is a few kB (the straight stent's,
 /// with its snapshots and timing, 5 kB; a failure report adds the residuals of one step); the limit only keeps
 /// a file put in its place (a device, a FIFO, a huge file) from costing more than that.
-pub const MAX_SUMMARY_BYTES: u64 = 16 * 1024 * 1024;
+pub(crate) const MAX_SUMMARY_BYTES: u64 = 16 * 1024 * 1024;
 
 /// The JSON of the run summary at `path`, read as a regular file of at most [`MAX_SUMMARY_BYTES`]
 /// ([`read_regular_file`]).
@@ -84,7 +84,7 @@ pub const MAX_SUMMARY_BYTES: u64 = 16 * 1024 * 1024;
 /// # Errors
 /// A message (without the path) saying why it cannot be read: missing, not a regular file, too large, not
 /// UTF-8 or not JSON.
-pub fn read_json<T: serde::de::DeserializeOwned>(path: &Path) -> Result<T, String> {
+pub(crate) fn read_json<T: serde::de::DeserializeOwned>(path: &Path) -> Result<T, String> {
     let bytes = read_regular_file(path, MAX_SUMMARY_BYTES).map_err(|e| match e {
         InputError::Io(e) => e.to_string(),
         InputError::NotRegular(what) => format!("{what}, not a regular file"),

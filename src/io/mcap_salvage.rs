@@ -26,7 +26,7 @@ const RECORD_PREFIX: usize = 9;
 
 /// What [`salvage`] found and did.
 #[derive(Debug, Clone, PartialEq, Eq)]
-pub enum Salvage {
+pub(crate) enum Salvage {
     /// The file was already a complete MCAP file; nothing was changed.
     AlreadyValid {
         /// Its size \[bytes\].
@@ -50,7 +50,7 @@ pub enum Salvage {
 
 /// Why a recording cannot be salvaged.
 #[derive(Debug, thiserror::Error)]
-pub enum SalvageError {
+pub(crate) enum SalvageError {
     /// Reading or cutting the file failed.
     #[error("{path}: {source}")]
     Io {
@@ -71,7 +71,7 @@ pub enum SalvageError {
 ///
 /// # Errors
 /// [`SalvageError`] when the file cannot be read or cut, or is not an MCAP recording at all.
-pub fn salvage(path: &Path) -> Result<Salvage, SalvageError> {
+pub(crate) fn salvage(path: &Path) -> Result<Salvage, SalvageError> {
     let io_err = |source| SalvageError::Io {
         path: path.to_path_buf(),
         source,
@@ -220,8 +220,9 @@ fn has_summary(bytes: &[u8]) -> bool {
             .is_some_and(|start| start.iter().any(|&b| b != 0))
 }
 
-/// Whether `bytes` is a complete MCAP file that the reference reader reads to its end.
-pub fn is_valid(bytes: &[u8]) -> bool {
+/// Whether `bytes` is a complete MCAP file that the reference reader reads to its end (the tests' check).
+#[cfg(test)]
+fn is_valid(bytes: &[u8]) -> bool {
     bytes.len() >= 2 * MAGIC.len() && bytes.ends_with(MAGIC) && messages_in(bytes).is_some()
 }
 

@@ -34,7 +34,7 @@ pub enum MeshIoError {
 
 /// What a snapshot file says about the state it holds (for its header).
 #[derive(Debug, Clone, Copy)]
-pub struct SnapshotState<'a> {
+pub(crate) struct SnapshotState<'a> {
     /// The model.
     pub model: &'a Model,
     /// Step number (0: the initial state).
@@ -44,7 +44,7 @@ pub struct SnapshotState<'a> {
 }
 
 /// A file format of snapshot meshes.
-pub trait MeshFormat: Sync {
+pub(crate) trait MeshFormat: Sync {
     /// The file extension, also the snapshot's key in summary.json (`stl`).
     fn extension(&self) -> &'static str;
 

@@ -3,26 +3,26 @@
 //! reduced model) is computed in [`crate::post`]; this layer writes it. The YAML design language is
 //! [`crate::design`], above this layer: the writers see a design through [`output::RunDesign`].
 
-pub mod atomic;
+pub(crate) mod atomic;
 pub mod centreline;
 pub mod chart;
 pub mod checkpoint;
 pub mod configurations;
 pub mod formats;
 pub mod history;
-pub mod input;
-pub mod mcap;
-pub mod mcap_salvage;
-pub mod mesh_format;
-pub mod no_follow;
+pub(crate) mod input;
+pub(crate) mod mcap;
+pub(crate) mod mcap_salvage;
+pub(crate) mod mesh_format;
+pub(crate) mod no_follow;
 pub mod obj;
 pub mod output;
 pub mod render;
 pub mod run_charts;
 pub mod run_folder;
 pub mod snapshots;
-pub mod state;
+pub(crate) mod state;
 pub mod stl;
-pub mod summary;
+pub(crate) mod summary;
 pub mod threemf;
 pub mod vtk;

@@ -36,7 +36,7 @@ use std::path::{Component, Path, PathBuf};
 ///
 /// # Errors
 /// The operating system's, with the path in the message when `path` is a link.
-pub fn open(path: &Path, options: &mut OpenOptions) -> io::Result<File> {
+pub(crate) fn open(path: &Path, options: &mut OpenOptions) -> io::Result<File> {
     options
         .custom_flags(libc::O_NOFOLLOW | libc::O_CLOEXEC)
         .open(path)
@@ -47,7 +47,7 @@ pub fn open(path: &Path, options: &mut OpenOptions) -> io::Result<File> {
 ///
 /// # Errors
 /// As [`open`].
-pub fn create(path: &Path) -> io::Result<File> {
+pub(crate) fn create(path: &Path) -> io::Result<File> {
     open(
         path,
         OpenOptions::new().write(true).create(true).truncate(true),
@@ -59,7 +59,7 @@ pub fn create(path: &Path) -> io::Result<File> {
 ///
 /// # Errors
 /// As [`open`], and the write's.
-pub fn write(path: &Path, bytes: &[u8]) -> io::Result<()> {
+pub(crate) fn write(path: &Path, bytes: &[u8]) -> io::Result<()> {
     io::Write::write_all(&mut create(path)?, bytes)
 }
 
@@ -70,7 +70,7 @@ pub fn write(path: &Path, bytes: &[u8]) -> io::Result<()> {
 ///
 /// # Errors
 /// The operating system's; a folder of `relative` that is a link is an error naming it.
-pub fn remove_inside(root: &Path, relative: &Path) -> io::Result<bool> {
+pub(crate) fn remove_inside(root: &Path, relative: &Path) -> io::Result<bool> {
     let (Some(folder), Some(name)) = (relative.parent(), relative.file_name()) else {
         return Err(io::Error::new(
             io::ErrorKind::InvalidInput,
@@ -85,7 +85,7 @@ pub fn remove_inside(root: &Path, relative: &Path) -> io::Result<bool> {
 ///
 /// # Errors
 /// The operating system's; a component that is a link is an error naming it.
-pub fn folder_inside(root: &Path, relative: &Path) -> io::Result<FolderInside> {
+pub(crate) fn folder_inside(root: &Path, relative: &Path) -> io::Result<FolderInside> {
     Ok(FolderInside {
         path: root.join(relative),
         fd: open_folder_inside(root, relative)?,
@@ -94,7 +94,7 @@ pub fn folder_inside(root: &Path, relative: &Path) -> io::Result<FolderInside> {
 
 /// A folder opened without following links ([`folder_inside`]).
 #[derive(Debug)]
-pub struct FolderInside {
+pub(crate) struct FolderInside {
     path: PathBuf,
     fd: OwnedFd,
 }
@@ -105,7 +105,7 @@ impl FolderInside {
     ///
     /// # Errors
     /// The folder cannot be read.
-    pub fn names(&self) -> io::Result<Vec<std::ffi::OsString>> {
+    pub(crate) fn names(&self) -> io::Result<Vec<std::ffi::OsString>> {
         std::fs::read_dir(&self.path)?
             .map(|e| e.map(|e| e.file_name()))
             .collect()
@@ -115,7 +115,7 @@ impl FolderInside {
     ///
     /// # Errors
     /// The operating system's, naming the file.
-    pub fn remove(&self, name: &OsStr) -> io::Result<bool> {
+    pub(crate) fn remove(&self, name: &OsStr) -> io::Result<bool> {
         let c = c_name(name)?;
         // SAFETY: `self.fd` is an open directory descriptor owned by `self`, alive for the call, and `c` a
         // NUL-terminated string that outlives it; unlinkat(2) touches no memory of ours beyond reading `c`.
@@ -135,7 +135,7 @@ impl FolderInside {
 
 /// The paths below `root`, among `relatives` and their folders, that are symbolic links (each once, in the
 /// order met), with what they point at. Looks only; a path that does not exist is no link.
-pub fn links_inside<'a>(
+pub(crate) fn links_inside<'a>(
     root: &Path,
     relatives: impl IntoIterator<Item = &'a Path>,
 ) -> Vec<(PathBuf, PathBuf)> {

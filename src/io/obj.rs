@@ -12,7 +12,7 @@ use crate::geometry::mesh::TriangleMesh;
 use crate::io::atomic::write_atomically;
 use crate::io::stl::{MeshIoError, check_writable};
 
-/// OBJ snapshots ([`super::formats::FORMATS`]): a comment naming the design, step, time and units.
+/// OBJ snapshots (`super::formats::FORMATS`): a comment naming the design, step, time and units.
 pub struct Obj;
 
 impl super::mesh_format::MeshFormat for Obj {

@@ -27,10 +27,10 @@ use std::path::{Path, PathBuf};
 use tiny_skia::{Color, Pixmap, Transform};
 
 /// Pixels drawn per output pixel along each axis.
-pub const SUPERSAMPLING: u32 = 2;
+pub(crate) const SUPERSAMPLING: u32 = 2;
 
 /// Default width of a panel in pixels.
-pub const PANEL_WIDTH: u32 = 480;
+pub(crate) const PANEL_WIDTH: u32 = 480;
 
 /// Most pixels of a panel (2048²): its supersampled buffers take 16 bytes a sub-pixel, 270 MB at this size.
 const MAX_PANEL_PIXELS: u64 = 2048 * 2048;
@@ -43,7 +43,7 @@ const GAP: Real = 0.03;
 
 /// Errors of the pictures.
 #[derive(Debug, thiserror::Error)]
-pub enum RenderError {
+pub(crate) enum RenderError {
     /// Nothing to frame (no triangle in a framing layer) or no panel.
     #[error("nothing to draw: no triangle in the panels")]
     Empty,
@@ -75,7 +75,7 @@ pub enum RenderError {
 
 /// Triangles drawn in one colour.
 #[derive(Debug, Clone, Copy)]
-pub struct Layer<'a> {
+pub(crate) struct Layer<'a> {
     /// The triangles (closed and wound outward: faces turned away from the viewer are not drawn).
     pub mesh: &'a TriangleMesh,
     /// Colour lit face-on, RGB in [0, 1].
@@ -88,18 +88,18 @@ pub struct Layer<'a> {
 }
 
 /// Colour of a device.
-pub const DEVICE: [f32; 3] = [0.30, 0.45, 0.70];
+pub(crate) const DEVICE: [f32; 3] = [0.30, 0.45, 0.70];
 /// Colour of the initial shape behind it.
-pub const GHOST: [f32; 3] = [0.80, 0.80, 0.80];
+pub(crate) const GHOST: [f32; 3] = [0.80, 0.80, 0.80];
 /// Colour of a vessel lumen.
-pub const LUMEN: [f32; 3] = [0.85, 0.35, 0.35];
+pub(crate) const LUMEN: [f32; 3] = [0.85, 0.35, 0.35];
 
 /// Draws `panels` (each a list of layers) in `view`, each panel `panel_width` pixels wide; the panels are drawn
 /// in parallel.
 ///
 /// # Errors
 /// [`RenderError::Empty`] without a framing triangle, [`RenderError::Size`] for a picture too large.
-pub fn render(
+pub(crate) fn render(
     panels: &[Vec<Layer<'_>>],
     view: View,
     panel_width: u32,
@@ -377,7 +377,7 @@ impl Canvas {
 ///
 /// # Errors
 /// [`RenderError::Read`] for a mesh that cannot be read, otherwise as [`render`].
-pub fn render_snapshots(
+pub(crate) fn render_snapshots(
     initial: &Path,
     states: &[PathBuf],
     lumen: Option<&Path>,
@@ -442,7 +442,7 @@ fn columns(n: usize, aspect: Real) -> usize {
 ///
 /// # Errors
 /// [`RenderError::Write`] when encoding or writing fails.
-pub fn write_png(path: &Path, pixmap: &Pixmap) -> Result<(), RenderError> {
+pub(crate) fn write_png(path: &Path, pixmap: &Pixmap) -> Result<(), RenderError> {
     let bytes = pixmap.encode_png().map_err(|e| RenderError::Write {
         path: path.to_path_buf(),
         message: e.to_string(),

@@ -27,17 +27,17 @@ use std::ops::ControlFlow;
 use std::path::{Path, PathBuf};
 
 /// Collects the states of a run for its charts.
-pub struct RunCharts {
+pub(crate) struct RunCharts {
     channels: Vec<LoadChannel>,
     samples: Vec<StateSample>,
 }
 
 impl RunCharts {
     /// Folder of the charts inside the run folder.
-    pub const FOLDER: &'static str = super::run_folder::CHARTS_FOLDER;
+    pub(crate) const FOLDER: &'static str = super::run_folder::CHARTS_FOLDER;
 
     /// An empty collection for a run of `model`.
-    pub fn new(model: &Model) -> Self {
+    pub(crate) fn new(model: &Model) -> Self {
         Self {
             channels: load_channels(model),
             samples: Vec::new(),
@@ -45,18 +45,18 @@ impl RunCharts {
     }
 
     /// The states recorded so far.
-    pub fn samples(&self) -> &[StateSample] {
+    pub(crate) fn samples(&self) -> &[StateSample] {
         &self.samples
     }
 
     /// Continues the charts of a resumed run with the states recorded up to its checkpoint.
-    pub fn resumed(mut self, samples: Vec<StateSample>) -> Self {
+    pub(crate) fn resumed(mut self, samples: Vec<StateSample>) -> Self {
         self.samples = samples;
         self
     }
 
     /// The charts of the states recorded so far (see the module documentation).
-    pub fn charts(&self, model: &Model) -> Vec<(&'static str, LineChart)> {
+    pub(crate) fn charts(&self, model: &Model) -> Vec<(&'static str, LineChart)> {
         let name = &model.name;
         let length = model.units.length();
         let times: Vec<Real> = self.samples.iter().map(|s| s.time).collect();
@@ -299,7 +299,7 @@ impl RunCharts {
     ///
     /// # Errors
     /// [`ChartError`] when a chart cannot be listed, drawn or written.
-    pub fn write(
+    pub(crate) fn write(
         &self,
         model: &Model,
         run_dir: &Path,

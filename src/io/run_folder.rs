@@ -29,23 +29,23 @@ use std::path::{Path, PathBuf};
 use std::sync::{Arc, Mutex, PoisonError};
 
 /// The manifest's file name inside a run folder.
-pub const MANIFEST: &str = ".stentkit-run";
+pub(crate) const MANIFEST: &str = ".stentkit-run";
 /// The lock file's name inside a run folder.
-pub const LOCK: &str = ".stentkit-run.lock";
+pub(crate) const LOCK: &str = ".stentkit-run.lock";
 /// The space reserve's file name inside a run folder (see [`RunFolder::reserve`]).
-pub const RESERVE: &str = ".stentkit-reserve";
+pub(crate) const RESERVE: &str = ".stentkit-reserve";
 /// The checkpoint's file name ([`crate::io::checkpoint`]). The run folder's layout is named here, below the
 /// writers that fill it, so that the folder's rules need none of them.
-pub const CHECKPOINT_FILE: &str = "checkpoint.bin";
+pub(crate) const CHECKPOINT_FILE: &str = "checkpoint.bin";
 /// The ParaView collection of the run's field files ([`crate::io::snapshots`]).
-pub const COLLECTION_FILE: &str = "run.pvd";
+pub(crate) const COLLECTION_FILE: &str = "run.pvd";
 /// The folder of the snapshots ([`crate::io::snapshots::SnapshotWriter`]).
-pub const SNAPSHOTS_FOLDER: &str = "snapshots";
+pub(crate) const SNAPSHOTS_FOLDER: &str = "snapshots";
 /// The folder of the charts ([`crate::io::run_charts::RunCharts`]).
-pub const CHARTS_FOLDER: &str = "charts";
+pub(crate) const CHARTS_FOLDER: &str = "charts";
 /// The names every run writes (or may write) in its folder besides the snapshots and charts: none of them may
 /// be a symbolic link ([`classify`]).
-pub const RUN_NAMES: [&str; 10] = [
+pub(crate) const RUN_NAMES: [&str; 10] = [
     MANIFEST,
     LOCK,
     RESERVE,
@@ -100,7 +100,7 @@ fn io_error(path: &Path) -> impl FnOnce(io::Error) -> RunFolderError + '_ {
 
 /// What a folder holds, as far as a run is concerned.
 #[derive(Debug, Clone, PartialEq, Eq)]
-pub enum FolderKind {
+pub(crate) enum FolderKind {
     /// Missing, or holding nothing (a lone lock file of ours counts as nothing).
     Empty,
     /// A stentkit run folder; the files stentkit wrote there (relative paths).
@@ -115,7 +115,7 @@ pub enum FolderKind {
 /// # Errors
 /// [`RunFolderError::Refused`] for a path that is not a folder or a folder with links;
 /// [`RunFolderError::Io`] when the folder or its manifest cannot be read.
-pub fn classify(dir: &Path) -> Result<FolderKind, RunFolderError> {
+pub(crate) fn classify(dir: &Path) -> Result<FolderKind, RunFolderError> {
     if !dir.exists() {
         return Ok(FolderKind::Empty);
     }
@@ -258,7 +258,11 @@ fn forbidden(dir: &Path, design_file: &Path) -> Option<&'static str> {
 ///
 /// # Errors
 /// [`RunFolderError::Refused`] (bad input), [`RunFolderError::Io`].
-pub fn check(dir: &Path, design_file: &Path, force: bool) -> Result<FitFolder, RunFolderError> {
+pub(crate) fn check(
+    dir: &Path,
+    design_file: &Path,
+    force: bool,
+) -> Result<FitFolder, RunFolderError> {
     let refuse = |reason: String| RunFolderError::Refused {
         path: dir.to_path_buf(),
         reason,
@@ -296,7 +300,7 @@ pub fn check(dir: &Path, design_file: &Path, force: bool) -> Result<FitFolder, R
 
 /// A folder [`check`] found fit for a run, not yet taken: nothing has been written.
 #[derive(Debug)]
-pub struct FitFolder {
+pub(crate) struct FitFolder {
     dir: PathBuf,
     /// Files of the earlier run here.
     previous: BTreeSet<PathBuf>,
@@ -304,12 +308,12 @@ pub struct FitFolder {
 
 impl FitFolder {
     /// The folder.
-    pub fn dir(&self) -> &Path {
+    pub(crate) fn dir(&self) -> &Path {
         &self.dir
     }
 
     /// Bytes of the earlier run's files: what `--force` will free.
-    pub fn previous_bytes(&self) -> u64 {
+    pub(crate) fn previous_bytes(&self) -> u64 {
         files_bytes(&self.dir, &self.previous)
     }
 
@@ -317,7 +321,7 @@ impl FitFolder {
     ///
     /// # Errors
     /// [`RunFolderError::Busy`] when another run holds the lock, [`RunFolderError::Io`].
-    pub fn open(self) -> Result<RunFolder, RunFolderError> {
+    pub(crate) fn open(self) -> Result<RunFolder, RunFolderError> {
         RunFolder::take(self.dir, self.previous)
     }
 }
@@ -331,7 +335,10 @@ impl FitFolder {
 /// # Errors
 /// [`RunFolderError::Refused`] (bad input) for a folder that is not a run folder or holds no checkpoint,
 /// [`RunFolderError::Io`].
-pub fn check_resume(dir: &Path, checkpoint: &Path) -> Result<ResumableFolder, RunFolderError> {
+pub(crate) fn check_resume(
+    dir: &Path,
+    checkpoint: &Path,
+) -> Result<ResumableFolder, RunFolderError> {
     let refuse = |reason: String| RunFolderError::Refused {
         path: dir.to_path_buf(),
         reason,
@@ -365,7 +372,7 @@ pub fn check_resume(dir: &Path, checkpoint: &Path) -> Result<ResumableFolder, Ru
 /// The folder of an earlier run that [`check_resume`] found fit to continue, not yet taken: nothing has been
 /// written.
 #[derive(Debug)]
-pub struct ResumableFolder {
+pub(crate) struct ResumableFolder {
     dir: PathBuf,
     /// The files its manifest lists.
     files: BTreeSet<PathBuf>,
@@ -377,7 +384,7 @@ impl ResumableFolder {
     ///
     /// # Errors
     /// [`RunFolderError::Busy`] when a run holds it, [`RunFolderError::Io`].
-    pub fn open(self) -> Result<RunFolder, RunFolderError> {
+    pub(crate) fn open(self) -> Result<RunFolder, RunFolderError> {
         let folder = RunFolder::take(self.dir, BTreeSet::new())?;
         remove_stale_temporaries(&folder.dir, &self.files)?;
         Ok(folder)
@@ -585,7 +592,7 @@ impl Drop for Reserve {
 ///
 /// # Errors
 /// [`RunFolderError::Io`] naming the file that could not be removed.
-pub fn remove_stale_temporaries(
+pub(crate) fn remove_stale_temporaries(
     dir: &Path,
     owned: &BTreeSet<PathBuf>,
 ) -> Result<Vec<PathBuf>, RunFolderError> {
@@ -654,13 +661,13 @@ fn lock(dir: &Path) -> Result<File, RunFolderError> {
 ///
 /// # Errors
 /// As [`RunFolder::open`].
-pub fn lock_existing(dir: &Path) -> Result<File, RunFolderError> {
+pub(crate) fn lock_existing(dir: &Path) -> Result<File, RunFolderError> {
     lock(dir)
 }
 
 /// `2026-11-23T21:56:03Z` for a system time (UTC; days to civil date by Howard Hinnant's algorithm,
 /// <https://howardhinnant.github.io/date_algorithms.html#civil_from_days>).
-pub fn utc_timestamp(time: std::time::SystemTime) -> String {
+pub(crate) fn utc_timestamp(time: std::time::SystemTime) -> String {
     let secs = time
         .duration_since(std::time::UNIX_EPOCH)
         .map_or(0, |d| d.as_secs());

@@ -1,11 +1,11 @@
 //! Snapshots of a run: the full device as closed tubes swept along the deformed centrelines with the solver's
-//! section frames, written in the design's formats ([`super::formats`]; binary STL by default, OBJ on request)
+//! section frames, written in the design's formats (`super::formats`; binary STL by default, OBJ on request)
 //! at the initial state, at the final one, at the events of the shape-memory cycle ([`crate::model::cycle`]:
 //! programmed, fixed, released), at a few times between them, every `every` steps and at the requested times
 //! (time stepping lands on those: they are the model's record times). Each is named by its time and phase,
 //! `snapshots/t1.750_fixed.stl` ([`snapshot_name`]). With each snapshot, unless the design turns them off, the
 //! fields along the rods for ParaView (`.vtp`, [`super::vtk`], listed with their times in `run.pvd`); and the
-//! full device's centrelines are kept for the configuration figures drawn at the end ([`super::configurations`]).
+//! full device's centrelines are kept for the configuration figures drawn at the end (`super::configurations`).
 
 use super::chart::ChartError;
 use super::configurations::{self, CENTRELINE_SAMPLES, Configuration};
@@ -163,7 +163,7 @@ pub struct Snapshot {
     /// Its phase in the model's cycle ([`Model::phase_at`]).
     pub phase: Option<Phase>,
     /// Its files relative to the run folder, one per format of the design in the registry's order
-    /// ([`super::formats::FORMATS`]), each with its format's extension, then the fields for ParaView (`.vtp`)
+    /// (`super::formats::FORMATS`), each with its format's extension, then the fields for ParaView (`.vtp`)
     /// when the design writes them.
     pub files: Vec<PathBuf>,
     /// Triangles of the mesh.
@@ -225,7 +225,7 @@ pub enum SnapshotError {
 /// `rings` rings per patch.
 ///
 /// # Errors
-/// [`DeviceMeshError`] naming the patch index that cannot be swept.
+/// `DeviceMeshError` naming the patch index that cannot be swept.
 pub fn current_device_mesh(
     sim: &Simulation<'_>,
     segments: usize,
@@ -309,7 +309,7 @@ impl SnapshotWriter {
     }
 
     /// Lists every snapshot file in `manifest` before writing it (a run folder's files, see
-    /// [`crate::io::run_folder`]).
+    /// `crate::io::run_folder`).
     pub fn with_manifest(mut self, manifest: Manifest) -> Self {
         self.manifest = Some(manifest);
         self
@@ -436,7 +436,7 @@ impl SnapshotWriter {
         }
     }
 
-    /// Draws the configuration figures ([`crate::io::configurations`]) of the snapshots written by this process
+    /// Draws the configuration figures (`crate::io::configurations`) of the snapshots written by this process
     /// into `charts/`, each file listed in the manifest first; returns their paths relative to the run folder.
     ///
     /// # Errors

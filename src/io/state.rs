@@ -9,7 +9,7 @@ use crate::solver::{Simulation, StepReport};
 
 /// Largest number of load channels recorded (a condition on a large node set would otherwise add one per
 /// node); the first ones in node order are kept.
-pub const MAX_LOAD_CHANNELS: usize = 32;
+pub(crate) const MAX_LOAD_CHANNELS: usize = 32;
 
 /// Where a recorded load value comes from.
 #[derive(Debug, Clone, PartialEq)]
@@ -37,7 +37,7 @@ pub struct LoadChannel {
 /// Every input of the model that varies in time (at most [`MAX_LOAD_CHANNELS`]): non-zero node loads and
 /// prescribed values (except those set by the programme), non-zero distributed loads, and the programme's
 /// ramp factor.
-pub fn load_channels(model: &Model) -> Vec<LoadChannel> {
+pub(crate) fn load_channels(model: &Model) -> Vec<LoadChannel> {
     let units = model.units;
     let driven: Vec<usize> = model
         .programme

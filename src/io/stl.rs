@@ -1,6 +1,6 @@
 //! Binary STL export of triangle meshes (via `stl_io`), and an STL reader for round-trip checks.
 //!
-//! Every file is written through [`crate::io::atomic`], so that an interrupted or failed export never leaves a
+//! Every file is written through `crate::io::atomic`, so that an interrupted or failed export never leaves a
 //! half-written mesh behind: the target either keeps its old content or gets the complete new one.
 //!
 //! Binary STL stores `f32` coordinates and one facet normal per triangle; the normals written here are
@@ -32,7 +32,7 @@ pub fn write_stl(path: &Path, mesh: &TriangleMesh) -> Result<(), MeshIoError> {
     write_stl_with_header(path, mesh, "")
 }
 
-/// Binary STL snapshots ([`super::formats::FORMATS`]): an 80-byte header naming the design, step, time and
+/// Binary STL snapshots (`super::formats::FORMATS`): an 80-byte header naming the design, step, time and
 /// unit system.
 pub struct Stl;
 

@@ -427,7 +427,7 @@ pub struct StabilisationSummary {
 /// [`crate::solver::simulation::model_fingerprint`] (`v1-63e8c603b3fbccd4`). The version tells a fingerprint of
 /// another form — a summary written by a stentkit that hashed the model otherwise (before version 1: 16 hex
 /// digits alone) — from one of another model.
-pub fn model_fingerprint_text(model: &Model) -> String {
+pub(crate) fn model_fingerprint_text(model: &Model) -> String {
     format!(
         "v{}-{:016x}",
         crate::model::fingerprint::VERSION,
@@ -522,7 +522,7 @@ impl RunSummaryFile {
 
 /// Peak resident memory of this process so far \[MiB\]: `VmHWM` of `/proc/self/status` (Linux); `None` where that
 /// is not available.
-pub fn peak_memory_mib() -> Option<Real> {
+pub(crate) fn peak_memory_mib() -> Option<Real> {
     let status = std::fs::read_to_string("/proc/self/status").ok()?;
     let line = status.lines().find(|l| l.starts_with("VmHWM:"))?;
     let kib: Real = line.split_whitespace().nth(1)?.parse().ok()?;

@@ -15,7 +15,7 @@ use crate::io::atomic::write_atomically;
 use crate::io::stl::{MeshIoError, check_writable};
 use crate::model::Units;
 
-/// 3MF snapshots and print files ([`super::formats::FORMATS`]): the model's title names the design, step and
+/// 3MF snapshots and print files (`super::formats::FORMATS`): the model's title names the design, step and
 /// time; the unit is the design's length unit.
 pub struct ThreeMf;
 

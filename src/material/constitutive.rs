@@ -230,7 +230,7 @@ pub trait ConstitutiveLaw: Clone + fmt::Debug + PartialEq + Send + Sync {
 macro_rules! register_laws {
     ($($(#[$doc:meta])* $variant:ident($law:ty),)+) => {
         /// A material of the model: one of the registered constitutive laws (the list in `material/mod.rs`;
-        /// see [`crate::material::constitutive`]).
+        /// see `crate::material::constitutive`).
         #[derive(Debug, Clone, PartialEq, serde::Serialize)]
         pub enum MaterialLaw {
             $($(#[$doc])* $variant($law),)+
@@ -380,13 +380,13 @@ pub(crate) use register_laws;
 /// The panic of `MaterialLaw`'s methods given the state of another law (a programmer error).
 #[doc(hidden)]
 #[track_caller]
-pub fn state_of_another_law(law: &str) -> ! {
+pub(crate) fn state_of_another_law(law: &str) -> ! {
     panic!("a {law} material was given the state of another law")
 }
 
 /// `Ok(())` when a saved state has the `expected` length, else [`MaterialError::StateLength`]: for
 /// [`ConstitutiveLaw::restore_state`] implementations.
-pub fn check_state_length(values: &[Real], expected: usize) -> Result<(), MaterialError> {
+pub(crate) fn check_state_length(values: &[Real], expected: usize) -> Result<(), MaterialError> {
     if values.len() == expected {
         Ok(())
     } else {
@@ -398,10 +398,10 @@ pub fn check_state_length(values: &[Real], expected: usize) -> Result<(), Materi
 }
 
 /// Numbers of one [`SectionStrains`] or [`SectionStress`] when saved (four `Vec3`).
-pub const SECTION_NUMBERS: usize = 12;
+pub(crate) const SECTION_NUMBERS: usize = 12;
 
 /// Appends the twelve numbers of `strains` to `out` (`Γ_N`, `K_M`, `Γ_N,s`, `K_M,s`).
-pub fn push_strains(out: &mut Vec<Real>, strains: &SectionStrains) {
+pub(crate) fn push_strains(out: &mut Vec<Real>, strains: &SectionStrains) {
     for v in [
         &strains.force,
         &strains.moment,
@@ -413,7 +413,7 @@ pub fn push_strains(out: &mut Vec<Real>, strains: &SectionStrains) {
 }
 
 /// Appends the twelve numbers of `stress` to `out` (`N`, `M`, `N,s`, `M,s`).
-pub fn push_stress(out: &mut Vec<Real>, stress: &SectionStress) {
+pub(crate) fn push_stress(out: &mut Vec<Real>, stress: &SectionStress) {
     for v in [
         &stress.force,
         &stress.moment,
@@ -439,7 +439,7 @@ fn four_vectors(values: &[Real]) -> [crate::math::Vec3; 4] {
 
 /// The strains of twelve numbers written by [`push_strains`]. Panics unless `values.len() == 12`.
 #[track_caller]
-pub fn read_strains(values: &[Real]) -> SectionStrains {
+pub(crate) fn read_strains(values: &[Real]) -> SectionStrains {
     let [force, moment, force_ds, moment_ds] = four_vectors(values);
     SectionStrains {
         force,
@@ -451,7 +451,7 @@ pub fn read_strains(values: &[Real]) -> SectionStrains {
 
 /// The stress of twelve numbers written by [`push_stress`]. Panics unless `values.len() == 12`.
 #[track_caller]
-pub fn read_stress(values: &[Real]) -> SectionStress {
+pub(crate) fn read_stress(values: &[Real]) -> SectionStress {
     let [force, moment, force_ds, moment_ds] = four_vectors(values);
     SectionStress {
         force,

@@ -190,7 +190,7 @@ pub fn update_branch_strains(
     }
 }
 
-/// Where the temperature varies along the rod (module docs of [`super::maxwell`]): the extra history of the
+/// Where the temperature varies along the rod (module docs of `super::maxwell`): the extra history of the
 /// s-derivatives from the slopes `coeffs_ds = (β_α,s, γ_α,s, δ_α,s)` of the step coefficients,
 /// `H_N,s += S_N ⊙ Σ_α E_α (γ_α,s Γ_N^n + δ_α,s Γ_Nα^n)` and likewise for `H_M,s`, added to `history`.
 /// Panics if the branch counts differ.

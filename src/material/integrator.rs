@@ -268,7 +268,7 @@ pub fn step_coefficients_into(
 /// coefficients along the reference arc length \[1/length\] — exact derivatives of the formulas of the module
 /// docs through `λ_α,s = λ_α · d ln(rate_factor)/dT · T,s` ([`super::Wlf::log_rate_slope`]); zero where a
 /// rate is capped ([`MAX_STEP_RATE`]) or frozen. They make the s-derivative of (★) exact (module docs of
-/// [`super::maxwell`], *Temperature that varies along the rod*).
+/// `super::maxwell`, *Temperature that varies along the rod*).
 ///
 /// Errors as [`step_coefficients_into`] (also for a non-finite `T,s`).
 #[allow(clippy::too_many_arguments)]

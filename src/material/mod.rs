@@ -1,4 +1,4 @@
-//! Material: the constitutive interface the solver calls ([`ConstitutiveLaw`], [`constitutive`]), its laws —
+//! Material: the constitutive interface the solver calls ([`ConstitutiveLaw`], `constitutive`), its laws —
 //! the generalized Maxwell (Prony) solid with the WLF shift of relaxation times ([`MaxwellLaw`]) and the plain
 //! elastic material ([`ElasticLaw`]) —, cross-section stiffnesses and the internal-variable updates.
 //!
@@ -7,7 +7,7 @@
 //! The laws are registered in one list, the `register_laws!` invocation below, which makes [`MaterialLaw`] (the
 //! material of a model's patch) and [`MaterialState`] (its internal variables). **A new law is a new module
 //! plus one registration line**: write `material/<law>.rs` implementing [`ConstitutiveLaw`], declare it here
-//! (`pub mod <law>;`) and add `Name(<law>::Type),` to the list (see [`constitutive`] for the interface and why
+//! (`pub mod <law>;`) and add `Name(<law>::Type),` to the list (see `constitutive` for the interface and why
 //! it is an enum).
 //!
 //! # Model (paper §2.2, §3.1)
@@ -28,7 +28,7 @@
 //! # Time stepping
 //!
 //! Every [`Integrator`] advances a branch by an update affine in the new total strain
-//! (see [`integrator`] for the three formulas, and the correspondence with the paper's Eqs.
+//! (see `integrator` for the three formulas, and the correspondence with the paper's Eqs.
 //! `evol_f_thermal_disc`, `N_constitutive_disc`, `M_constitutive_disc`):
 //!
 //! ```text
@@ -52,16 +52,16 @@
 //! Constructors validate their data (`try_new`) and report the offending value in a [`MaterialError`];
 //! time stepping reports non-finite inputs (a temperature schedule returning NaN) rather than propagating NaN.
 
-pub mod constitutive;
-pub mod elastic;
-pub mod history;
-pub mod integrator;
-pub mod law;
-pub mod maxwell;
-pub mod point;
-pub mod prony;
-pub mod section;
-pub mod wlf;
+pub(crate) mod constitutive;
+pub(crate) mod elastic;
+pub(crate) mod history;
+pub(crate) mod integrator;
+pub(crate) mod law;
+pub(crate) mod maxwell;
+pub(crate) mod point;
+pub(crate) mod prony;
+pub(crate) mod section;
+pub(crate) mod wlf;
 
 pub use constitutive::{
     ConstitutiveLaw, MaterialNotice, PointStrains, PointTemperature, StepInput,
@@ -87,9 +87,9 @@ use crate::math::{Real, Short};
 
 // The registry of constitutive laws: one line per law (module docs).
 constitutive::register_laws! {
-    /// Linear elastic: a modulus and a Poisson ratio, no internal variables ([`elastic`]).
+    /// Linear elastic: a modulus and a Poisson ratio, no internal variables (`elastic`).
     Elastic(elastic::ElasticLaw),
-    /// Generalized Maxwell solid with WLF shift and a time integrator (paper §2.2, §3.1; [`maxwell`]).
+    /// Generalized Maxwell solid with WLF shift and a time integrator (paper §2.2, §3.1; `maxwell`).
     Maxwell(maxwell::MaxwellLaw),
 }
 

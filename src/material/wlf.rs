@@ -27,7 +27,7 @@ use crate::math::Real;
 
 /// Largest accepted `C1` \[-\]. `C1` is a decimal exponent bound (`1/a_T < 10^{C1}`); `10^{300}` is still
 /// finite in `f64` (max ≈ `1.8e308`). Measured polymers have `C1` ≈ 8–40 (the "universal" value is 17.44).
-pub const MAX_C1: Real = 300.0;
+pub(crate) const MAX_C1: Real = 300.0;
 
 /// Validated WLF constants: `C1 > 0` \[-\], `C2 > 0` \[K\], reference (glass-transition) temperature `Tg` \[°C\].
 #[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
@@ -38,7 +38,7 @@ pub struct Wlf {
 }
 
 impl Wlf {
-    /// Validates `0 < C1 ≤` [`MAX_C1`], `C2 > 0` \[K\] (finite and not subnormal) and a finite `Tg` \[°C\].
+    /// Validates `0 < C1 ≤` `MAX_C1`, `C2 > 0` \[K\] (finite and not subnormal) and a finite `Tg` \[°C\].
     pub fn try_new(c1: Real, c2: Real, tg: Real) -> Result<Self, MaterialError> {
         if !(c1 > 0.0 && c1 <= MAX_C1) {
             return Err(MaterialError::WlfC1 { value: c1 });

@@ -14,7 +14,7 @@ use super::{KnotVector, MathError, NurbsCurve, Real, Vec3};
 /// comes from. When every knot span holds data the pivots are positive; one that has lost all but 10⁻¹² of its
 /// diagonal means a control point the data barely determine (spans of nearly one point each, the fit close to
 /// interpolating noise): its value would carry round-off amplified 10¹², so the system is reported singular.
-pub const MIN_RELATIVE_PIVOT: Real = 1e-12;
+pub(crate) const MIN_RELATIVE_PIVOT: Real = 1e-12;
 
 /// The degree-`degree` curve with `count` control points closest to `points` at `params` (increasing, from
 /// 0 to 1) in the least-squares sense, through the first and last point.
@@ -22,7 +22,7 @@ pub const MIN_RELATIVE_PIVOT: Real = 1e-12;
 /// # Errors
 /// [`MathError::InvalidCurve`] unless `degree < count ≤ points.len()` and there is one parameter per point;
 /// [`MathError::Singular`] when the normal equations are singular.
-pub fn approximate(
+pub(crate) fn approximate(
     points: &[Vec3],
     params: &[Real],
     degree: usize,
@@ -145,7 +145,7 @@ fn band_cholesky_solve(band: &[Real], size: usize, p: usize, b: &mut [Vec3]) {
 
 /// Chord-length parameters of `points`, normalised to `[0, 1]` (Piegl–Tiller Eq. 9.5); `None` when two
 /// consecutive points coincide.
-pub fn chord_parameters(points: &[Vec3]) -> Option<Vec<Real>> {
+pub(crate) fn chord_parameters(points: &[Vec3]) -> Option<Vec<Real>> {
     let mut params = vec![0.0];
     for w in points.windows(2) {
         let d = (w[1] - w[0]).norm();

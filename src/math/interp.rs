@@ -14,12 +14,12 @@ use super::{KnotVector, MathError, NurbsCurve, Real, Vec3};
 /// Smallest accepted pivot of the banded elimination, relative to the largest entry of its row (entries lie
 /// in `[0, 1]`). With increasing sites that satisfy Schoenberg–Whitney every pivot is positive; a pivot below
 /// this means the sites nearly violate the condition and the interpolant would be meaningless.
-pub const MIN_RELATIVE_PIVOT: Real = 1e-14;
+pub(crate) const MIN_RELATIVE_PIVOT: Real = 1e-14;
 
 /// The factored collocation matrix of a knot vector at a set of sites (banded LU without pivoting, see the
 /// module docs); [`Interpolator::curve`] then solves for the control points of any data.
 #[derive(Debug, Clone)]
-pub struct Interpolator {
+pub(crate) struct Interpolator {
     knots: KnotVector,
     /// Site order: `order[i]` is the index (in the caller's arrays) of the `i`-th smallest site.
     order: Vec<usize>,
@@ -35,7 +35,7 @@ impl Interpolator {
     /// [`MathError::OutOfDomain`] for a parameter outside the domain (or NaN), and [`MathError::Singular`] for
     /// repeated parameters or when the Schoenberg–Whitney condition `N_i(u_(i)) > 0` fails for the sorted
     /// sites `u_(i)` (the matrix is then singular).
-    pub fn try_new(knots: KnotVector, params: &[Real]) -> Result<Self, MathError> {
+    pub(crate) fn try_new(knots: KnotVector, params: &[Real]) -> Result<Self, MathError> {
         let n = knots.num_basis();
         let p = knots.degree();
         if params.len() != n {
@@ -119,14 +119,9 @@ impl Interpolator {
         Ok(Self { knots, order, band })
     }
 
-    /// The knot vector of the interpolants.
-    pub fn knots(&self) -> &KnotVector {
-        &self.knots
-    }
-
     /// The B-spline curve through `points[i]` at the `i`-th parameter given to [`Interpolator::try_new`]
     /// (forward and back substitution with the banded factors).
-    pub fn curve(&self, points: &[Vec3]) -> Result<NurbsCurve, MathError> {
+    pub(crate) fn curve(&self, points: &[Vec3]) -> Result<NurbsCurve, MathError> {
         let n = self.knots.num_basis();
         let p = self.knots.degree();
         let width = 2 * p + 1;
@@ -164,7 +159,7 @@ impl Interpolator {
 ///
 /// Global interpolation after Piegl–Tiller A9.1 with the caller's knots and parameters, solved by the banded
 /// LU of [`Interpolator`]; errors as for [`Interpolator::try_new`].
-pub fn interpolate(
+pub(crate) fn interpolate(
     knots: KnotVector,
     params: &[Real],
     points: &[Vec3],
@@ -173,10 +168,8 @@ pub fn interpolate(
 }
 
 /// The B-spline curve with knot vector `knots` that passes through `points[i]` at the Greville abscissae.
-pub fn interpolate_at_greville(
-    knots: KnotVector,
-    points: &[Vec3],
-) -> Result<NurbsCurve, MathError> {
+#[cfg(test)]
+fn interpolate_at_greville(knots: KnotVector, points: &[Vec3]) -> Result<NurbsCurve, MathError> {
     let params = knots.greville();
     interpolate(knots, &params, points)
 }

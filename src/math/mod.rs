@@ -5,13 +5,13 @@
 //! Everything here is pure and allocation-light; algorithms cite their source (Piegl & Tiller, *The NURBS
 //! Book*, 2nd ed., algorithm numbers A2.1 …).
 
-pub mod approx;
+pub(crate) mod approx;
 pub mod basis;
 pub mod curve;
-pub mod interp;
+pub(crate) mod interp;
 pub mod knots;
 pub mod quote;
-pub mod serial;
+pub(crate) mod serial;
 pub mod so3;
 
 pub use basis::BasisTable;

@@ -12,7 +12,7 @@ use super::{Mat3, Vec3};
 use serde::ser::{Serialize, SerializeTuple, Serializer};
 
 /// A value made of vectors and matrices that serialises as their components ([module docs](self)).
-pub trait Components {
+pub(crate) trait Components {
     /// Serialises `self` into `serializer`.
     ///
     /// # Errors
@@ -24,7 +24,7 @@ pub trait Components {
 ///
 /// # Errors
 /// The serializer's.
-pub fn components<T: Components, S: Serializer>(
+pub(crate) fn components<T: Components, S: Serializer>(
     value: &T,
     serializer: S,
 ) -> Result<S::Ok, S::Error> {

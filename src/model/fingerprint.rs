@@ -15,7 +15,7 @@
 //!
 //! **The form.** JSON as `serde_json` writes it, `{"description":"stentkit model","version":V,"model":{…}}`:
 //! fields in declaration order, enums by variant name, maps (node sets) in key order, vectors and matrices as
-//! their components ([`crate::math::serial`]), every float in its shortest round-trip form, so that two models
+//! their components (`crate::math::serial`), every float in its shortest round-trip form, so that two models
 //! share a description exactly when every number is bit for bit the same (except that NaN and ±∞, which the
 //! builder refuses anywhere they could reach a model, would all be `null`). The hash is 64-bit FNV-1a of those
 //! bytes (`Fnv1a`); a collision of two different models has a probability of about 2⁻⁶⁴.
@@ -26,7 +26,7 @@
 //! its *form* changes on purpose (a field added, renamed or moved, a type's serialisation changed), [`VERSION`]
 //! is raised so that the old and new descriptions of a model can never be taken for each other, and the
 //! test's committed description (`tests/data/fingerprint/`) is written again. The checkpoint file's own
-//! format version ([`crate::io::checkpoint::VERSION`]) says which fingerprint its checkpoints carry.
+//! format version (`crate::io::checkpoint::VERSION`) says which fingerprint its checkpoints carry.
 //!
 //! The description exists only in memory (written into the hasher as it is made); nothing here touches a
 //! file.

@@ -10,10 +10,10 @@
 pub mod builder;
 pub mod cycle;
 pub mod fingerprint;
-pub mod programme;
-pub mod schedule;
+pub(crate) mod programme;
+pub(crate) mod schedule;
 pub mod stent;
-pub mod temperature;
+pub(crate) mod temperature;
 
 pub use programme::{DrivenNode, Programme, ProgrammeError, ProgrammeKind};
 pub use schedule::{ScheduleError, TimeFunction};
@@ -315,7 +315,7 @@ impl StepPlan {
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, serde::Serialize)]
 pub enum LinearMethod {
     /// Banded LU per patch interior and a sparse LU of the Schur complement on the patch ends
-    /// ([`crate::solver::block`]); the general sparse LU where that is impossible.
+    /// (`crate::solver::block`); the general sparse LU where that is impossible.
     #[default]
     Block,
     /// faer's general sparse LU of the whole system.
@@ -397,7 +397,7 @@ impl Default for ArcLengthSettings {
 /// than that fraction, and the dissipated energy is reported per step and for the run, with a warning when
 /// it exceeds `limit` of the largest strain energy the run reached, or when a damped step's damping force is
 /// more than `limit` of the loads and reactions on the device (the result is then not quasi-static;
-/// [`crate::solver::simulation::stabilisation`]).
+/// `crate::solver::simulation::stabilisation`).
 #[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
 pub struct StabilisationSettings {
     /// Dissipated energy aimed at by the first damped step, as a fraction of the strain energy (in (0, 1):

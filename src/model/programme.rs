@@ -87,7 +87,7 @@ pub enum ProgrammeError {
 
 /// Relative size (of the largest target displacement) below which a target component along a prescribed
 /// symmetry normal counts as zero: symmetric placements give round-off there (~1e-15 of the device size).
-pub const SYMMETRY_TOLERANCE: Real = 1e-9;
+pub(crate) const SYMMETRY_TOLERANCE: Real = 1e-9;
 
 impl Programme {
     /// The ramp factor `f(t)`: 0 before `ramp.0`, linear to 1 at `ramp.1`, 1 after.

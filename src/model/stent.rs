@@ -395,7 +395,7 @@ pub fn symmetry_planes(stent: &GeneratedStent) -> Vec<(Vec3, Vec3)> {
 /// device — every node mirrored about every combination of symmetry planes, weights shared among the copies —
 /// onto their permanent positions ([`best_fit_rigid`]). A free device has no preferred placement once released;
 /// placing the temporary shape this way gives its displacement `η_temp = P_temp − P_0` no rigid part, so the
-/// gauge that fixes the free device's rigid motion at the release ([`crate::solver::gauge`]) holds it where a full
+/// gauge that fixes the free device's rigid motion at the release (`crate::solver::gauge`) holds it where a full
 /// recovery brings every node back to `P_0`. By symmetry of the mirrored point sets the fitted motion respects
 /// the symmetry planes.
 pub fn align_temporary(

@@ -1,12 +1,12 @@
 //! The full device from a (possibly symmetry-reduced) model, as exports draw it (DESIGN §5: exports always
 //! show the full device): closed tube meshes and centrelines, mirrored back about the model's symmetry planes.
 //!
-//! Both take the rods sampled as [`PatchShape`]s, from a running simulation
-//! ([`crate::solver::shape::current_shapes`], with the solver's section frames) or from the reference geometry
+//! Both take the rods sampled as `PatchShape`s, from a running simulation
+//! (`crate::solver::shape::current_shapes`, with the solver's section frames) or from the reference geometry
 //! ([`reference_patch_shapes`], rotation-minimising frames, no simulation needed). Each patch is swept with its
-//! own section phase ([`section_phase`]) so that tubes meeting at a joint never share a ring; rods lying in a
+//! own section phase (`section_phase`) so that tubes meeting at a joint never share a ring; rods lying in a
 //! symmetry plane (bridges kept with half their section) are drawn once at their full drawing diameter, and
-//! rods ending on a plane are welded to their mirror images ([`device_mesh`]).
+//! rods ending on a plane are welded to their mirror images (`device_mesh`).
 
 use crate::geometry::GeometryError;
 use crate::geometry::device_tubes::{DeviceMeshError, RodTube, device_mesh, section_phase};
@@ -134,7 +134,7 @@ pub fn device_sample_counts(model: &Model, samples: usize) -> Vec<usize> {
 }
 
 /// Samples every patch of the model in its reference shape with rotation-minimising frames: `m + 1` points
-/// at `u = k/m`, `m = samples_per_point · n` (the sampling of [`crate::solver::shape`]).
+/// at `u = k/m`, `m = samples_per_point · n` (the sampling of `crate::solver::shape`).
 ///
 /// # Errors
 /// [`GeometryError`] with the patch index when a frame cannot be evaluated.
@@ -174,7 +174,7 @@ pub fn reference_patch_shapes(
 /// with `segments` vertices around, mirrored about the model's symmetry planes.
 ///
 /// # Errors
-/// [`DeviceMeshError`] whose `rod` is the index of the patch that cannot be swept.
+/// `DeviceMeshError` whose `rod` is the index of the patch that cannot be swept.
 pub fn device_tube_mesh(
     model: &Model,
     shapes: &[PatchShape],

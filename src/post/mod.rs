@@ -2,7 +2,7 @@
 //! files. The `io` writers (snapshots, the MCAP recording, the disk estimate) and `stentkit mesh` draw what this
 //! module computes.
 //!
-//! [`device`] samples every patch (the deformed state through [`crate::solver::shape`], or the reference
+//! [`device`] samples every patch (the deformed state through `crate::solver::shape`, or the reference
 //! geometry with rotation-minimising frames), decimates the samples to a drawing budget, and turns a
 //! symmetry-reduced model back into the full device (DESIGN §5: exports always show the full device): mirror
 //! copies of every patch, centrelines and closed tube meshes. [`path`] reads an arc-length path's limit loads; [`recovery`]

@@ -1,7 +1,7 @@
 //! The device as one printable solid: the union of its wires (each patch's centreline swept by a ball of the
 //! wire's radius, so the joints are filled with the balls at the wire ends), contoured on a grid
 //! ([`crate::geometry::solid::union_surface`]), simplified within a tolerance
-//! ([`crate::geometry::simplify::simplify`]) and stood upright on the build plate. What `stentkit mesh --print`
+//! (`crate::geometry::simplify::simplify`) and stood upright on the build plate. What `stentkit mesh --print`
 //! and `stentkit export --print` write (issue 19, item 1), where the tube meshes of the snapshots are one closed
 //! body per rod, overlapping at the joints, which slicers and mesh-repair tools flag.
 //!
@@ -45,7 +45,7 @@ pub const MAX_SPACING_PER_RADIUS: Real = 1.0;
 /// (12.5 times the default). A wire's section then stays a polygon of at least five sides (a side's sagitta
 /// `r (1 − cos π/m)` is at most r/4 for m ≥ 5); a tolerance of the order of the radius lets the collapses
 /// flatten a wire, and one beyond the gaps between the wires lets them join wires
-/// ([`crate::geometry::simplify`] is meant for tolerances far below both). Measured on the straight stent
+/// (`crate::geometry::simplify` is meant for tolerances far below both). Measured on the straight stent
 /// (r = 0.3 mm, processor time): the default r/50 gives 152 836 triangles in 22.9 s, r/10 17 306 in 24.9 s,
 /// r/4 5370 in 25.6 s, r/2 2450 and r 1454 in 27 s; `--deviation 1e9` had not finished after 15 minutes.
 pub const MAX_TOLERANCE_PER_RADIUS: Real = 0.25;

@@ -13,7 +13,7 @@ use std::path::Path;
 
 /// Room a run keeps free for finishing \[bytes\]: the summary (a few kB) and the charts (tens of kB each), written
 /// after a disk that filled up during the run ([`crate::io::run_folder::RunFolder::reserve`]).
-pub const FINISHING_RESERVE: usize = 1 << 20;
+pub(crate) const FINISHING_RESERVE: usize = 1 << 20;
 
 /// Refuses (with [`RunError::Refused`]) a run into `folder` whose estimated output plus [`FINISHING_RESERVE`]
 /// exceeds the free space of the folder's file system (of its nearest existing ancestor, if it does not exist
@@ -23,7 +23,7 @@ pub const FINISHING_RESERVE: usize = 1 << 20;
 /// # Errors
 /// [`RunError::Refused`] naming the design file, the field that sizes the largest part (with its line and
 /// column when the design sets it), the estimate by part and the free space.
-pub fn check_space(design: &Design, folder: &FitFolder) -> Result<(), RunError> {
+pub(crate) fn check_space(design: &Design, folder: &FitFolder) -> Result<(), RunError> {
     let dir = folder.dir();
     let estimate = estimated_disk(design);
     let needed = estimate.total() + FINISHING_RESERVE as u64;
@@ -48,7 +48,7 @@ pub fn check_space(design: &Design, folder: &FitFolder) -> Result<(), RunError> 
 
 /// Free bytes of the file system of `dir` (of its nearest existing ancestor, if it does not exist yet: the
 /// current folder for a relative `runs/x` whose `runs` does not exist), or `None` when they cannot be read.
-pub fn free_space(dir: &Path) -> Option<u64> {
+pub(crate) fn free_space(dir: &Path) -> Option<u64> {
     std::path::absolute(dir)
         .ok()?
         .ancestors()
@@ -57,7 +57,7 @@ pub fn free_space(dir: &Path) -> Option<u64> {
 }
 
 /// `:line:column` of `field` in the design text `source`, or nothing when the text does not set it.
-pub fn position(source: &str, field: &str) -> String {
+pub(crate) fn position(source: &str, field: &str) -> String {
     Locator::new(source)
         .get(field)
         .map(|p| format!(":{}:{}", p.line, p.column))

@@ -11,7 +11,7 @@
 //! DIR/charts/*.svg            histories (io::run_charts)
 //! ```
 //!
-//! The folder is taken through [`crate::io::run_folder`] (refusals, lock, manifest, `force`). The outputs that
+//! The folder is taken through `crate::io::run_folder` (refusals, lock, manifest, `force`). The outputs that
 //! follow the simulation are the [`recorder::RECORDERS`], observed with the console's progress display.
 //! `summary.json` exists from the start (`"status": "running"`) and is rewritten every [`HEARTBEAT`] (2 s) with
 //! the last converged step, when the recorders also make what they wrote readable (the recording's chunk is
@@ -23,10 +23,10 @@
 //!
 //! **Checkpoints and resume.** Every [`RunSettings::checkpoint_every`] seconds of wall time (default 60), right
 //! after a heartbeat (so the recording's chunks hold every state up to it), and when an interruption stops the
-//! run, the run writes `checkpoint.bin` ([`crate::io::checkpoint`]: the simulation's
+//! run, the run writes `checkpoint.bin` (`crate::io::checkpoint`: the simulation's
 //! [`crate::solver::Checkpoint`] and each recorder's position under its name), atomically, listed in the
 //! manifest; a completed run removes it. [`Folder::Resume`] takes the folder of a killed or interrupted run
-//! ([`run_folder::check_resume`]), refuses another design (model and output fingerprints), a run that completed
+//! (`run_folder::check_resume`), refuses another design (model and output fingerprints), a run that completed
 //! or failed, a folder without a checkpoint and whatever a recorder refuses (a history shorter than the
 //! checkpoint's or missing) with [`RunError::Refused`] (a refusal changes nothing, the summary included, so the
 //! run can still be resumed once the cause is put right), restores the simulation and continues every recorder

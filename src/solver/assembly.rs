@@ -28,8 +28,8 @@
 //! rows by `E A`, moment rows by `E I / L`, per unit length by one more `1/L`, translations by `L`), used by
 //! Newton's normalised norms.
 
-pub use super::actions::{Actions, ReleaseRamp};
-pub use super::discretisation::point_position;
+pub(crate) use super::actions::{Actions, ReleaseRamp};
+pub(crate) use super::discretisation::point_position;
 use super::discretisation::{CollocationPoint, Discretisation};
 use super::state::State;
 use super::terms::{EndLoad, InteriorLoad, PointView, Terms};
@@ -40,7 +40,7 @@ use crate::model::Model;
 use rayon::prelude::*;
 
 /// Receives the tangent's entries in a fixed order: first to record the sparsity pattern, then to fill values.
-pub enum Sink<'a> {
+pub(crate) enum Sink<'a> {
     /// Records `(row, column)` of every entry.
     Pattern(&'a mut Vec<(usize, usize)>),
     /// Writes the values in the recorded order.
@@ -84,7 +84,7 @@ impl Sink<'_> {
 /// The constitutive data of one time step: the section law of every collocation point (from its patch's
 /// material, [`crate::material::ConstitutiveLaw::section_law`]).
 #[derive(Debug, Clone, Copy)]
-pub struct StepMaterial<'a> {
+pub(crate) struct StepMaterial<'a> {
     /// Section law per collocation point.
     pub laws: &'a [SectionLaw],
 }
@@ -101,7 +101,7 @@ impl StepMaterial<'_> {
 /// Everything one assembly reads: the discrete problem, the iterate, the section laws of the step, the loads of
 /// the instant and the terms beyond the rod ([`super::terms`]).
 #[derive(Clone, Copy)]
-pub struct Assembly<'a> {
+pub(crate) struct Assembly<'a> {
     /// The discrete problem.
     pub disc: &'a Discretisation,
     /// The iterate.
@@ -141,7 +141,7 @@ struct NodeRows {
 
 /// Everything the assembly needs that does not change during a run.
 #[derive(Debug, Clone)]
-pub struct Assembler {
+pub(crate) struct Assembler {
     nodes: Vec<NodeRows>,
     /// Reference modulus of each patch's material for residual scales (instantaneous modulus) \[stress\].
     modulus_scale: Vec<Real>,
@@ -160,7 +160,7 @@ fn interior_entry_count(point: &CollocationPoint) -> usize {
 
 /// Tangent and residual of one Newton iteration, and the row scales of the residual.
 #[derive(Debug, Clone, Default)]
-pub struct Linearisation {
+pub(crate) struct Linearisation {
     /// Residual vector (one entry per equation).
     pub residual: Vec<Real>,
     /// Dimensionless scale of each row (residual / scale is strain-like).
@@ -169,7 +169,7 @@ pub struct Linearisation {
 
 impl Assembler {
     /// Prepares the node equations of `model` on `disc`.
-    pub fn new(model: &Model, disc: &Discretisation) -> Self {
+    pub(crate) fn new(model: &Model, disc: &Discretisation) -> Self {
         let nodes = model
             .nodes
             .iter()
@@ -239,7 +239,7 @@ impl Assembler {
     /// Assembles the residual into `lin` and the tangent into `sink` (entries in the pattern's order), with the
     /// point terms and constraints of `at.terms` ([`super::terms`]). With constraints the system has one more
     /// unknown (a multiplier, in `state.multipliers`) and equation per constraint equation, after the rod's.
-    pub fn assemble(&self, at: &Assembly<'_>, lin: &mut Linearisation, sink: &mut Sink<'_>) {
+    pub(crate) fn assemble(&self, at: &Assembly<'_>, lin: &mut Linearisation, sink: &mut Sink<'_>) {
         let disc = at.disc;
         let n = disc.num_unknowns();
         let m = at.terms.multipliers();
@@ -334,7 +334,7 @@ impl Assembler {
 
     /// Per end of node `k`: `(σ R N, σ R M)` in the given state (see [`super::Simulation::node_end_resultants`]).
     #[allow(non_snake_case)]
-    pub fn node_end_resultants(
+    pub(crate) fn node_end_resultants(
         &self,
         disc: &Discretisation,
         state: &State,
@@ -756,7 +756,7 @@ fn kinematics(point: &CollocationPoint, state: &State, g: usize) -> Kinematics {
 }
 
 /// The total strains `Γ_N = Γ − Γ0`, `K_M = K − K0` and their arc-length derivatives at collocation point `g`.
-pub fn point_strains(disc: &Discretisation, state: &State, g: usize) -> SectionStrains {
+pub(crate) fn point_strains(disc: &Discretisation, state: &State, g: usize) -> SectionStrains {
     let point = &disc.points[g];
     strains(point, state, g, &kinematics(point, state, g))
 }

@@ -192,7 +192,7 @@ struct PatchBlock {
 }
 
 /// The global system solved by banded patch LUs and a Schur complement on the patch ends.
-pub struct BlockSystem {
+pub(crate) struct BlockSystem {
     n: usize,
     /// Pushed entries.
     entries: usize,
@@ -225,7 +225,7 @@ impl BlockSystem {
     /// first unknowns are the control points of the patches given as `(first control point, count)`, six
     /// unknowns each; unknowns past them join the border. `None` when the pattern is not block-bordered (an
     /// interior row reaching outside its patch), so the caller uses the general sparse LU.
-    pub fn new(
+    pub(crate) fn new(
         n: usize,
         entries: &[(usize, usize)],
         patches: &[(usize, usize)],
@@ -369,18 +369,18 @@ impl BlockSystem {
     }
 
     /// Forgets the factorisation.
-    pub fn invalidate(&mut self) {
+    pub(crate) fn invalidate(&mut self) {
         self.factored = false;
     }
 
     /// True when a factorisation is available for solves.
-    pub fn is_factored(&self) -> bool {
+    pub(crate) fn is_factored(&self) -> bool {
         self.factored
     }
 
     /// Factorises the matrix whose pushed entries are `entry_values` (in the pattern's assembly order).
     /// `Err(Singular)` when a patch interior or the Schur complement has no pivot.
-    pub fn factor(&mut self, entry_values: &[Real]) -> Result<(), SolverError> {
+    pub(crate) fn factor(&mut self, entry_values: &[Real]) -> Result<(), SolverError> {
         assert_eq!(
             entry_values.len(),
             self.entries,
@@ -450,7 +450,7 @@ impl BlockSystem {
     }
 
     /// Solves `A x = b` in place with the last factorisation.
-    pub fn solve_in_place(&mut self, rhs: &mut [Real]) {
+    pub(crate) fn solve_in_place(&mut self, rhs: &mut [Real]) {
         assert!(self.factored, "solve before a successful factorisation");
         // y_k = A_II,k⁻¹ b_I,k, in place in the interior slices of `rhs`.
         let mut slices: Vec<&mut [Real]> = Vec::with_capacity(self.patches.len());

@@ -40,7 +40,7 @@ fn node_at(model: &Model, k: usize, j: usize, n: usize) -> Option<(usize, bool)>
 
 /// Names equation row `row`: e.g. ``patch `hook`, collocation point 4 of 10 (u = 0.35): moment balance, y``
 /// or ``node `tip` (end of patch `bend`): prescribed component u2``.
-pub fn describe_row(model: &Model, disc: &Discretisation, row: usize) -> String {
+pub(crate) fn describe_row(model: &Model, disc: &Discretisation, row: usize) -> String {
     let (g, i) = (row / 6, row % 6);
     let Some((k, j, n)) = locate(disc, g) else {
         return format!(
@@ -80,7 +80,7 @@ pub fn describe_row(model: &Model, disc: &Discretisation, row: usize) -> String 
 }
 
 /// Names unknown `column`: e.g. ``patch `hook`, control point 3 of 10: rotation θ2``.
-pub fn describe_unknown(model: &Model, disc: &Discretisation, column: usize) -> String {
+pub(crate) fn describe_unknown(model: &Model, disc: &Discretisation, column: usize) -> String {
     let (g, i) = (column / 6, column % 6);
     let Some((k, j, n)) = locate(disc, g) else {
         return format!("gauge multiplier {}", column - 6 * disc.points.len());
@@ -99,7 +99,11 @@ pub fn describe_unknown(model: &Model, disc: &Discretisation, column: usize) -> 
 
 /// The patches whose unknowns in `values` are not finite, with how many, in patch order: e.g.
 /// ``patch `hook` (60 of 60 unknowns)``.
-pub fn non_finite_patches(model: &Model, disc: &Discretisation, values: &[f64]) -> Vec<String> {
+pub(crate) fn non_finite_patches(
+    model: &Model,
+    disc: &Discretisation,
+    values: &[f64],
+) -> Vec<String> {
     disc.patches
         .iter()
         .enumerate()
@@ -122,7 +126,7 @@ pub fn non_finite_patches(model: &Model, disc: &Discretisation, values: &[f64]) 
 
 /// A connected part of the model (patches joined through nodes) on which no node has a prescribed component.
 #[derive(Debug, Clone, PartialEq, Eq)]
-pub struct FreeBody {
+pub(crate) struct FreeBody {
     /// Its patches, by index.
     pub patches: Vec<usize>,
     /// Its nodes, by index.
@@ -133,7 +137,7 @@ pub struct FreeBody {
 /// nodes prescribes any component (at any time). Each can translate as a rigid body, so the tangent is singular
 /// whatever the loads. (A part held by too few components — say one translation — is not found here; its
 /// singular tangent shows as a non-finite Newton increment on its patches.)
-pub fn free_bodies(model: &Model) -> Vec<FreeBody> {
+pub(crate) fn free_bodies(model: &Model) -> Vec<FreeBody> {
     let np = model.patches.len();
     // Union–find over patches.
     let mut parent: Vec<usize> = (0..np).collect();

@@ -15,7 +15,7 @@ use crate::math::{Mat3, Real, Vec3};
 use crate::model::{End, Model, PatchEnd};
 
 /// Basis values at one collocation point for one control point: `N`, `N,s`, `N,ss` (arc-length derivatives).
-pub type BasisRow = [Real; 3];
+pub(crate) type BasisRow = [Real; 3];
 
 /// One collocation point: where it is, its basis table and the reference kinematics.
 #[derive(Debug, Clone, PartialEq)]
@@ -196,7 +196,7 @@ impl Discretisation {
 }
 
 /// The position `c = Σ N_j p_j` at collocation point `g`.
-pub fn point_position(disc: &Discretisation, control: &[Vec3], g: usize) -> Vec3 {
+pub(crate) fn point_position(disc: &Discretisation, control: &[Vec3], g: usize) -> Vec3 {
     let point = &disc.points[g];
     point
         .basis

@@ -26,14 +26,14 @@ use crate::solver::terms::Constraint;
 
 /// One constraint: per driven node, the coefficient vector `a_l` on its displacement.
 #[derive(Debug, Clone, PartialEq)]
-pub struct GaugeRow {
+pub(crate) struct GaugeRow {
     /// `(node index, a_l)`.
     pub terms: Vec<(usize, Vec3)>,
 }
 
 /// The active gauge constraints and the positions they freeze.
 #[derive(Debug, Clone, PartialEq)]
-pub struct Gauge {
+pub(crate) struct Gauge {
     /// The constraints (one extra unknown and equation each).
     pub rows: Vec<GaugeRow>,
     /// Positions of the constrained nodes at the release, `c_l^rel`, by node index.
@@ -74,7 +74,7 @@ fn complement(normals: &[Vec3]) -> Vec<Vec3> {
 impl Gauge {
     /// The constraints for the model's driven nodes, freezing the given current positions (`positions[k]` is
     /// the position of node `k`). `None` when the model has no programme.
-    pub fn new(model: &Model, positions: &[Vec3], length_scale: Real) -> Option<Self> {
+    pub(crate) fn new(model: &Model, positions: &[Vec3], length_scale: Real) -> Option<Self> {
         let programme = model.programme.as_ref()?;
         let normals: Vec<Vec3> = model
             .symmetry_planes

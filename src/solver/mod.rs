@@ -1,22 +1,22 @@
 //! The quasi-static IGA-collocation solver (paper §3; DESIGN §4).
 //!
-//! [`Simulation`] owns the discrete problem ([`discretisation`]), the evolving [`state::State`], the assembly of
-//! residual and tangent ([`assembly`]) and the linear solves ([`linear`]: the block-bordered solver of [`block`]
-//! or the sparse LU of [`sparse`]), with the loads, dampers and constraints beyond the rod as [`terms`]. It steps through time with Newton's method on normalised per-field norms,
+//! [`Simulation`] owns the discrete problem (`discretisation`), the evolving `state::State`, the assembly of
+//! residual and tangent (`assembly`) and the linear solves (`linear`: the block-bordered solver of `block`
+//! or the sparse LU of `sparse`), with the loads, dampers and constraints beyond the rod as [`terms`]. It steps through time with Newton's method on normalised per-field norms,
 //! cuts the step when Newton fails (restoring the last converged state), and reports every converged step to an
 //! [`Observer`] — the engine reports, observers record.
 
-pub mod actions;
-pub mod assembly;
-pub mod block;
-pub mod diagnose;
-pub mod discretisation;
-pub mod gauge;
-pub mod linear;
-pub mod shape;
+pub(crate) mod actions;
+pub(crate) mod assembly;
+pub(crate) mod block;
+pub(crate) mod diagnose;
+pub(crate) mod discretisation;
+pub(crate) mod gauge;
+pub(crate) mod linear;
+pub(crate) mod shape;
 pub mod simulation;
-pub mod sparse;
-pub mod state;
+pub(crate) mod sparse;
+pub(crate) mod state;
 pub mod terms;
 
 pub use simulation::{

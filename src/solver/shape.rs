@@ -46,25 +46,12 @@ fn frame_at(disc: &Discretisation, rotations: &[Mat3], patch: usize, u: Real) ->
 }
 
 /// Samples every patch of the simulation in its current configuration.
-pub fn current_shapes(sim: &Simulation<'_>, samples_per_point: usize) -> Vec<PatchShape> {
+pub(crate) fn current_shapes(sim: &Simulation<'_>, samples_per_point: usize) -> Vec<PatchShape> {
     shapes(
         sim.discretisation(),
         sim.model(),
         &sim.state().control,
         &sim.state().rotation,
-        samples_per_point,
-    )
-}
-
-/// Samples every patch in the reference configuration.
-pub fn reference_shapes(sim: &Simulation<'_>, samples_per_point: usize) -> Vec<PatchShape> {
-    let disc = sim.discretisation();
-    let rotations: Vec<Mat3> = disc.points.iter().map(|p| p.rotation0).collect();
-    shapes(
-        disc,
-        sim.model(),
-        &disc.control0,
-        &rotations,
         samples_per_point,
     )
 }

@@ -14,7 +14,7 @@ use faer::sparse::{SparseColMatRef, SymbolicSparseColMatRef};
 use faer::{Conj, MatMut, Par};
 
 /// A square sparse matrix pattern, its symbolic LU analysis and reusable numeric storage.
-pub struct SparseSystem {
+pub(crate) struct SparseSystem {
     n: usize,
     col_ptr: Vec<usize>,
     row_idx: Vec<usize>,
@@ -41,7 +41,7 @@ impl std::fmt::Debug for SparseSystem {
 
 impl SparseSystem {
     /// Analyses the pattern given as `(row, column)` pairs in assembly order (repeats are summed).
-    pub fn new(n: usize, entries: &[(usize, usize)]) -> Result<Self, SolverError> {
+    pub(crate) fn new(n: usize, entries: &[(usize, usize)]) -> Result<Self, SolverError> {
         // Sort entry indices by (column, row) and merge repeats into slots.
         let mut order: Vec<usize> = (0..entries.len()).collect();
         order.sort_unstable_by_key(|&k| (entries[k].1, entries[k].0));
@@ -98,33 +98,23 @@ impl SparseSystem {
     }
 
     /// Number of unknowns.
-    pub fn size(&self) -> usize {
+    pub(crate) fn size(&self) -> usize {
         self.n
     }
 
-    /// Number of entries one assembly pushes.
-    pub fn entries(&self) -> usize {
-        self.slot.len()
-    }
-
     /// Forgets the factorisation (it belonged to a state that was abandoned).
-    pub fn invalidate(&mut self) {
+    pub(crate) fn invalidate(&mut self) {
         self.factored = false;
     }
 
     /// True when a factorisation is available for solves.
-    pub fn is_factored(&self) -> bool {
+    pub(crate) fn is_factored(&self) -> bool {
         self.factored
-    }
-
-    /// Number of structural non-zeros.
-    pub fn nonzeros(&self) -> usize {
-        self.row_idx.len()
     }
 
     /// Factorises the matrix whose pushed entries are `entry_values` (in the pattern's assembly order).
     /// `Err(Singular)` when no pivot is found: the tangent is singular.
-    pub fn factor(&mut self, entry_values: &[Real]) -> Result<(), SolverError> {
+    pub(crate) fn factor(&mut self, entry_values: &[Real]) -> Result<(), SolverError> {
         assert_eq!(
             entry_values.len(),
             self.slot.len(),
@@ -173,7 +163,7 @@ impl SparseSystem {
     }
 
     /// Solves `A x = b` in place with the last factorisation (`rhs` holds `b` on entry and `x` on exit).
-    pub fn solve_in_place(&mut self, rhs: &mut [Real]) {
+    pub(crate) fn solve_in_place(&mut self, rhs: &mut [Real]) {
         assert!(self.factored, "solve before a successful factorisation");
         let lu = LuRef::new_unchecked(&self.symbolic, &self.numeric);
         let n = rhs.len();

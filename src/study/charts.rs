@@ -5,11 +5,11 @@ use crate::math::Real;
 use crate::post::chart::{LineChart, Scale, Series};
 
 /// Wall times are charted on a log axis; a run faster than the clock resolves is drawn at this floor \[s\].
-pub const WALL_TIME_FLOOR: Real = 1e-6;
+pub(crate) const WALL_TIME_FLOOR: Real = 1e-6;
 
 /// One curve of an error study: a label and its runs as `(parameter, error, wall time [s])`.
 #[derive(Debug, Clone, PartialEq)]
-pub struct ErrorCurve {
+pub(crate) struct ErrorCurve {
     /// Legend entry (e.g. `p = 4`, `backward-euler`).
     pub label: String,
     /// Runs as `(parameter, relative error, wall time [s])`; runs with a zero or failed error are left out.
@@ -18,7 +18,7 @@ pub struct ErrorCurve {
 
 /// Titles and axis labels of the two charts of an error study.
 #[derive(Debug, Clone, PartialEq)]
-pub struct ErrorChartLabels {
+pub(crate) struct ErrorChartLabels {
     /// Title of the error-against-parameter chart.
     pub by_parameter: String,
     /// Title of the work–precision chart.
@@ -29,7 +29,7 @@ pub struct ErrorChartLabels {
 
 /// The two log–log charts of an error study: error against the study's parameter and error against wall time
 /// (work–precision), one series per curve.
-pub fn error_charts(curves: &[ErrorCurve], labels: &ErrorChartLabels) -> [LineChart; 2] {
+pub(crate) fn error_charts(curves: &[ErrorCurve], labels: &ErrorChartLabels) -> [LineChart; 2] {
     let y = "relative displacement error";
     let mut by_parameter = LineChart::new(&labels.by_parameter, &labels.parameter, y);
     let mut by_time = LineChart::new(&labels.by_time, "wall time of the run [s]", y);

@@ -22,7 +22,7 @@ use std::fmt::Write as _;
 
 /// One run of a convergence study.
 #[derive(Debug, Clone, PartialEq)]
-pub struct ConvergencePoint {
+pub(crate) struct ConvergencePoint {
     /// Degree.
     pub degree: usize,
     /// Control points per patch.
@@ -41,7 +41,7 @@ pub struct ConvergencePoint {
 
 /// Settings of a convergence study.
 #[derive(Debug, Clone, PartialEq)]
-pub struct ConvergenceStudy {
+pub(crate) struct ConvergenceStudy {
     /// Degrees to run.
     pub degrees: Vec<usize>,
     /// Control points per patch to run (values `≤ p` are skipped for that `p`).
@@ -130,7 +130,7 @@ pub fn convergence_study(
 }
 
 /// The rows as CSV, with a comment header saying what the error is measured against.
-pub fn convergence_csv(
+pub(crate) fn convergence_csv(
     rows: &[ConvergencePoint],
     study: &ConvergenceStudy,
     design: &str,
@@ -163,7 +163,7 @@ pub fn convergence_csv(
 
 /// The two charts of a convergence study: error against `n` and error against wall time (work–precision),
 /// one series per degree, on log–log axes.
-pub fn convergence_charts(
+pub(crate) fn convergence_charts(
     rows: &[ConvergencePoint],
     study: &ConvergenceStudy,
     design: &str,

@@ -11,9 +11,9 @@
 //! * [`variant`]: the variants of a model a study runs — time stepping and integrator changed on the built
 //!   model, geometry (`p`, `n`, crowns) re-built by the design ([`variant::VariedDesign`]).
 //! * [`sample`]: one run of a model sampled on a grid of points per patch.
-//! * [`charts`]: the pair of log–log charts error-against-parameter and error-against-wall-time.
-//! * [`convergence`]: error against `p` and `n` (the paper's Fig. conv_circ) and work–precision.
-//! * [`time`]: error against the time step per internal-variable integrator, observed orders.
+//! * `charts`: the pair of log–log charts error-against-parameter and error-against-wall-time.
+//! * `convergence`: error against `p` and `n` (the paper's Fig. conv_circ) and work–precision.
+//! * `time`: error against the time step per internal-variable integrator, observed orders.
 //! * [`tune`]: the cheapest `p`, `n` and time tolerance whose results stay within a tolerance of a finer run.
 //! * [`stability`]: where each integrator rings (one Maxwell branch against its exact solution) and where
 //!   Newton needs cuts or fails (load steps, heating rate, release snap).
@@ -27,12 +27,12 @@
 //! the design language above it, seen through [`variant::VariedDesign`]; the stability maps read their
 //! embedded designs through a [`stability::ReadDesign`] their caller hands in.
 
-pub mod charts;
-pub mod convergence;
+pub(crate) mod charts;
+pub(crate) mod convergence;
 pub mod fit;
 pub mod sample;
 pub mod stability;
-pub mod time;
+pub(crate) mod time;
 pub mod tune;
 pub mod variant;
 

@@ -26,7 +26,7 @@ use std::fmt::Write as _;
 
 /// Which run the errors of a time-step study are measured against.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub enum TimeReference {
+pub(crate) enum TimeReference {
     /// The exponential integrator with the smallest step of the study halved.
     Auto,
     /// The design's own `time.step` and integrator.
@@ -37,7 +37,7 @@ pub enum TimeReference {
 
 /// Settings of a time-step study.
 #[derive(Debug, Clone, PartialEq)]
-pub struct TimeStudy {
+pub(crate) struct TimeStudy {
     /// Integrators to compare.
     pub integrators: Vec<Integrator>,
     /// Nominal time steps `h` \[time\].
@@ -54,7 +54,7 @@ pub struct TimeStudy {
 
 /// One run of a time-step study.
 #[derive(Debug, Clone, PartialEq)]
-pub struct TimePoint {
+pub(crate) struct TimePoint {
     /// The integrator.
     pub integrator: Integrator,
     /// Nominal step `h` \[time\]; for an error-controlled run the mean step `T / steps` (its first step when
@@ -76,7 +76,7 @@ pub struct TimePoint {
 
 /// The result of a time-step study.
 #[derive(Debug, Clone, PartialEq)]
-pub struct TimeStudyResult {
+pub(crate) struct TimeStudyResult {
     /// Every run, integrator by integrator, steps in the given order.
     pub rows: Vec<TimePoint>,
     /// What the reference run was, in words (for the CSV header, chart titles and the terminal).
@@ -91,7 +91,7 @@ pub struct TimeStudyResult {
 ///
 /// # Errors
 /// A step that is not positive, or a failed reference run.
-pub fn time_study(
+pub(crate) fn time_study(
     model: &Model,
     study: &TimeStudy,
     mut progress: impl FnMut(&str),
@@ -204,7 +204,7 @@ fn error_points(rows: &[TimePoint], integrator: Integrator) -> Vec<(Real, Real)>
 
 /// The rows as CSV, with a comment header naming the design, the study time and the reference run; failed
 /// runs have an empty error and their message in the last column.
-pub fn time_csv(result: &TimeStudyResult, study: &TimeStudy, design: &str) -> String {
+pub(crate) fn time_csv(result: &TimeStudyResult, study: &TimeStudy, design: &str) -> String {
     let mut s = String::new();
     let _ = writeln!(
         s,
@@ -245,7 +245,11 @@ pub fn time_csv(result: &TimeStudyResult, study: &TimeStudy, design: &str) -> St
 
 /// The two charts of a time-step study: error against `h` and error against wall time, one series per
 /// integrator (labelled with its observed order), on log–log axes; the titles name the reference.
-pub fn time_charts(result: &TimeStudyResult, study: &TimeStudy, design: &str) -> [LineChart; 2] {
+pub(crate) fn time_charts(
+    result: &TimeStudyResult,
+    study: &TimeStudy,
+    design: &str,
+) -> [LineChart; 2] {
     let runs = |keep: &dyn Fn(&TimePoint) -> bool| -> Vec<(Real, Real, Real)> {
         result
             .rows

@@ -22,7 +22,7 @@ const CHARTS_FOLDER: &str = "charts";
 
 /// One variant's row.
 #[derive(Debug, Clone, PartialEq)]
-pub struct Row {
+pub(crate) struct Row {
     /// Index of the variant in the plan.
     pub index: usize,
     /// What its files say.
@@ -33,7 +33,7 @@ pub struct Row {
 
 /// What [`collect`] wrote.
 #[derive(Debug, Clone, PartialEq)]
-pub struct Collected {
+pub(crate) struct Collected {
     /// The plan.
     pub plan: Plan,
     /// The rows, in the plan's order.
@@ -96,7 +96,7 @@ const AFTER_RATIOS: [Column; 5] = [
 ///
 /// # Errors
 /// [`SweepError`] when the folder holds no sweep or a file cannot be written.
-pub fn collect(dir: &SweepDir, times: Option<&[Real]>) -> Result<Collected, SweepError> {
+pub(crate) fn collect(dir: &SweepDir, times: Option<&[Real]>) -> Result<Collected, SweepError> {
     let plan = dir.read_plan()?;
     let models: Vec<_> = plan
         .variants

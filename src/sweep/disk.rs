@@ -26,7 +26,7 @@ const NEUTRAL_MATERIAL_FIELDS: [&str; 5] = ["E_inf", "prony", "nu", "wlf", "inte
 /// Whether the field at `path` (or anything below it) cannot change what a run writes
 /// ([`estimated_disk`]): the section (`section…`) and the constitutive constants of a material
 /// (`material.wlf.Tg`, `materials[1].prony`, … : `NEUTRAL_MATERIAL_FIELDS`).
-pub fn size_neutral(path: &[PathStep]) -> bool {
+pub(crate) fn size_neutral(path: &[PathStep]) -> bool {
     let neutral = |field: &str| NEUTRAL_MATERIAL_FIELDS.contains(&field);
     match path {
         [PathStep::Key(section), ..] => {
@@ -40,7 +40,7 @@ pub fn size_neutral(path: &[PathStep]) -> bool {
 
 /// A sweep's estimate ([`estimate`]).
 #[derive(Debug, Clone, Default)]
-pub struct SweepEstimate {
+pub(crate) struct SweepEstimate {
     /// Variants counted (those still to run).
     pub variants: usize,
     /// Bytes they are estimated to write: their runs and their design files (or refusals).
@@ -63,7 +63,11 @@ struct Representative {
 
 /// Estimates what the variants `todo` of `plan` will write (module docs); `None` when `stop` said so (asked
 /// before each design is built).
-pub fn estimate(plan: &Plan, todo: &[usize], stop: &dyn Fn() -> bool) -> Option<SweepEstimate> {
+pub(crate) fn estimate(
+    plan: &Plan,
+    todo: &[usize],
+    stop: &dyn Fn() -> bool,
+) -> Option<SweepEstimate> {
     // Which parameters can change a variant's size; a path that does not parse is treated as one that can.
     let neutral: Vec<bool> = plan
         .parameters

@@ -25,7 +25,7 @@ use std::path::Path;
 
 /// The metrics of one run (module docs); `None` where the run does not give it.
 #[derive(Debug, Clone, PartialEq, Default)]
-pub struct Metrics {
+pub(crate) struct Metrics {
     /// Wall time of the run \[s\].
     pub wall_time_s: Option<Real>,
     /// Converged steps.
@@ -55,7 +55,7 @@ pub struct Metrics {
 
 /// `history.csv` as columns.
 #[derive(Debug, Clone, PartialEq, Default)]
-pub struct History {
+pub(crate) struct History {
     names: Vec<String>,
     rows: Vec<Vec<Real>>,
 }
@@ -63,7 +63,7 @@ pub struct History {
 impl History {
     /// Parses the text of a `history.csv` (a row that does not parse whole ends the table: a killed run's
     /// last line may be cut).
-    pub fn parse(text: &str) -> Self {
+    pub(crate) fn parse(text: &str) -> Self {
         let mut lines = text.lines();
         let names: Vec<String> = lines
             .next()
@@ -133,7 +133,7 @@ fn first_at_or_below(series: &[(Real, Real)], from: Real, level: Real) -> Option
 
 /// When a programme releases the device: the release time and the duration of its ramp.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Release {
+pub(crate) struct Release {
     /// `t_r` \[time\].
     pub time: Real,
     /// The release ramp \[time\] (`time.release_ramp`).
@@ -142,7 +142,7 @@ pub struct Release {
 
 impl Release {
     /// The release of `model`'s programme, if it has one that releases.
-    pub fn of(model: &Model) -> Option<Self> {
+    pub(crate) fn of(model: &Model) -> Option<Self> {
         let time = model.programme.as_ref()?.release?;
         Some(Self {
             time,
@@ -153,7 +153,7 @@ impl Release {
 
 /// The metrics of the run whose history is `history` and whose `summary.json` is `summary`, released at
 /// `release`, with the recovery ratio taken at `times` (module docs).
-pub fn metrics(
+pub(crate) fn metrics(
     release: Option<Release>,
     history: &History,
     summary: Option<&serde_json::Value>,
@@ -196,7 +196,7 @@ pub fn metrics(
 }
 
 /// [`metrics`] of the run folder `run` of `model`.
-pub fn run_metrics(model: &Model, run: &Path, times: &[Real]) -> Metrics {
+pub(crate) fn run_metrics(model: &Model, run: &Path, times: &[Real]) -> Metrics {
     let history = std::fs::read_to_string(run.join("history.csv"))
         .map(|t| History::parse(&t))
         .unwrap_or_default();

@@ -41,10 +41,10 @@
 //! (its design was refused), or `task_error.txt` (its run was refused before it wrote a summary), or nothing
 //! yet.
 
-pub mod collect;
-pub mod disk;
-pub mod metrics;
-pub mod slurm;
+pub(crate) mod collect;
+pub(crate) mod disk;
+pub(crate) mod metrics;
+pub(crate) mod slurm;
 
 use crate::design::set::{PathStep, parse_path, path_text};
 use crate::design::{Design, DesignError, DesignOverrides, SetOverride, load_design_with};

@@ -24,11 +24,11 @@ use std::path::{Path, PathBuf};
 use std::process::Command;
 
 /// The job file in a sweep folder.
-pub const JOBS_FILE: &str = "slurm.json";
+pub(crate) const JOBS_FILE: &str = "slurm.json";
 
 /// What `--slurm` asks of the scheduler.
 #[derive(Debug, Clone, PartialEq, Default)]
-pub struct SlurmOptions {
+pub(crate) struct SlurmOptions {
     /// `--partition` (the cluster's default when `None`).
     pub partition: Option<String>,
     /// `--time` limit per task, `HH:MM:SS` (the partition's default when `None`).
@@ -42,7 +42,7 @@ pub struct SlurmOptions {
 }
 
 /// `0-3,7,9-10`: the indices as Slurm's array ranges.
-pub fn array_ranges(indices: &[usize]) -> String {
+pub(crate) fn array_ranges(indices: &[usize]) -> String {
     let mut parts = Vec::new();
     let mut i = 0;
     while i < indices.len() {
@@ -98,7 +98,7 @@ fn job_name(plan: &Plan) -> String {
 ///
 /// # Errors
 /// [`SweepError::Script`] naming the value, shown with escapes.
-pub fn check_script_values(
+pub(crate) fn check_script_values(
     dir: &Path,
     exe: &Path,
     plan: &Plan,
@@ -156,7 +156,7 @@ pub fn check_script_values(
 ///
 /// # Errors
 /// [`SweepError::Script`] for a value the script cannot hold ([`check_script_values`]).
-pub fn sbatch_text(
+pub(crate) fn sbatch_text(
     dir: &Path,
     exe: &Path,
     plan: &Plan,
@@ -215,7 +215,7 @@ pub fn sbatch_text(
 
 /// One submitted job array.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub struct Job {
+pub(crate) struct Job {
     /// Slurm's job id.
     pub id: String,
     /// The variants (array task ids) it holds.
@@ -223,7 +223,7 @@ pub struct Job {
 }
 
 /// The jobs submitted for a sweep folder (`DIR/slurm.json`), oldest first.
-pub fn read_jobs(dir: &SweepDir) -> Vec<Job> {
+pub(crate) fn read_jobs(dir: &SweepDir) -> Vec<Job> {
     std::fs::read_to_string(dir.dir.join(JOBS_FILE))
         .ok()
         .and_then(|t| serde_json::from_str(&t).ok())
@@ -234,7 +234,7 @@ pub fn read_jobs(dir: &SweepDir) -> Vec<Job> {
 ///
 /// # Errors
 /// [`SweepError::Io`] when the file cannot be written.
-pub fn record_job(dir: &SweepDir, job: Job) -> Result<(), SweepError> {
+pub(crate) fn record_job(dir: &SweepDir, job: Job) -> Result<(), SweepError> {
     let mut jobs = read_jobs(dir);
     jobs.push(job);
     let path = dir.dir.join(JOBS_FILE);
@@ -251,7 +251,7 @@ pub fn record_job(dir: &SweepDir, job: Job) -> Result<(), SweepError> {
 ///
 /// # Errors
 /// A message when sbatch cannot be started or refuses the script (its own message).
-pub fn submit(script: &Path) -> Result<String, String> {
+pub(crate) fn submit(script: &Path) -> Result<String, String> {
     let out = Command::new("sbatch")
         .arg("--parsable")
         .arg(script)
@@ -278,7 +278,7 @@ pub fn submit(script: &Path) -> Result<String, String> {
 /// The scheduler's state (`PENDING`, `RUNNING`, …) of every task of `jobs` that Slurm still lists, by
 /// variant index; `None` when `squeue` cannot be run (not a Slurm machine). A task Slurm no longer lists has
 /// ended: its files say how.
-pub fn queued(jobs: &[Job]) -> Option<BTreeMap<usize, String>> {
+pub(crate) fn queued(jobs: &[Job]) -> Option<BTreeMap<usize, String>> {
     if jobs.is_empty() {
         return Some(BTreeMap::new());
     }
@@ -308,7 +308,7 @@ fn parse_squeue(text: &str) -> BTreeMap<usize, String> {
 ///
 /// # Errors
 /// [`SweepError::Io`] when the folder cannot be resolved.
-pub fn absolute(dir: &Path) -> Result<PathBuf, SweepError> {
+pub(crate) fn absolute(dir: &Path) -> Result<PathBuf, SweepError> {
     std::fs::canonicalize(dir).map_err(|source| SweepError::Io {
         path: dir.to_path_buf(),
         source,

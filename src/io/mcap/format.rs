@@ -7,12 +7,12 @@ use serde_json::Value;
 use std::fmt::Write as _;
 
 /// Frame of every scene entity.
-pub const FRAME_ID: &str = "world";
+pub(crate) const FRAME_ID: &str = "world";
 
 /// Decimals of recorded coordinates for a device of size `scale` (largest distance of a control point from
 /// the origin) \[length\]: `max(0, 5 − ⌊log₁₀ scale⌋)`, a resolution `10^(⌊log₁₀ scale⌋ − 5)` between `10⁻⁶` and
 /// `10⁻⁵` of the size.
-pub fn coordinate_decimals(scale: Real) -> usize {
+pub(crate) fn coordinate_decimals(scale: Real) -> usize {
     if !(scale > 0.0 && scale.is_finite()) {
         return 6;
     }
@@ -20,7 +20,7 @@ pub fn coordinate_decimals(scale: Real) -> usize {
 }
 
 /// A key usable in a Foxglove message path (`/state.probes.tip.x`): letters, digits and `_`.
-pub fn path_key(name: &str) -> String {
+pub(crate) fn path_key(name: &str) -> String {
     name.chars()
         .map(|c| if c.is_ascii_alphanumeric() { c } else { '_' })
         .collect()

@@ -26,8 +26,8 @@
 mod format;
 mod schema;
 
-pub use format::{FRAME_ID, coordinate_decimals, path_key};
-pub use schema::scene_update_schema;
+pub(crate) use format::{coordinate_decimals, path_key};
+pub(crate) use schema::scene_update_schema;
 
 use super::output::{RecordingSettings, RunDesign, SnapshotSettings};
 use super::snapshots::SnapshotSchedule;
@@ -47,13 +47,13 @@ use std::ops::ControlFlow;
 use std::path::{Path, PathBuf};
 
 /// Topic of the state channel.
-pub const STATE_TOPIC: &str = "/state";
+pub(crate) const STATE_TOPIC: &str = "/state";
 /// Topic of the centrelines.
-pub const CENTRELINE_TOPIC: &str = "/centrelines";
+pub(crate) const CENTRELINE_TOPIC: &str = "/centrelines";
 /// Topic of the tube meshes.
-pub const DEVICE_TOPIC: &str = "/device";
+pub(crate) const DEVICE_TOPIC: &str = "/device";
 /// Topic of the vessel a stent sits on (a centreline read from a file): one message at the start.
-pub const VESSEL_TOPIC: &str = "/vessel";
+pub(crate) const VESSEL_TOPIC: &str = "/vessel";
 
 /// What the recording says about the run that made it.
 #[derive(Debug, Clone, PartialEq)]

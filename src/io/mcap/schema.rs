@@ -6,7 +6,7 @@ use serde_json::{Map, Value, json};
 
 /// JSON Schema of the `foxglove.SceneUpdate` fields used here (entities with line and triangle-list
 /// primitives); Foxglove recognises the message by its schema name.
-pub fn scene_update_schema() -> Value {
+pub(crate) fn scene_update_schema() -> Value {
     let xyz = |title: &str| {
         json!({
             "title": title, "type": "object",

@@ -11,7 +11,7 @@ use crate::model::{Component, Node, Patch, TimeFunction};
 use std::collections::{BTreeMap, HashMap};
 
 /// Orthonormality tolerance of a given basis: rows typed with about seven significant digits pass.
-pub const BASIS_TOLERANCE: Real = 1e-6;
+pub(super) const BASIS_TOLERANCE: Real = 1e-6;
 
 /// The components' names in messages.
 const NAMES: [&str; 6] = ["u1", "u2", "u3", "θ1", "θ2", "θ3"];

@@ -3,7 +3,7 @@
 //!
 //! A recorder owns its files (it claims them in the run folder's manifest as it creates them), its position in a
 //! checkpoint (the bytes [`Recorder::position`] encodes and its kind's `resume` decodes, with
-//! [`crate::io::checkpoint::Encoder`] and [`crate::io::checkpoint::Decoder`]), its resume (its kind's
+//! `crate::io::checkpoint::Encoder` and `crate::io::checkpoint::Decoder`), its resume (its kind's
 //! `check_resume` before anything is written, then `resume`), its part of `summary.json`
 //! ([`Recorder::summarise`]), how it is finished whatever happened ([`Recorder::finish`]: the state of its
 //! files and its problem, if any) and what it will write, estimated before the run starts (its kind's

@@ -43,13 +43,13 @@ use crate::solver::terms::Terms;
 const ESTIMATE_ORDER: Real = 2.0;
 
 /// Safety factor of the proposed step.
-pub const SAFETY: Real = 0.9;
+pub(crate) const SAFETY: Real = 0.9;
 
 /// Largest growth of the step from one step to the next.
-pub const MAX_FACTOR: Real = 2.0;
+pub(crate) const MAX_FACTOR: Real = 2.0;
 
 /// Largest shrink of the step from one attempt to the next.
-pub const MIN_FACTOR: Real = 0.2;
+pub(crate) const MIN_FACTOR: Real = 0.2;
 
 /// The share of the tolerance each step's estimate is held to. For smooth histories the estimate (backward
 /// Euler's local error) is far above the trapezoidal rule's own, but not at a jump of strain: a branch jumped to
@@ -60,11 +60,11 @@ pub const MIN_FACTOR: Real = 0.2;
 /// tolerance. Measured global errors over the tolerance: creep after a jump 0.50 / 0.43 / 0.47 at 1e-3 / 1e-4 /
 /// 1e-5 (1.07 when held to all of the tolerance); pure bending 0.26 / 0.20 / 0.31; the four paper cases at
 /// 1e-1 … 1e-4 at most 0.30 (docs/speed.md, `cargo bench --bench adaptive`).
-pub const LOCAL_FRACTION: Real = 0.5;
+pub(crate) const LOCAL_FRACTION: Real = 0.5;
 
 /// The estimate over its share of the tolerance ([`LOCAL_FRACTION`]): a step is accepted when this is at most
 /// 1; 0 without an estimate (no internal variables).
-pub fn error_ratio(estimate: Option<Real>, tolerance: Real) -> Real {
+pub(crate) fn error_ratio(estimate: Option<Real>, tolerance: Real) -> Real {
     estimate.map_or(0.0, |e| e / (LOCAL_FRACTION * tolerance))
 }
 

@@ -29,7 +29,7 @@
 //! Newton's normalised norm, so that a tolerance means the same on a stent and an arch, or, where held nodes
 //! keep the configuration from showing it, the strain that carries the two updates' stress difference — and a
 //! step whose estimate exceeds its share of the tolerance is rejected and retried shorter; the next step comes from a PI controller
-//! with growth and shrink limits ([`adaptive`]). Steps still land on every schedule breakpoint (releases, load
+//! with growth and shrink limits (`adaptive`). Steps still land on every schedule breakpoint (releases, load
 //! and temperature breakpoints, snapshot times), Newton failures still halve the step, and a step at
 //! `min_step` whose estimate is above the tolerance is accepted with a notice (said once). Fixed steps (no
 //! tolerance) are unchanged. [`StepReport::error_estimate`] and [`StepReport::rejected`] report each step.
@@ -45,7 +45,7 @@
 //! [`Simulation::probe_displacement`], [`Simulation::node_end_resultants`]). [`Simulation::run`] is the loop over
 //! [`Simulation::step_with`] that tells a list of observers the caller owns ([`Observers`]) of each step.
 //! [`Simulation::checkpoint`] and [`Simulation::restore`] save and restore the whole state, so that a restored
-//! simulation continues bit for bit ([`checkpoint`]).
+//! simulation continues bit for bit (`checkpoint`).
 //!
 //! **Interruption.** [`Observer::interrupted`] is polled by Newton before every iteration and by
 //! [`Simulation::step_with`] before every attempt of a step (first, retried with a fresh tangent, or cut). When

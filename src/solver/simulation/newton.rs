@@ -27,7 +27,7 @@ const SINGULAR_INCREMENT: Real = 1e8;
 
 /// With error-controlled steps, Newton's tolerance as a fraction of the error allowed per step (see
 /// [`Simulation::newton_tolerance`]).
-pub const NEWTON_SHARE: Real = 1e-2;
+pub(super) const NEWTON_SHARE: Real = 1e-2;
 
 /// An iteration counts as stagnant when its residual is above this fraction of the previous one.
 const STAGNATION_RATIO: Real = 0.5;

@@ -19,7 +19,7 @@ pub struct NewtonReport {
     /// tangent must be (nearly) singular is largest.
     pub diagnosis: Option<String>,
     /// For a solve that did not converge: the equation whose normalised residual was largest at the last
-    /// assembly, in the designer's terms ([`crate::solver::diagnose::describe_row`]).
+    /// assembly, in the designer's terms (`crate::solver::diagnose::describe_row`).
     pub worst_equation: Option<String>,
     /// True when the step was accepted at the round-off floor: the tolerance asked (below
     /// [`super::ROUND_OFF_TOLERANCE`]) was not met, the residual stopped falling, and the iterate met the stopping rule

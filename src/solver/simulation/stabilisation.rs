@@ -61,17 +61,17 @@ use crate::solver::state::State;
 use crate::solver::terms::damping::Damping;
 
 /// How many times a damped step that still fails has its factor multiplied by [`ESCALATION`] before it is cut.
-pub const MAX_ESCALATIONS: usize = 3;
+pub(crate) const MAX_ESCALATIONS: usize = 3;
 
 /// The factor by which a failed damped step's damping is raised.
-pub const ESCALATION: Real = 10.0;
+pub(crate) const ESCALATION: Real = 10.0;
 
 /// The stabiliser's memory, kept over steps (and in checkpoints).
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct StabiliserState {
     /// The damping factor `c` \[1/time\] while the damping is on; `None` when off.
     pub factor: Option<Real>,
-    /// Escalations of the factor in the step in progress ([`MAX_ESCALATIONS`]).
+    /// Escalations of the factor in the step in progress (`MAX_ESCALATIONS`).
     pub escalations: usize,
     /// The factor the damping was last switched on with (the energy rule's, or the given one) \[1/time\]: it
     /// is lowered back towards this after each damped step.

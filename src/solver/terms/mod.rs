@@ -1,14 +1,14 @@
 //! The solver's seams for physics beyond the rod itself: **point terms** (loads, dampers, foundations, contact
 //! at the collocation points and patch ends) and **constraints** (rows held by Lagrange multipliers).
 //!
-//! The collocated equations (module docs of [`super::assembly`]) are the rod's balance laws at the interior
+//! The collocated equations (module docs of `super::assembly`) are the rod's balance laws at the interior
 //! collocation points and the node equations at the patch ends. Everything else that acts on the device enters
-//! through one of two interfaces, and the assembly ([`super::assembly::Assembler::assemble`]) calls every term
+//! through one of two interfaces, and the assembly (`super::assembly::Assembler::assemble`) calls every term
 //! of a list ([`Terms`]) in its order:
 //!
 //! **[`PointTerm`]** — something that acts at a point of the rod.
-//! - *What it sees* ([`PointView`]): the discretisation, the current iterate ([`State`]), the resolved loads of
-//!   the instant ([`Actions`]), the collocation point (its index, basis, section shape, reference kinematics),
+//! - *What it sees* ([`PointView`]): the discretisation, the current iterate (`State`), the resolved loads of
+//!   the instant (`Actions`), the collocation point (its index, basis, section shape, reference kinematics),
 //!   the point's position `c` and rotation `R` (with `Rᵀ`), and whether the tangent is wanted this time.
 //! - *What it returns*, at an **interior point** ([`PointTerm::interior`], into [`InteriorLoad`]): a spatial
 //!   force density `n̄` and couple density `m̄` [force/length, force·length/length], which the balance laws take
@@ -35,7 +35,7 @@
 //!   converged state and `c/h`), which drops it when the attempt ends either way.
 //!
 //! **[`Constraint`]** — equations held by Lagrange multipliers. A constraint of `m` rows adds `m` unknowns
-//! (its multipliers `λ_j`, stored after the rod's unknowns in [`State::multipliers`]) and `m` equations, linear
+//! (its multipliers `λ_j`, stored after the rod's unknowns in `State::multipliers`) and `m` equations, linear
 //! in the positions of nodes (the position of a node's first end):
 //! ```text
 //! C_j = Σ_l a_jl · (c_l − c̄_l) = 0,
@@ -48,7 +48,7 @@
 //!
 //! The terms of today: [`distributed::DistributedLoad`] (the model's distributed loads), the viscous
 //! regularisation [`damping::Damping`] of automatic stabilisation, and the gauge constraints
-//! ([`super::gauge::Gauge`]) of a released device.
+//! (`super::gauge::Gauge`) of a released device.
 //!
 //! **A new term** is one module here (a type implementing [`PointTerm`]; its `pub mod` line above) plus one
 //! registration line: in `registered_terms` of `simulation/mod.rs` for a term every simulation of a model has,

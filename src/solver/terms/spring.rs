@@ -17,7 +17,7 @@ use crate::solver::discretisation::point_position;
 
 /// Springs to ground along the rods and at their ends (module docs).
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub struct SpringToGround {
+pub(crate) struct SpringToGround {
     /// Foundation stiffness `k` \[force/length²\].
     pub foundation: Real,
     /// Rotational foundation stiffness `k_r` \[force\].
