@@ -14,7 +14,7 @@
 //! draws through `io`; a design whose geometry it varies is re-built by the design language above it, through
 //! [`study::variant::VariedDesign`]. `design` is the YAML design language: it translates a design file into
 //! [`model::builder`] calls and sits above `io`, whose centreline files it reads and whose output formats it names;
-//! `io`'s writers see a design through [`io::output::RunDesign`]. `sweep` owns a sweep folder's files and asks Slurm
+//! `io`'s writers see a design through `io::output::RunDesign`. `sweep` owns a sweep folder's files and asks Slurm
 //! (`sbatch`, `squeue`) about its jobs; the processes that run variants are `cli`'s. `run` is a run as a library
 //! call: the recorders of a run folder in one registry, the heartbeat, checkpoints and resume, with the interruption
 //! and the console passed in; `cli` parses, prints and maps signals onto it.
@@ -66,7 +66,7 @@ pub mod sweep;
 
 // The entry points most programs need, at the crate root: build a model in code or read a design file, and
 // simulate it step by step (a run into a run folder, as the command line does, is [`run::run`]).
-pub use io::design::{Design, load_design, parse_design};
+pub use design::{Design, load_design, parse_design};
 pub use model::Model;
 pub use model::builder::ModelBuilder;
 pub use solver::{Observer, Simulation, SolverError, StepReport};

@@ -180,8 +180,8 @@ pub struct RunOptions {
 /// Simulates the design and writes the run folder, on this terminal, stopped by the process's signals.
 ///
 /// # Errors
-/// A [`BadInput`] or [`crate::design::DesignError`] for a design or folder refused before anything ran
-/// (exit status 2), [`Interrupted`] for a run stopped by a signal (130), anything else for a failed run (1).
+/// A `BadInput` or [`crate::design::DesignError`] for a design or folder refused before anything ran
+/// (exit status 2), `Interrupted` for a run stopped by a signal (130), anything else for a failed run (1).
 pub fn run(design_path: &Path, options: RunOptions) -> anyhow::Result<()> {
     let started = Instant::now();
     signals::install();

@@ -5,7 +5,7 @@
 //! name, the memory it may take, the output settings — is checked here.
 
 use super::dto::*;
-pub use super::issue::Issue;
+pub(crate) use super::issue::Issue;
 use super::issue::{Result, issue, mesh_key_path};
 use super::materials::{material, material_index, named_materials};
 use super::size::{MemoryEstimate, StepCount, check_size};
@@ -32,7 +32,7 @@ fn time_function(f: &TimeFn, path: &str) -> Result<TimeFunction> {
 
 /// A design built and validated by [`build`].
 #[derive(Debug, Clone)]
-pub struct Built {
+pub(crate) struct Built {
     /// The model.
     pub model: Model,
     /// Snapshot and recording settings.
@@ -49,7 +49,7 @@ pub struct Built {
 
 /// Builds and validates the model (with `temporary_shape`, the device in its programme's temporary shape,
 /// without the programme); returns it with the output settings, the warnings found and the memory estimate.
-pub fn build(dto: &DesignDto, default_name: &str, temporary_shape: bool) -> Result<Built> {
+pub(crate) fn build(dto: &DesignDto, default_name: &str, temporary_shape: bool) -> Result<Built> {
     if let Some(v) = dto.version
         && v != 1
     {
@@ -269,7 +269,7 @@ fn builder_issue(e: BuildError, dto: &DesignDto) -> Issue {
 
 /// The design field path of a builder [`Field`]: the builder counts patches, nodes, conditions, loads and probes
 /// in the order this module adds them, which is the order of the design's lists.
-pub fn field_path(field: &Field, dto: &DesignDto) -> String {
+pub(crate) fn field_path(field: &Field, dto: &DesignDto) -> String {
     match *field {
         Field::Patches => "patches".into(),
         Field::Patch { index, field } => {
@@ -375,7 +375,7 @@ pub fn field_path(field: &Field, dto: &DesignDto) -> String {
 
 /// Longest design name \[bytes\]: the name is the run folder's name (`runs/<name>`), and 255 bytes is the
 /// longest file name of the usual file systems (ext4, XFS, Btrfs, APFS).
-pub const MAX_NAME_BYTES: usize = 255;
+pub(crate) const MAX_NAME_BYTES: usize = 255;
 
 /// What a design name may be, as the errors say it.
 const NAME_RULE: &str = "a name becomes the run folder `runs/<name>`, so it must be one folder name: not empty, not `.` or `..`, at most 255 bytes, without `/`, `\\` or control characters";
@@ -836,7 +836,7 @@ fn distributed_load(k: usize, d: &DistributedLoadDto) -> Result<DistributedLoadS
 }
 
 /// The first step of error-controlled stepping when the design gives none, as a fraction of the end time.
-pub const DEFAULT_FIRST_STEP_FRACTION: Real = 1e-3;
+pub(crate) const DEFAULT_FIRST_STEP_FRACTION: Real = 1e-3;
 
 /// The time stepping of the design: fixed steps of `step`, or error-controlled ones from `step` (default
 /// [`DEFAULT_FIRST_STEP_FRACTION`] of the end time) when a tolerance is given.

@@ -122,10 +122,10 @@ impl<'de> Deserialize<'de> for NonNegative {
 }
 
 /// A 3-vector of finite numbers, written `[x, y, z]`.
-pub type Vector = [Finite; 3];
+pub(crate) type Vector = [Finite; 3];
 
 /// A design's vector as the model's.
-pub fn vec3(v: &Vector) -> crate::math::Vec3 {
+pub(crate) fn vec3(v: &Vector) -> crate::math::Vec3 {
     crate::math::Vec3::new(v[0].0, v[1].0, v[2].0)
 }
 

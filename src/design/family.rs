@@ -18,11 +18,11 @@ fn family(dto: &StentDto) -> &'static dyn FamilyBlock {
 
 /// The device of a `stent:` block, of the family it names (lengths in units of `metres_per_unit` metres), with
 /// what `check` says about a file centreline and the vessel of one.
-pub fn device(dto: &StentDto, metres_per_unit: Real) -> Result<Device> {
+pub(crate) fn device(dto: &StentDto, metres_per_unit: Real) -> Result<Device> {
     family(dto).device(dto, metres_per_unit)
 }
 
 /// The size of a `stent:` block's device, asked of its family ([`FamilyCounts`]).
-pub fn counts(dto: &StentDto) -> FamilyCounts {
+pub(crate) fn counts(dto: &StentDto) -> FamilyCounts {
     family(dto).counts(dto)
 }

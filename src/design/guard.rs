@@ -33,17 +33,17 @@ use super::locate::Position;
 /// temperature table of 100 000 rows still fits (about 400 kB and 2 MB). Reading a design of this size takes
 /// about 0.8 s and 170 MB (about 40 bytes of memory per byte of YAML, measured), so the limit also bounds what
 /// merely reading a design can cost.
-pub const MAX_DESIGN_BYTES: usize = 4 * 1024 * 1024;
+pub(crate) const MAX_DESIGN_BYTES: usize = 4 * 1024 * 1024;
 
 /// Deepest nesting of mappings and sequences a design may have: 32 levels, the root mapping being level 1.
 /// The format itself needs at most 6 (`conditions[k].displacement[i]` given as a table `[[t, v], …]`: root,
 /// `conditions`, the entry, `displacement`, the table, a row). At 32 levels the parsers' quadratic terms
 /// cost nothing.
-pub const MAX_NESTING_DEPTH: usize = 32;
+pub(crate) const MAX_NESTING_DEPTH: usize = 32;
 
 /// Why a design's text is refused before parsing, and where.
 #[derive(Debug, Clone, PartialEq, Eq)]
-pub struct Refusal {
+pub(crate) struct Refusal {
     /// Where the limit is exceeded.
     pub position: Position,
     /// What is wrong and what is allowed.
@@ -51,7 +51,7 @@ pub struct Refusal {
 }
 
 /// The refusal of a design of `bytes` bytes (more than [`MAX_DESIGN_BYTES`]), reported at its start.
-pub fn too_large(bytes: u64) -> Refusal {
+pub(crate) fn too_large(bytes: u64) -> Refusal {
     let size = format!(
         "{bytes} bytes ({:.1} MiB)",
         bytes as f64 / (1024.0 * 1024.0)
@@ -71,7 +71,7 @@ pub fn too_large(bytes: u64) -> Refusal {
 /// # Errors
 /// [`Refusal`] at the start of the text for its size, at the bracket, dash or key that opens the first level
 /// beyond the limit, or at the first alias.
-pub fn check_text(text: &str) -> Result<(), Refusal> {
+pub(crate) fn check_text(text: &str) -> Result<(), Refusal> {
     if text.len() > MAX_DESIGN_BYTES {
         return Err(too_large(text.len() as u64));
     }

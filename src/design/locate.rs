@@ -6,7 +6,7 @@ use std::collections::HashMap;
 
 /// A position in the source: line and column, both 1-based.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub struct Position {
+pub(crate) struct Position {
     /// Line, 1-based.
     pub line: usize,
     /// Column, 1-based.
@@ -20,7 +20,7 @@ const MAX_PATH_KEY_BYTES: usize = 64;
 
 /// Field path → position of its value (and of its key, for mapping entries).
 #[derive(Debug, Default, Clone)]
-pub struct Locator {
+pub(crate) struct Locator {
     values: HashMap<String, Position>,
     keys: HashMap<String, Position>,
 }
@@ -41,7 +41,7 @@ fn join_key(parent: &str, key: &str) -> String {
 impl Locator {
     /// Indexes `text`; a document that does not parse gives an empty index (the deserialiser reports the
     /// syntax error itself).
-    pub fn new(text: &str) -> Self {
+    pub(crate) fn new(text: &str) -> Self {
         let mut values = HashMap::new();
         let mut keys = HashMap::new();
         let mut stack: Vec<Frame> = Vec::new();
@@ -103,18 +103,18 @@ impl Locator {
     }
 
     /// The position of the key of the mapping entry `path`, if the document has that entry.
-    pub fn key(&self, path: &str) -> Option<Position> {
+    pub(crate) fn key(&self, path: &str) -> Option<Position> {
         self.keys.get(path).copied()
     }
 
     /// The position of `path`'s value, if the document has that field.
-    pub fn get(&self, path: &str) -> Option<Position> {
+    pub(crate) fn get(&self, path: &str) -> Option<Position> {
         self.values.get(path).copied()
     }
 
     /// The position of `path`'s value, or of the nearest enclosing field that exists (so an error about a
     /// missing field points at its parent), or line 1 column 1.
-    pub fn find(&self, path: &str) -> Position {
+    pub(crate) fn find(&self, path: &str) -> Position {
         let mut p = path;
         loop {
             if let Some(pos) = self.values.get(p) {

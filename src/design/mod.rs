@@ -1,29 +1,29 @@
 //! YAML design files (format version 1): reading, validation and the errors a designer sees.
 //!
-//! A design is read in three passes: serde_yaml deserialises it into [`dto`] types (unknown fields, missing
-//! fields, wrong types and bad single numbers are reported there with line and column); [`build`] generates
-//! the geometry and checks everything that involves several values; [`locate`] maps the field path of such a
+//! A design is read in three passes: serde_yaml deserialises it into `dto` types (unknown fields, missing
+//! fields, wrong types and bad single numbers are reported there with line and column); `build` generates
+//! the geometry and checks everything that involves several values; `locate` maps the field path of such a
 //! check back to its line and column. Every error names the file, the line and column, the field, what is
-//! wrong and what is allowed. Before any of this, [`guard`] refuses text too large, too deeply nested or with
+//! wrong and what is allowed. Before any of this, `guard` refuses text too large, too deeply nested or with
 //! aliases, which would make the parsers slow or the design enormous. [`tuned_text`] writes a design's text
 //! with the discretisation `stentkit tune` chose.
 //!
 //! Layer: above `io` (it reads centreline files and names output formats through it) and `study` (a
 //! [`Design`] is the [`crate::study::variant::VariedDesign`] a study re-builds, [`variants`]); `io`'s writers
-//! see it as an [`crate::io::output::RunDesign`].
+//! see it as an `crate::io::output::RunDesign`.
 
-pub mod build;
+pub(crate) mod build;
 mod diamond;
-pub mod dto;
-pub mod family;
-pub mod guard;
-pub mod issue;
-pub mod locate;
-pub mod materials;
-pub mod set;
-pub mod size;
+pub(crate) mod dto;
+pub(crate) mod family;
+pub(crate) mod guard;
+pub(crate) mod issue;
+pub(crate) mod locate;
+pub(crate) mod materials;
+pub(crate) mod set;
+pub(crate) mod size;
 
-pub mod stent;
+pub(crate) mod stent;
 mod tuned;
 pub mod variants;
 pub mod vessel;
@@ -49,13 +49,13 @@ pub struct Design {
     pub warnings: Vec<String>,
     /// How the design was read where it involved a choice (a file centreline's fit), for `check`.
     pub notes: Vec<String>,
-    /// The memory a run is estimated to need (below [`size::MEMORY_LIMIT_BYTES`]: larger designs are refused).
+    /// The memory a run is estimated to need (below `size::MEMORY_LIMIT_BYTES`: larger designs are refused).
     pub memory: size::MemoryEstimate,
     /// The steps a run takes when no step is cut ([`Model::planned_steps`], computed once here: it sorts every
     /// breakpoint).
     pub steps: crate::model::StepPlan,
     /// The YAML text as read (embedded in run recordings); with `--set` overrides, the resolved design
-    /// ([`set::resolved_text`]).
+    /// (`set::resolved_text`).
     pub source: String,
     /// The `--set` overrides applied, as given (`stent.crowns=8`).
     pub overrides: Vec<String>,
@@ -167,7 +167,7 @@ impl fmt::Display for DesignError {
 /// error chains print it twice).
 impl std::error::Error for DesignError {}
 
-/// Reads and validates the design file at `path`. At most [`guard::MAX_DESIGN_BYTES`] are read: a larger
+/// Reads and validates the design file at `path`. At most `guard::MAX_DESIGN_BYTES` are read: a larger
 /// file is refused without reading the rest.
 pub fn load_design(path: &Path) -> Result<Design, DesignError> {
     load_design_with(path, &DesignOverrides::default())
@@ -257,7 +257,7 @@ pub struct DesignOverrides {
     /// Crowns of the generated stent (replaces `stent.crowns`); a design without a `stent` block is refused.
     pub crowns: Option<usize>,
     /// `--set PATH=VALUE` overrides of any field, applied in order to the file's YAML before it is read
-    /// ([`set`]); the others above are applied after them.
+    /// (`set`); the others above are applied after them.
     pub sets: Vec<SetOverride>,
     /// Build the device in the temporary shape its programme drives it to, without the programme
     /// ([`crate::model::builder::ModelBuilder::temporary_shape`]; `stentkit mesh --state temporary`).

@@ -89,7 +89,7 @@ impl fmt::Display for SetOverride {
 ///
 /// # Errors
 /// A message for an empty path or key, or a malformed index.
-pub fn parse_path(text: &str) -> Result<Vec<PathStep>, String> {
+pub(crate) fn parse_path(text: &str) -> Result<Vec<PathStep>, String> {
     if text.is_empty() {
         return Err("the field path is empty".into());
     }
@@ -124,7 +124,7 @@ pub fn parse_path(text: &str) -> Result<Vec<PathStep>, String> {
 }
 
 /// The path as text (`a.b[2].c`).
-pub fn path_text(path: &[PathStep]) -> String {
+pub(crate) fn path_text(path: &[PathStep]) -> String {
     let mut text = String::new();
     for step in path {
         match step {
@@ -142,7 +142,7 @@ pub fn path_text(path: &[PathStep]) -> String {
 /// What applying one override did: the path of the first map it created (if any), so that an error about a
 /// field below it is the override's.
 #[derive(Debug, Clone, PartialEq)]
-pub struct Applied {
+pub(crate) struct Applied {
     /// The override's own path (`stent.crowns`).
     pub field: String,
     /// The shallowest map the override created, when the path did not exist (`mesh` for `mesh.n=30` on a
@@ -155,7 +155,7 @@ pub struct Applied {
 /// # Errors
 /// A message when the path goes through a value that is not a map (for a key) or a sequence (for an index),
 /// or an index is past the end of its sequence.
-pub fn apply(root: &mut Value, set: &SetOverride) -> Result<Applied, String> {
+pub(crate) fn apply(root: &mut Value, set: &SetOverride) -> Result<Applied, String> {
     let mut node = root;
     let mut created = None;
     for (i, step) in set.path.iter().enumerate() {
@@ -229,7 +229,7 @@ fn at_or_below(field: &str, root: &str) -> bool {
 
 /// The override an error about `field` belongs to, if any: the last one whose path or created map holds
 /// `field` (module docs).
-pub fn owner<'a>(
+pub(crate) fn owner<'a>(
     applied: &'a [(Applied, &'a SetOverride)],
     field: &str,
 ) -> Option<&'a SetOverride> {
@@ -247,7 +247,7 @@ pub fn owner<'a>(
 ///
 /// # Errors
 /// When the tree cannot be written as YAML (it was read from YAML, so this does not happen).
-pub fn resolved_text(
+pub(crate) fn resolved_text(
     root: &Value,
     file: &std::path::Path,
     sets: &[SetOverride],

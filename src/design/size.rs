@@ -12,7 +12,7 @@ use crate::model::{StepPlan, TimeSettings};
 /// naming the field and the estimate instead of exhausting the machine. The paper's curved stent needs about
 /// 0.1 GB; 8 GB leaves two orders of magnitude for refined studies while staying below the memory of a
 /// typical workstation.
-pub const MEMORY_LIMIT_BYTES: Real = 8e9;
+pub(crate) const MEMORY_LIMIT_BYTES: Real = 8e9;
 
 /// Estimated bytes per control point of degree `p` with `branches` Maxwell branches: the tangent's entries
 /// (6 rows × 6(p+1) columns, each with its pattern, slot and value: ~48 bytes) and its LU factors (banded
@@ -189,7 +189,7 @@ fn busiest_schedule(dto: &DesignDto) -> Option<String> {
 /// deserialised design (degree and size of every patch, the stent's patch count, the snapshot mesh size) and
 /// the number of time steps `steps` (nominal before the model exists, [`StepCount::planned`] after), in
 /// floating point so that absurd sizes do not overflow.
-pub fn estimated_memory(dto: &DesignDto, steps: &StepCount) -> MemoryEstimate {
+pub(crate) fn estimated_memory(dto: &DesignDto, steps: &StepCount) -> MemoryEstimate {
     let branches = dto.material.prony.len();
     let mesh = dto.mesh.as_ref();
     // (path, what, bytes, patches)
@@ -303,7 +303,7 @@ pub fn estimated_memory(dto: &DesignDto, steps: &StepCount) -> MemoryEstimate {
 }
 
 /// `1.2 GB`-style size (`more than 1e308 bytes` when the count overflowed).
-pub fn human_bytes(bytes: Real) -> String {
+pub(crate) fn human_bytes(bytes: Real) -> String {
     if bytes == Real::INFINITY {
         "more than 1e308 bytes".to_string()
     } else if bytes >= 1e15 {
@@ -325,7 +325,7 @@ pub fn human_bytes(bytes: Real) -> String {
 
 /// Whether `estimate` is above [`MEMORY_LIMIT_BYTES`] (or not a number): then what it would need, in words
 /// (`would need about 2 TB of memory (patch `beam` (…): 2 TB), more than stentkit's limit of 8.0 GB`).
-pub fn over_limit(estimate: &MemoryEstimate) -> Option<String> {
+pub(crate) fn over_limit(estimate: &MemoryEstimate) -> Option<String> {
     let total = estimate.total();
     if !(total.is_nan() || total > MEMORY_LIMIT_BYTES) {
         return None;

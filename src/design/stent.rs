@@ -43,7 +43,7 @@ use std::sync::Arc;
 
 /// A generated device of a `stent:` block: its family's specification, what `check` says about it, and the
 /// vessel of a file centreline.
-pub type Device = (
+pub(crate) type Device = (
     Arc<dyn StentFamily>,
     Vec<String>,
     Option<crate::model::Vessel>,
@@ -438,7 +438,7 @@ fn lumen_radius_at(vessel: &crate::model::Vessel, s: Real) -> Option<Real> {
 }
 
 /// The crown and bridge discretisations: each role's own mesh, else the design's.
-pub fn mesh(dto: &StentDto, mesh: Option<&MeshDto>) -> Result<StentMesh> {
+pub(crate) fn mesh(dto: &StentDto, mesh: Option<&MeshDto>) -> Result<StentMesh> {
     let pick = |own: Option<&MeshDto>, own_path: &str| -> Result<(usize, usize)> {
         let one = |f: fn(&MeshDto) -> Option<usize>, key: &str| {
             own.and_then(f).or(mesh.and_then(f)).ok_or_else(|| {
@@ -459,7 +459,7 @@ pub fn mesh(dto: &StentDto, mesh: Option<&MeshDto>) -> Result<StentMesh> {
 }
 
 /// The programme of a `programme:` block, with the checks of its form (which fields go with which kind).
-pub fn programme(dto: &ProgrammeDto, metres_per_unit: Real) -> Result<ProgrammeSpec> {
+pub(crate) fn programme(dto: &ProgrammeDto, metres_per_unit: Real) -> Result<ProgrammeSpec> {
     let base = "programme";
     let target = match dto.kind {
         ProgrammeKindDto::RadialContraction => {

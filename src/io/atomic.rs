@@ -22,7 +22,7 @@ use super::no_follow;
 
 /// Whether an atomic write waits for the disk before it renames its temporary into place.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Durability {
+pub(crate) enum Durability {
     /// Synced (`fsync`) before the rename: once the call returns the new content survives a power loss.
     Synced,
     /// Renamed as soon as written: the new content survives the process being killed (the kernel holds it),
@@ -51,7 +51,7 @@ static TEMPORARY_COUNTER: AtomicU64 = AtomicU64::new(0);
 ///
 /// # Errors
 /// The I/O error of creating, writing, syncing or renaming the temporary file; the target is then unchanged.
-pub fn write_bytes_atomically(path: &Path, bytes: &[u8]) -> io::Result<()> {
+pub(crate) fn write_bytes_atomically(path: &Path, bytes: &[u8]) -> io::Result<()> {
     write_file_atomically(path, bytes, Durability::Synced)
 }
 
@@ -60,7 +60,7 @@ pub fn write_bytes_atomically(path: &Path, bytes: &[u8]) -> io::Result<()> {
 ///
 /// # Errors
 /// The I/O error of creating, writing, syncing or renaming the temporary file; the target is then unchanged.
-pub fn write_file_atomically(
+pub(crate) fn write_file_atomically(
     path: &Path,
     contents: impl AsRef<[u8]>,
     durability: Durability,
@@ -141,7 +141,7 @@ where
 }
 
 /// The file a temporary `.<name>.<pid>.<n>.tmp` of this module was to become (`<name>`), if `name` is one.
-pub fn temporary_target(name: &str) -> Option<&str> {
+pub(crate) fn temporary_target(name: &str) -> Option<&str> {
     let rest = name.strip_prefix('.')?.strip_suffix(".tmp")?;
     let (rest, counter) = rest.rsplit_once('.')?;
     let (target, pid) = rest.rsplit_once('.')?;
@@ -157,7 +157,7 @@ pub fn temporary_target(name: &str) -> Option<&str> {
 ///
 /// # Errors
 /// [`RemoveError`] naming the temporary that could not be removed.
-pub fn remove_stale_temporaries(
+pub(crate) fn remove_stale_temporaries(
     dir: &Path,
     folder: &Path,
     owns: &dyn Fn(&str) -> bool,

@@ -46,7 +46,7 @@ impl Polyline {
 }
 
 /// Largest centreline file stentkit reads \[bytes\]: 4 MiB, the limit of a design file
-/// ([`crate::design::guard::MAX_DESIGN_BYTES`]). VMTK's aorta centreline (409 points, zlib-compressed) is
+/// (`crate::design::guard::MAX_DESIGN_BYTES`). VMTK's aorta centreline (409 points, zlib-compressed) is
 /// 15 kB; 4 MiB holds about 150 000 points as CSV (5 decimals, 28 bytes a row) and 262 144 in VTK's default
 /// inline base64 `Float32` encoding. The file is read once into memory (parsing adds a few times its size), so
 /// the limit also bounds what reading costs.

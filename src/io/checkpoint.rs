@@ -133,7 +133,7 @@ pub(crate) const SETTINGS_DESCRIPTION_VERSION: u32 = 1;
 
 /// The fingerprint of the outputs' settings of a design: as the model's ([`crate::model::fingerprint`]), a
 /// hash of their serialised, versioned description (every field of [`super::output::OutputSettings`]).
-pub fn settings_fingerprint(settings: &super::output::OutputSettings) -> u64 {
+pub(crate) fn settings_fingerprint(settings: &super::output::OutputSettings) -> u64 {
     crate::model::fingerprint::fingerprint_of(
         "stentkit output settings",
         SETTINGS_DESCRIPTION_VERSION,

@@ -22,7 +22,7 @@ pub struct SnapshotSettings {
     /// ([`crate::io::snapshots::SnapshotSchedule`]); 0 for none. Default [`Self::DEFAULT_BETWEEN`] when the
     /// design sets neither `every` nor `times`.
     pub between: usize,
-    /// The file formats, by extension, in the registry's order ([`crate::io::formats`]; default STL only).
+    /// The file formats, by extension, in the registry's order (`crate::io::formats`; default STL only).
     pub formats: Vec<&'static str>,
     /// Vertices around each tube section.
     pub segments: usize,
@@ -33,10 +33,10 @@ pub struct SnapshotSettings {
     /// [`crate::io::vtk`]).
     pub vtk: bool,
     /// The views of the configuration figures (`output.configurations.views`); `None`: the defaults
-    /// ([`crate::io::configurations::default_views`]).
+    /// (`crate::io::configurations::default_views`).
     pub views: Option<Vec<crate::io::configurations::View>>,
     /// A shaded picture of the configuration figures' states (`output.configurations.render`, default true;
-    /// [`crate::io::render`]).
+    /// `crate::io::render`).
     pub render: bool,
 }
 

@@ -66,14 +66,14 @@ pub(crate) fn position(source: &str, field: &str) -> String {
 
 /// `history.csv 203 kB, run.mcap 19.0 MB, 8 snapshots 42.0 MB, charts 3.0 MB, summary.json 10 kB`: the parts in
 /// the registry's order ([`DiskEstimate::describe`]).
-pub fn parts(estimate: &DiskEstimate) -> String {
+pub(crate) fn parts(estimate: &DiskEstimate) -> String {
     estimate.describe(&|bytes| human_bytes(bytes as Real), false)
 }
 
 /// The field that sizes the largest part of `estimate` that has one ([`DiskEstimate::largest`]), and what to
 /// do with it (`output`, in general terms, for an estimate without advice: never met, as `history.csv`'s part
 /// has some).
-pub fn largest_part(estimate: &DiskEstimate) -> (&'static str, &'static str) {
+pub(crate) fn largest_part(estimate: &DiskEstimate) -> (&'static str, &'static str) {
     estimate
         .largest()
         .and_then(|p| p.advice)

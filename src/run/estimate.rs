@@ -3,7 +3,7 @@
 //! `history.csv`, `run.mcap`, the snapshots — binary STL and OBJ of the full device, the field files for
 //! ParaView, the vessel's lumen —, the charts with the configuration figures), and the run adds its
 //! `summary.json`. [`estimated_disk`] asks them in the registry's order; the total, the largest part and the
-//! by-part text of `check` and of a refusal ([`super::disk`]) are made by going through the parts, so a new
+//! by-part text of `check` and of a refusal (`super::disk`) are made by going through the parts, so a new
 //! recorder's estimate is counted wherever the estimate is used.
 //!
 //! Everything but the recording's compression is counted from what the writers write: the snapshot steps of

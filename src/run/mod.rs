@@ -37,9 +37,9 @@
 //! run's: the same history.csv byte for byte.
 //!
 //! **Disk.** A new run is refused when its estimated output ([`estimate`]: each recorder's part and the
-//! summary) and [`disk::FINISHING_RESERVE`] exceed the free space ([`disk::check_space`]).
+//! summary) and `disk::FINISHING_RESERVE` exceed the free space (`disk::check_space`).
 
-pub mod disk;
+pub(crate) mod disk;
 pub mod estimate;
 pub mod recorder;
 

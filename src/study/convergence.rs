@@ -70,7 +70,7 @@ impl ConvergenceStudy {
 /// # Errors
 /// The first run that fails ([`StudyError::Run`] says which): every run must succeed for the rates to mean
 /// anything.
-pub fn convergence_study(
+pub(crate) fn convergence_study(
     design: &dyn VariedDesign,
     study: &ConvergenceStudy,
     mut progress: impl FnMut(&str),

@@ -1,8 +1,8 @@
 //! `sweep.csv` and the charts of a sweep folder: one row per variant (its parameters, state, wall time and
-//! [`super::metrics`]), and each metric against each numeric parameter, one line per combination of the other
+//! `super::metrics`), and each metric against each numeric parameter, one line per combination of the other
 //! parameters. Collecting reads only the folder's files, so it gives the same table whether the variants ran
 //! here or on a cluster, and it can run while variants are still running (their rows say so). The table and
-//! the charts are written atomically ([`crate::io::atomic`]), after removing the temporaries a collection
+//! the charts are written atomically (`crate::io::atomic`), after removing the temporaries a collection
 //! killed outright left of them (module docs of [`super`]).
 
 use super::metrics::{Metrics, Release, run_metrics};
@@ -31,19 +31,19 @@ pub(crate) struct Row {
     pub metrics: Metrics,
 }
 
-/// What [`collect`] wrote.
+/// What [`collect`] wrote (its parts are the crate's own: a program gets the table from `sweep.csv`).
 #[derive(Debug, Clone, PartialEq)]
-pub(crate) struct Collected {
+pub struct Collected {
     /// The plan.
-    pub plan: Plan,
+    pub(crate) plan: Plan,
     /// The rows, in the plan's order.
-    pub rows: Vec<Row>,
+    pub(crate) rows: Vec<Row>,
     /// The times of the recovery-ratio columns.
-    pub times: Vec<Real>,
+    pub(crate) times: Vec<Real>,
     /// `DIR/sweep.csv`.
-    pub csv: PathBuf,
+    pub(crate) csv: PathBuf,
     /// The charts written.
-    pub charts: Vec<PathBuf>,
+    pub(crate) charts: Vec<PathBuf>,
 }
 
 /// A fixed metric column: name, unit kind, value.
@@ -96,7 +96,7 @@ const AFTER_RATIOS: [Column; 5] = [
 ///
 /// # Errors
 /// [`SweepError`] when the folder holds no sweep or a file cannot be written.
-pub(crate) fn collect(dir: &SweepDir, times: Option<&[Real]>) -> Result<Collected, SweepError> {
+pub fn collect(dir: &SweepDir, times: Option<&[Real]>) -> Result<Collected, SweepError> {
     let plan = dir.read_plan()?;
     let models: Vec<_> = plan
         .variants

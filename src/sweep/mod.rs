@@ -13,7 +13,7 @@
 //! only what it names.
 //!
 //! **Folder.** `DIR/sweep.json` (the plan: the design file, the parameters, the variants with their
-//! overrides), and per variant `DIR/variants/vNNN/`: `design.yaml` (the resolved design, [`crate::design::set`]),
+//! overrides), and per variant `DIR/variants/vNNN/`: `design.yaml` (the resolved design, `crate::design::set`),
 //! `run/` (its run folder), `log.txt` (what its run printed) or `error.txt` (why its design was refused: a
 //! variant the values make invalid is a failed row, not the end of the sweep). Nothing in DIR is removed by a
 //! sweep: a rerun skips completed variants, continues interrupted or killed ones from their checkpoint, starts
@@ -23,7 +23,7 @@
 //! its sweep (edited by hand: [`SweepDir::read_plan`]).
 //!
 //! **Preparation** ([`SweepDir::prepare`]) writes `sweep.json` first, then the variants' designs, every file
-//! through a temporary renamed into place ([`crate::io::atomic`]; `sweep.json` synced to disk, the designs
+//! through a temporary renamed into place (`crate::io::atomic`; `sweep.json` synced to disk, the designs
 //! not: a design a power loss left empty is written again): a preparation stopped by a signal (between two
 //! variants) or killed outright leaves a folder the same command continues — it checks the designs already
 //! written and writes the rest — and never half a file.
@@ -32,8 +32,8 @@
 //! it was writing (io::atomic's name). A folder holding only temporaries of `sweep.json` is as good as empty
 //! ([`SweepDir::check`]); the preparation removes the temporaries of the files it writes — `sweep.json` and
 //! `sweep.csv` in the folder, `design.yaml` and `error.txt` in each variant's — and the collection those of
-//! `sweep.csv` and of the charts ([`collect::collect`]); a variant's `run/` is a run folder, whose own
-//! temporaries its run removes ([`crate::io::run_folder`]). Nothing else is removed, and a sweep folder has no
+//! `sweep.csv` and of the charts (`collect::collect`); a variant's `run/` is a run folder, whose own
+//! temporaries its run removes (`crate::io::run_folder`). Nothing else is removed, and a sweep folder has no
 //! lock: one command at a time prepares or collects it (two at once could remove each other's temporary in
 //! progress, and the later rename fails with an error naming the file).
 //!
@@ -41,7 +41,7 @@
 //! (its design was refused), or `task_error.txt` (its run was refused before it wrote a summary), or nothing
 //! yet.
 
-pub(crate) mod collect;
+pub mod collect;
 pub(crate) mod disk;
 pub(crate) mod metrics;
 pub(crate) mod slurm;
@@ -525,7 +525,7 @@ impl SweepDir {
     /// design, or the reason it was refused, checking those an earlier preparation wrote. The plan comes
     /// first and every file is written through a temporary renamed into place, so a preparation killed at any
     /// moment leaves a folder this continues; the temporaries a killed one left are removed (module docs).
-    /// `known` holds resolutions already made ([`disk::SweepEstimate::resolved`]); `stop` is asked before each
+    /// `known` holds resolutions already made (`disk::SweepEstimate::resolved`); `stop` is asked before each
     /// variant, and when it says so the preparation ends there.
     ///
     /// # Errors

@@ -64,7 +64,7 @@ pub struct Checkpoint {
     pub tangent: Option<TangentOrigin>,
     /// Where the solver's time went so far.
     pub timing: SolverTiming,
-    /// The stabiliser's memory ([`super::stabilisation`]).
+    /// The stabiliser's memory (`super::stabilisation`).
     pub stabiliser: super::StabiliserState,
 }
 

@@ -21,7 +21,7 @@ pub struct Clock {
     /// Cuts of the step in progress (0 between steps; kept over an interruption, so that the continued step
     /// reports them all).
     pub step_cuts: usize,
-    /// The memory of error-controlled stepping ([`super::adaptive`]).
+    /// The memory of error-controlled stepping (`super::adaptive`).
     pub control: StepControl,
 }
 

@@ -59,36 +59,36 @@
 //! few parts, each a struct in its own module owning its fields: the [`Clock`] (time, steps, step size, cuts,
 //! error control; `clock`), the solution (the configuration and the steps' increments; `solution`), the
 //! releases (ramps and gauge constraints; `releases`), the arc-length path's state (`arclength`), the
-//! stabiliser (its memory and the attempt's damping; [`stabilisation`]), the workspace (linear system,
+//! stabiliser (its memory and the attempt's damping; `stabilisation`), the workspace (linear system,
 //! assembly, increment, factorisation record; `workspace`), the run's record (notices, timing; `record`) and
 //! fixed measures of the model (`measures`). What a step changes — clock, solution, releases, arc-length
 //! state, the terms' states — is saved by one value, the [`StepSnapshot`] (`snapshot`): roll-back puts back
 //! the snapshot taken at the start of an attempt, and a [`Checkpoint`] is that snapshot between steps plus the
 //! run's records.
 //!
-//! The concepts live in their own files: [`report`] (what a step and a run report), [`observer`] (who is told),
-//! [`adaptive`] (the time-error estimate and the step-size controller), `arclength` (arc-length continuation),
-//! [`timing`] (where the wall time went), `stepping` (the step loop and roll-back), `newton`
+//! The concepts live in their own files: `report` (what a step and a run report), `observer` (who is told),
+//! `adaptive` (the time-error estimate and the step-size controller), `arclength` (arc-length continuation),
+//! `timing` (where the wall time went), `stepping` (the step loop and roll-back), `newton`
 //! (Newton's method on normalised norms and its diagnostics), `releases` (release ramps and gauge constraints),
 //! `constitutive` (the materials at the points: step preparation, commit, roll-back), `snapshot` (what a step
-//! changes, taken and put back) and [`checkpoint`] (the whole state as a value, and its restore).
-pub mod adaptive;
+//! changes, taken and put back) and `checkpoint` (the whole state as a value, and its restore).
+pub(crate) mod adaptive;
 mod arclength;
-pub mod checkpoint;
+pub(crate) mod checkpoint;
 mod clock;
 mod constitutive;
-pub mod fields;
+pub(crate) mod fields;
 mod measures;
 mod newton;
-pub mod observer;
+pub(crate) mod observer;
 mod record;
 mod releases;
-pub mod report;
+pub(crate) mod report;
 mod snapshot;
 mod solution;
-pub mod stabilisation;
+pub(crate) mod stabilisation;
 mod stepping;
-pub mod timing;
+pub(crate) mod timing;
 mod workspace;
 
 pub use arclength::ArcState;
