@@ -62,6 +62,7 @@ time: {end: 1.0, step: 0.25}
 ";
 
 #[test]
+#[ignore = "full size (every design of designs/, the paper stents included): run by .ci/run with cargo test --release -- --ignored"]
 fn check_describes_every_design() {
     // Every count `check` prints must equal the model's own; the fit error and warnings lines are present.
     let dir = TempDir::new("cli-check");
@@ -130,6 +131,7 @@ fn check_describes_every_design() {
 }
 
 #[test]
+#[ignore = "full size (every design of designs/, the paper stents included): run by .ci/run with cargo test --release -- --ignored"]
 fn mesh_writes_stl_and_obj_for_every_design() {
     let dir = TempDir::new("cli-mesh");
     for file in designs_and_good_small() {

@@ -8,6 +8,7 @@ use crate::outputs::{
 use crate::reliability::folder_bytes;
 
 #[test]
+#[ignore = "full size (the paper's straight stent): run by .ci/run with cargo test --release -- --ignored"]
 fn the_flagship_run_folder_is_lean_and_its_snapshots_are_named_by_phase_and_exported_again() {
     // The straight stent as the README runs it. Its cycle (designs/straight_stent.yaml): the programme's ramp
     // ends at 1 s (programmed), it is released at 1.75 s (fixed: still held) and the release ramp of one
