@@ -494,7 +494,50 @@ def stability_maps():
     return head + "\n" + "\n".join(f"- {f}" for f in facts) + "\n"
 
 
+def curved_sensitivity():
+    """docs/reproduction.md: the curved stent's ratios with one open choice of the paper changed at a time."""
+    asset = "assets/curved_sensitivity.csv"
+    head = stamp(asset)  # first: the asset must be the one its provenance describes
+    data, _ = rows(asset)
+    keys = ["plain_mean", "max", "min", "median", "largest_target_node", "mean_rigid_fit_removed", "max_rigid_fit_removed"]
+    body = []
+    for r in data:
+        choice, variant = r["open_choice"] or "—", r["variant"] if r["open_choice"] else f"**{r['variant']}**"
+        if r["failure"]:
+            body.append([choice, variant, f"fails: {r['failure']}"] + [""] * (len(keys) + 1))
+            continue
+        means = " / ".join(f"{float(r[k]):.3f}" for k in ("mean_3.1", "mean_3.4", "mean_4"))
+        delta = f"{float(r['delta_mean_3.4']):+.3f}".replace("-", "−")
+        body.append([choice, variant, means, delta] + [f"{float(r[k]):.3f}" for k in keys])
+    header = [
+        "open choice", "variant", "mean 3.1 / 3.4 / 4 s", "Δ mean @ 3.4", "plain mean", "max", "min", "median",
+        "largest-target node", "mean, rigid fit removed", "max, rigid fit removed",
+    ]
+    return head + "\n" + table(header, body)
+
+
+def print_solids():
+    """docs/run-folder.md: the paper stents' print solids: triangles, volume against Manifold's, time and sizes."""
+    asset = "assets/print_solids.csv"
+    head = stamp(asset)  # first: the asset must be the one its provenance describes
+    data, _ = rows(asset)
+    percent = lambda r: f"{float(r['difference_pct']):+.3f} %".replace("-", "−")
+    lines = [
+        ("contour / written triangles", lambda r: f"{grouped(r['contour_triangles'])} / {grouped(r['written_triangles'])}"),
+        ("volume", lambda r: f"{r['volume_mm3']} mm³"),
+        (
+            "union of the same wires' tubes in Manifold (128-gon tubes, balls at the rod ends; `scripts/check_print.py`)",
+            lambda r: f"{r['manifold_mm3']} mm³ ({percent(r)})",
+        ),
+        ("time, files", lambda r: f"{r['time_s']} s; {r['size_3mf_mb']} MB 3MF, {r['size_stl_mb']} MB STL"),
+    ]
+    body = [[name] + [cell(r) for r in data] for name, cell in lines]
+    return head + "\n" + table([""] + [r["stent"] for r in data], body)
+
+
 GENERATORS = {
+    "curved-sensitivity": curved_sensitivity,
+    "print-solids": print_solids,
     "stability-maps": stability_maps,
     "adaptive-time-error": adaptive_time_error,
     "adaptive-cases": adaptive_cases,
