@@ -10,7 +10,8 @@ A page holds a generated block between
 and this script writes the block NAME from the asset its generator reads (below), opening it with a line that
 says which asset, when and on what it was measured and by which command. When and on what come from the
 asset's entry in assets/provenance.json, whose `sha256` ties the entry to the asset's bytes: an asset measured
-again must get a new entry (date, machine, command, hash), or this script refuses it.
+again must get a new entry (date, machine, command, hash), or this script refuses it. An entry's optional `note`
+follows the command in the stamp (e.g. that the asset was transcribed from a page, at which commit).
 
     python3 scripts/docs_tables.py           # rewrite the blocks in place
     python3 scripts/docs_tables.py --check   # exit 1, with a diff, if a block differs from what it would write
@@ -395,8 +396,8 @@ def scaling():
 
 
 def minutes(seconds):
-    """`8 min 51 s` (or `58 s`)."""
-    m, s = divmod(int(seconds), 60)
+    """`8 min 51 s` (or `58 s`), to the second."""
+    m, s = divmod(round(float(seconds)), 60)
     return f"{m} min {s} s" if m else f"{s} s"
 
 
@@ -406,7 +407,14 @@ def build_times():
     head = stamp(asset)  # first: the asset must be the one its provenance describes
     data, _ = rows(asset)
     body = [
-        [r["measured"], r["commit"], r["command"], minutes(r["wall_s"]), f"{r['processor_s']} s", r["of_which"] or "—"]
+        [
+            r["measured"],
+            r["commit"],
+            r["command"],
+            minutes(r["wall_s"]),
+            f"{r['processor_s']} s",
+            r["of_which"] or "—",
+        ]
         for r in data
     ]
     header = ["measured", "commit", "command", "wall time", "processor time", "of which"]
@@ -447,15 +455,14 @@ def stability_maps():
     facts = []
     with_cuts = [r["load_steps"] for r in bend if not clean(r)]
     without = [r["load_steps"] for r in bend if clean(r)]
-    facts.append(
-        f"**bend45**: step cuts with {listed(with_cuts)} load steps, none with {listed(without)}."
-    )
+    facts.append(f"**bend45**: step cuts with {listed(with_cuts)} load steps, none with {listed(without)}.")
     full = max(float(r["heating_duration_s"]) for r in heating)
     slow = [r for r in heating if float(r["heating_duration_s"]) == full]
     fast = [r for r in heating if float(r["heating_duration_s"]) < full and clean(r)]
     facts.append(
         f"**heating**: heated over the {full:g} s of the load ramp, steps h = {listed(r['h_s'] for r in slow)} s "
-        f"needed {', '.join(r['cuts'] for r in slow)} cuts; heated over {listed(r['heating_duration_s'] for r in fast)} s "
+        f"needed {', '.join(r['cuts'] for r in slow)} cuts; heated over "
+        f"{listed(r['heating_duration_s'] for r in fast)} s "
         f"({listed(round(float(r['dT_per_step_K']), 2) for r in fast)} K per step) with h = "
         f"{listed(dict.fromkeys(r['h_s'] for r in fast))} s, none."
     )
@@ -469,8 +476,9 @@ def stability_maps():
     damped = [r for r in coarse_release if r["stabilised"] == "1"]
     hot = {r["stabilised"]: r["cuts"] for r in release if r["hot"] == "1"}
     facts.append(
-        f"**release** (a two-crown straight stent): n = 20: no cuts at h = {listed(ok)} s for every release ramp tried ({ramps[0]:g}–{ramps[-1]:g} s), "
-        f"cuts at h = {listed(h for h in steps if h not in ok)} s; n = {failed[0]['n']}: fails at t = "
+        f"**release** (a two-crown straight stent): n = 20: no cuts at h = {listed(ok)} s for every release ramp "
+        f"tried ({ramps[0]:g}–{ramps[-1]:g} s), cuts at h = {listed(h for h in steps if h not in ok)} s; "
+        f"n = {failed[0]['n']}: fails at t = "
         + ", ".join(f"{float(r['time_reached']):.4f} s (ramp {float(r['release_ramp_s']):g} s)" for r in failed)
         + ", and stabilised completes, dissipating "
         + ", ".join(sci(float(r["dissipated_ratio"])) for r in damped)
@@ -499,10 +507,20 @@ def curved_sensitivity():
     asset = "assets/curved_sensitivity.csv"
     head = stamp(asset)  # first: the asset must be the one its provenance describes
     data, _ = rows(asset)
-    keys = ["plain_mean", "max", "min", "median", "largest_target_node", "mean_rigid_fit_removed", "max_rigid_fit_removed"]
+    keys = [
+        "plain_mean",
+        "max",
+        "min",
+        "median",
+        "largest_target_node",
+        "mean_rigid_fit_removed",
+        "max_rigid_fit_removed",
+    ]
     body = []
     for r in data:
-        choice, variant = r["open_choice"] or "—", r["variant"] if r["open_choice"] else f"**{r['variant']}**"
+        # The row without an open choice is ours, in bold.
+        choice = r["open_choice"] or "—"
+        variant = r["variant"] if r["open_choice"] else f"**{r['variant']}**"
         if r["failure"]:
             body.append([choice, variant, f"fails: {r['failure']}"] + [""] * (len(keys) + 1))
             continue
@@ -523,10 +541,14 @@ def print_solids():
     data, _ = rows(asset)
     percent = lambda r: f"{float(r['difference_pct']):+.3f} %".replace("-", "−")
     lines = [
-        ("contour / written triangles", lambda r: f"{grouped(r['contour_triangles'])} / {grouped(r['written_triangles'])}"),
+        (
+            "contour / written triangles",
+            lambda r: f"{grouped(r['contour_triangles'])} / {grouped(r['written_triangles'])}",
+        ),
         ("volume", lambda r: f"{r['volume_mm3']} mm³"),
         (
-            "union of the same wires' tubes in Manifold (128-gon tubes, balls at the rod ends; `scripts/check_print.py`)",
+            "union of the same wires' tubes in Manifold (128-gon tubes, balls at the rod ends; "
+            "`scripts/check_print.py`)",
             lambda r: f"{r['manifold_mm3']} mm³ ({percent(r)})",
         ),
         ("time, files", lambda r: f"{r['time_s']} s; {r['size_3mf_mb']} MB 3MF, {r['size_stl_mb']} MB STL"),
