@@ -24,7 +24,11 @@
 //! Runs shorter than 5 s are repeated three times and the shortest wall time is reported.
 //!
 //! `cargo bench --bench adaptive` runs all four (about 6 minutes on two cores); `cargo bench --bench adaptive
-//! -- curved` (or `straight`, `arch`, `cantilever`) one. The tables in docs/speed.md come from it.
+//! -- curved` (or `straight`, `arch`, `cantilever`) one. It prints each case's table; with
+//! `STENTKIT_WRITE_ASSETS=1` in the environment it also writes it, unrounded, to `assets/adaptive/<case>.csv`
+//! (the case's model name, e.g. `curved_stent.csv`), the asset `scripts/docs_tables.py` makes the work–precision
+//! tables of docs/speed.md from. An asset measured again needs a new entry in `assets/provenance.json` (date,
+//! machine, command, sha256), or the script refuses it.
 
 use std::path::Path;
 use stentkit::design::load_design;
@@ -202,6 +206,7 @@ fn main() {
             (format!("p = {p}, n = {n}, τ = {tol:e}"), run(&model))
         });
         report(
+            root,
             &case,
             &paper.model,
             &rows,
@@ -222,7 +227,18 @@ fn times(model: &Model, case: &Case) -> Vec<Real> {
     times
 }
 
+/// A CSV field: quoted when it holds a comma or a quote.
+fn field(text: &str) -> String {
+    if text.contains([',', '"']) {
+        format!("\"{}\"", text.replace('"', "\"\""))
+    } else {
+        text.to_string()
+    }
+}
+
+#[allow(clippy::too_many_arguments)]
 fn report(
+    root: &Path,
     case: &Case,
     model: &Model,
     rows: &[Row],
@@ -239,10 +255,20 @@ fn report(
         None => (reference, "the paper settings"),
     };
     println!("`results err` against {against}.\n");
+    // The same table for assets/adaptive/<case>.csv (STENTKIT_WRITE_ASSETS=1), unrounded; an empty field where
+    // the table shows "—".
+    let mut csv = format!(
+        "# case: {} ({})\n# results err against: {against}\nrun,tolerance,tuned_to,wall_s,steps,newton_iterations",
+        model.name, case.design
+    );
     let mut head = "| run | wall s | steps | Newton its |".to_string();
     for q in &case.quantities {
         head.push_str(&format!(" {} | Δ |", q.name));
+        csv.push_str(&format!(",{},{} Δ", field(q.name), field(q.name)));
     }
+    csv.push_str(
+        ",cfg_err_over_tolerance,cfg_err_time,results_err,results_err_quantity,results_err_time\n",
+    );
     head.push_str(" cfg err / τ | results err |");
     println!("{head}");
     println!("{}", "|---".repeat(head.matches('|').count() - 1) + "|");
@@ -258,10 +284,21 @@ fn report(
             "| {} | {:.2} | {} | {} |",
             row.label, row.run.wall, row.run.summary.steps, row.run.summary.iterations
         );
+        let tuned_to = std::ptr::eq(row, rows.last().expect("rows")).then_some(case.tuned_to);
+        let mut record = format!(
+            "{},{},{},{},{},{}",
+            field(&row.label),
+            row.tolerance.map_or(String::new(), |t| format!("{t:e}")),
+            tuned_to.map_or(String::new(), |t| format!("{t:e}")),
+            row.run.wall,
+            row.run.summary.steps,
+            row.run.summary.iterations
+        );
         for q in &case.quantities {
             let (a, b) = at(q.time);
             let (x, y) = ((q.value)(a), (q.value)(b));
             line.push_str(&format!(" {x:.6} | {:.1e} |", (x - y).abs()));
+            record.push_str(&format!(",{x},{}", (x - y).abs()));
         }
         let (configuration, when) = row
             .run
@@ -280,15 +317,37 @@ fn report(
         let cfg = row.tolerance.map_or("—".to_string(), |tol| {
             format!("{:.3} @ {when}", configuration / tol)
         });
+        match row.tolerance {
+            Some(tol) => record.push_str(&format!(",{},{when}", configuration / tol)),
+            None => record.push_str(",,"),
+        }
         let results = difference(&row.run.states, &results_reference.states, names);
         if std::ptr::eq(&row.run, results_reference) {
             line.push_str(&format!(" {cfg} | — (reference) |"));
+            record.push_str(",,,");
         } else {
             line.push_str(&format!(
                 " {cfg} | {:.1e} ({} @ {}) |",
                 results.value, results.quantity, results.time
             ));
+            record.push_str(&format!(
+                ",{},{},{}",
+                results.value,
+                field(&results.quantity),
+                results.time
+            ));
         }
         println!("{line}");
+        csv.push_str(&record);
+        csv.push('\n');
+    }
+    if std::env::var_os("STENTKIT_WRITE_ASSETS").is_some() {
+        let path = root
+            .join("assets/adaptive")
+            .join(format!("{}.csv", model.name));
+        std::fs::create_dir_all(path.parent().expect("a folder"))
+            .expect("assets/adaptive is writable");
+        std::fs::write(&path, csv).expect("the asset is writable");
+        println!("\nwrote {}", path.display());
     }
 }

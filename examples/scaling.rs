@@ -4,6 +4,11 @@
 //! The criterion benchmarks (`cargo bench --bench solver`) measure the same kernels with statistics.
 //!
 //! Run: cargo run --release --example scaling
+//!
+//! With `STENTKIT_WRITE_ASSETS=1` in the environment it also writes the table, unrounded, to
+//! `assets/scaling.csv` (the growth exponents in a comment line), the asset `scripts/docs_tables.py` makes the
+//! scaling table of docs/speed.md from. An asset measured again needs a new entry in `assets/provenance.json`
+//! (date, machine, command, sha256), or the script refuses it.
 
 #[path = "../benches/support/stents.rs"]
 mod stents;
@@ -33,6 +38,7 @@ fn main() {
         "crowns", "patches", "unknowns", "residual ms", "tangent ms", "factor+solve ms", "step ms"
     );
     let mut rows: Vec<(f64, [f64; 4])> = Vec::new();
+    let mut csv = String::from("crowns,unknowns,residual_ms,tangent_ms,factor_solve_ms,step_ms\n");
     for crowns in stents::CROWNS {
         let model = stents::stent_model(crowns);
         let mut sim = stents::warmed_up(&model);
@@ -57,17 +63,34 @@ fn main() {
             model.patches.len(),
             model.num_unknowns()
         );
+        csv.push_str(&format!(
+            "{crowns},{},{residual},{tangent},{factor},{step}\n",
+            model.num_unknowns()
+        ));
         rows.push((crowns as f64, [residual, tangent, factor, step]));
     }
     let exponent = |k: usize| {
         let points: Vec<(f64, f64)> = rows.iter().map(|(c, v)| (*c, v[k])).collect();
         fit_log_slope(&points).map_or("n/a".to_string(), |q| format!("{q:.2}"))
     };
-    println!(
+    let exponents = format!(
         "growth exponent (cost ∝ crowns^q): residual {}, tangent {}, factor+solve {}, step {}",
         exponent(0),
         exponent(1),
         exponent(2),
         exponent(3)
     );
+    println!("{exponents}");
+    if std::env::var_os("STENTKIT_WRITE_ASSETS").is_some() {
+        let header = format!(
+            "# straight stents (benches/support/stents.rs), p = {}, n = {}, h = {} s, after {} steps of the ramp; mean ms per call\n# {exponents}\n",
+            stents::MESH.0,
+            stents::MESH.1,
+            stents::STEP,
+            stents::WARM_UP_STEPS
+        );
+        let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("assets/scaling.csv");
+        std::fs::write(&path, header + &csv).expect("assets/scaling.csv is writable");
+        println!("wrote {}", path.display());
+    }
 }
