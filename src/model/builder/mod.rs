@@ -27,7 +27,7 @@ pub mod field;
 mod nodes;
 
 pub use checks::FIT_WARNING_FRACTION;
-use checks::check_discretisation;
+use checks::{check_discretisation, check_model_name, check_temperature};
 pub use field::{
     BuildError, ConditionField, Field, NodeField, PatchField, ProbeField, ProgrammeField, Result,
     SolverField, StentField, TimeField,
@@ -681,7 +681,8 @@ impl ModelBuilder {
         self.probes.push((name.into(), at));
     }
 
-    /// Times within `(0, end]` at which the state is recorded; time stepping lands on each.
+    /// Times within `(0, end]` at which the state is recorded; time stepping lands on each. The model holds
+    /// them sorted and without repeats; [`ModelBuilder::build`] refuses one outside `(0, end]`.
     pub fn record_times(&mut self, times: Vec<Real>) -> &mut Self {
         self.record_times = times;
         self
@@ -696,6 +697,7 @@ impl ModelBuilder {
     /// symmetry conditions, the programme and the conditions, and checks them.
     pub fn build(&self) -> Result<Built> {
         let mut warnings = Vec::new();
+        check_model_name(&self.name)?;
         let time = self.time.settings()?;
         if let Some(why) = time.error_control_refusal(&self.materials) {
             return Err(BuildError::new(Field::Time(TimeField::Tolerance), why));
@@ -811,6 +813,7 @@ impl ModelBuilder {
                 ));
             }
         };
+        check_temperature(&temperature)?;
         for w in shifts {
             let freeze = w.frozen_below();
             let (lo, _) = match &self.temperature_field {
@@ -834,6 +837,7 @@ impl ModelBuilder {
             &nodes,
         )?;
         let probes = self.probes(&patches, &nodes)?;
+        let record_times = checks::record_times(&self.record_times, time.end)?;
         let model = Model {
             name: self.name.clone(),
             units: self.units,
@@ -851,7 +855,7 @@ impl ModelBuilder {
             node_sets,
             programme,
             symmetry_planes,
-            record_times: self.record_times.clone(),
+            record_times,
             vessel: self.vessel.clone(),
         };
         Ok(Built { model, warnings })
