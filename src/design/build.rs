@@ -887,7 +887,7 @@ fn solver_settings(s: Option<&SolverDto>) -> SolverSettings {
 /// written for a shorter run (1.75 s of a 3.25 s programme, issue 19) does silently. Time-driven runs only (an
 /// arc-length path reads its schedules at `time.end`).
 fn short_schedule_warning(model: &crate::model::Model) -> Option<String> {
-    let schedule = &model.temperature;
+    let schedule = model.temperature();
     let &(last, value) = schedule.points().last()?;
     let end = model.time().end;
     (model.solver().path.arc_length().is_none()
@@ -912,9 +912,9 @@ fn hot_release_warnings(model: &crate::model::Model) -> Vec<String> {
     else {
         return Vec::new();
     };
-    let temperature = model.temperature.value(release);
+    let temperature = model.temperature().value(release);
     model
-        .materials
+        .materials()
         .iter()
         .zip(&model.material_names)
         .filter_map(|(law, name)| {
