@@ -498,8 +498,8 @@ pub struct Model {
     /// Distributed loads.
     pub distributed_loads: Vec<DistributedLoad>,
     /// Temperature [°C] as a function of time, uniform over the device — or, with a `temperature_field`, the
-    /// schedule reports show as the device's ([`TemperatureField::reference`]) ([`Model::temperature`]; changed
-    /// through [`Model::with_temperature`]).
+    /// schedule reports show as the device's ([`TemperatureField::reference`]). Read through
+    /// [`Model::temperature`], changed through [`Model::with_temperature`].
     temperature: TimeFunction,
     /// A temperature that varies in space, which the material sees instead of `temperature` (`None`: uniform).
     pub temperature_field: Option<TemperatureField>,
