@@ -145,8 +145,10 @@ fn main() {
         // Runs under 5 s are repeated three times and their shortest wall time kept (the machine's noise is
         // ±20 % on a single run of a few seconds).
         let run = |model: &Model| -> WatchedRun {
-            let mut model = model.clone();
-            model.record_times = times.clone();
+            let model = model
+                .clone()
+                .with_record_times(times.clone())
+                .expect("record times within the run");
             let once = || watched_run(&model, &locations, None).expect("the run converges");
             let mut best = once();
             if best.wall < 5.0 {
@@ -249,7 +251,7 @@ fn report(
 ) {
     let reference = &rows[0].run;
     let lengths = node_lengths(model);
-    println!("\n### {} ({})\n", model.name, case.design);
+    println!("\n### {} ({})\n", model.name(), case.design);
     let (results_reference, against) = match tight {
         Some((label, run)) => (run, label.as_str()),
         None => (reference, "the paper settings"),

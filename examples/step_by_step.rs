@@ -26,7 +26,7 @@ fn main() -> Result<(), Box<dyn Error>> {
     let probe = &model.probes[0];
     println!(
         "{}: {} patches, {} unknowns, {} steps to t = {} s; probe `{}`",
-        model.name,
+        model.name(),
         model.patches.len(),
         model.num_unknowns(),
         design.steps.total(),

@@ -20,9 +20,14 @@ pub fn describe(design: &Design, file: &str) -> String {
     let (model, warnings) = (&design.model, &design.warnings);
     let mut s = String::new();
     let u = model.units;
-    let _ = writeln!(s, "design      {} ({file}), units {}", model.name, u.name());
-    for (k, law) in model.materials.iter().enumerate() {
-        let label = if model.materials.len() == 1 {
+    let _ = writeln!(
+        s,
+        "design      {} ({file}), units {}",
+        model.name(),
+        u.name()
+    );
+    for (k, law) in model.materials().iter().enumerate() {
+        let label = if model.materials().len() == 1 {
             "material   ".to_string()
         } else {
             format!("material {k}  `{}`:", model.material_names[k])
@@ -30,7 +35,7 @@ pub fn describe(design: &Design, file: &str) -> String {
         let _ = writeln!(s, "{label} {}", describe_material(law, u.stress()));
     }
     // Shear factors with the first material's ν (the design's one material).
-    let poisson = model.materials.first().map_or(0.0, |m| m.poisson());
+    let poisson = model.materials().first().map_or(0.0, |m| m.poisson());
     for (k, sec) in model.sections.iter().enumerate() {
         let kind = match sec {
             crate::material::Section::Circular(_) => {
@@ -83,7 +88,7 @@ pub fn describe(design: &Design, file: &str) -> String {
             None => "exact".to_string(),
             Some(e) => format!("fit error {e:.3e} {}", u.length()),
         };
-        let material = if model.materials.len() > 1 {
+        let material = if model.materials().len() > 1 {
             format!(", material `{}`", model.material_names[p.material])
         } else {
             String::new()

@@ -144,7 +144,7 @@ pub(crate) fn run(run_dir: &Path, options: &ExportOptions) -> anyhow::Result<()>
                     .collect();
                 BadInput(format!(
                     "`{name}` is not an event of {}; its events: {}",
-                    model.name,
+                    model.name(),
                     known.join(", ")
                 ))
             })?
@@ -166,7 +166,7 @@ pub(crate) fn run(run_dir: &Path, options: &ExportOptions) -> anyhow::Result<()>
     while sim.time() < target - snap {
         match sim
             .step()
-            .with_context(|| format!("re-running {} to t = {}", model.name, target))?
+            .with_context(|| format!("re-running {} to t = {}", model.name(), target))?
         {
             Some(report) => step = report.step,
             None => break,

@@ -115,7 +115,7 @@ pub(crate) fn run(
     let header = format!(
         "{}{} {} shape, units {} (lengths in {})",
         if solid { "print solid: " } else { "" },
-        model.name,
+        model.name(),
         match state {
             State::Permanent => "reference (permanent)",
             State::Temporary => "temporary (programmed)",
@@ -181,7 +181,7 @@ pub(super) fn write_centrelines(
     use std::fmt::Write as _;
     let mut text = format!(
         "# {}: wire centrelines, lengths in {}\nrod,point,x,y,z,radius\n",
-        model.name,
+        model.name(),
         model.units.length()
     );
     let mut rods = 0;

@@ -230,7 +230,7 @@ pub fn run_with(
     let folder = match &options.resume {
         Some(dir) => Folder::Resume(dir.clone()),
         None => Folder::New {
-            dir: run_dir(options.output.clone(), &design.model.name),
+            dir: run_dir(options.output.clone(), design.model.name()),
             force: options.force,
         },
     };

@@ -72,13 +72,13 @@ pub(crate) fn convergence(
     create(output)?;
     let rows = convergence_study(&design, &study, progress)?;
     let [csv, by_n_svg, by_time_svg] = CONVERGENCE_FILES.map(|f| output.join(f));
-    write(&csv, &convergence_csv(&rows, &study, &model.name))?;
-    let [by_n, by_time] = convergence_charts(&rows, &study, &model.name);
+    write(&csv, &convergence_csv(&rows, &study, model.name()))?;
+    let [by_n, by_time] = convergence_charts(&rows, &study, model.name());
     write_svg(&by_n, &by_n_svg)?;
     write_svg(&by_time, &by_time_svg)?;
     println!(
         "{}: {} runs → {} (and error_vs_n.svg, error_vs_time.svg)",
-        model.name,
+        model.name(),
         rows.len(),
         csv.display()
     );
@@ -222,13 +222,15 @@ pub(crate) fn time(
     create(output)?;
     let result = time_study(model, &study, progress)?;
     let [csv, by_h_svg, by_time_svg] = TIME_FILES.map(|f| output.join(f));
-    write(&csv, &time_csv(&result, &study, &model.name))?;
-    let [by_h, by_time] = time_charts(&result, &study, &model.name);
+    write(&csv, &time_csv(&result, &study, model.name()))?;
+    let [by_h, by_time] = time_charts(&result, &study, model.name());
     write_svg(&by_h, &by_h_svg)?;
     write_svg(&by_time, &by_time_svg)?;
     println!(
         "{}: errors at t = {} against {}",
-        model.name, study.time, result.reference
+        model.name(),
+        study.time,
+        result.reference
     );
     for (integrator, order) in &result.orders {
         match order {

@@ -33,7 +33,7 @@ pub(crate) fn run(
     };
     println!(
         "tuning {} to {} (results: displacements over the largest, Δr over its largest, recovery ratios absolute)",
-        design.model.name,
+        design.model.name(),
         Short(tolerance)
     );
     println!(

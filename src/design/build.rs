@@ -2,7 +2,8 @@
 //! [`ModelBuilder`] calls, which generate the geometry and make every check that involves more than one value.
 //! A failed check names a builder [`Field`]; [`field_path`] turns it into the design's field path, which
 //! [`super`] turns into a line and column. What is about the design file itself — its version, the run folder's
-//! name, the memory it may take, the output settings — is checked here.
+//! name (by the builder's rule for a model name, in the design's words), the memory it may take, the output
+//! settings — is checked here.
 
 use super::dto::*;
 pub(crate) use super::issue::Issue;
@@ -17,6 +18,7 @@ use crate::geometry::analytic::{
 use crate::material::{CircularSection, MaterialLaw, Section, SectionProperties, ShearFactor};
 use crate::math::quote::quoted;
 use crate::math::{Mat3, Real, Vec3};
+use crate::model::builder::checks::{NAME_RULE, check_name};
 use crate::model::builder::*;
 use crate::model::temperature::FieldError;
 use crate::model::*;
@@ -232,7 +234,8 @@ pub(crate) fn build(dto: &DesignDto, default_name: &str, temporary_shape: bool) 
     })
 }
 
-/// The design's name: its `name`, or the file's stem, checked by [`check_name`].
+/// The design's name: its `name`, or the file's stem, checked by the builder's rule for a model name
+/// ([`check_name`]) with the design's words.
 fn design_name(dto: &DesignDto, default_name: &str) -> Result<String> {
     match &dto.name {
         Some(name) => {
@@ -271,6 +274,9 @@ fn builder_issue(e: BuildError, dto: &DesignDto) -> Issue {
 /// in the order this module adds them, which is the order of the design's lists.
 pub(crate) fn field_path(field: &Field, dto: &DesignDto) -> String {
     match *field {
+        Field::Name => "name".into(),
+        // The design's snapshot times are checked (and those at 0 dropped) before they are given.
+        Field::RecordTime { .. } => "output.snapshots.times".into(),
         Field::Patches => "patches".into(),
         Field::Patch { index, field } => {
             let base = format!("patches[{index}]");
@@ -370,42 +376,6 @@ pub(crate) fn field_path(field: &Field, dto: &DesignDto) -> String {
             ProgrammeField::Align => "programme.temporary.align",
         }
         .into(),
-    }
-}
-
-/// Longest design name \[bytes\]: the name is the run folder's name (`runs/<name>`), and 255 bytes is the
-/// longest file name of the usual file systems (ext4, XFS, Btrfs, APFS).
-pub(crate) const MAX_NAME_BYTES: usize = 255;
-
-/// What a design name may be, as the errors say it.
-const NAME_RULE: &str = "a name becomes the run folder `runs/<name>`, so it must be one folder name: not empty, not `.` or `..`, at most 255 bytes, without `/`, `\\` or control characters";
-
-/// Why `name` cannot be a run folder's name, if it cannot: a single normal path component on every platform
-/// (no separator, no `.` or `..`, no absolute path or drive prefix), without control characters.
-fn check_name(name: &str) -> std::result::Result<(), String> {
-    if name.is_empty() {
-        return Err("it is empty".into());
-    }
-    if name == "." || name == ".." {
-        return Err("it names a folder itself, not a new one".into());
-    }
-    if let Some(c) = name.chars().find(|&c| c == '/' || c == '\\') {
-        return Err(format!("it contains `{c}`, a path separator"));
-    }
-    if let Some(c) = name.chars().find(|c| c.is_control()) {
-        return Err(format!(
-            "it contains the control character {}",
-            c.escape_debug()
-        ));
-    }
-    if name.len() > MAX_NAME_BYTES {
-        return Err(format!("it has {} bytes", name.len()));
-    }
-    // Whatever the platform adds (a Windows drive prefix such as `C:`): one normal component, itself.
-    let mut components = std::path::Path::new(name).components();
-    match (components.next(), components.next()) {
-        (Some(std::path::Component::Normal(c)), None) if c == name => Ok(()),
-        _ => Err("it is not a plain folder name on this system".into()),
     }
 }
 
@@ -917,7 +887,7 @@ fn solver_settings(s: Option<&SolverDto>) -> SolverSettings {
 /// written for a shorter run (1.75 s of a 3.25 s programme, issue 19) does silently. Time-driven runs only (an
 /// arc-length path reads its schedules at `time.end`).
 fn short_schedule_warning(model: &crate::model::Model) -> Option<String> {
-    let schedule = &model.temperature;
+    let schedule = model.temperature();
     let &(last, value) = schedule.points().last()?;
     let end = model.time().end;
     (model.solver().path.arc_length().is_none()
@@ -942,9 +912,9 @@ fn hot_release_warnings(model: &crate::model::Model) -> Vec<String> {
     else {
         return Vec::new();
     };
-    let temperature = model.temperature.value(release);
+    let temperature = model.temperature().value(release);
     model
-        .materials
+        .materials()
         .iter()
         .zip(&model.material_names)
         .filter_map(|(law, name)| {

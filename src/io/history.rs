@@ -322,7 +322,7 @@ impl HistoryWriter {
             let u = sim.probe_displacement(&p.location);
             line.push_str(&format!(",{:.12e},{:.12e},{:.12e}", u.x, u.y, u.z));
         }
-        let temperature = sim.model().temperature.value(sim.schedule_time());
+        let temperature = sim.model().temperature().value(sim.schedule_time());
         let (iterations, residual, cuts) = match report {
             Some(r) => (
                 r.newton.iterations,

@@ -28,7 +28,7 @@ impl super::mesh_format::MeshFormat for Obj {
     ) -> Result<(), MeshIoError> {
         let header = format!(
             "{}: full device at step {}, t = {} s; units {} (lengths in {})",
-            s.model.name,
+            s.model.name(),
             s.step,
             s.time,
             s.model.units.name(),

@@ -57,7 +57,7 @@ impl RunCharts {
 
     /// The charts of the states recorded so far (see the module documentation).
     pub(crate) fn charts(&self, model: &Model) -> Vec<(&'static str, LineChart)> {
-        let name = &model.name;
+        let name = model.name();
         let length = model.units.length();
         let times: Vec<Real> = self.samples.iter().map(|s| s.time).collect();
         let series = |f: &dyn Fn(&StateSample) -> Real| -> Vec<(Real, Real)> {
@@ -170,7 +170,7 @@ impl RunCharts {
             chart
                 .series
                 .push(Series::new("largest ratio", recovery(&|r| r.ratio_max)));
-            let (lo, hi) = model.temperature.range();
+            let (lo, hi) = model.temperature().range();
             let span = if hi > lo { hi - lo } else { 1.0 };
             let temperature = || {
                 Series::new(

@@ -414,7 +414,7 @@ impl SnapshotWriter {
         }
         self.configurations.push(Configuration {
             time,
-            temperature: model.temperature.value(sim.schedule_time()),
+            temperature: model.temperature().value(sim.schedule_time()),
             lines: device_centrelines(model, &current_device_shapes(sim, CENTRELINE_SAMPLES)),
         });
         Ok(())
@@ -443,7 +443,7 @@ impl SnapshotWriter {
     /// [`ChartError`] when the initial shape cannot be sampled, a figure drawn or a file written.
     pub fn write_configuration_figures(&self, model: &Model) -> Result<Vec<PathBuf>, ChartError> {
         let title = |message: String| ChartError::Drawing {
-            title: format!("{}: configurations", model.name),
+            title: format!("{}: configurations", model.name()),
             message,
         };
         let shapes = reference_patch_shapes(model, samples_per_point(model, CENTRELINE_SAMPLES))
@@ -454,7 +454,7 @@ impl SnapshotWriter {
             .collect();
         let initial = Configuration {
             time: 0.0,
-            temperature: model.temperature.value(0.0),
+            temperature: model.temperature().value(0.0),
             lines: device_centrelines(model, &shapes),
         };
         let times: Vec<Real> = self.configurations.iter().map(|c| c.time).collect();
@@ -480,7 +480,7 @@ impl SnapshotWriter {
         let mut files = configurations::write(
             &folder,
             charts,
-            (&model.name, model.units.length()),
+            (model.name(), model.units.length()),
             &initial,
             &rows,
             &views,
@@ -576,7 +576,7 @@ impl SnapshotWriter {
         }
         let header = format!(
             "{} vessel lumen, lengths in {}",
-            model.name,
+            model.name(),
             model.units.length()
         );
         Ok(stl::write_stl_with_header(

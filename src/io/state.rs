@@ -171,7 +171,7 @@ impl StateSample {
             step: report.map_or(0, |r| r.step),
             time,
             dt: report.map_or(0.0, |r| r.dt),
-            temperature: model.temperature.value(sim.schedule_time()),
+            temperature: model.temperature().value(sim.schedule_time()),
             loads: channels
                 .iter()
                 .map(|c| sim.load_scale() * c.value(model, sim.schedule_time()))

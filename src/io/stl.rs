@@ -49,7 +49,7 @@ impl super::mesh_format::MeshFormat for Stl {
     ) -> Result<(), MeshIoError> {
         let header = format!(
             "{} step {} t={:.6} {}",
-            s.model.name,
+            s.model.name(),
             s.step,
             s.time,
             s.model.units.name()

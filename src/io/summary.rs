@@ -445,7 +445,7 @@ impl RunSummaryFile {
         warnings: Vec<String>,
     ) -> Self {
         Self {
-            design: model.name.clone(),
+            design: model.name().to_string(),
             design_file: design_file.to_string(),
             model_fingerprint: model_fingerprint_text(model),
             overrides: Vec::new(),

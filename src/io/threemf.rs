@@ -30,7 +30,7 @@ impl super::mesh_format::MeshFormat for ThreeMf {
         mesh: &TriangleMesh,
         s: &super::mesh_format::SnapshotState<'_>,
     ) -> Result<(), MeshIoError> {
-        let title = format!("{} step {} t={:.6}", s.model.name, s.step, s.time);
+        let title = format!("{} step {} t={:.6}", s.model.name(), s.step, s.time);
         write_3mf(path, mesh, s.model.units, &title)
     }
 }

@@ -479,13 +479,14 @@ impl Default for SolverSettings {
 /// The whole continuous problem.
 #[derive(Debug, Clone, PartialEq, serde::Serialize)]
 pub struct Model {
-    /// Design name.
-    pub name: String,
+    /// Design name ([`Model::name`]; changed through [`Model::with_name`], which checks it as the builder does).
+    name: String,
     /// Unit system of every number.
     pub units: Units,
     /// The materials (constitutive laws), referred to by [`Patch::material`]: a design's `material` (index 0,
-    /// every patch's unless it names another) and its named `materials`.
-    pub materials: Vec<MaterialLaw>,
+    /// every patch's unless it names another) and its named `materials` ([`Model::materials`]; their
+    /// internal-variable update changed through [`Model::with_integrator`]).
+    materials: Vec<MaterialLaw>,
     /// The name of each material, in the order of `materials` (unique; `history.csv`'s per-material columns).
     pub material_names: Vec<String>,
     /// Cross-sections, referred to by [`Patch::section`].
@@ -497,8 +498,9 @@ pub struct Model {
     /// Distributed loads.
     pub distributed_loads: Vec<DistributedLoad>,
     /// Temperature [°C] as a function of time, uniform over the device — or, with a `temperature_field`, the
-    /// schedule reports show as the device's ([`TemperatureField::reference`]).
-    pub temperature: TimeFunction,
+    /// schedule reports show as the device's ([`TemperatureField::reference`]). Read through
+    /// [`Model::temperature`], changed through [`Model::with_temperature`].
+    temperature: TimeFunction,
     /// A temperature that varies in space, which the material sees instead of `temperature` (`None`: uniform).
     pub temperature_field: Option<TemperatureField>,
     /// Time stepping ([`Model::time`]; changed through [`Model::with_time`], which checks it as the builder does).
@@ -516,9 +518,10 @@ pub struct Model {
     /// own mirror image and carries half its section in the reduced model.
     #[serde(serialize_with = "crate::math::serial::components")]
     pub symmetry_planes: Vec<(Vec3, Vec3)>,
-    /// Times within `(0, end]` at which the state is recorded (snapshots) \[time\]: time stepping lands on each,
-    /// as on a schedule breakpoint.
-    pub record_times: Vec<Real>,
+    /// Times within `(0, end]` at which the state is recorded (snapshots) \[time\], sorted and without repeats:
+    /// time stepping lands on each, as on a schedule breakpoint ([`Model::record_times`]; changed through
+    /// [`Model::with_record_times`]).
+    record_times: Vec<Real>,
     /// The vessel a stent was placed on (a centreline read from a file), for the outputs to show beside it.
     pub vessel: Option<Vessel>,
 }
@@ -542,6 +545,28 @@ impl Model {
     /// Newton settings.
     pub fn solver(&self) -> &SolverSettings {
         &self.solver
+    }
+
+    /// Design name (the run folder's name, `runs/<name>`).
+    pub fn name(&self) -> &str {
+        &self.name
+    }
+
+    /// The materials (constitutive laws), referred to by [`Patch::material`], in the order of
+    /// [`Model::material_names`].
+    pub fn materials(&self) -> &[MaterialLaw] {
+        &self.materials
+    }
+
+    /// Temperature [°C] as a function of time, uniform over the device — or, with a `temperature_field`, the
+    /// schedule reports show as the device's.
+    pub fn temperature(&self) -> &TimeFunction {
+        &self.temperature
+    }
+
+    /// Times within `(0, end]` at which the state is recorded \[time\], sorted and without repeats.
+    pub fn record_times(&self) -> &[Real] {
+        &self.record_times
     }
 
     /// The material regions of a device made of several materials: every material some patch uses, in material

@@ -68,12 +68,12 @@ pub fn recovery_warning(sim: &Simulation<'_>) -> Option<String> {
         return None;
     }
     let tg = model
-        .materials
+        .materials()
         .iter()
         .filter_map(|law| crate::material::ConstitutiveLaw::temperature_shift(law).map(|w| w.tg()))
         .fold(Real::NEG_INFINITY, Real::max);
     let coldest = sim.temperature_extremes(t).map_or_else(
-        || model.temperature.value(sim.schedule_time()),
+        || model.temperature().value(sim.schedule_time()),
         |(lo, _)| lo,
     );
     if coldest < tg {

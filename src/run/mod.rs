@@ -671,7 +671,7 @@ fn setup<'m, 'c>(
         };
         console.say(&format!(
             "stentkit run: {} — {} patches, {} unknowns, {plan} → {}",
-            model.name,
+            model.name(),
             model.patches.len(),
             model.num_unknowns(),
             folder.dir().display()
@@ -949,7 +949,7 @@ fn run_in(
     };
     let report = format!(
         "{}: {} steps to {reached}, {} Newton iterations ({:.2} per step), {} factorisations, {} step cuts, {} snapshots, {}, folder {}, wall time {:.2} s, peak memory {} → {}",
-        model.name,
+        model.name(),
         totals.steps,
         totals.iterations,
         totals.iterations as f64 / totals.steps.max(1) as f64,

@@ -208,7 +208,7 @@ impl Assembler {
         let modulus_scale = model
             .patches
             .iter()
-            .map(|p| model.materials[p.material].reference_modulus())
+            .map(|p| model.materials()[p.material].reference_modulus())
             .collect();
         let patch_length = model
             .patches

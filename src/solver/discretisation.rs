@@ -84,7 +84,7 @@ impl Discretisation {
     /// Builds the collocation points, basis tables and reference kinematics of every patch.
     pub fn new(model: &Model) -> Result<Self, SolverError> {
         let shapes = model
-            .materials
+            .materials()
             .iter()
             .flat_map(|law| model.sections.iter().map(|s| law.section_shape(s)))
             .collect();
@@ -93,11 +93,11 @@ impl Discretisation {
         let mut control0 = Vec::with_capacity(model.num_collocation_points());
         for (k, patch) in model.patches.iter().enumerate() {
             assert!(
-                patch.material < model.materials.len(),
+                patch.material < model.materials().len(),
                 "patch `{}` refers to material {} of {}",
                 patch.name,
                 patch.material,
-                model.materials.len()
+                model.materials().len()
             );
             let shape = Self::shape_index(model, patch.material, patch.section);
             let curve = &patch.curve;

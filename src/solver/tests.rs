@@ -199,7 +199,7 @@ fn initial_laws(model: &Model, disc: &Discretisation) -> Vec<SectionLaw> {
     disc.points
         .iter()
         .map(|p| {
-            let law = &model.materials[model.patches[p.patch].material];
+            let law = &model.materials()[model.patches[p.patch].material];
             law.section_law(&law.new_state(vec![disc.shapes[p.shape]]), 0)
         })
         .collect()

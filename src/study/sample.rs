@@ -99,7 +99,7 @@ pub struct WatchedRun {
     pub summary: RunSummary,
 }
 
-/// Runs `model` to its end time and records, at each of its record times (`model.record_times`, which every run
+/// Runs `model` to its end time and records, at each of its record times ([`Model::record_times`], which every run
 /// lands on), the displacements at `locations`, the recovery measures and, with `grid_samples`, the grid.
 ///
 /// # Errors
@@ -109,12 +109,12 @@ pub fn watched_run(
     locations: &[ProbeLocation],
     grid_samples: Option<usize>,
 ) -> Result<WatchedRun, SolverError> {
-    let mut times = model.record_times.clone();
-    times.sort_by(Real::total_cmp);
+    // The model holds its record times sorted.
+    let times = model.record_times();
     let started = Instant::now();
     let mut sim = Simulation::new(model)?;
     let mut watch = Watch {
-        times: &times,
+        times,
         locations,
         grid_samples,
         states: Vec::new(),

@@ -246,19 +246,19 @@ impl Runner<'_> {
             Stepping::Fixed(h) => (Some(h), None),
             Stepping::Tolerance(tol) => (None, Some(tol)),
         };
-        let mut model = TimeVariant {
+        // The whole schedule is compared at the comparison times, a screening run by its grid at its end.
+        let model = TimeVariant {
             end: Some(key.end),
             step,
             tolerance,
             ..TimeVariant::default()
         }
-        .of(&rebuilt)?;
-        // The whole schedule is compared at the comparison times, a screening run by its grid at its end.
-        model.record_times = if whole {
+        .of(&rebuilt)?
+        .with_record_times(if whole {
             self.times.clone()
         } else {
             vec![key.end]
-        };
+        })?;
         let grid = (!whole).then_some(SAMPLES);
         Ok(watched_run(&model, &self.locations, grid)?)
     }

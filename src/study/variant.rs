@@ -6,9 +6,9 @@
 //! ([`VariedDesign::rebuild`]): the design language ([`crate::design`], above this layer) implements it.
 
 use super::{StudyError, positive};
-use crate::material::{Integrator, MaterialLaw, MaxwellLaw};
+use crate::material::Integrator;
 use crate::math::Real;
-use crate::model::{Model, StepPlan};
+use crate::model::{Model, StepPlan, TimeSettings};
 
 /// Settings of the time stepping and the internal-variable update a study changes on a built model; `None`
 /// keeps the model's.
@@ -30,8 +30,8 @@ pub struct TimeVariant {
 }
 
 impl TimeVariant {
-    /// A copy of `model` changed to this variant: the time settings through [`Model::with_time`], which checks
-    /// them as the builder does.
+    /// A copy of `model` changed to this variant: the time settings through [`Model::with_time`] and the
+    /// internal-variable update through [`Model::with_integrator`], which check them as the builder does.
     ///
     /// # Errors
     /// [`StudyError::InvalidSetting`] when a value is not positive and finite, [`StudyError::StepBeyondEnd`]
@@ -68,14 +68,16 @@ impl TimeVariant {
         }
         let mut model = model.clone();
         if let Some(integrator) = self.integrator {
-            for law in &mut model.materials {
-                if let MaterialLaw::Maxwell(maxwell) = law {
-                    *maxwell = MaxwellLaw::new(maxwell.material().clone(), integrator);
-                }
-            }
+            // The update is changed under fixed steps: error control is then checked once, for the new time
+            // stepping with the new update (below and by `with_time`), not for either with the old other.
+            let fixed = TimeSettings {
+                tolerance: None,
+                ..model.time().clone()
+            };
+            model = model.with_time(fixed)?.with_integrator(integrator)?;
         }
         // As the builder does: error control only where its estimate holds (`Integrator::companion`).
-        if let Some(why) = time.error_control_refusal(&model.materials) {
+        if let Some(why) = time.error_control_refusal(model.materials()) {
             return Err(StudyError::Refused(why));
         }
         Ok(model.with_time(time)?)

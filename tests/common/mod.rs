@@ -191,11 +191,11 @@ impl Recorder {
 /// Runs a model to its end time; returns the finished simulation and the record of its steps.
 #[track_caller]
 pub fn solve(model: &Model) -> (Simulation<'_>, Recorder) {
-    let mut sim = Simulation::new(model).unwrap_or_else(|e| panic!("{}: {e}", model.name));
+    let mut sim = Simulation::new(model).unwrap_or_else(|e| panic!("{}: {e}", model.name()));
     let mut recorder = Recorder::default();
     let summary = sim
         .run(&mut [&mut recorder])
-        .unwrap_or_else(|e| panic!("{}: {e}", model.name));
+        .unwrap_or_else(|e| panic!("{}: {e}", model.name()));
     assert!(!summary.stopped);
     (sim, recorder)
 }

@@ -68,7 +68,7 @@ struct Run {
 fn run(p: usize, n: usize) -> Run {
     let model = model_from_text(&elastic_arch(p, n), "circular_arch_elastic.yaml");
     assert!(matches!(
-        model.materials.as_slice(),
+        model.materials(),
         [stentkit::material::MaterialLaw::Elastic(e)] if e.modulus() == 80.59e6
     ));
     let start = Instant::now();

@@ -51,14 +51,14 @@ fn cut_bend() -> Model {
 fn a_restored_simulation_continues_bit_for_bit() {
     // The bend again with the extrapolated start (`solver.extrapolate`), which reads the last step's increment.
     let bend = cut_bend();
-    let mut extrapolated = bend
+    let extrapolated = bend
         .clone()
         .with_solver(SolverSettings {
             extrapolate: true,
             ..bend.solver().clone()
         })
-        .expect("valid settings");
-    extrapolated.name = "bend45_extrapolated".into();
+        .and_then(|m| m.with_name("bend45_extrapolated"))
+        .expect("valid settings and name");
     for model in [
         small_stent(),
         small_stent_adaptive(),
@@ -67,12 +67,12 @@ fn a_restored_simulation_continues_bit_for_bit() {
     ] {
         let mut full = Simulation::new(&model).expect("simulation");
         let reports = finish(&mut full);
-        assert!(full.is_finished(), "{}", model.name);
+        assert!(full.is_finished(), "{}", model.name());
         if model.time().tolerance.is_some() {
             let rejected: usize = reports.iter().map(|r| r.rejected).sum();
             println!(
                 "{}: {} steps, {rejected} rejected",
-                model.name,
+                model.name(),
                 reports.len()
             );
             assert!(rejected > 0, "the adaptive run rejects some steps");
@@ -95,7 +95,7 @@ fn a_restored_simulation_continues_bit_for_bit() {
                 ahead,
                 reports[at..],
                 "{} from step {at}: uninterrupted",
-                model.name
+                model.name()
             );
             first.restore(&checkpoint).expect("same model");
             let rewound = finish(&mut first);
@@ -103,7 +103,7 @@ fn a_restored_simulation_continues_bit_for_bit() {
                 rewound,
                 reports[at..],
                 "{} from step {at}: rewound",
-                model.name
+                model.name()
             );
             assert!(first.state() == full.state());
             // A new simulation of the same model.
@@ -116,17 +116,17 @@ fn a_restored_simulation_continues_bit_for_bit() {
                 resumed,
                 reports[at..],
                 "{} from step {at}: new simulation",
-                model.name
+                model.name()
             );
             assert!(
                 second.state() == full.state(),
                 "{} from step {at}",
-                model.name
+                model.name()
             );
             assert_eq!(second.notices(), full.notices());
             println!(
                 "{}: restored at step {at} (t = {}, factorisation {}), {} more steps bit for bit",
-                model.name,
+                model.name(),
                 checkpoint.snapshot.clock.time,
                 if checkpoint.tangent.is_some() {
                     "rebuilt"

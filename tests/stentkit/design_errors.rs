@@ -491,7 +491,7 @@ fn a_design_name_is_one_folder_name() {
         );
         let design = stentkit::design::parse_design(&text, Path::new("named.yaml"))
             .unwrap_or_else(|e| panic!("{name}: {e}"));
-        assert_eq!(design.model.name, name);
+        assert_eq!(design.model.name(), name);
     }
 }
 

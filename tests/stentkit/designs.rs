@@ -43,10 +43,10 @@ fn elastic_designs_use_the_elastic_law() {
             assert_eq!(d.model.material_names, ["tg55", "tg70", "tg85", "bridge"]);
             assert_eq!(d.model.material_regions().len(), 4);
         } else {
-            assert_eq!(d.model.materials.len(), 1, "{name}");
+            assert_eq!(d.model.materials().len(), 1, "{name}");
             assert!(d.model.patches.iter().all(|p| p.material == 0), "{name}");
         }
-        for law in &d.model.materials {
+        for law in d.model.materials() {
             match law {
                 MaterialLaw::Elastic(_) => assert!(elastic, "{name} is viscoelastic"),
                 MaterialLaw::Maxwell(m) => {

@@ -737,9 +737,11 @@ fn a_million_breakpoints_are_counted_in_linear_time() {
     // 1) given a temperature table at t = k · 1e-6, k = 0 … 10⁶: every interval is shorter than the step, so
     // the run would land on each of the 10⁶ breakpoints; counted in well under a second (the count is linear
     // after a sort; the bound leaves a hundredfold margin on this shared machine).
-    let mut model = fixtures::bend45().model();
     let table = (0..=1_000_000).map(|k| (k as f64 * 1e-6, 20.0)).collect();
-    model.temperature = stentkit::model::TimeFunction::try_table(table).expect("increasing");
+    let model = fixtures::bend45()
+        .model()
+        .with_temperature(stentkit::model::TimeFunction::try_table(table).expect("increasing"))
+        .expect("a finite schedule");
     let started = std::time::Instant::now();
     let plan = model.planned_steps();
     let elapsed = started.elapsed();

@@ -428,8 +428,8 @@ fn l_frame_joint_and_clamp_balance_the_loads() {
 // `cantilever_tip_deflection`, `series_bar_elongation`). Sketch: patch a from the clamp at (0, 0, 0) to the
 // joint at (0.6, 0, 0), patch b from there to the tip at (1, 0, 0); circular section d = 0.05 m (SI); patch a
 // of E1 = 2e9 Pa, ν1 = 0.3, patch b of E2 = 5e8 Pa, ν2 = 0.35 (its own shear modulus and Cowper factor). The
-// design file gives one material; the second is set in code (`Model::materials`, `Patch::material`), which is
-// the data structure under test. Two runs: a transverse tip force P = 0.02 N along z (tip deflection 1.3e-5 of
+// design file gives the second as a named material of patch b (`Model::materials`, `Patch::material`: the data
+// structure under test). Two runs: a transverse tip force P = 0.02 N along z (tip deflection 1.3e-5 of
 // the length) and an axial tip force F = 5 kN (strain 1.3e-6 … 5e-6; the rod's axial law is exactly linear).
 // The exact linear solutions are cubic in each span, which a degree-6 spline represents exactly; Newton is
 // driven to the round-off floor (tolerance 1e-13, a factorisation per iteration), so what is left is the
@@ -440,7 +440,7 @@ fn l_frame_joint_and_clamp_balance_the_loads() {
 #[test]
 fn a_cantilever_of_two_materials_deflects_as_beam_theory_says() {
     use crate::common::{CantileverSpan, cantilever_tip_deflection, series_bar_elongation};
-    use stentkit::material::{ConstitutiveLaw, ElasticLaw, MaterialLaw};
+    use stentkit::material::ConstitutiveLaw;
     let text = |force: &str| {
         format!(
             r#"
@@ -448,6 +448,8 @@ version: 1
 name: two_materials
 units: SI
 material: {{E_inf: 2.0e9, nu: 0.3}}
+materials:
+  - {{name: soft, E_inf: 5.0e8, nu: 0.35}}
 section: {{diameter: 0.05}}
 mesh: {{p: 6, n: 10}}
 patches:
@@ -455,6 +457,7 @@ patches:
     line: {{from: [0, 0, 0], to: [0.6, 0, 0]}}
   - name: b
     line: {{from: [0.6, 0, 0], to: [1, 0, 0]}}
+    material: soft
 nodes:
   - {{name: clamp, ends: [a.start]}}
   - {{name: joint, ends: [a.end, b.start]}}
@@ -490,13 +493,11 @@ solver: {{tolerance: 1.0e-13, reuse_factorisation: false}}
             series_bar_elongation(&spans, area, 5000.0),
         ),
     ] {
-        let mut model = model_from_text(&text(force), "two_materials.yaml");
-        assert_eq!(model.materials.len(), 1, "the design gives one material");
-        model.materials.push(MaterialLaw::from(
-            ElasticLaw::try_new(e2, nu2).expect("valid"),
-        ));
-        model.patches[1].material = 1;
-        assert_eq!(model.materials[0].poisson(), nu1);
+        let model = model_from_text(&text(force), "two_materials.yaml");
+        assert_eq!(model.materials().len(), 2, "the design gives two materials");
+        assert_eq!(model.patches[1].material, 1);
+        assert_eq!(model.materials()[0].poisson(), nu1);
+        assert_eq!(model.materials()[1].poisson(), nu2);
         let (sim, _) = solve(&model);
         let tip = node_displacement(&sim, "tip");
         let measured = tip.dot(&direction);

@@ -62,8 +62,10 @@ fn a_tuned_arch_stays_within_its_tolerance_of_the_paper_settings() {
     let paper = load_design(&design).expect("the paper design reads");
     let times = comparison_times(&paper.model);
     let tip = |model: &stentkit::model::Model| -> Vec<stentkit::math::Vec3> {
-        let mut model = model.clone();
-        model.record_times = times.clone();
+        let model = model
+            .clone()
+            .with_record_times(times.clone())
+            .expect("comparison times within the run");
         let k = model
             .nodes
             .iter()

@@ -185,8 +185,9 @@ fn error_controlled_steps_keep_the_bending_error_below_the_tolerance() {
         .collect();
     for tolerance in [1e-3, 1e-4, 1e-5] {
         let time = TimeSpec::new(3.0, 1e-3).with_tolerance(tolerance);
-        let mut model = bending_model_with(Integrator::Trapezoidal, time);
-        model.record_times = record.clone();
+        let model = bending_model_with(Integrator::Trapezoidal, time)
+            .with_record_times(record.clone())
+            .expect("record times within the run");
         let samples = run_model(&model);
         let mut compared = 0;
         let mut error: Real = 0.0;
@@ -362,8 +363,10 @@ fn error_control_sees_the_errors_made_while_nodes_are_held() {
     times.sort_by(Real::total_cmp);
     let nodes: Vec<ProbeLocation> = (0..paper.nodes.len()).map(ProbeLocation::Node).collect();
     let run = |model: &Model| {
-        let mut model = model.clone();
-        model.record_times = times.clone();
+        let model = model
+            .clone()
+            .with_record_times(times.clone())
+            .expect("record times within the run");
         let run = watched_run(&model, &nodes, None).expect("the run converges");
         assert_eq!(run.states.len(), times.len(), "every time reached");
         run

@@ -192,7 +192,7 @@ impl McapRecorder {
         let metadata: BTreeMap<String, String> = [
             ("stentkit_version", info.version.clone()),
             ("command_line", info.command_line.clone()),
-            ("design", model.name.clone()),
+            ("design", model.name().to_string()),
             ("design_file", design.path().display().to_string()),
             ("units", units.name().to_string()),
             ("length_unit", units.length().to_string()),
@@ -289,7 +289,7 @@ impl McapRecorder {
             schedule: SnapshotSchedule::new(snapshots, model),
             settings,
             thickness,
-            temperature_range: model.temperature.range(),
+            temperature_range: model.temperature().range(),
             decimals: coordinate_decimals(
                 model
                     .patches
@@ -476,7 +476,7 @@ impl McapRecorder {
     fn centreline_message(&self, sim: &Simulation<'_>, log_time: u64) -> String {
         let shapes = current_device_shapes(sim, self.settings.centreline_points);
         let (lo, hi) = self.temperature_range;
-        let color = temperature_color(sim.model().temperature.value(sim.schedule_time()), lo, hi);
+        let color = temperature_color(sim.model().temperature().value(sim.schedule_time()), lo, hi);
         let mut lines = String::new();
         for (i, (points, thickness)) in device_centrelines(sim.model(), &shapes)
             .iter()

@@ -33,6 +33,8 @@ pub type Result<T> = std::result::Result<T, BuildError>;
 /// One input of the builder.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Field {
+    /// The model's name ([`super::ModelBuilder::new`]).
+    Name,
     /// The set of patches as a whole (e.g. there is none).
     Patches,
     /// A patch added with [`super::ModelBuilder::patch`].
@@ -80,6 +82,11 @@ pub enum Field {
     },
     /// The programme ([`super::ModelBuilder::programme`]).
     Programme(ProgrammeField),
+    /// A record time given to [`super::ModelBuilder::record_times`].
+    RecordTime {
+        /// Its index in the list given.
+        index: usize,
+    },
 }
 
 /// A part of a patch.

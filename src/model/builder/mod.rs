@@ -27,7 +27,7 @@ pub mod field;
 mod nodes;
 
 pub use checks::FIT_WARNING_FRACTION;
-use checks::check_discretisation;
+use checks::{check_discretisation, check_model_name, check_temperature};
 pub use field::{
     BuildError, ConditionField, Field, NodeField, PatchField, ProbeField, ProgrammeField, Result,
     SolverField, StentField, TimeField,
@@ -39,7 +39,7 @@ use crate::geometry::analytic::ParametricCurve;
 use crate::geometry::fit::{FitSettings, fit_curve};
 use crate::geometry::stent::StentFamily;
 use crate::geometry::{GeometryError, Parameter, primitives};
-use crate::material::{ConstitutiveLaw, MaterialLaw, Section, Wlf};
+use crate::material::{ConstitutiveLaw, Integrator, MaterialLaw, MaxwellLaw, Section, Wlf};
 use crate::math::quote::quoted;
 use crate::math::{Mat3, Real, Vec3};
 use std::collections::{BTreeMap, HashMap};
@@ -449,6 +449,58 @@ impl Model {
         self.solver = solver;
         Ok(self)
     }
+
+    /// This model named `name`, checked as [`ModelBuilder::build`] checks a name: it becomes the run folder
+    /// `runs/<name>`, so it must be one plain folder name.
+    ///
+    /// # Errors
+    /// At [`Field::Name`] when `name` is not one folder name.
+    pub fn with_name(mut self, name: impl Into<String>) -> Result<Model> {
+        let name = name.into();
+        check_model_name(&name)?;
+        self.name = name;
+        Ok(self)
+    }
+
+    /// This model recording its state at `times`, checked as [`ModelBuilder::build`] checks them and held as it
+    /// holds them: each within `(0, time.end]`, then sorted and without repeats.
+    ///
+    /// # Errors
+    /// At [`Field::RecordTime`] of the first time that is not finite or not within `(0, time.end]`.
+    pub fn with_record_times(mut self, times: Vec<Real>) -> Result<Model> {
+        self.record_times = checks::record_times(&times, self.time.end)?;
+        Ok(self)
+    }
+
+    /// This model with the temperature schedule `temperature` [°C], checked as [`ModelBuilder::build`] checks
+    /// it (every value finite). With a [`Model::temperature_field`], the field stays what the material sees and
+    /// `temperature` is the schedule the reports show. (The builder's warning of a temperature at or below a WLF
+    /// singularity is not repeated here.)
+    ///
+    /// # Errors
+    /// At [`Field::Temperature`] when a value is not finite.
+    pub fn with_temperature(mut self, temperature: TimeFunction) -> Result<Model> {
+        check_temperature(&temperature)?;
+        self.temperature = temperature;
+        Ok(self)
+    }
+
+    /// This model with every viscoelastic (Maxwell) material's internal variables updated by `integrator` (an
+    /// elastic material has none), checked with the model's settings as [`ModelBuilder::build`] checks them
+    /// ([`Model::with_settings`]): error-controlled steps only where the new update has an estimate.
+    ///
+    /// # Errors
+    /// As [`Model::with_settings`]: at [`Field::Time`]`(`[`TimeField::Tolerance`]`)` when the model's steps are
+    /// error-controlled and `integrator` has no estimate ([`Integrator::companion`]).
+    pub fn with_integrator(mut self, integrator: Integrator) -> Result<Model> {
+        for law in &mut self.materials {
+            if let MaterialLaw::Maxwell(maxwell) = law {
+                *maxwell = MaxwellLaw::new(maxwell.material().clone(), integrator);
+            }
+        }
+        let (time, solver) = (self.time.clone(), self.solver.clone());
+        self.with_settings(time, solver)
+    }
 }
 
 /// How patch ends that no node names are joined.
@@ -681,7 +733,8 @@ impl ModelBuilder {
         self.probes.push((name.into(), at));
     }
 
-    /// Times within `(0, end]` at which the state is recorded; time stepping lands on each.
+    /// Times within `(0, end]` at which the state is recorded; time stepping lands on each. The model holds
+    /// them sorted and without repeats; [`ModelBuilder::build`] refuses one outside `(0, end]`.
     pub fn record_times(&mut self, times: Vec<Real>) -> &mut Self {
         self.record_times = times;
         self
@@ -696,6 +749,7 @@ impl ModelBuilder {
     /// symmetry conditions, the programme and the conditions, and checks them.
     pub fn build(&self) -> Result<Built> {
         let mut warnings = Vec::new();
+        check_model_name(&self.name)?;
         let time = self.time.settings()?;
         if let Some(why) = time.error_control_refusal(&self.materials) {
             return Err(BuildError::new(Field::Time(TimeField::Tolerance), why));
@@ -811,6 +865,7 @@ impl ModelBuilder {
                 ));
             }
         };
+        check_temperature(&temperature)?;
         for w in shifts {
             let freeze = w.frozen_below();
             let (lo, _) = match &self.temperature_field {
@@ -834,6 +889,7 @@ impl ModelBuilder {
             &nodes,
         )?;
         let probes = self.probes(&patches, &nodes)?;
+        let record_times = checks::record_times(&self.record_times, time.end)?;
         let model = Model {
             name: self.name.clone(),
             units: self.units,
@@ -851,7 +907,7 @@ impl ModelBuilder {
             node_sets,
             programme,
             symmetry_planes,
-            record_times: self.record_times.clone(),
+            record_times,
             vessel: self.vessel.clone(),
         };
         Ok(Built { model, warnings })
@@ -1285,6 +1341,131 @@ mod tests {
             .expect("a longer run");
         assert_eq!(changed.time(), &longer);
         assert_eq!(changed.solver(), model.solver());
+    }
+
+    // The setters of the name, record times, temperature and internal-variable update refuse what the builder
+    // refuses, with the builder's error (field and message), and leave a model as the builder would have made it.
+    #[test]
+    fn a_changed_name_is_checked_as_the_builder_checks_it() {
+        let model = elastic().build().expect("valid").model;
+        let refused = model
+            .clone()
+            .with_name("runs/frame")
+            .expect_err("a path, not a folder name");
+        assert_eq!(refused.field, Field::Name);
+        assert!(refused.message.contains("a path separator"), "{refused}");
+        let mut b = elastic();
+        b.name = "runs/frame".into();
+        assert_eq!(b.build().expect_err("refused"), refused);
+
+        let renamed = model.clone().with_name("frame_2").expect("a folder name");
+        assert_eq!(renamed.name(), "frame_2");
+    }
+
+    #[test]
+    fn changed_record_times_are_checked_and_held_as_the_builder_holds_them() {
+        let model = elastic().build().expect("valid").model;
+        assert_eq!(model.time().end, 1.0);
+        let beyond = vec![0.5, 1.5];
+        let refused = model
+            .clone()
+            .with_record_times(beyond.clone())
+            .expect_err("a record time beyond the end");
+        assert_eq!(refused.field, Field::RecordTime { index: 1 });
+        assert!(refused.message.contains("≤ the end time 1"), "{refused}");
+        let mut b = elastic();
+        b.record_times(beyond);
+        assert_eq!(b.build().expect_err("refused"), refused);
+        for bad in [0.0, Real::NAN, Real::INFINITY] {
+            let refused = model.clone().with_record_times(vec![bad]);
+            assert_eq!(
+                refused.expect_err("not within (0, end]").field,
+                Field::RecordTime { index: 0 },
+                "{bad}"
+            );
+        }
+
+        let times = vec![0.75, 0.25, 1.0, 0.25];
+        let changed = model
+            .clone()
+            .with_record_times(times.clone())
+            .expect("within the run");
+        assert_eq!(changed.record_times(), [0.25, 0.75, 1.0]);
+        let mut b = elastic();
+        b.record_times(times);
+        assert_eq!(b.build().expect("valid").model, changed);
+    }
+
+    #[test]
+    fn a_changed_temperature_is_checked_as_the_builder_checks_it() {
+        let model = elastic().build().expect("valid").model;
+        let refused = model
+            .clone()
+            .with_temperature(TimeFunction::constant(Real::NAN))
+            .expect_err("not a temperature");
+        assert_eq!(refused.field, Field::Temperature);
+        assert!(refused.message.contains("is not finite"), "{refused}");
+        let mut b = elastic();
+        b.temperature(TimeFunction::constant(Real::NAN));
+        assert_eq!(b.build().expect_err("refused"), refused);
+
+        let hot = TimeFunction::constant(90.0);
+        let changed = model.with_temperature(hot.clone()).expect("finite");
+        let mut b = elastic();
+        b.temperature(hot);
+        assert_eq!(b.build().expect("valid").model, changed);
+    }
+
+    #[test]
+    fn a_changed_integrator_is_checked_as_the_builder_checks_it() {
+        use crate::material::{Material, Prony, PronyBranch};
+        let maxwell = |integrator| {
+            let branch = PronyBranch {
+                modulus: 2.0e6,
+                tau_g: 0.5,
+            };
+            let prony = Prony::try_new(1.0e6, vec![branch]).expect("valid series");
+            let material = Material::try_new(prony, 0.3, None).expect("valid");
+            let section = CircularSection::try_new(0.01).expect("d > 0").into();
+            let mut b =
+                ModelBuilder::new("relaxing", MaxwellLaw::new(material, integrator), section);
+            let line = PatchShape::Line {
+                from: Vec3::zeros(),
+                to: Vec3::x(),
+            };
+            b.patch("beam", line, 3, 6);
+            b.condition(ConditionSpec::clamp("beam.start"));
+            b.time(TimeSpec::new(1.0, 0.1).with_tolerance(1e-3));
+            b
+        };
+        let model = maxwell(Integrator::Trapezoidal)
+            .build()
+            .expect("error control with the trapezoidal rule")
+            .model;
+        let refused = model
+            .clone()
+            .with_integrator(Integrator::BackwardEuler)
+            .expect_err("backward Euler has no time-error estimate");
+        assert_eq!(refused.field, Field::Time(TimeField::Tolerance));
+        assert!(
+            refused.message.contains("need `integrator: trapezoidal`"),
+            "{refused}"
+        );
+        let b = maxwell(Integrator::BackwardEuler);
+        assert_eq!(b.build().expect_err("refused"), refused);
+
+        let fixed_steps = TimeSettings {
+            tolerance: None,
+            ..model.time().clone()
+        };
+        let fixed = model.with_time(fixed_steps).expect("fixed steps");
+        let changed = fixed
+            .with_integrator(Integrator::BackwardEuler)
+            .expect("fixed steps need no estimate");
+        let MaterialLaw::Maxwell(law) = &changed.materials()[0] else {
+            panic!("a Maxwell law stays one");
+        };
+        assert_eq!(law.integrator(), Integrator::BackwardEuler);
     }
 
     #[test]

@@ -97,7 +97,7 @@ fn estimated_files(s: &Sizing<'_>) -> [(&'static str, u64); 4] {
     let stl = written("stl") * (84.0 + 50.0 * triangles);
     let obj = written("obj")
         * (OBJ_HEADER_BYTES
-            + model.name.len() as Real
+            + model.name().len() as Real
             + vertices * OBJ_VERTEX_LINE_BYTES
             + triangles * (3.0 * digits(vertices) + 5.0));
     // The field files: per collocation point three coordinates, 34 field values and a connectivity entry,

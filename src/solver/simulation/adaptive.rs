@@ -119,7 +119,7 @@ impl Simulation<'_> {
         let mut companion = Vec::new();
         let mut any = false;
         for group in &self.materials.groups {
-            let law = &model.materials[group.material];
+            let law = &model.materials()[group.material];
             let has = with_step_input(
                 model,
                 self.materials.places(),

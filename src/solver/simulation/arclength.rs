@@ -219,7 +219,7 @@ impl Simulation<'_> {
                         step: self.clock.step,
                         time: self.clock.time,
                         dt: ds,
-                        temperature: self.model.temperature.value(end_time),
+                        temperature: self.model.temperature().value(end_time),
                         newton: inc.newton,
                         cuts: std::mem::take(&mut self.clock.step_cuts),
                         error_estimate: None,

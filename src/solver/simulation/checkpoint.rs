@@ -274,7 +274,7 @@ impl Simulation<'_> {
             .iter()
             .map(|g| {
                 let mut values = Vec::new();
-                self.model.materials[g.material].save_state(&g.state, &mut values);
+                self.model.materials()[g.material].save_state(&g.state, &mut values);
                 (g.material, values)
             })
             .collect();
@@ -346,7 +346,7 @@ impl Simulation<'_> {
                 });
             }
             let mut state = group.state.clone();
-            self.model.materials[group.material]
+            self.model.materials()[group.material]
                 .restore_state(&mut state, values)
                 .map_err(|source| CheckpointError::Material {
                     material: group.material,
@@ -357,7 +357,7 @@ impl Simulation<'_> {
         for (group, state) in self.materials.groups.iter_mut().zip(states) {
             group.state = state;
         }
-        self.materials.refresh_laws(&self.model.materials);
+        self.materials.refresh_laws(self.model.materials());
         // Each term's state at the tangent's origin is checked by restoring it first (module docs of
         // `crate::solver::terms`), then the snapshot's own with every other part a step changes.
         if let Some(origin) = &checkpoint.tangent {

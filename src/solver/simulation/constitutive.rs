@@ -51,7 +51,7 @@ pub(super) fn with_step_input<R>(
     (t_n, t_np1): (Real, Real),
     f: impl FnOnce(&StepInput<'_>) -> R,
 ) -> R {
-    let temperature = |t: Real| model.temperature.value(t);
+    let temperature = |t: Real| model.temperature().value(t);
     match &model.temperature_field {
         Some(field) => {
             let at = |i: usize, t: Real| {
@@ -90,7 +90,7 @@ impl PointMaterials {
     /// The states of the model's materials at rest, and their laws before the first step.
     pub(super) fn new(model: &Model, disc: &Discretisation) -> Self {
         let mut groups: Vec<MaterialPoints> = Vec::new();
-        for (material, law) in model.materials.iter().enumerate() {
+        for (material, law) in model.materials().iter().enumerate() {
             let points: Vec<usize> = (0..disc.points.len())
                 .filter(|&g| model.patches[disc.points[g].patch].material == material)
                 .collect();
@@ -124,7 +124,7 @@ impl PointMaterials {
                 Vec::new()
             },
         };
-        out.refresh_laws(&model.materials);
+        out.refresh_laws(model.materials());
         out
     }
 
@@ -181,7 +181,7 @@ impl Simulation<'_> {
                 &materials.places,
                 &group.points,
                 (t_n, t_np1),
-                |step| model.materials[group.material].prepare_step(&mut group.state, step),
+                |step| model.materials()[group.material].prepare_step(&mut group.state, step),
             )?;
             if let Some(notice) = notice {
                 let key = (group.material, notice.kind().to_string());
@@ -191,7 +191,7 @@ impl Simulation<'_> {
                 }
             }
         }
-        materials.refresh_laws(&model.materials);
+        materials.refresh_laws(model.materials());
         SolverTiming::add(&mut self.record.timing.material, start);
         Ok(())
     }
@@ -204,7 +204,7 @@ impl Simulation<'_> {
         for group in &mut self.materials.groups {
             let points = &group.points;
             let strains = |i: usize| point_strains(disc, state, points[i]);
-            self.model.materials[group.material].commit_step(&mut group.state, &strains);
+            self.model.materials()[group.material].commit_step(&mut group.state, &strains);
         }
         // The point terms' state after the materials' (module docs of `crate::solver::terms`).
         for term in &mut self.terms {

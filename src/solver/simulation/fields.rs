@@ -216,13 +216,14 @@ impl Simulation<'_> {
                         let (x, tangent) = &self.materials.places()[g];
                         field.at(x, tangent, t).0
                     }
-                    None => model.temperature.value(t),
+                    None => model.temperature().value(t),
                 };
                 let (viscous_strain, viscous_curvature) = self
                     .materials
-                    .viscous_strains(&model.materials, g)
+                    .viscous_strains(model.materials(), g)
                     .unwrap_or_default();
-                let wlf = model.materials[model.patches[point.patch].material].temperature_shift();
+                let wlf =
+                    model.materials()[model.patches[point.patch].material].temperature_shift();
                 PointFields {
                     patch: point.patch,
                     arc_length: self.arc_lengths()[g],

@@ -228,7 +228,7 @@ impl Simulation<'_> {
                         step: self.clock.step,
                         time: target,
                         dt,
-                        temperature: self.model.temperature.value(target),
+                        temperature: self.model.temperature().value(target),
                         newton,
                         cuts,
                         error_estimate: estimate,
@@ -345,7 +345,7 @@ impl Simulation<'_> {
             "a part refused the snapshot it saved itself: {restored:?}"
         );
         self.stabiliser.damping = None;
-        self.materials.roll_back(&self.model.materials);
+        self.materials.roll_back(self.model.materials());
         let revert = match why {
             Abandon::Interrupted => self.work.tangent.revert_attempt(),
             Abandon::Rejected => {

@@ -97,12 +97,12 @@ pub fn heating_map(
         if duration < ARCH_END {
             schedule.push((ARCH_END, ARCH_COLD + ARCH_HEATING));
         }
-        let mut model = TimeVariant {
+        let model = TimeVariant {
             step: Some(h),
             ..TimeVariant::default()
         }
-        .of(&arch)?;
-        model.temperature = TimeFunction::try_table(schedule)?;
+        .of(&arch)?
+        .with_temperature(TimeFunction::try_table(schedule)?)?;
         let run = newton_run(&model)?;
         let per_step = ARCH_HEATING * h.min(duration) / duration;
         progress(&format!(
@@ -206,7 +206,7 @@ pub fn release_map(
             model = stabilised_model(model)?;
         }
         if hot {
-            model.temperature = TimeFunction::constant(HOT);
+            model = model.with_temperature(TimeFunction::constant(HOT))?;
         }
         let run = newton_run(&model)?;
         let at_release = run
