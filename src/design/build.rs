@@ -277,6 +277,9 @@ pub(crate) fn field_path(field: &Field, dto: &DesignDto) -> String {
         Field::Name => "name".into(),
         // The design's snapshot times are checked (and those at 0 dropped) before they are given.
         Field::RecordTime { .. } => "output.snapshots.times".into(),
+        // Not yet in the design language (issue 33 builds it on the builder's contact).
+        Field::Obstacle { index, .. } => format!("obstacles[{index}]"),
+        Field::ContactSettings => "contact".into(),
         Field::Patches => "patches".into(),
         Field::Patch { index, field } => {
             let base = format!("patches[{index}]");

@@ -10,11 +10,13 @@
 pub mod builder;
 pub mod cycle;
 pub mod fingerprint;
+pub(crate) mod obstacle;
 pub(crate) mod programme;
 pub(crate) mod schedule;
 pub mod stent;
 pub(crate) mod temperature;
 
+pub use obstacle::{Contact, ContactSettings, Distance, Obstacle, Surface, Wall};
 pub use programme::{DrivenNode, Programme, ProgrammeError, ProgrammeKind};
 pub use schedule::{ScheduleError, TimeFunction};
 pub use temperature::{Profile, TemperatureField};
@@ -524,6 +526,10 @@ pub struct Model {
     record_times: Vec<Real>,
     /// The vessel a stent was placed on (a centreline read from a file), for the outputs to show beside it.
     pub vessel: Option<Vessel>,
+    /// Surfaces the rods touch and the contact law (`None`: nothing to touch). Left out of the serialised
+    /// description when `None`, so the checkpoint fingerprints of models without contact stay as they were.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub contact: Option<Contact>,
 }
 
 /// A vessel segment: its smoothed centreline and, where the file gave it, the lumen radius along it.
@@ -712,6 +718,9 @@ impl Model {
             for f in load.force.iter().chain(&load.couple) {
                 times.extend(f.breakpoints());
             }
+        }
+        for obstacle in self.contact.iter().flat_map(|c| &c.obstacles) {
+            times.extend(obstacle.surface.breakpoints());
         }
         let end = self.time.end;
         times.retain(|&t| t > 0.0 && t <= end);

@@ -112,3 +112,102 @@ pub(crate) fn check_temperature(temperature: &TimeFunction) -> Result<()> {
         None => Ok(()),
     }
 }
+
+/// Checks a model's contact (the checks [`super::ModelBuilder::contact`] lists), at the obstacle and part at
+/// fault. A wire through a surface at the start is refused with where it is: the contact law would throw it out
+/// with a force of the penalty times the penetration in the first step.
+pub(crate) fn contact(contact: &crate::model::Contact, model: &crate::model::Model) -> Result<()> {
+    use super::field::ObstacleField;
+    use crate::model::{Surface, Wall};
+    let settings = &contact.settings;
+    let positive = |x: Real| x.is_finite() && x > 0.0;
+    if !(positive(settings.penalty) && positive(settings.regularisation) && positive(settings.tolerance)) {
+        return Err(BuildError::new(
+            Field::ContactSettings,
+            format!(
+                "the penalty ({}), the law's transition band ({}) and the penetration tolerance ({}) must be positive and finite",
+                settings.penalty, settings.regularisation, settings.tolerance
+            ),
+        ));
+    }
+    let wire = model
+        .patches
+        .iter()
+        .map(|p| 0.5 * model.sections[p.section].diameter())
+        .fold(0.0, Real::max);
+    for (index, obstacle) in contact.obstacles.iter().enumerate() {
+        let at = |field| Field::Obstacle { index, field };
+        if contact.obstacles[..index].iter().any(|o| o.name == obstacle.name) {
+            return Err(BuildError::new(
+                at(ObstacleField::Name),
+                format!("two obstacles are named {}: names must be unique", quoted(&obstacle.name)),
+            ));
+        }
+        let (direction, schedule) = match &obstacle.surface {
+            Surface::Cylinder { axis, radius, .. } => (axis, radius),
+            Surface::Plane { normal, offset, .. } => (normal, offset),
+        };
+        if !((direction.norm() - 1.0).abs() <= 1e-9) {
+            return Err(BuildError::new(
+                at(ObstacleField::Direction),
+                format!("the direction must be a unit vector (its length is {})", direction.norm()),
+            ));
+        }
+        if let Surface::Cylinder { .. } = obstacle.surface {
+            let (lo, _) = schedule.range();
+            if !(lo > wire) {
+                return Err(BuildError::new(
+                    at(ObstacleField::Schedule),
+                    format!(
+                        "the cylinder's radius reaches {lo}, not more than the wire's radius {wire}: no wire fits inside it"
+                    ),
+                ));
+            }
+        }
+        match obstacle.wall {
+            Wall::Rigid => {}
+            Wall::Compliant { modulus, thickness, width } => {
+                if matches!(obstacle.surface, Surface::Plane { .. }) {
+                    return Err(BuildError::new(
+                        at(ObstacleField::Wall),
+                        "a compliant wall is a thin tube (stiffness E_w h / R²): a plane's wall must be rigid".to_string(),
+                    ));
+                }
+                if !(positive(modulus) && positive(thickness) && positive(width)) {
+                    return Err(BuildError::new(
+                        at(ObstacleField::Wall),
+                        format!(
+                            "a compliant wall needs a positive modulus ({modulus}), thickness ({thickness}) and width ({width})"
+                        ),
+                    ));
+                }
+            }
+        }
+        // The wires at the start: every patch sampled densely against the surface at t = 0.
+        for patch in &model.patches {
+            let r = 0.5 * model.sections[patch.section].diameter();
+            let samples = 8 * patch.curve.num_points();
+            let (lo, hi) = patch.curve.knots().domain();
+            for i in 0..=samples {
+                let x = patch.curve.point(lo + (hi - lo) * i as Real / samples as Real);
+                let Some(d) = obstacle.surface.distance(&x, 0.0) else {
+                    continue;
+                };
+                if d.value - r < -settings.tolerance {
+                    return Err(BuildError::new(
+                        at(ObstacleField::Schedule),
+                        format!(
+                            "patch {} starts {:.4} through the surface (at {:.4}, {:.4}, {:.4}): a device must start clear of every obstacle",
+                            quoted(&patch.name),
+                            r - d.value,
+                            x.x,
+                            x.y,
+                            x.z
+                        ),
+                    ));
+                }
+            }
+        }
+    }
+    Ok(())
+}

@@ -87,6 +87,28 @@ pub enum Field {
         /// Its index in the list given.
         index: usize,
     },
+    /// An obstacle given to [`super::ModelBuilder::contact`].
+    Obstacle {
+        /// Its index in the list given.
+        index: usize,
+        /// Which part of it.
+        field: ObstacleField,
+    },
+    /// The contact law's settings given to [`super::ModelBuilder::contact`].
+    ContactSettings,
+}
+
+/// A part of an obstacle.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum ObstacleField {
+    /// Its name.
+    Name,
+    /// Its axis (a cylinder) or normal (a plane).
+    Direction,
+    /// Its radius schedule (a cylinder) or offset schedule (a plane).
+    Schedule,
+    /// Its wall.
+    Wall,
 }
 
 /// A part of a patch.

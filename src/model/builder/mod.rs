@@ -548,6 +548,8 @@ pub struct ModelBuilder {
     record_times: Vec<Real>,
     /// The vessel a stent sits on, for the outputs.
     vessel: Option<crate::model::Vessel>,
+    /// Surfaces the rods touch.
+    contact: Option<crate::model::Contact>,
 }
 
 impl ModelBuilder {
@@ -583,6 +585,7 @@ impl ModelBuilder {
             probes: Vec::new(),
             record_times: Vec::new(),
             vessel: None,
+            contact: None,
         }
     }
 
@@ -640,6 +643,15 @@ impl ModelBuilder {
     /// The vessel the stent sits on, for the outputs ([`crate::model::Vessel`]).
     pub fn vessel(&mut self, vessel: crate::model::Vessel) -> &mut Self {
         self.vessel = Some(vessel);
+        self
+    }
+
+    /// Surfaces the rods touch and the contact law ([`crate::model::Contact`]), checked when the model is built:
+    /// unique names, unit axes and normals, a positive penalty, band and tolerance, a compliant wall only on a
+    /// cylinder and with a positive modulus, thickness and width, a cylinder never narrower than a wire, and no
+    /// wire through a surface at the start.
+    pub fn contact(&mut self, contact: crate::model::Contact) -> &mut Self {
+        self.contact = Some(contact);
         self
     }
 
@@ -909,7 +921,11 @@ impl ModelBuilder {
             symmetry_planes,
             record_times,
             vessel: self.vessel.clone(),
+            contact: self.contact.clone(),
         };
+        if let Some(contact) = &model.contact {
+            checks::contact(contact, &model)?;
+        }
         Ok(Built { model, warnings })
     }
 

@@ -113,6 +113,7 @@ use super::discretisation::Discretisation;
 use super::gauge::Gauge;
 use super::linear::LinearSystem;
 use super::state::State;
+use super::terms::contact::SurfaceContact;
 use super::terms::damping::Damping;
 use super::terms::distributed::DistributedLoad;
 use super::terms::{Constraint, PointTerm, Terms};
@@ -187,7 +188,7 @@ impl<'m> Simulation<'m> {
         let mut lin = Linearisation::default();
         let actions = Actions::at(model, 0.0, &[]);
         let materials = PointMaterials::new(model, &disc);
-        let terms = registered_terms(model);
+        let terms = registered_terms(model, &disc);
         let (point, constraints) = assembly_terms(&terms, None, None);
         assembler.assemble(
             &Assembly {
@@ -348,8 +349,17 @@ impl Simulation<'_> {
 
 /// The point terms of `model` that every assembly includes, in the order they add up: the registry of
 /// [`crate::solver::terms`] (a new term is one line here).
-fn registered_terms(_model: &Model) -> Vec<Box<dyn PointTerm + Send>> {
-    vec![Box::new(DistributedLoad)]
+fn registered_terms(model: &Model, disc: &Discretisation) -> Vec<Box<dyn PointTerm + Send>> {
+    let mut terms: Vec<Box<dyn PointTerm + Send>> = vec![Box::new(DistributedLoad)];
+    if let Some(contact) = &model.contact {
+        terms.push(Box::new(SurfaceContact::new(
+            model,
+            disc,
+            contact.obstacles.clone(),
+            contact.settings,
+        )));
+    }
+    terms
 }
 
 /// The terms of one assembly: the registered ones, then the damping of stabilisation when it is on, and the

@@ -172,6 +172,25 @@ impl Simulation<'_> {
                     newton.factorisations += factorisations;
                 }
             }
+            // Augmented Lagrange: a term that enforces a condition by multipliers (contact) may ask for the
+            // converged step to be solved again with updated multipliers.
+            let mut updates = 0;
+            while let Ok(newton) = &attempt
+                && updates < self.max_augmentations()
+                && self.augment_terms()
+            {
+                updates += 1;
+                let done = (newton.iterations, newton.factorisations);
+                attempt = if observer.interrupted() {
+                    Err(NewtonFailure::Interrupted)
+                } else {
+                    self.newton(target, false, &*observer)
+                };
+                if let Ok(newton) = &mut attempt {
+                    newton.iterations += done.0;
+                    newton.factorisations += done.1;
+                }
+            }
             // Error control: a converged step whose time-error estimate exceeds the tolerance is rejected and
             // retried shorter (module `adaptive`), unless it is already the smallest step.
             let mut estimate = None;
@@ -366,6 +385,22 @@ impl Simulation<'_> {
     }
 
     /// Forgets every factorisation (the next Newton iteration assembles and factorises afresh).
+    /// The most augmented-Lagrange updates of a step over the point terms ([`crate::solver::terms::PointTerm::max_augmentations`]).
+    fn max_augmentations(&self) -> usize {
+        self.terms.iter().map(|t| t.max_augmentations()).max().unwrap_or(0)
+    }
+
+    /// Lets every point term update its multipliers at the converged state ([`crate::solver::terms::PointTerm::augment`]); whether
+    /// any did (then the step is solved again).
+    fn augment_terms(&mut self) -> bool {
+        let (disc, state) = (&self.disc, &self.solution.state);
+        let mut any = false;
+        for term in &mut self.terms {
+            any |= term.augment(disc, state);
+        }
+        any
+    }
+
     pub(super) fn forget_factorisation(&mut self) {
         self.work.system.invalidate();
         if let Some((_, system, _)) = &mut self.releases.gauge {

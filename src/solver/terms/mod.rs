@@ -57,6 +57,7 @@
 //! is the example: the module, and `sim.add_term(Box::new(SpringToGround { … }))` in the test of a bar on a
 //! foundation against its closed form.
 
+pub mod contact;
 pub mod damping;
 pub mod distributed;
 #[cfg(test)]
@@ -81,6 +82,23 @@ pub trait PointTerm: Sync {
     /// Adds this term's concentrated load on a node through one of its patch ends (and, when `at.tangent`, its
     /// derivatives). The default adds nothing.
     fn end(&self, _at: &PointView<'_>, _load: &mut EndLoad) {}
+
+    /// A step (or an attempt at one) to time `t` begins: a term that depends on time (a moving surface) takes
+    /// it here. The default ignores it.
+    fn prepare(&mut self, _t: Real) {}
+
+    /// A step converged at `state`, not yet committed: a term that enforces a condition by augmented-Lagrange
+    /// updates (contact) updates its multipliers and returns `true` if the step must be solved again with them,
+    /// at most [`PointTerm::max_augmentations`] times per step. What it changes is part of its saved state
+    /// ([`PointTerm::save`]), so a roll-back of the step undoes it. The default changes nothing.
+    fn augment(&mut self, _disc: &Discretisation, _state: &State) -> bool {
+        false
+    }
+
+    /// The most augmented-Lagrange updates per step ([`PointTerm::augment`]; the default: none).
+    fn max_augmentations(&self) -> usize {
+        0
+    }
 
     /// A step converged at `state`: the term updates what it keeps between steps (module docs). The default
     /// keeps nothing.

@@ -1,6 +1,7 @@
 //! The generic central-difference test of every term's tangent, a check that it fails for a term with a wrong
 //! tangent, and the spring to ground against a closed form.
 
+use super::contact::SurfaceContact;
 use super::damping::Damping;
 use super::distributed::DistributedLoad;
 use super::spring::SpringToGround;
@@ -103,6 +104,46 @@ fn spring() -> SpringToGround {
     }
 }
 
+/// Contact of the test structure with a compliant cylinder around the arc's centre and a rigid plane under it, placed so that
+/// at the deformed state of the tests some points are clear, some in the law's quadratic band and some on its
+/// linear branch (the three branches and the cylinder's curvature term all enter the tangent). Forces of the
+/// order of the structure's own residual terms.
+fn contact(model: &Model, disc: &Discretisation) -> SurfaceContact {
+    use crate::model::{ContactSettings, Obstacle, Surface, Wall};
+    let constant = TimeFunction::constant;
+    let obstacles = vec![
+        Obstacle {
+            name: "cylinder".into(),
+            surface: Surface::Cylinder {
+                point: Vec3::new(0.0, 1.0, 0.0),
+                axis: Vec3::new(0.2, 0.0, 1.0).normalize(),
+                radius: constant(1.02),
+            },
+            wall: Wall::Compliant {
+                modulus: 1e4,
+                thickness: 0.1,
+                width: 0.2,
+            },
+        },
+        Obstacle {
+            name: "plane".into(),
+            surface: Surface::Plane {
+                point: Vec3::zeros(),
+                normal: Vec3::new(0.1, 0.0, 1.0).normalize(),
+                offset: constant(-0.1),
+            },
+            wall: Wall::Rigid,
+        },
+    ];
+    let settings = ContactSettings {
+        penalty: 1e3,
+        regularisation: 0.06,
+        tolerance: 1e-3,
+        max_updates: 5,
+    };
+    SurfaceContact::new(model, disc, obstacles, settings)
+}
+
 /// The gauge of the tests: a translation and a rotation-like row on the free end of the leg (node 2) and the
 /// clamped start of the arc (node 0, whose prescribed components take no multiplier force), with origins off
 /// the reference so that the rows' residuals are not zero.
@@ -144,7 +185,8 @@ fn every_terms_tangent_matches_central_differences() {
     };
     let spring = spring();
     let gauge = gauge();
-    let point_terms: [&dyn PointTerm; 3] = [&DistributedLoad, &damping, &spring];
+    let contact = contact(&model, &disc);
+    let point_terms: [&dyn PointTerm; 4] = [&DistributedLoad, &damping, &spring, &contact];
     for term in point_terms {
         let (worst, report) = term_tangent_error(
             &model,
