@@ -524,6 +524,11 @@ pub struct Model {
     record_times: Vec<Real>,
     /// The vessel a stent was placed on (a centreline read from a file), for the outputs to show beside it.
     pub vessel: Option<Vessel>,
+    /// The patches (indices into `patches`) that connect the crowns of a generated stent, as its family says
+    /// (`StentFamily::is_connector`: the ring family's bridges), for advice that names them. A label, not
+    /// mechanics: left out of the serialised description (the checkpoint fingerprint).
+    #[serde(skip)]
+    pub connectors: Vec<usize>,
 }
 
 /// A vessel segment: its smoothed centreline and, where the file gave it, the lumen radius along it.
