@@ -261,7 +261,8 @@ fn report(
     // the table shows "—".
     let mut csv = format!(
         "# case: {} ({})\n# results err against: {against}\nrun,tolerance,tuned_to,wall_s,steps,newton_iterations",
-        model.name, case.design
+        model.name(),
+        case.design
     );
     let mut head = "| run | wall s | steps | Newton its |".to_string();
     for q in &case.quantities {
@@ -346,7 +347,7 @@ fn report(
     if std::env::var_os("STENTKIT_WRITE_ASSETS").is_some() {
         let path = root
             .join("assets/adaptive")
-            .join(format!("{}.csv", model.name));
+            .join(format!("{}.csv", model.name()));
         std::fs::create_dir_all(path.parent().expect("a folder"))
             .expect("assets/adaptive is writable");
         std::fs::write(&path, csv).expect("the asset is writable");

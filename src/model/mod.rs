@@ -530,6 +530,11 @@ pub struct Model {
     /// description when `None`, so the checkpoint fingerprints of models without contact stay as they were.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub contact: Option<Contact>,
+    /// The patches (indices into `patches`) that connect the crowns of a generated stent, as its family says
+    /// (`StentFamily::is_connector`: the ring family's bridges), for advice that names them. A label, not
+    /// mechanics: left out of the serialised description (the checkpoint fingerprint).
+    #[serde(skip)]
+    pub connectors: Vec<usize>,
 }
 
 /// A vessel segment: its smoothed centreline and, where the file gave it, the lumen radius along it.

@@ -1052,13 +1052,14 @@ fn suggestions(model: &crate::model::Model, failure: &FailureReport) -> Vec<Stri
         )),
     }
     // The patch of the worst equation, as `describe_row` quotes it.
-    let patch = failure.worst_equation.as_deref().and_then(|w| {
+    let worst = failure.worst_equation.as_deref().and_then(|w| {
         model
             .patches
             .iter()
-            .find(|p| w.contains(&format!("`{}`", p.name)))
+            .position(|p| w.contains(&format!("`{}`", p.name)))
     });
-    if let Some(patch) = patch {
+    if let Some(index) = worst {
+        let patch = &model.patches[index];
         let d = model.sections[patch.section].diameter();
         if patch
             .fit_error
@@ -1071,11 +1072,8 @@ fn suggestions(model: &crate::model::Model, failure: &FailureReport) -> Vec<Stri
                 100.0 * patch.fit_error.unwrap_or(0.0) / d
             ));
         }
-        // A generated stent's bridges are `b<crown>_<k>` (geometry::stent::bridges).
-        let bridge = model.programme.is_some()
-            && patch.name.starts_with('b')
-            && patch.name[1..].starts_with(|c: char| c.is_ascii_digit());
-        if bridge {
+        // A connector of a generated stent (its family's bridges) under a programme.
+        if model.programme.is_some() && model.connectors.contains(&index) {
             out.push(format!(
                 "stiffer or shorter bridges: the largest residual is on bridge `{}`, and slender bridges buckle into loops under the programme (straight bridges, a smaller `stent.bridges.amplitude`, a thicker `section`)",
                 patch.name

@@ -791,6 +791,13 @@ impl ModelBuilder {
             )?),
             None => None,
         };
+        // The generated patches come first in the model: a connector's index there is its index in the stent.
+        let connectors = stent.as_ref().map_or_else(Vec::new, |s| {
+            (s.geometry.patches.iter().enumerate())
+                .filter(|(_, g)| s.family.is_connector(&g.role))
+                .map(|(k, _)| k)
+                .collect()
+        });
         // The stent's fitted patches and nodes move into the model; its geometry stays for the programme.
         let generated = stent
             .as_mut()
@@ -922,6 +929,7 @@ impl ModelBuilder {
             record_times,
             vessel: self.vessel.clone(),
             contact: self.contact.clone(),
+            connectors,
         };
         if let Some(contact) = &model.contact {
             checks::contact(contact, &model)?;
