@@ -121,7 +121,10 @@ pub(crate) fn contact(contact: &crate::model::Contact, model: &crate::model::Mod
     use crate::model::{Surface, Wall};
     let settings = &contact.settings;
     let positive = |x: Real| x.is_finite() && x > 0.0;
-    if !(positive(settings.penalty) && positive(settings.regularisation) && positive(settings.tolerance)) {
+    if !(positive(settings.penalty)
+        && positive(settings.regularisation)
+        && positive(settings.tolerance))
+    {
         return Err(BuildError::new(
             Field::ContactSettings,
             format!(
@@ -137,10 +140,16 @@ pub(crate) fn contact(contact: &crate::model::Contact, model: &crate::model::Mod
         .fold(0.0, Real::max);
     for (index, obstacle) in contact.obstacles.iter().enumerate() {
         let at = |field| Field::Obstacle { index, field };
-        if contact.obstacles[..index].iter().any(|o| o.name == obstacle.name) {
+        if contact.obstacles[..index]
+            .iter()
+            .any(|o| o.name == obstacle.name)
+        {
             return Err(BuildError::new(
                 at(ObstacleField::Name),
-                format!("two obstacles are named {}: names must be unique", quoted(&obstacle.name)),
+                format!(
+                    "two obstacles are named {}: names must be unique",
+                    quoted(&obstacle.name)
+                ),
             ));
         }
         let (direction, schedule) = match &obstacle.surface {
@@ -150,7 +159,10 @@ pub(crate) fn contact(contact: &crate::model::Contact, model: &crate::model::Mod
         if !((direction.norm() - 1.0).abs() <= 1e-9) {
             return Err(BuildError::new(
                 at(ObstacleField::Direction),
-                format!("the direction must be a unit vector (its length is {})", direction.norm()),
+                format!(
+                    "the direction must be a unit vector (its length is {})",
+                    direction.norm()
+                ),
             ));
         }
         if let Surface::Cylinder { .. } = obstacle.surface {
@@ -166,7 +178,11 @@ pub(crate) fn contact(contact: &crate::model::Contact, model: &crate::model::Mod
         }
         match obstacle.wall {
             Wall::Rigid => {}
-            Wall::Compliant { modulus, thickness, width } => {
+            Wall::Compliant {
+                modulus,
+                thickness,
+                width,
+            } => {
                 if matches!(obstacle.surface, Surface::Plane { .. }) {
                     return Err(BuildError::new(
                         at(ObstacleField::Wall),
@@ -189,7 +205,9 @@ pub(crate) fn contact(contact: &crate::model::Contact, model: &crate::model::Mod
             let samples = 8 * patch.curve.num_points();
             let (lo, hi) = patch.curve.knots().domain();
             for i in 0..=samples {
-                let x = patch.curve.point(lo + (hi - lo) * i as Real / samples as Real);
+                let x = patch
+                    .curve
+                    .point(lo + (hi - lo) * i as Real / samples as Real);
                 let Some(d) = obstacle.surface.distance(&x, 0.0) else {
                     continue;
                 };

@@ -387,7 +387,11 @@ impl Simulation<'_> {
     /// Forgets every factorisation (the next Newton iteration assembles and factorises afresh).
     /// The most augmented-Lagrange updates of a step over the point terms ([`crate::solver::terms::PointTerm::max_augmentations`]).
     fn max_augmentations(&self) -> usize {
-        self.terms.iter().map(|t| t.max_augmentations()).max().unwrap_or(0)
+        self.terms
+            .iter()
+            .map(|t| t.max_augmentations())
+            .max()
+            .unwrap_or(0)
     }
 
     /// Lets every point term update its multipliers at the converged state ([`crate::solver::terms::PointTerm::augment`]); whether

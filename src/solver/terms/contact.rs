@@ -43,7 +43,10 @@ fn ramp(x: Real, delta: Real) -> (Real, Real) {
     } else if x >= delta {
         (x, 1.0)
     } else {
-        ((x + delta) * (x + delta) / (4.0 * delta), (x + delta) / (2.0 * delta))
+        (
+            (x + delta) * (x + delta) / (4.0 * delta),
+            (x + delta) / (2.0 * delta),
+        )
     }
 }
 
@@ -75,7 +78,12 @@ pub struct SurfaceContact {
 
 impl SurfaceContact {
     /// The contact of `model`'s rods with `obstacles` under `settings`, multipliers zero, surfaces at `t = 0`.
-    pub fn new(model: &Model, disc: &Discretisation, obstacles: Vec<Obstacle>, settings: ContactSettings) -> Self {
+    pub fn new(
+        model: &Model,
+        disc: &Discretisation,
+        obstacles: Vec<Obstacle>,
+        settings: ContactSettings,
+    ) -> Self {
         let radius = model
             .patches
             .iter()
@@ -234,8 +242,9 @@ mod tests {
     use crate::math::{Real, Vec3};
     use crate::model::builder::{ConditionSpec, ModelBuilder, PatchShape, TimeSpec};
     use crate::model::{Contact, ContactSettings, Model, Obstacle, Surface, TimeFunction, Wall};
+    use crate::solver::Simulation;
     use crate::solver::discretisation::point_position;
-    use crate::solver::{NoObserver, Simulation};
+    use crate::solver::simulation::NoObserver;
     use std::f64::consts::FRAC_PI_2;
 
     /// Reference radius, wire diameter, Young's modulus of the ring tests.
@@ -284,21 +293,23 @@ mod tests {
             surface: Surface::Cylinder {
                 point: Vec3::zeros(),
                 axis: Vec3::z(),
-                radius: TimeFunction::try_table(vec![(0.0, from), (1.0, to)]).expect("increasing times"),
+                radius: TimeFunction::try_table(vec![(0.0, from), (1.0, to)])
+                    .expect("increasing times"),
             },
             wall,
         }
     }
 
     /// Runs the quarter ring inside `obstacle` to t = 1; returns the collocation points' distances from the
-    /// axis and the hoop force at the end on y = 0 (the y component of the force the rod exerts on that node).
+    /// axis and the y component of the force the rod's start (on y = 0) exerts on its node.
     fn crimp(obstacle: Obstacle, settings: ContactSettings) -> (Vec<Real>, Real) {
         let model = quarter_ring(Contact {
             obstacles: vec![obstacle],
             settings,
         });
         let mut sim = Simulation::new(&model).expect("discretised");
-        sim.run(&mut [&mut NoObserver]).expect("the crimp converges");
+        sim.run(&mut [&mut NoObserver])
+            .expect("the crimp converges");
         let disc = sim.discretisation();
         let radii = (0..disc.points.len())
             .map(|g| {
@@ -346,9 +357,11 @@ mod tests {
         let rho = radii.iter().sum::<Real>() / radii.len() as Real;
         let area = std::f64::consts::PI * D * D / 4.0;
         let expected = E * area * (rho / R0 - 1.0);
+        // The rod's start pushes on its node with σ N t, σ = −1 and t = +y there: −N in y.
         assert!(
-            (hoop - expected).abs() <= 1e-7 * expected.abs(),
-            "hoop force {hoop}, closed form {expected}"
+            (hoop + expected).abs() <= 1e-7 * expected.abs(),
+            "hoop force {} against the closed form {expected}",
+            -hoop
         );
     }
 

@@ -144,6 +144,53 @@ fn contact(model: &Model, disc: &Discretisation) -> SurfaceContact {
     SurfaceContact::new(model, disc, obstacles, settings)
 }
 
+/// The contact of the tangent test acts where it should be tested: at the deformed state some interior points
+/// are clear of both surfaces, some in the law's quadratic band and some on its linear branch, and both
+/// obstacles press on some point (else the central-difference comparison would check nothing of it).
+#[test]
+fn the_tangent_tests_contact_covers_every_branch_of_its_law() {
+    let model = test_model();
+    let disc = Discretisation::new(&model).expect("discretisation");
+    let contact = contact(&model, &disc);
+    let state = deformed_state(&disc, 0);
+    let (mut clear, mut band, mut linear) = (0, 0, 0);
+    let mut pressed = [false; 2];
+    for (g, point) in disc.points.iter().enumerate() {
+        if disc.is_end(g) {
+            continue;
+        }
+        let x = crate::solver::discretisation::point_position(&disc, &state.control, g);
+        for (k, pressed) in pressed.iter_mut().enumerate() {
+            let Some(c) = contact.at(k, g, point.patch, &x) else {
+                continue;
+            };
+            *pressed |= c.pressure > 0.0;
+            if c.stiffness == 0.0 {
+                clear += 1;
+            } else if c.stiffness > -contact_penalty(&contact, k) {
+                band += 1;
+            } else {
+                linear += 1;
+            }
+        }
+    }
+    assert!(
+        clear > 0 && band > 0 && linear > 0,
+        "clear {clear}, band {band}, linear {linear}"
+    );
+    assert_eq!(pressed, [true, true]);
+}
+
+/// The penalty obstacle `k` of the test's contact uses (its line stiffness, for the compliant cylinder).
+fn contact_penalty(contact: &SurfaceContact, k: usize) -> Real {
+    let obstacle = &contact.obstacles()[k];
+    obstacle
+        .surface
+        .radius(0.0)
+        .and_then(|r| obstacle.wall.line_stiffness(r))
+        .unwrap_or(1e3)
+}
+
 /// The gauge of the tests: a translation and a rotation-like row on the free end of the leg (node 2) and the
 /// clamped start of the arc (node 0, whose prescribed components take no multiplier force), with origins off
 /// the reference so that the rows' residuals are not zero.
