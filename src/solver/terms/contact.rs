@@ -111,7 +111,7 @@ impl SurfaceContact {
 
     /// The penalty and multiplier of obstacle `k` at point `g` (a compliant wall: its line stiffness, no
     /// multiplier).
-    fn law(&self, k: usize, g: usize) -> (Real, Real) {
+    pub(crate) fn law(&self, k: usize, g: usize) -> (Real, Real) {
         let obstacle = &self.obstacles[k];
         match obstacle
             .surface
