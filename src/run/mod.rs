@@ -469,7 +469,7 @@ impl Outputs<'_> {
             summary.above_limit = st.above_limit(settings);
         }
         s.warnings.clone_from(&self.design_warnings);
-        s.warnings.extend(sim.stabilisation_warnings());
+        s.warnings.extend(sim.warnings());
         s.final_time = sim.time();
         for recorder in &self.recorders {
             recorder.summarise(s, sim);
@@ -803,14 +803,15 @@ fn run_in(
     }]);
     summary.summary.timing.run_s = run_started.elapsed().as_secs_f64();
     outputs.console.end(&sim);
-    // What the result must be read with: the stabilisation above its limit, and a device that ended heated but
+    // What the result must be read with: the stabilisation above its limit, a term's own (contact above its
+    // penetration tolerance), and a device that ended heated but
     // not recovered (a completed run only). Said here and in summary.json's `warnings`, whatever the status.
     let recovered = result
         .as_ref()
         .is_ok_and(|s| !s.stopped && sim.is_finished())
         .then(|| crate::post::recovery::recovery_warning(&sim))
         .flatten();
-    for warning in sim.stabilisation_warnings().iter().chain(&recovered) {
+    for warning in sim.warnings().iter().chain(&recovered) {
         outputs.console.say(&format!("warning: {warning}"));
     }
 

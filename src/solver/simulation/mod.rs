@@ -247,6 +247,17 @@ impl Simulation<'_> {
         self.forget_factorisation();
     }
 
+    /// What the result must be read with: the stabilisation above its limit
+    /// ([`Simulation::stabilisation_warnings`]) and each point term's own (contact left above its penetration
+    /// tolerance).
+    pub fn warnings(&self) -> Vec<String> {
+        let mut out = self.stabilisation_warnings();
+        for term in &self.terms {
+            out.extend(term.warnings());
+        }
+        out
+    }
+
     /// Messages worth telling the user, each added once (e.g. that relaxation froze below `Tg − C2`), in the
     /// order they arose.
     pub fn notices(&self) -> &[String] {

@@ -173,13 +173,10 @@ impl Simulation<'_> {
                 }
             }
             // Augmented Lagrange: a term that enforces a condition by multipliers (contact) may ask for the
-            // converged step to be solved again with updated multipliers.
-            let mut updates = 0;
+            // converged step to be solved again with updated multipliers (each term bounds its own updates).
             while let Ok(newton) = &attempt
-                && updates < self.max_augmentations()
                 && self.augment_terms()
             {
-                updates += 1;
                 let done = (newton.iterations, newton.factorisations);
                 attempt = if observer.interrupted() {
                     Err(NewtonFailure::Interrupted)
@@ -385,15 +382,6 @@ impl Simulation<'_> {
     }
 
     /// Forgets every factorisation (the next Newton iteration assembles and factorises afresh).
-    /// The most augmented-Lagrange updates of a step over the point terms ([`crate::solver::terms::PointTerm::max_augmentations`]).
-    fn max_augmentations(&self) -> usize {
-        self.terms
-            .iter()
-            .map(|t| t.max_augmentations())
-            .max()
-            .unwrap_or(0)
-    }
-
     /// Lets every point term update its multipliers at the converged state ([`crate::solver::terms::PointTerm::augment`]); whether
     /// any did (then the step is solved again).
     fn augment_terms(&mut self) -> bool {

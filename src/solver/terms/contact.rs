@@ -23,9 +23,11 @@
 //!
 //! **Augmented Lagrange (Uzawa).** After a step converged, if the largest penetration at a rigid wall exceeds
 //! the settings' tolerance, every point's multiplier becomes its pressure, `λ ← p(g)`, and the step is solved
-//! again from where it converged ([`PointTerm::augment`]); at most `max_updates` times. The multipliers are the
-//! term's state: they start the next step where this one left them, a roll-back restores them, a checkpoint
-//! keeps them.
+//! again from where it converged ([`PointTerm::augment`]); at most `max_updates` times. If the penetration is
+//! still above the tolerance then, the step is kept and the run's warnings say so (how many steps, the largest
+//! penetration, when first: [`PointTerm::warnings`], into summary.json and on stderr). The multipliers, the
+//! step's update count and that record are the term's state: the multipliers start the next step where this one
+//! left them, a roll-back restores all three, a checkpoint keeps them.
 //!
 //! **Switching in and out.** The law is C¹, so Newton sees a continuous tangent as points enter and leave
 //! contact within the transition band `2δ`.
@@ -74,6 +76,19 @@ pub struct SurfaceContact {
     time: Real,
     /// Augmented-Lagrange multipliers per obstacle and collocation point \[force/length\].
     multipliers: Vec<Vec<Real>>,
+    /// Augmented-Lagrange updates made in the step being solved.
+    updates: usize,
+    /// Steps kept with the penetration above the tolerance after every update: how many, the largest
+    /// penetration, the first step's time.
+    unresolved: Unresolved,
+}
+
+/// Steps that ran out of augmented-Lagrange updates (module docs).
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+struct Unresolved {
+    steps: usize,
+    largest: Real,
+    first: Real,
 }
 
 impl SurfaceContact {
@@ -96,17 +111,14 @@ impl SurfaceContact {
             radius,
             time: 0.0,
             multipliers,
+            updates: 0,
+            unresolved: Unresolved::default(),
         }
     }
 
     /// The obstacles.
     pub fn obstacles(&self) -> &[Obstacle] {
         &self.obstacles
-    }
-
-    /// The multipliers of obstacle `k` per collocation point \[force/length\].
-    pub fn multipliers(&self, k: usize) -> &[Real] {
-        &self.multipliers[k]
     }
 
     /// The penalty and multiplier of obstacle `k` at point `g` (a compliant wall: its line stiffness, no
@@ -139,10 +151,16 @@ impl SurfaceContact {
         })
     }
 
-    /// The largest penetration (most negative gap, as a positive length; 0 if none) at the interior collocation
-    /// points of `state` (where the law acts), over the rigid obstacles.
-    pub fn largest_rigid_penetration(&self, disc: &Discretisation, state: &State) -> Real {
+    /// The largest penetration at the rigid walls (most negative gap, as a positive length; 0 if none) over
+    /// the interior collocation points of `state` (where the law acts), and each such point's pressure
+    /// `(obstacle, point, p)`.
+    fn rigid_contact(
+        &self,
+        disc: &Discretisation,
+        state: &State,
+    ) -> (Real, Vec<(usize, usize, Real)>) {
         let mut worst: Real = 0.0;
+        let mut pressures = Vec::new();
         for (k, obstacle) in self.obstacles.iter().enumerate() {
             if obstacle.wall != Wall::Rigid {
                 continue;
@@ -152,12 +170,12 @@ impl SurfaceContact {
                     continue;
                 }
                 let x = point_position(disc, &state.control, g);
-                if let Some(c) = self.at(k, g, point.patch, &x) {
-                    worst = worst.max(-c.gap);
-                }
+                let c = self.at(k, g, point.patch, &x);
+                worst = worst.max(c.map_or(0.0, |c| -c.gap));
+                pressures.push((k, g, c.map_or(0.0, |c| c.pressure)));
             }
         }
-        worst
+        (worst, pressures)
     }
 }
 
@@ -186,46 +204,70 @@ impl PointTerm for SurfaceContact {
 
     fn prepare(&mut self, t: Real) {
         self.time = t;
+        self.updates = 0;
     }
 
     fn augment(&mut self, disc: &Discretisation, state: &State) -> bool {
-        if self.largest_rigid_penetration(disc, state) <= self.settings.tolerance {
+        let (worst, pressures) = self.rigid_contact(disc, state);
+        if worst <= self.settings.tolerance {
             return false;
         }
-        for k in 0..self.obstacles.len() {
-            if self.obstacles[k].wall != Wall::Rigid {
-                continue;
+        if self.updates == self.settings.max_updates {
+            let u = &mut self.unresolved;
+            if u.steps == 0 {
+                u.first = self.time;
             }
-            for (g, point) in disc.points.iter().enumerate() {
-                if disc.is_end(g) {
-                    continue;
-                }
-                let x = point_position(disc, &state.control, g);
-                let pressure = self.at(k, g, point.patch, &x).map_or(0.0, |c| c.pressure);
-                self.multipliers[k][g] = pressure;
-            }
+            u.steps += 1;
+            u.largest = u.largest.max(worst);
+            return false;
+        }
+        self.updates += 1;
+        for (k, g, pressure) in pressures {
+            self.multipliers[k][g] = pressure;
         }
         true
     }
 
-    fn max_augmentations(&self) -> usize {
-        self.settings.max_updates
+    fn warnings(&self) -> Vec<String> {
+        let u = &self.unresolved;
+        if u.steps == 0 {
+            return Vec::new();
+        }
+        vec![format!(
+            "contact: in {} step(s) the penetration stayed above its tolerance {:e} after {} augmented-Lagrange update(s), by up to {:.3e} (first at t = {}): raise `max_updates` or the penalty",
+            u.steps, self.settings.tolerance, self.settings.max_updates, u.largest, u.first
+        )]
     }
 
     fn save(&self, out: &mut Vec<Real>) {
-        out.push(self.time);
+        let u = &self.unresolved;
+        out.extend([
+            self.time,
+            self.updates as Real,
+            u.steps as Real,
+            u.largest,
+            u.first,
+        ]);
         for m in &self.multipliers {
             out.extend_from_slice(m);
         }
     }
 
     fn restore(&mut self, values: &[Real]) -> Result<(), usize> {
-        let expected = 1 + self.multipliers.iter().map(Vec::len).sum::<usize>();
+        const HEAD: usize = 5;
+        let expected = HEAD + self.multipliers.iter().map(Vec::len).sum::<usize>();
         if values.len() != expected {
             return Err(expected);
         }
+        // Counts are saved as reals: exact below 2^53.
         self.time = values[0];
-        let mut rest = &values[1..];
+        self.updates = values[1] as usize;
+        self.unresolved = Unresolved {
+            steps: values[2] as usize,
+            largest: values[3],
+            first: values[4],
+        };
+        let mut rest = &values[HEAD..];
         for m in &mut self.multipliers {
             let (mine, tail) = rest.split_at(m.len());
             m.copy_from_slice(mine);
@@ -301,8 +343,9 @@ mod tests {
     }
 
     /// Runs the quarter ring inside `obstacle` to t = 1; returns the collocation points' distances from the
-    /// axis and the y component of the force the rod's start (on y = 0) exerts on its node.
-    fn crimp(obstacle: Obstacle, settings: ContactSettings) -> (Vec<Real>, Real) {
+    /// axis, the y component of the force the rod's start (on y = 0) exerts on its node, and the run's
+    /// warnings.
+    fn crimp(obstacle: Obstacle, settings: ContactSettings) -> (Vec<Real>, Real, Vec<String>) {
         let model = quarter_ring(Contact {
             obstacles: vec![obstacle],
             settings,
@@ -323,7 +366,7 @@ mod tests {
             .position(|n| n.name == "ring.start")
             .expect("node at the start");
         let hoop = sim.node_end_resultants(start)[0].0.y;
-        (radii, hoop)
+        (radii, hoop, sim.warnings())
     }
 
     /// Source: a Simo–Reissner ring of reference radius `R0` pressed uniformly to radius `ρ` keeps its
@@ -345,7 +388,8 @@ mod tests {
             max_updates: 10,
         };
         let crimped = R0 + r - 0.5;
-        let (radii, hoop) = crimp(cylinder(R0 + r + 0.2, crimped, Wall::Rigid), settings);
+        let (radii, hoop, warnings) = crimp(cylinder(R0 + r + 0.2, crimped, Wall::Rigid), settings);
+        assert!(warnings.is_empty(), "{warnings:?}");
         let target = crimped - r;
         for (g, rho) in radii.iter().enumerate() {
             assert!(
@@ -363,6 +407,35 @@ mod tests {
             "hoop force {} against the closed form {expected}",
             -hoop
         );
+    }
+
+    /// The same crimp without augmented-Lagrange updates: the penalty alone leaves a penetration of about
+    /// `q/ε ≈ 1e-3` in every step of contact, above the 1e-6 tolerance, and the run says so in its warnings
+    /// instead of completing silently; the warning names the largest penetration, which lies between the
+    /// tolerance and the penalty's estimate with a margin of ten (q ≈ 0.98 at the end, ε = 1e3).
+    #[test]
+    fn a_crimp_left_above_its_penetration_tolerance_is_warned_about() {
+        let r = D / 2.0;
+        let settings = ContactSettings {
+            penalty: 1e3,
+            regularisation: 1e-4,
+            tolerance: 1e-6,
+            max_updates: 0,
+        };
+        let (_, _, warnings) = crimp(cylinder(R0 + r + 0.2, R0 + r - 0.5, Wall::Rigid), settings);
+        assert_eq!(warnings.len(), 1, "{warnings:?}");
+        assert!(
+            warnings[0].contains("penetration stayed above its tolerance"),
+            "{}",
+            warnings[0]
+        );
+        let largest: Real = warnings[0]
+            .split("by up to ")
+            .nth(1)
+            .and_then(|t| t.split_whitespace().next())
+            .and_then(|t| t.parse().ok())
+            .expect("the largest penetration in the warning");
+        assert!((1e-4..1e-2).contains(&largest), "{largest}");
     }
 
     /// Source: the same ring pressed into a compliant tube: the wall is a foundation of line stiffness
@@ -388,7 +461,7 @@ mod tests {
             width,
         };
         let tube = R0 + r - 0.5;
-        let (radii, _) = crimp(cylinder(R0 + r + 0.2, tube, wall), settings);
+        let (radii, _, _) = crimp(cylinder(R0 + r + 0.2, tube, wall), settings);
         let area = std::f64::consts::PI * D * D / 4.0;
         let ring = E * area / (R0 * R0);
         let k = modulus * thickness * width / (tube * tube);

@@ -88,16 +88,18 @@ pub trait PointTerm: Sync {
     fn prepare(&mut self, _t: Real) {}
 
     /// A step converged at `state`, not yet committed: a term that enforces a condition by augmented-Lagrange
-    /// updates (contact) updates its multipliers and returns `true` if the step must be solved again with them,
-    /// at most [`PointTerm::max_augmentations`] times per step. What it changes is part of its saved state
-    /// ([`PointTerm::save`]), so a roll-back of the step undoes it. The default changes nothing.
+    /// updates (contact) updates its multipliers and returns `true` if the step must be solved again with them.
+    /// The term bounds its own updates per step (counted from [`PointTerm::prepare`]) and, when they run out
+    /// with the condition still violated, says so in [`PointTerm::warnings`]. What it changes is part of its
+    /// saved state ([`PointTerm::save`]), so a roll-back of the step undoes it. The default changes nothing.
     fn augment(&mut self, _disc: &Discretisation, _state: &State) -> bool {
         false
     }
 
-    /// The most augmented-Lagrange updates per step ([`PointTerm::augment`]; the default: none).
-    fn max_augmentations(&self) -> usize {
-        0
+    /// What the run's result must be read with, from this term (e.g. contact left above its tolerance); the
+    /// default: nothing.
+    fn warnings(&self) -> Vec<String> {
+        Vec::new()
     }
 
     /// A step converged at `state`: the term updates what it keeps between steps (module docs). The default
