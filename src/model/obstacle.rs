@@ -87,13 +87,14 @@ impl Surface {
                 let d = x - point;
                 let perp = d - axis * axis.dot(&d);
                 let rho = perp.norm();
-                if rho <= Real::EPSILON * radius.value(t).abs().max(1.0) {
+                let r = radius.value(t);
+                if rho <= Real::EPSILON * r.abs().max(1.0) {
                     return None;
                 }
                 let e = perp / rho;
                 let projector = Mat3::identity() - axis * axis.transpose() - e * e.transpose();
                 Some(Distance {
-                    value: radius.value(t) - rho,
+                    value: r - rho,
                     normal: -e,
                     hessian: -projector / rho,
                 })

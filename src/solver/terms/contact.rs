@@ -372,8 +372,8 @@ mod tests {
     /// Source: a Simo–Reissner ring of reference radius `R0` pressed uniformly to radius `ρ` keeps its
     /// curvature per reference length (`2π` over `2π R0`) and stretches its centreline by `ρ/R0`: hoop force
     /// `N = EA (ρ/R0 − 1)`, no moment change, and equilibrium of a piece, `N' + q = 0` per reference length with
-    /// `|t'| = 1/R0`, gives the line pressure `q = −N/R0` (derived in the module docs of the issue's
-    /// verification; the uniform moment `EI(1/ρ − 1/R0)` of an inextensible reading does not enter it). Here: a
+    /// `|t'| = 1/R0`, gives the line pressure `q = −N/R0` (derived here; a uniform moment, such as the
+    /// `EI(1/ρ − 1/R0)` of an inextensible reading, has no derivative and does not enter it). Here: a
     /// rigid crimper shrinks from a clear 0.2 to 0.5 below the wire's reach (5 % hoop strain); augmented
     /// Lagrange must bring the penetration below its tolerance 1e-6 (the penalty alone leaves
     /// `q/ε ≈ 1e-3`), the points stay on one circle (uniform pressure), and the hoop force is the closed form's
