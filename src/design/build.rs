@@ -23,7 +23,8 @@ use crate::model::builder::*;
 use crate::model::temperature::FieldError;
 use crate::model::*;
 
-fn time_function(f: &TimeFn, path: &str) -> Result<TimeFunction> {
+/// A design function of time as a model's, its table's errors at `path`.
+pub(crate) fn time_function(f: &TimeFn, path: &str) -> Result<TimeFunction> {
     match f {
         TimeFn::Constant(v) => Ok(TimeFunction::constant(*v)),
         TimeFn::Table(points) => {
@@ -102,6 +103,9 @@ pub(crate) fn build(dto: &DesignDto, default_name: &str, temporary_shape: bool) 
     }
     if let Some(p) = &dto.programme {
         builder.programme(stent::programme(p, metres_per_unit)?);
+    }
+    if let Some(c) = super::contact::contact(dto, section.diameter())? {
+        builder.contact(c);
     }
     if temporary_shape {
         builder.temporary_shape();
@@ -277,9 +281,31 @@ pub(crate) fn field_path(field: &Field, dto: &DesignDto) -> String {
         Field::Name => "name".into(),
         // The design's snapshot times are checked (and those at 0 dropped) before they are given.
         Field::RecordTime { .. } => "output.snapshots.times".into(),
-        // Not yet in the design language (issue 33 builds it on the builder's contact).
-        Field::Obstacle { index, .. } => format!("obstacles[{index}]"),
-        Field::ContactSettings => "contact".into(),
+        Field::Obstacle { index, field } => {
+            let base = format!("obstacles[{index}]");
+            // The obstacles after the design's are a crimp programme's crimper.
+            let Some(o) = dto.obstacles.get(index) else {
+                return "programme".into();
+            };
+            let shape = if o.cylinder.is_some() {
+                "cylinder"
+            } else {
+                "plane"
+            };
+            match field {
+                ObstacleField::Name => format!("{base}.name"),
+                ObstacleField::Direction if o.cylinder.is_some() => format!("{base}.cylinder.axis"),
+                ObstacleField::Direction => format!("{base}.plane.normal"),
+                ObstacleField::Schedule if o.cylinder.is_some() => {
+                    format!("{base}.cylinder.radius")
+                }
+                ObstacleField::Schedule => format!("{base}.plane.offset"),
+                ObstacleField::Wall if o.wall.is_some() => format!("{base}.wall"),
+                ObstacleField::Wall => format!("{base}.{shape}"),
+            }
+        }
+        Field::ContactSettings if dto.contact.is_some() => "contact".into(),
+        Field::ContactSettings => "obstacles".into(),
         Field::Patches => "patches".into(),
         Field::Patch { index, field } => {
             let base = format!("patches[{index}]");

@@ -304,6 +304,12 @@ pub struct DesignDto {
     /// A temperature that varies in space along an axis: schedules at stations, or a moving front.
     #[serde(default)]
     pub temperature_field: Option<TemperatureFieldDto>,
+    /// Surfaces the rods touch: crimpers, sheaths, plates (module docs of `crate::model::obstacle`).
+    #[serde(default)]
+    pub obstacles: Vec<ObstacleDto>,
+    /// How contact with the obstacles is enforced (defaults from the design's material and wire).
+    #[serde(default)]
+    pub contact: Option<ContactDto>,
     /// Time stepping.
     pub time: TimeDto,
     /// Newton settings.
@@ -312,6 +318,91 @@ pub struct DesignDto {
     /// Outputs.
     #[serde(default)]
     pub output: Option<OutputDto>,
+}
+
+/// An obstacle: a named surface (give exactly one of `cylinder` or `plane`) with its wall and the times it
+/// acts between.
+#[derive(Debug, Clone, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct ObstacleDto {
+    /// Unique name (history columns, messages); `crimper` is taken by a crimp programme's.
+    pub name: String,
+    /// A circular cylinder that keeps the rods inside it (a crimper, a sheath, a tube).
+    #[serde(default)]
+    pub cylinder: Option<CylinderDto>,
+    /// A plane that keeps the rods on the side its normal points to (a crush plate, a table).
+    #[serde(default)]
+    pub plane: Option<PlaneDto>,
+    /// A compliant wall (a thin elastic tube acting as a radial foundation of stiffness `E h / R²`); without
+    /// it the wall is rigid.
+    #[serde(default)]
+    pub wall: Option<WallDto>,
+    /// The time it is put in place \[time\]: it acts after it (default 0, from the start).
+    #[serde(default)]
+    pub from: Option<NonNegative>,
+    /// The time it is withdrawn \[time\] (default: never).
+    #[serde(default)]
+    pub until: Option<Positive>,
+}
+
+/// A cylinder obstacle.
+#[derive(Debug, Clone, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct CylinderDto {
+    /// A point of its axis \[length\].
+    pub point: Vector,
+    /// Direction of its axis (normalised when read).
+    pub axis: Vector,
+    /// Its radius \[length\]: a number or a table `[[t, r], …]` (a crimper closes and opens).
+    pub radius: TimeFn,
+}
+
+/// A plane obstacle.
+#[derive(Debug, Clone, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct PlaneDto {
+    /// A point of the plane \[length\].
+    pub point: Vector,
+    /// Its normal, pointing to the rods' side (normalised when read).
+    pub normal: Vector,
+    /// Its displacement along the normal \[length\]: a number or a table `[[t, s], …]` (default 0).
+    #[serde(default)]
+    pub offset: Option<TimeFn>,
+}
+
+/// A compliant wall: a thin tube of Young's modulus `E`, thickness and the width of wall each unit length of
+/// wire carries.
+#[derive(Debug, Clone, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct WallDto {
+    /// Young's modulus of the wall \[stress\].
+    #[serde(rename = "E")]
+    pub modulus: Option<Positive>,
+    /// Wall thickness \[length\].
+    #[serde(default)]
+    pub thickness: Option<Positive>,
+    /// Width of wall per unit length of wire \[length\] (default: the wire's diameter).
+    #[serde(default)]
+    pub width: Option<Positive>,
+}
+
+/// The contact law's settings (every one optional).
+#[derive(Debug, Clone, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct ContactDto {
+    /// Penalty \[force/length²\]: line force per unit wire length per unit penetration (default: the design
+    /// material's instantaneous modulus `E_inf + Σ E_α`).
+    #[serde(default)]
+    pub penalty: Option<Positive>,
+    /// Width of the law's quadratic transition \[length\] (default: a tenth of `tolerance`).
+    #[serde(default)]
+    pub regularisation: Option<Positive>,
+    /// Largest penetration a step may keep \[length\] (default: 1 % of the wire diameter).
+    #[serde(default)]
+    pub tolerance: Option<Positive>,
+    /// Most augmented-Lagrange updates per step (default 10).
+    #[serde(default)]
+    pub max_updates: Option<usize>,
 }
 
 /// Material block.
@@ -1188,19 +1279,21 @@ pub enum ProgrammeKindDto {
     RadialContraction,
     /// `η = P_temp − P_0`.
     TargetShape,
+    /// A crimper closes on the device to a radial contraction `Δr`, holds, and opens at the release.
+    Crimp,
 }
 
 /// The `programme:` block.
 #[derive(Debug, Clone, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct ProgrammeDto {
-    /// `radial_contraction` or `target_shape`.
+    /// `radial_contraction`, `target_shape` or `crimp`.
     pub kind: ProgrammeKindDto,
     /// The driven node set (default `all_joints`): `all_joints`, `crests`, `troughs`, `crown_<k>` (k = 1, 2, …
     /// along the centreline), `bridge_ends` or `symmetry`.
     #[serde(default)]
     pub nodes: Option<String>,
-    /// Radial contraction `Δr` \[length\] (radial_contraction).
+    /// Radial contraction `Δr` \[length\] (radial_contraction, crimp).
     #[serde(default)]
     pub delta_r: Option<Positive>,
     /// The temporary placement (target_shape).
@@ -1208,9 +1301,12 @@ pub struct ProgrammeDto {
     pub temporary: Option<TemporaryDto>,
     /// Ramp `[start, end]` \[time\]: the target is reached linearly over it and then held.
     pub ramp: [NonNegative; 2],
-    /// Release time \[time\]: the driven components become free (default: never).
+    /// Release time \[time\]: the driven components become free, or the crimper opens (default: never).
     #[serde(default)]
     pub release: Option<NonNegative>,
+    /// Time a crimper takes to open from the release \[time\] (crimp; default a tenth of the ramp).
+    #[serde(default)]
+    pub open: Option<Positive>,
 }
 
 /// The temporary placement of a target-shape programme.

@@ -13,6 +13,7 @@
 //! see it as an `crate::io::output::RunDesign`.
 
 pub(crate) mod build;
+mod contact;
 mod diamond;
 pub(crate) mod dto;
 pub(crate) mod family;

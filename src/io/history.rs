@@ -201,10 +201,7 @@ impl HistoryWriter {
         }
         if let Some(programme) = &sim.model().programme {
             header.push_str(",recovery_ratio_mean,recovery_ratio_max");
-            if matches!(
-                programme.kind,
-                crate::model::ProgrammeKind::RadialContraction { .. }
-            ) {
+            if programme.is_radial() {
                 header.push_str(",delta_r");
             }
             let model = sim.model();

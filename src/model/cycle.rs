@@ -3,13 +3,14 @@
 //! these events ([`crate::io::snapshots`]), and `stentkit export --phase` finds its state by them.
 //!
 //! A model has a cycle when something that drives it is let go: a prescribed component with a `release` (a
-//! programme's driven nodes, or any condition written with one), or a load that returns to zero and stays
-//! there (the cantilever of paper §4.2, programmed by a tip force and moment). Then
+//! programme's driven nodes, or any condition written with one), a load that returns to zero and stays
+//! there (the cantilever of paper §4.2, programmed by a tip force and moment), or a crimper that opens. Then
 //!
 //! * **fixed** is the earliest let-go: a release time, or the start of a load's last descent to zero (the
 //!   device is still held in its programmed shape, cooled or not);
 //! * **released** is the latest end of one: a release time plus the release ramp
-//!   ([`super::TimeSettings::release_ramp`]), or the time a load reaches zero for good;
+//!   ([`super::TimeSettings::release_ramp`]), the time a load reaches zero for good, or the end of a crimper's
+//!   opening (a crimper is let go when it starts to open at the programme's release);
 //! * **programmed** is the last time before *fixed* at which one of those drives changed slope: the end of the
 //!   programme's ramp (the paper's t = 1 s), or the end of the load's rise. A drive held from the start has
 //!   none.
@@ -127,6 +128,21 @@ fn load_let_go(f: &TimeFunction) -> Option<(Real, Real)> {
 }
 
 impl Model {
+    /// A crimper programme's let-go: the crimper opening from the release, with its radius schedule (whose
+    /// breakpoints before the release are the programming).
+    fn crimper_let_go(&self) -> Option<((Real, Real), &TimeFunction)> {
+        let programme = self.programme.as_ref()?;
+        let super::ProgrammeKind::Crimp { obstacle, open, .. } = programme.kind else {
+            return None;
+        };
+        let release = programme.release?;
+        let crimper = self.contact.as_ref()?.obstacles.get(obstacle)?;
+        let super::Surface::Cylinder { radius, .. } = &crimper.surface else {
+            return None;
+        };
+        Some(((release, release + open), radius))
+    }
+
     /// The model's shape-memory cycle, if it has one (see [`crate::model::cycle`]). An arc-length path has
     /// none: its `time` is the path parameter.
     pub fn cycle(&self) -> Option<Cycle> {
@@ -144,6 +160,7 @@ impl Model {
                     .flat_map(|l| l.force.iter().chain(&l.couple))
                     .filter_map(|f| load_let_go(f).map(|times| (times, f))),
             )
+            .chain(self.crimper_let_go())
             .collect::<Vec<_>>();
         let fixed = drives.iter().map(|((f, _), _)| *f).reduce(Real::min)?;
         let released = drives.iter().map(|((_, r), _)| *r).reduce(Real::max)?;

@@ -725,7 +725,7 @@ impl Model {
             }
         }
         for obstacle in self.contact.iter().flat_map(|c| &c.obstacles) {
-            times.extend(obstacle.surface.breakpoints());
+            times.extend(obstacle.breakpoints());
         }
         let end = self.time.end;
         times.retain(|&t| t > 0.0 && t <= end);

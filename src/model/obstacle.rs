@@ -26,6 +26,39 @@ pub struct Obstacle {
     pub surface: Surface,
     /// Rigid, or a compliant wall.
     pub wall: Wall,
+    /// The times it acts between, `(from, until)`: from just after `from` (an obstacle put in place at
+    /// `from`, such as a vessel the programmed device is deployed in, or a sheath put over it) to `until`
+    /// (withdrawn; `None`: never). `(0, None)` acts over the whole run.
+    pub active: (Real, Option<Real>),
+}
+
+impl Obstacle {
+    /// An obstacle acting over the whole run.
+    pub fn new(name: impl Into<String>, surface: Surface, wall: Wall) -> Self {
+        Self {
+            name: name.into(),
+            surface,
+            wall,
+            active: (0.0, None),
+        }
+    }
+
+    /// Whether it acts in a step ending at `t`: after `from` (from the start, the initial state included, when
+    /// `from` is 0), up to and including `until`.
+    pub fn is_active(&self, t: Real) -> bool {
+        let (from, until) = self.active;
+        (from <= 0.0 || t > from) && until.is_none_or(|u| t <= u)
+    }
+
+    /// The times at which its surface's schedule changes its rate or it is put in place or withdrawn (time
+    /// stepping lands on them).
+    pub fn breakpoints(&self) -> Vec<Real> {
+        let (from, until) = self.active;
+        let mut times = self.surface.breakpoints();
+        times.extend((from > 0.0).then_some(from));
+        times.extend(until);
+        times
+    }
 }
 
 /// The geometry of an obstacle.

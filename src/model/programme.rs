@@ -26,6 +26,19 @@ pub enum ProgrammeKind {
     },
     /// The displacement to a temporary placement, `η_temp = P_temp − P_0`.
     TargetShape,
+    /// A crimper: a cylinder around the stent axis (the model's contact obstacle `obstacle`) closes until the
+    /// wires' reach is `R − Δr`, holds, and opens over `open` from the release. Nothing is prescribed: the
+    /// temporary shape is what contact makes it, and the targets are the nominal `−Δr e_r` of a radial
+    /// contraction (the recovery measures' reference). The device is free from the start, its rigid-body
+    /// motion fixed by the gauge constraints (`crate::solver::gauge`).
+    Crimp {
+        /// Nominal radial contraction `Δr` \[length\], `0 < Δr < R`.
+        delta_r: Real,
+        /// Index of the crimper in the model's contact obstacles.
+        obstacle: usize,
+        /// Time the crimper takes to open from the release \[time\].
+        open: Real,
+    },
 }
 
 /// One driven node.
@@ -90,6 +103,30 @@ pub enum ProgrammeError {
 pub(crate) const SYMMETRY_TOLERANCE: Real = 1e-9;
 
 impl Programme {
+    /// Whether it prescribes its driven nodes (a crimper drives them through contact instead).
+    pub fn prescribes(&self) -> bool {
+        !matches!(self.kind, ProgrammeKind::Crimp { .. })
+    }
+
+    /// Whether its target is a radial contraction of the driven nodes (by prescription or by a crimper), whose
+    /// mean radial displacement the outputs report as the paper's Δr.
+    pub fn is_radial(&self) -> bool {
+        matches!(
+            self.kind,
+            ProgrammeKind::RadialContraction { .. } | ProgrammeKind::Crimp { .. }
+        )
+    }
+
+    /// The time from which the device is free and its rigid-body motion is fixed by gauge constraints: the
+    /// release for a programme that prescribes its nodes, the start for a crimper (`None`: never released).
+    pub fn free_from(&self) -> Option<Real> {
+        if self.prescribes() {
+            self.release
+        } else {
+            Some(0.0)
+        }
+    }
+
     /// The ramp factor `f(t)`: 0 before `ramp.0`, linear to 1 at `ramp.1`, 1 after.
     pub fn factor(&self) -> TimeFunction {
         TimeFunction::try_table(vec![(self.ramp.0, 0.0), (self.ramp.1, 1.0)])

@@ -8,7 +8,8 @@
 use super::builder::checks::{FIT_WARNING_FRACTION, check_discretisation};
 use super::builder::field::{BuildError, Field, ProgrammeField, Result, StentField};
 use super::{
-    Component, DrivenNode, End, Node, NodeConditions, Patch, PatchEnd, Programme, ProgrammeKind,
+    Component, DrivenNode, End, Node, NodeConditions, Obstacle, Patch, PatchEnd, Programme,
+    ProgrammeKind, TimeFunction,
 };
 use crate::geometry::GeometryError;
 use crate::geometry::fit::{FitSettings, best_fit_rigid, fit_curve};
@@ -63,6 +64,14 @@ pub enum ProgrammeTarget {
     RadialContraction {
         /// Radius change Δr \[length\], `0 < Δr < R`.
         delta_r: Real,
+    },
+    /// A crimper closes on the device until the wires' reach is `R − Δr` (`R` the largest crown radius) over the
+    /// ramp, holds, and opens over `open` from the release ([`crate::model::ProgrammeKind::Crimp`]).
+    Crimp {
+        /// Nominal radius change Δr \[length\], `0 < Δr < R`.
+        delta_r: Real,
+        /// Time the crimper takes to open \[time\], > 0.
+        open: Real,
     },
     /// Every driven node moves to its place in a temporary shape of the same crowns (paper §4.3, curved
     /// stent).
@@ -120,7 +129,8 @@ impl ProgrammeSpec {
     /// shrinks every crown by Δr; a target shape is its `temporary` placement.
     pub fn placement(&self) -> Placement {
         match &self.target {
-            ProgrammeTarget::RadialContraction { delta_r } => (
+            ProgrammeTarget::RadialContraction { delta_r }
+            | ProgrammeTarget::Crimp { delta_r, .. } => (
                 TemporarySpec {
                     centreline: crate::geometry::stent::TemporaryCentreline::Same,
                     radius: None,
@@ -491,7 +501,8 @@ pub fn programme(
     // Δr must stay below the smallest crown radius.
     let radius = stent.family.radius_range().0;
     let (kind, targets): (ProgrammeKind, Vec<Vec3>) = match &spec.target {
-        &ProgrammeTarget::RadialContraction { delta_r } => {
+        &ProgrammeTarget::RadialContraction { delta_r }
+        | &ProgrammeTarget::Crimp { delta_r, .. } => {
             if !(delta_r > 0.0 && delta_r.is_finite()) {
                 return Err(BuildError::new(
                     at(ProgrammeField::DeltaR),
@@ -506,8 +517,25 @@ pub fn programme(
                     ),
                 ));
             }
+            let kind = match spec.target {
+                ProgrammeTarget::Crimp { open, .. } => {
+                    if !(open > 0.0 && open.is_finite()) {
+                        return Err(BuildError::new(
+                            at(ProgrammeField::Whole),
+                            format!("the crimper's opening time {open} must be > 0 and finite"),
+                        ));
+                    }
+                    // The crimper is the model's last obstacle: the builder appends it (`crimper`).
+                    ProgrammeKind::Crimp {
+                        delta_r,
+                        obstacle: usize::MAX,
+                        open,
+                    }
+                }
+                _ => ProgrammeKind::RadialContraction { delta_r },
+            };
             (
-                ProgrammeKind::RadialContraction { delta_r },
+                kind,
                 geometry.nodes.iter().map(|n| -n.radial * delta_r).collect(),
             )
         }
@@ -557,8 +585,84 @@ pub fn programme(
         ramp: (t0, t1),
         release: spec.release,
     };
-    programme
-        .apply(nodes)
-        .map_err(|e| BuildError::new(at(ProgrammeField::Temporary), e.to_string()))?;
+    if programme.prescribes() {
+        programme
+            .apply(nodes)
+            .map_err(|e| BuildError::new(at(ProgrammeField::Temporary), e.to_string()))?;
+    }
     Ok(programme)
+}
+
+/// The crimper of a crimp programme ([`crate::model::ProgrammeKind::Crimp`]): a rigid cylinder around the stent's
+/// straight axis whose radius starts 2 % clear of the device's outermost wire (the patches sampled at eight
+/// points per control point), holds there until the ramp starts, closes linearly over the ramp until the wires'
+/// reach is `R − Δr` (`R` the largest crown radius; its radius `R − Δr + d/2`, `d` the thickest wire), holds
+/// until the release and opens back over `open`. A crimper is a straight cylinder: a stent on a curved
+/// centreline is refused.
+pub fn crimper(
+    programme: &Programme,
+    stent: &GeneratedStent,
+    patches: &[Patch],
+    sections: &[Section],
+) -> Result<Obstacle> {
+    let at = || Field::Programme(ProgrammeField::Whole);
+    let ProgrammeKind::Crimp { delta_r, open, .. } = programme.kind else {
+        return Err(BuildError::new(at(), "not a crimp programme"));
+    };
+    let nodes = &stent.geometry.nodes;
+    let Some(first) = nodes.first() else {
+        return Err(BuildError::new(at(), "the stent has no nodes"));
+    };
+    let (point, axis) = (first.axis_point, first.axis_tangent.normalize());
+    let scale = stent.family.radius_range().1;
+    let off_axis = |x: &Vec3| {
+        let d = x - point;
+        (d - axis * axis.dot(&d)).norm()
+    };
+    if nodes.iter().any(|n| {
+        n.axis_tangent.normalize().cross(&axis).norm() > 1e-9
+            || off_axis(&n.axis_point) > 1e-9 * scale
+    }) {
+        return Err(BuildError::new(
+            at(),
+            "a crimper is a straight cylinder: `kind: crimp` needs a stent on a straight centreline",
+        ));
+    }
+    let mut reach: Real = 0.0;
+    let mut wire: Real = 0.0;
+    for patch in patches {
+        let r = 0.5 * sections[patch.section].diameter();
+        wire = wire.max(r);
+        let samples = 8 * patch.curve.num_points();
+        let (lo, hi) = patch.curve.knots().domain();
+        for i in 0..=samples {
+            let x = patch
+                .curve
+                .point(lo + (hi - lo) * i as Real / samples as Real);
+            reach = reach.max(off_axis(&x) + r);
+        }
+    }
+    let start = 1.02 * reach;
+    let closed = stent.family.radius_range().1 - delta_r + wire;
+    let (t0, t1) = programme.ramp;
+    let mut table = Vec::new();
+    if t0 > 0.0 {
+        table.push((0.0, start));
+    }
+    table.extend([(t0, start), (t1, closed)]);
+    if let Some(r) = programme.release {
+        table.extend([(r, closed), (r + open, start)]);
+    }
+    table.dedup_by(|b, a| a.0 == b.0 && a.1 == b.1);
+    let radius = TimeFunction::try_table(table)
+        .map_err(|e| BuildError::new(Field::Programme(ProgrammeField::Release), e.to_string()))?;
+    Ok(Obstacle::new(
+        "crimper",
+        crate::model::Surface::Cylinder {
+            point,
+            axis,
+            radius,
+        },
+        crate::model::Wall::Rigid,
+    ))
 }

@@ -4,7 +4,7 @@
 //! and `sweep` judge by them.
 
 use crate::math::{Real, Vec3};
-use crate::model::{ProbeLocation, ProgrammeKind};
+use crate::model::ProbeLocation;
 use crate::solver::Simulation;
 
 /// Recovery measures of a programme (DESIGN §7; paper §4.3).
@@ -35,7 +35,8 @@ pub fn recovery(sim: &Simulation<'_>) -> Option<Recovery> {
     Some(Recovery {
         ratio_mean: programme.target_fraction(&u),
         ratio_max: programme.target_fraction_max(&u),
-        delta_r: matches!(programme.kind, ProgrammeKind::RadialContraction { .. })
+        delta_r: programme
+            .is_radial()
             .then(|| -programme.mean_radial_displacement(&u)),
         by_material: model
             .material_regions()

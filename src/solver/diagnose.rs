@@ -134,7 +134,8 @@ pub(crate) struct FreeBody {
 }
 
 /// The parts of the model that no condition holds: connected components of the patch–node graph none of whose
-/// nodes prescribes any component (at any time). Each can translate as a rigid body, so the tangent is singular
+/// nodes prescribes any component (at any time) or is held by gauge constraints from the start (a crimper's
+/// driven nodes). Each can translate as a rigid body, so the tangent is singular
 /// whatever the loads. (A part held by too few components — say one translation — is not found here; its
 /// singular tangent shows as a non-finite Newton increment on its patches.)
 pub(crate) fn free_bodies(model: &Model) -> Vec<FreeBody> {
@@ -157,12 +158,20 @@ pub(crate) fn free_bodies(model: &Model) -> Vec<FreeBody> {
         }
     }
     let mut held = vec![false; np];
-    for node in &model.nodes {
-        let prescribed = node
-            .conditions
-            .components
-            .iter()
-            .any(|c| matches!(c, Component::Prescribed { .. }));
+    // A device free from the start (a crimper's) is held by its gauge constraints on the driven nodes.
+    let gauged: Vec<usize> = model
+        .programme
+        .iter()
+        .filter(|p| p.free_from() == Some(0.0))
+        .flat_map(|p| p.nodes.iter().map(|d| d.node))
+        .collect();
+    for (k, node) in model.nodes.iter().enumerate() {
+        let prescribed = gauged.contains(&k)
+            || node
+                .conditions
+                .components
+                .iter()
+                .any(|c| matches!(c, Component::Prescribed { .. }));
         if prescribed && let Some(e) = node.ends.first() {
             let r = root(&mut parent, e.patch);
             held[r] = true;

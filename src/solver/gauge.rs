@@ -17,6 +17,10 @@
 //! self-equilibrated device their converged values are zero (sum the equilibrium rows: `λ Σ w_l = 0`), so the
 //! constraints fix the placement without changing the deformation.
 //!
+//! A device programmed by a crimper (`crate::model::ProgrammeKind::Crimp`) is free from the start: nothing
+//! holds it but contact, which fixes no rigid mode along the crimper's axis; its gauge acts from the first step,
+//! freezing the reference placement.
+//!
 //! The gauge is a [`Constraint`] ([`crate::solver::terms`]): the assembly writes its rows and the multipliers'
 //! forces; the simulation builds it at the release and keeps its frozen positions (in its checkpoints too).
 

@@ -174,10 +174,7 @@ pub(super) fn state_schema(model: &Model, channels: &[LoadChannel], keys: &State
             "recovery_ratio_max".into(),
             num("largest |η| / |η_temp| over the driven nodes".into()),
         );
-        if matches!(
-            p.kind,
-            crate::model::ProgrammeKind::RadialContraction { .. }
-        ) {
+        if p.is_radial() {
             map.insert(
                 "delta_r".into(),
                 num(format!(

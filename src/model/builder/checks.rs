@@ -199,8 +199,9 @@ pub(crate) fn contact(contact: &crate::model::Contact, model: &crate::model::Mod
                 }
             }
         }
-        // The wires at the start: every patch sampled densely against the surface at t = 0.
-        for patch in &model.patches {
+        // The wires at the start: every patch sampled densely against the surface at t = 0 (an obstacle put
+        // in place later is checked by the solver when it is: `crate::solver::terms::contact`).
+        for patch in model.patches.iter().filter(|_| obstacle.is_active(0.0)) {
             let r = 0.5 * model.sections[patch.section].diameter();
             let samples = 8 * patch.curve.num_points();
             let (lo, hi) = patch.curve.knots().domain();

@@ -29,8 +29,8 @@ mod nodes;
 pub use checks::FIT_WARNING_FRACTION;
 use checks::{check_discretisation, check_model_name, check_temperature};
 pub use field::{
-    BuildError, ConditionField, Field, NodeField, PatchField, ProbeField, ProgrammeField, Result,
-    SolverField, StentField, TimeField,
+    BuildError, ConditionField, Field, NodeField, ObstacleField, PatchField, ProbeField,
+    ProgrammeField, Result, SolverField, StentField, TimeField,
 };
 
 use super::stent::{self as stent_model, ProgrammeSpec, StentMesh};
@@ -851,7 +851,7 @@ impl ModelBuilder {
                 };
                 let programme =
                     stent_model::programme(p, stent, &mut nodes, time.end, &mut warnings)?;
-                for d in &programme.nodes {
+                for d in programme.nodes.iter().filter(|_| programme.prescribes()) {
                     for i in 0..3 {
                         preset
                             .entry((d.node, i))
@@ -909,6 +909,22 @@ impl ModelBuilder {
         )?;
         let probes = self.probes(&patches, &nodes)?;
         let record_times = checks::record_times(&self.record_times, time.end)?;
+        // A crimper programme's crimper is the last obstacle.
+        let mut contact = self.contact.clone();
+        let mut programme = programme;
+        if let (Some(p), Some(s)) = (programme.as_mut(), &stent)
+            && let ProgrammeKind::Crimp { obstacle, .. } = &mut p.kind
+        {
+            let Some(c) = contact.as_mut() else {
+                return Err(BuildError::new(
+                    Field::Programme(ProgrammeField::Whole),
+                    "a crimper programme needs the contact settings (`ModelBuilder::contact`, a design's `contact:`)",
+                ));
+            };
+            *obstacle = c.obstacles.len();
+            c.obstacles
+                .push(stent_model::crimper(p, s, &patches, &sections)?);
+        }
         let model = Model {
             name: self.name.clone(),
             units: self.units,
@@ -928,7 +944,7 @@ impl ModelBuilder {
             symmetry_planes,
             record_times,
             vessel: self.vessel.clone(),
-            contact: self.contact.clone(),
+            contact,
             connectors,
         };
         if let Some(contact) = &model.contact {

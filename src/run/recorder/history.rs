@@ -71,16 +71,7 @@ fn row_bytes(model: &Model, strain_limits: &[Option<Real>]) -> Real {
     let limits = strain_limits.iter().flatten().count() as Real;
     let peaks = 16.0 + 17.0 + name + 1.0 + 17.0 + 17.0 * limits;
     let recovery = match &model.programme {
-        Some(p) => {
-            36.0 + if matches!(
-                p.kind,
-                crate::model::ProgrammeKind::RadialContraction { .. }
-            ) {
-                18.0
-            } else {
-                0.0
-            }
-        }
+        Some(p) => 36.0 + if p.is_radial() { 18.0 } else { 0.0 },
         None => 0.0,
     };
     17.0 + 60.0 * model.probes.len() as Real + 11.0 + 3.0 + 11.0 + 3.0 + recovery + peaks + 1.0

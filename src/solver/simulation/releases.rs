@@ -127,10 +127,11 @@ impl Simulation<'_> {
         }
     }
 
-    /// Activates the gauge constraints for a step ending at `t_np1` once the programme's release has happened by
-    /// then (building them, and their extended system, the first time), and deactivates them otherwise.
+    /// Activates the gauge constraints for a step ending at `t_np1` once the programme has let the device free by
+    /// then (its release, or the start for a crimper: [`crate::model::Programme::free_from`]; building them, and
+    /// their extended system, the first time), and deactivates them otherwise.
     pub(super) fn set_gauge(&mut self, t_np1: Real) -> Result<(), SolverError> {
-        let release = self.model.programme.as_ref().and_then(|p| p.release);
+        let release = self.model.programme.as_ref().and_then(|p| p.free_from());
         let active = release.is_some_and(|r| r <= t_np1);
         if active && self.releases.gauge.is_none() {
             let positions: Vec<Vec3> = (0..self.model.nodes.len())

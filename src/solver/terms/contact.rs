@@ -29,6 +29,12 @@
 //! step's update count and that record are the term's state: the multipliers start the next step where this one
 //! left them, a roll-back restores all three, a checkpoint keeps them.
 //!
+//! **Obstacles put in place later** ([`crate::model::Obstacle::active`]: a sheath, a vessel the programmed
+//! device is deployed in) are checked when they arrive: at the converged state of the step that ends at their
+//! `from`, a wire deeper through the surface than the tolerance is recorded (the deepest: which obstacle,
+//! when, where) and said in the run's warnings — the law would push it out in one step, which is not a
+//! deployment. (Obstacles in place from the start are checked by the model's builder, located in the design.)
+//!
 //! **Switching in and out.** The law is C¹, so Newton sees a continuous tangent as points enter and leave
 //! contact within the transition band `2δ`.
 
@@ -81,6 +87,19 @@ pub struct SurfaceContact {
     /// Steps kept with the penetration above the tolerance after every update: how many, the largest
     /// penetration, the first step's time.
     unresolved: Unresolved,
+    /// Obstacles put in place (after the start) through the wires: how many, and the deepest.
+    placed: Placed,
+}
+
+/// Obstacles put in place through the wires (module docs): how many, and where the deepest went in.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+struct Placed {
+    count: usize,
+    /// The deepest penetration \[length\], the obstacle's index, the time, and the point.
+    largest: Real,
+    obstacle: usize,
+    time: Real,
+    at: Vec3,
 }
 
 /// Steps that ran out of augmented-Lagrange updates (module docs).
@@ -113,6 +132,7 @@ impl SurfaceContact {
             multipliers,
             updates: 0,
             unresolved: Unresolved::default(),
+            placed: Placed::default(),
         }
     }
 
@@ -136,9 +156,14 @@ impl SurfaceContact {
     }
 
     /// The contact of the point at `x` on patch `patch` (collocation point `g`) with obstacle `k`; `None` where
-    /// the surface has no normal there (a cylinder's axis).
+    /// the surface has no normal there (a cylinder's axis) and while the obstacle is not in place
+    /// ([`Obstacle::is_active`]).
     pub fn at(&self, k: usize, g: usize, patch: usize, x: &Vec3) -> Option<PointContact> {
-        let distance = self.obstacles[k].surface.distance(x, self.time)?;
+        let obstacle = &self.obstacles[k];
+        if !obstacle.is_active(self.time) {
+            return None;
+        }
+        let distance = obstacle.surface.distance(x, self.time)?;
         let gap = distance.value - self.radius[patch];
         let (penalty, multiplier) = self.law(k, g);
         let delta = 0.5 * self.settings.regularisation;
@@ -202,6 +227,38 @@ impl PointTerm for SurfaceContact {
         }
     }
 
+    fn commit(&mut self, disc: &Discretisation, state: &State) {
+        // An obstacle put in place at this step's end must find the wires clear of it (module docs).
+        let t = self.time;
+        for (k, obstacle) in self.obstacles.iter().enumerate() {
+            let from = obstacle.active.0;
+            if !(from > 0.0 && (from - t).abs() <= 1e-9 * from.max(1.0)) {
+                continue;
+            }
+            let mut deepest: Option<(Real, Vec3)> = None;
+            for (g, point) in disc.points.iter().enumerate() {
+                if disc.is_end(g) {
+                    continue;
+                }
+                let x = point_position(disc, &state.control, g);
+                let Some(d) = obstacle.surface.distance(&x, t) else {
+                    continue;
+                };
+                let depth = self.radius[point.patch] - d.value;
+                if depth > self.settings.tolerance && deepest.is_none_or(|(w, _)| depth > w) {
+                    deepest = Some((depth, x));
+                }
+            }
+            if let Some((depth, x)) = deepest {
+                let p = &mut self.placed;
+                p.count += 1;
+                if depth > p.largest {
+                    (p.largest, p.obstacle, p.time, p.at) = (depth, k, t, x);
+                }
+            }
+        }
+    }
+
     fn prepare(&mut self, t: Real) {
         self.time = t;
         self.updates = 0;
@@ -229,24 +286,48 @@ impl PointTerm for SurfaceContact {
     }
 
     fn warnings(&self) -> Vec<String> {
+        let mut said = Vec::new();
+        let p = &self.placed;
+        if p.count > 0 {
+            said.push(format!(
+                "contact: {} obstacle(s) were put in place through the wires, the deepest `{}` at t = {} by {:.3e} at ({:.4}, {:.4}, {:.4}), beyond the penetration tolerance {:e}: the first step after it pushed the wires out at once; put it in place where the device is clear of it",
+                p.count,
+                self.obstacles[p.obstacle].name,
+                p.time,
+                p.largest,
+                p.at.x,
+                p.at.y,
+                p.at.z,
+                self.settings.tolerance
+            ));
+        }
         let u = &self.unresolved;
         if u.steps == 0 {
-            return Vec::new();
+            return said;
         }
-        vec![format!(
+        said.push(format!(
             "contact: in {} step(s) the penetration stayed above its tolerance {:e} after {} augmented-Lagrange update(s), by up to {:.3e} (first at t = {}): raise `max_updates` or the penalty",
             u.steps, self.settings.tolerance, self.settings.max_updates, u.largest, u.first
-        )]
+        ));
+        said
     }
 
     fn save(&self, out: &mut Vec<Real>) {
         let u = &self.unresolved;
+        let p = &self.placed;
         out.extend([
             self.time,
             self.updates as Real,
             u.steps as Real,
             u.largest,
             u.first,
+            p.count as Real,
+            p.largest,
+            p.obstacle as Real,
+            p.time,
+            p.at.x,
+            p.at.y,
+            p.at.z,
         ]);
         for m in &self.multipliers {
             out.extend_from_slice(m);
@@ -254,7 +335,7 @@ impl PointTerm for SurfaceContact {
     }
 
     fn restore(&mut self, values: &[Real]) -> Result<(), usize> {
-        const HEAD: usize = 5;
+        const HEAD: usize = 12;
         let expected = HEAD + self.multipliers.iter().map(Vec::len).sum::<usize>();
         if values.len() != expected {
             return Err(expected);
@@ -266,6 +347,13 @@ impl PointTerm for SurfaceContact {
             steps: values[2] as usize,
             largest: values[3],
             first: values[4],
+        };
+        self.placed = Placed {
+            count: values[5] as usize,
+            largest: values[6],
+            obstacle: values[7] as usize,
+            time: values[8],
+            at: Vec3::new(values[9], values[10], values[11]),
         };
         let mut rest = &values[HEAD..];
         for m in &mut self.multipliers {
@@ -330,16 +418,16 @@ mod tests {
 
     /// A cylinder around the z axis whose radius goes linearly from `from` at t = 0 to `to` at t = 1.
     fn cylinder(from: Real, to: Real, wall: Wall) -> Obstacle {
-        Obstacle {
-            name: "crimper".into(),
-            surface: Surface::Cylinder {
+        Obstacle::new(
+            "crimper",
+            Surface::Cylinder {
                 point: Vec3::zeros(),
                 axis: Vec3::z(),
                 radius: TimeFunction::try_table(vec![(0.0, from), (1.0, to)])
                     .expect("increasing times"),
             },
             wall,
-        }
+        )
     }
 
     /// Runs the quarter ring inside `obstacle` to t = 1; returns the collocation points' distances from the

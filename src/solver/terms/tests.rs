@@ -112,28 +112,28 @@ fn contact(model: &Model, disc: &Discretisation) -> SurfaceContact {
     use crate::model::{ContactSettings, Obstacle, Surface, Wall};
     let constant = TimeFunction::constant;
     let obstacles = vec![
-        Obstacle {
-            name: "cylinder".into(),
-            surface: Surface::Cylinder {
+        Obstacle::new(
+            "cylinder",
+            Surface::Cylinder {
                 point: Vec3::new(0.0, 1.0, 0.0),
                 axis: Vec3::new(0.2, 0.0, 1.0).normalize(),
                 radius: constant(1.02),
             },
-            wall: Wall::Compliant {
+            Wall::Compliant {
                 modulus: 1e4,
                 thickness: 0.1,
                 width: 0.2,
             },
-        },
-        Obstacle {
-            name: "plane".into(),
-            surface: Surface::Plane {
+        ),
+        Obstacle::new(
+            "plane",
+            Surface::Plane {
                 point: Vec3::zeros(),
                 normal: Vec3::new(0.1, 0.0, 1.0).normalize(),
                 offset: constant(-0.1),
             },
-            wall: Wall::Rigid,
-        },
+            Wall::Rigid,
+        ),
     ];
     let settings = ContactSettings {
         penalty: 1e3,

@@ -1,0 +1,145 @@
+//! The design's `obstacles:` and `contact:` blocks: the surfaces the rods touch and how contact is enforced,
+//! into the builder's [`Contact`] (the physics: `crate::model::obstacle`, `crate::solver::terms::contact`).
+//!
+//! ```yaml
+//! obstacles:
+//!   - name: sheath
+//!     cylinder: {point: [0, 0, 0], axis: [1, 0, 0], radius: 5.4}
+//!     from: 1.8                   # put in place at t = 1.8 (default: from the start)
+//!     until: 2.4                  # withdrawn at t = 2.4 (default: never)
+//!   - name: plate
+//!     plane: {point: [0, 0, -6], normal: [0, 0, 1], offset: [[0, 0], [1, 2]]}
+//!   - name: tube
+//!     cylinder: {point: [0, 0, 0], axis: [1, 0, 0], radius: 21}
+//!     wall: {E: 1.0, thickness: 0.5}   # compliant (width: default the wire's diameter); rigid without it
+//! contact: {penalty: 2500, tolerance: 0.006, regularisation: 0.0006, max_updates: 10}
+//! ```
+//!
+//! A name of our own for each surface, because the words a designer uses (crimper, sheath, vessel, plate) are
+//! roles, not shapes: the shape is the key (`cylinder`, `plane`), the role is the name, which the outputs use.
+//!
+//! **Defaults** (stentkit's choice, stated in `contact`'s schema): the penalty is the design material's
+//! instantaneous modulus `E_inf + Σ E_α` — a line force per unit wire length per unit penetration has the
+//! units of a modulus, and this one makes the penalty's compliance comparable to the wire's own radial
+//! compliance, so Newton sees no new stiffness scale; the tolerance on penetration is 1 % of the wire
+//! diameter (what a drawing of the wire cannot show); the law's transition band is a tenth of the tolerance;
+//! at most 10 augmented-Lagrange updates per step. A `programme` of `kind: crimp` adds its crimper after the
+//! design's obstacles.
+
+use super::dto::{ContactDto, DesignDto, ObstacleDto, Positive, ProgrammeKindDto, vec3};
+use super::issue::{Result, issue};
+use crate::math::{Real, Vec3};
+use crate::model::{Contact, ContactSettings, Obstacle, Surface, TimeFunction, Wall};
+
+/// The contact of a design (`None` when it has no obstacle, no `contact` block and no crimper); `diameter` is
+/// the design's wire diameter.
+pub(crate) fn contact(dto: &DesignDto, diameter: Real) -> Result<Option<Contact>> {
+    let crimp = dto
+        .programme
+        .as_ref()
+        .is_some_and(|p| p.kind == ProgrammeKindDto::Crimp);
+    if dto.obstacles.is_empty() && !crimp {
+        return match dto.contact {
+            Some(_) => Err(issue(
+                "contact",
+                "contact settings without anything to touch: add `obstacles` (or a `programme` of `kind: crimp`), or remove `contact`",
+            )),
+            None => Ok(None),
+        };
+    }
+    let obstacles = dto
+        .obstacles
+        .iter()
+        .enumerate()
+        .map(|(k, o)| obstacle(o, &format!("obstacles[{k}]"), diameter))
+        .collect::<Result<Vec<_>>>()?;
+    Ok(Some(Contact {
+        obstacles,
+        settings: settings(dto.contact.as_ref(), dto, diameter),
+    }))
+}
+
+/// The settings of a `contact` block with the module's defaults.
+fn settings(c: Option<&ContactDto>, dto: &DesignDto, diameter: Real) -> ContactSettings {
+    let value = |f: fn(&ContactDto) -> Option<Positive>| c.and_then(f).map(|v| v.0);
+    let instantaneous =
+        dto.material.e_inf.0 + dto.material.prony.iter().map(|[e, _]| e.0).sum::<Real>();
+    let tolerance = value(|c| c.tolerance).unwrap_or(0.01 * diameter);
+    ContactSettings {
+        penalty: value(|c| c.penalty).unwrap_or(instantaneous),
+        regularisation: value(|c| c.regularisation).unwrap_or(0.1 * tolerance),
+        tolerance,
+        max_updates: c.and_then(|c| c.max_updates).unwrap_or(10),
+    }
+}
+
+/// A unit vector from a design vector, refused at `path` when it is zero.
+fn unit(v: &super::dto::Vector, path: String) -> Result<Vec3> {
+    let v = vec3(v);
+    let norm = v.norm();
+    if norm > 0.0 {
+        Ok(v / norm)
+    } else {
+        Err(issue(path, "a direction must not be zero"))
+    }
+}
+
+/// One obstacle of the list, at `base` (`obstacles[k]`).
+fn obstacle(o: &ObstacleDto, base: &str, diameter: Real) -> Result<Obstacle> {
+    let time_function = |f, key: &str| super::build::time_function(f, &format!("{base}.{key}"));
+    let surface = match (&o.cylinder, &o.plane) {
+        (Some(c), None) => Surface::Cylinder {
+            point: vec3(&c.point),
+            axis: unit(&c.axis, format!("{base}.cylinder.axis"))?,
+            radius: time_function(&c.radius, "cylinder.radius")?,
+        },
+        (None, Some(p)) => Surface::Plane {
+            point: vec3(&p.point),
+            normal: unit(&p.normal, format!("{base}.plane.normal"))?,
+            offset: match &p.offset {
+                Some(f) => time_function(f, "plane.offset")?,
+                None => TimeFunction::constant(0.0),
+            },
+        },
+        _ => {
+            return Err(issue(
+                base,
+                "give exactly one surface: `cylinder` or `plane`",
+            ));
+        }
+    };
+    let wall = match &o.wall {
+        None => Wall::Rigid,
+        Some(w) => {
+            let (Some(modulus), Some(thickness)) = (w.modulus, w.thickness) else {
+                return Err(issue(
+                    format!("{base}.wall"),
+                    "a compliant wall needs its Young's modulus `E` and its `thickness` (and takes `width`, default the wire's diameter); remove `wall` for a rigid one",
+                ));
+            };
+            Wall::Compliant {
+                modulus: modulus.0,
+                thickness: thickness.0,
+                width: w.width.map_or(diameter, |b| b.0),
+            }
+        }
+    };
+    let from = o.from.map_or(0.0, |f| f.0);
+    let until = o.until.map(|u| u.0);
+    if let Some(u) = until
+        && u <= from
+    {
+        return Err(issue(
+            format!("{base}.until"),
+            format!(
+                "the obstacle is withdrawn at t = {u}, not after it is put in place (t = {from})"
+            ),
+        ));
+    }
+    Ok(Obstacle {
+        name: o.name.clone(),
+        surface,
+        wall,
+        active: (from, until),
+    })
+}

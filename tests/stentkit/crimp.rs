@@ -1,0 +1,113 @@
+//! A programme by a crimper (`kind: crimp`) and obstacles in the design language (issue 33): what the design
+//! builds, checked against values worked out by hand from the design file.
+
+use stentkit::design::load_design;
+use stentkit::model::{ProgrammeKind, Surface, Wall};
+
+/// `designs/straight_stent_crimped.yaml`: the paper's straight stent (R = 20, wire d = 0.6, Δr = 15, ramp 0–1 s,
+/// release 1.75 s) with a sheath of radius 5.3 from 1.75 to 2.2 s. Worked out from the file and the crimper's
+/// rule (`crate::model::stent::crimper`): the crown wires lie on the cylinder of radius 20, so the device's
+/// reach is 20 + 0.3 and the crimper starts 2 % outside it, at 20.706; it closes until the wires' reach is
+/// R − Δr = 5, its radius 5.3, at t = 1; it opens over a tenth of the ramp (0.1 s) from the release. Nothing is
+/// prescribed but the symmetry: the driven nodes (every joint) keep only the components their symmetry planes
+/// set, and the device is gauged from the start. The cycle: programmed at the end of the ramp (1 s), fixed at
+/// the release (1.75 s), released when the crimper is open (1.85 s). Contact defaults: penalty = E_inf + Σ E_α
+/// = 80.59 + 2313.81 = 2394.4 MPa, tolerance 1 % of 0.6 = 6e-3, transition band 6e-4, 10 updates.
+#[test]
+fn a_crimp_programme_builds_its_crimper_and_prescribes_nothing() {
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("designs/straight_stent_crimped.yaml");
+    let design = load_design(&path).expect("the crimped straight stent loads");
+    let model = &design.model;
+    let programme = model.programme.as_ref().expect("a programme");
+    let ProgrammeKind::Crimp {
+        delta_r,
+        obstacle,
+        open,
+    } = programme.kind
+    else {
+        panic!("a crimp programme: {:?}", programme.kind);
+    };
+    assert_eq!((delta_r, open), (15.0, 0.1));
+    assert!(!programme.prescribes());
+    assert_eq!(programme.free_from(), Some(0.0));
+    let contact = model.contact.as_ref().expect("contact");
+    let names: Vec<&str> = contact.obstacles.iter().map(|o| o.name.as_str()).collect();
+    assert_eq!(
+        names,
+        ["sheath", "crimper"],
+        "the design's obstacles, then the crimper"
+    );
+    assert_eq!(obstacle, 1);
+    let crimper = &contact.obstacles[1];
+    assert_eq!(crimper.wall, Wall::Rigid);
+    let Surface::Cylinder {
+        point,
+        axis,
+        radius,
+    } = &crimper.surface
+    else {
+        panic!("a cylinder");
+    };
+    assert!(point.norm() < 1e-12 && (axis - stentkit::math::Vec3::x()).norm() < 1e-12);
+    // The reach is sampled on the fitted splines (fit error 2.7e-5 of the design): 1e-4 covers it.
+    for (t, expected) in [
+        (0.0, 1.02 * 20.3),
+        (0.5, 0.5 * (1.02 * 20.3 + 5.3)),
+        (1.0, 5.3),
+        (1.75, 5.3),
+        (1.85, 1.02 * 20.3),
+        (3.0, 1.02 * 20.3),
+    ] {
+        let r = radius.value(t);
+        assert!(
+            (r - expected).abs() < 1e-4,
+            "crimper radius {r} at t = {t}, expected {expected}"
+        );
+    }
+    let sheath = &contact.obstacles[0];
+    assert_eq!(sheath.active, (1.75, Some(2.2)));
+    assert!(
+        !sheath.is_active(1.75)
+            && sheath.is_active(1.76)
+            && sheath.is_active(2.2)
+            && !sheath.is_active(2.21)
+    );
+    let s = contact.settings;
+    assert!((s.penalty - 2394.4).abs() < 1e-9, "{}", s.penalty);
+    assert!((s.tolerance - 6e-3).abs() < 1e-15 && (s.regularisation - 6e-4).abs() < 1e-15);
+    assert_eq!(s.max_updates, 10);
+    // Only the symmetry planes prescribe: no node has a prescribed component on a non-symmetry node.
+    let prescribed: usize = model
+        .nodes
+        .iter()
+        .flat_map(|n| &n.conditions.components)
+        .filter(|c| c.is_prescribed_at(0.5))
+        .count();
+    let symmetry_nodes = model
+        .nodes
+        .iter()
+        .filter(|n| {
+            n.conditions
+                .components
+                .iter()
+                .any(|c| c.is_prescribed_at(0.5))
+        })
+        .count();
+    assert_eq!(
+        prescribed,
+        3 * symmetry_nodes,
+        "a symmetry node holds its normal translation and two rotations"
+    );
+    let cycle = model.cycle().expect("a cycle");
+    assert_eq!((cycle.programmed, cycle.fixed), (Some(1.0), 1.75));
+    assert!((cycle.released - 1.85).abs() < 1e-12, "{}", cycle.released);
+    // The crimper's breakpoints and the sheath's are times the run lands on.
+    let breakpoints = model.schedule_breakpoints();
+    for t in [1.0, 1.75, 1.85, 2.2] {
+        assert!(
+            breakpoints.iter().any(|b| (b - t).abs() < 1e-12),
+            "{t} in {breakpoints:?}"
+        );
+    }
+}
