@@ -13,6 +13,9 @@
 //! wall it carries, of width `b` (the wall area per unit length of wire), so its line force per unit wire length is
 //! `k b` times the wall's displacement: the contact law's penalty becomes the physical `k b`, and the
 //! penetration is the wall's displacement, not an error (no augmented-Lagrange updates).
+//!
+//! **Friction.** Each obstacle has its Coulomb coefficient ([`Obstacle::friction`]): a point in contact carries
+//! a tangential line force of at most `μ p` opposing its slip over the surface (the solver's regularised law).
 
 use super::schedule::TimeFunction;
 use crate::math::{Mat3, Real, Vec3};
@@ -26,6 +29,11 @@ pub struct Obstacle {
     pub surface: Surface,
     /// Rigid, or a compliant wall.
     pub wall: Wall,
+    /// Coulomb friction coefficient `μ ≥ 0` between the rods and this surface (0: frictionless). Per obstacle,
+    /// not in [`ContactSettings`], because it belongs to the pair of materials that touch: one device meets a
+    /// polished crimper (μ ≈ 0.1), a sheath and a vessel wall, each with its own; the regularisation of the law
+    /// (its stick stiffness) is the solver's (`crate::solver::terms::contact`).
+    pub friction: Real,
 }
 
 /// The geometry of an obstacle.

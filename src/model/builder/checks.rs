@@ -176,6 +176,15 @@ pub(crate) fn contact(contact: &crate::model::Contact, model: &crate::model::Mod
                 ));
             }
         }
+        if !(obstacle.friction.is_finite() && obstacle.friction >= 0.0) {
+            return Err(BuildError::new(
+                at(ObstacleField::Friction),
+                format!(
+                    "the friction coefficient must be zero or positive and finite (it is {})",
+                    obstacle.friction
+                ),
+            ));
+        }
         match obstacle.wall {
             Wall::Rigid => {}
             Wall::Compliant {
