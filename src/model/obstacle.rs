@@ -166,13 +166,16 @@ impl Lumen {
         (r0 + slope * (u - u0), slope)
     }
 
-    /// The parameter of the point of the centreline closest to `x`: the nearest of the search samples, then
-    /// Newton's method on `f(u) = (x − C(u))·C'(u) = 0` (`f' = −J`, `J = |C'|² − (x − C)·C''`). `None` when
-    /// the closest point is an end of the centreline (the point lies beyond the open tube's ends) or Newton does
-    /// not settle on a minimum (`J ≤ 0`: beyond a centre of curvature).
-    pub fn closest(&self, x: &Vec3) -> Option<Real> {
-        let (lo, hi) = self.centreline.knots().domain();
-        let mut u = self
+    /// The parameter of the point of the centreline closest to `x`: Newton's method on
+    /// `f(u) = (x − C(u))·C'(u) = 0` (`f' = −J`, `J = |C'|² − (x − C)·C''`) from `hint` (the point's parameter
+    /// at the last converged step) if given and it settles there, else from the nearest of the search samples.
+    /// `None` when the closest point is an end of the centreline (the point lies beyond the open tube's ends)
+    /// or Newton does not settle on a minimum (`J ≤ 0`: beyond a centre of curvature).
+    pub fn closest(&self, x: &Vec3, hint: Option<Real>) -> Option<Real> {
+        if let Some(u) = hint.and_then(|u| self.project(x, u)) {
+            return Some(u);
+        }
+        let start = self
             .samples
             .iter()
             .min_by(|a, b| {
@@ -181,6 +184,12 @@ impl Lumen {
                     .total_cmp(&(b.1 - x).norm_squared())
             })
             .map(|s| s.0)?;
+        self.project(x, start)
+    }
+
+    /// Newton's projection of `x` on the centreline from `u` ([`Lumen::closest`]).
+    fn project(&self, x: &Vec3, mut u: Real) -> Option<Real> {
+        let (lo, hi) = self.centreline.knots().domain();
         let scale = hi - lo;
         for _ in 0..50 {
             let d = self.centreline.derivatives(u, 2);
@@ -213,12 +222,16 @@ impl Lumen {
     /// unit only where `R' = 0` (a tapering lumen tilts its wall by `R' |∇u*|`); the contact law takes it as it
     /// is, its tangent consistent with it.
     ///
-    /// The first guess is a linear scan of the centreline's samples ([`SEARCH_SAMPLES`] per knot span): a
-    /// vessel's fitted centreline has a few tens of spans, so a scan of a few hundred points per evaluation
-    /// needs no spatial tree, and a fresh search at every evaluation is never misled by a point that moved
-    /// past a bend since the last step (at the price of the scan where a hint would start next to the answer).
-    pub fn distance(&self, x: &Vec3) -> Option<Distance> {
-        let u = self.closest(x)?;
+    /// The first guess is `hint`, the point's closest parameter at the last converged step (the contact term
+    /// keeps one per point), from which Newton's method takes a few iterations as the point moves little per
+    /// step; without one, or where Newton does not settle from it, a linear scan of the centreline's samples
+    /// ([`SEARCH_SAMPLES`] per knot span). A sorted scan, not a k-d tree: a vessel's fitted centreline has a few
+    /// tens of spans, so the scan is a few hundred points, paid only at a point's first contact check and at
+    /// the checks between collocation points once per step; a tree would save little and add a dependency.
+    /// A hint can lead to a local, not global, closest point where a vessel folds back within one step's
+    /// motion; a fitted vessel centreline does not.
+    pub fn distance(&self, x: &Vec3, hint: Option<Real>) -> Option<Distance> {
+        let u = self.closest(x, hint)?;
         let d = self.centreline.derivatives(u, 3);
         let (c1, c2, c3) = (d[1], d[2], d[3]);
         let r = x - d[0];
@@ -291,7 +304,24 @@ impl Surface {
                 normal: *normal,
                 hessian: Mat3::zeros(),
             }),
-            Surface::Lumen(lumen) => lumen.distance(x),
+            Surface::Lumen(lumen) => lumen.distance(x, None),
+        }
+    }
+
+    /// [`Surface::distance`] with a lumen's closest-point search started from `hint` ([`Lumen::distance`]);
+    /// the other surfaces ignore it.
+    pub fn distance_near(&self, x: &Vec3, t: Real, hint: Option<Real>) -> Option<Distance> {
+        match self {
+            Surface::Lumen(lumen) => lumen.distance(x, hint),
+            _ => self.distance(x, t),
+        }
+    }
+
+    /// A lumen's closest parameter to `x` ([`Lumen::closest`]); `None` for the other surfaces.
+    pub fn parameter(&self, x: &Vec3, hint: Option<Real>) -> Option<Real> {
+        match self {
+            Surface::Lumen(lumen) => lumen.closest(x, hint),
+            _ => None,
         }
     }
 
@@ -431,7 +461,7 @@ mod tests {
             Vec3::new(-1.0, 0.5, -3.0),
             Vec3::new(3.0, -2.0, 0.0),
         ] {
-            let a: Distance = lumen.distance(&x).expect("inside the tube's span");
+            let a: Distance = lumen.distance(&x, None).expect("inside the tube's span");
             let b = cylinder.distance(&x, 0.0).expect("off the axis");
             assert!((a.value - b.value).abs() < 1e-12, "{a:?} {b:?}");
             assert!((a.normal - b.normal).norm() < 1e-12, "{a:?} {b:?}");
@@ -461,7 +491,7 @@ mod tests {
         for angle in [0.3_f64, 1.0, 1.7] {
             for (dr, dz) in [(0.5, 0.2), (-1.2, 0.7), (0.1, -1.9), (2.5, 1.0)] {
                 let x = Vec3::new((rc + dr) * angle.cos(), (rc + dr) * angle.sin(), dz);
-                let d = lumen.distance(&x).expect("inside the arc's span");
+                let d = lumen.distance(&x, None).expect("inside the arc's span");
                 assert!(
                     (d.value - torus(&x)).abs() < 1e-12,
                     "{} {}",
@@ -491,11 +521,11 @@ mod tests {
         .expect("an arc");
         let (lo, hi) = centreline.knots().domain();
         let lumen = Lumen::try_new(centreline, vec![(lo, 2.5), (hi, 1.5)]).expect("a lumen");
-        let value = |x: &Vec3| lumen.distance(x).expect("inside").value;
+        let value = |x: &Vec3| lumen.distance(x, None).expect("inside").value;
         for angle in [0.4_f64, 1.1, 1.6] {
             for (dr, dz) in [(0.5, 0.2), (-1.0, 0.6), (0.3, -1.2)] {
                 let x = Vec3::new((8.0 + dr) * angle.cos(), (8.0 + dr) * angle.sin(), dz);
-                let d = lumen.distance(&x).expect("inside");
+                let d = lumen.distance(&x, None).expect("inside");
                 let (gradient, hessian) = differences(&value, &x, 1e-4);
                 assert!((d.normal - gradient).norm() < 1e-6, "{d:?} {gradient:?}");
                 assert!(relative(&d.hessian, &hessian) < 1e-6, "{d:?} {hessian:?}");
@@ -512,8 +542,14 @@ mod tests {
             vec![(0.0, 1.0)],
         )
         .expect("a lumen");
-        assert!(lumen.distance(&Vec3::new(0.1, 0.0, 12.0)).is_none());
-        assert!(lumen.distance(&Vec3::new(0.1, 0.0, 5.0)).is_some());
+        assert!(lumen.distance(&Vec3::new(0.1, 0.0, 12.0), None).is_none());
+        let inside = Vec3::new(0.1, 0.0, 5.0);
+        let u = lumen.closest(&inside, None).expect("inside the span");
+        // From a hint near the answer Newton lands on the same parameter; from a far one too.
+        for hint in [u + 1e-3, 0.05] {
+            let v = lumen.closest(&inside, Some(hint)).expect("inside");
+            assert!((u - v).abs() < 1e-12, "{u} from a scan, {v} from {hint}");
+        }
         let curve = || straight(Vec3::zeros(), Vec3::new(0.0, 0.0, 10.0));
         for (table, reason) in [
             (vec![], "empty"),

@@ -26,8 +26,8 @@
 //! again from where it converged ([`PointTerm::augment`]); at most `max_updates` times. If the penetration is
 //! still above the tolerance then, the step is kept and the run's warnings say so (how many steps, the largest
 //! penetration, when first: [`PointTerm::warnings`], into summary.json and on stderr). The multipliers, the
-//! step's update count, that record, the friction anchors and work and the record of penetration anywhere
-//! (below) are the term's state: the multipliers start the next step where this one left them, a roll-back
+//! step's update count, that record, the friction anchors and work, a lumen's closest-point parameters and
+//! the record of penetration anywhere (below) are the term's state: the multipliers start the next step where this one left them, a roll-back
 //! restores them all, a checkpoint keeps them.
 //!
 //! **Friction.** An obstacle with a Coulomb coefficient `μ > 0` ([`crate::model::Obstacle::friction`]) adds a
@@ -52,6 +52,11 @@
 //! along their normals) a point that sticks while the surface moves has `d` along the normal, hence no slip;
 //! a point sliding across a moving cylinder's curvature picks up an error of the order of its slip times the
 //! radius change over the radius.
+//!
+//! **Lumen.** The distance from a vessel's lumen ([`crate::model::Lumen`]) needs the closest point on its
+//! centreline: each point's parameter at the last converged step is kept (term state, set in
+//! [`PointTerm::commit`], saved with the rest) and starts the Newton projection of the next step's iterations;
+//! a point without one (its first step) is searched from the centreline's samples.
 //!
 //! **Tributary lengths.** A line force acts per unit reference length; the force a point carries is its line
 //! force times its tributary length ([`SurfaceContact::lengths`]): half the chord to each neighbouring
@@ -86,7 +91,7 @@ use super::{InteriorLoad, PointTerm, PointView};
 use crate::math::basis::nurbs_basis;
 use crate::math::quote::quoted;
 use crate::math::{Mat3, Real, Vec3};
-use crate::model::{ContactSettings, Distance, Model, Obstacle, Wall};
+use crate::model::{ContactSettings, Distance, Model, Obstacle, Surface, Wall};
 use crate::solver::discretisation::{Discretisation, point_position};
 use crate::solver::state::State;
 
@@ -191,6 +196,9 @@ pub struct SurfaceContact {
     anchors: Vec<Vec<Vec3>>,
     /// Friction work dissipated per obstacle: in the last committed step, and since the start \[force·length\].
     work: Vec<[Real; 2]>,
+    /// A lumen's closest centreline parameter per obstacle and collocation point at the last converged step,
+    /// the first guess of its search (NaN: none; empty for the other surfaces; module docs).
+    hints: Vec<Vec<Real>>,
     /// Tributary reference length of each collocation point \[length\] (module docs; zero at the patch ends).
     lengths: Vec<Real>,
     /// The sample points between the collocation points (module docs).
@@ -285,6 +293,13 @@ impl SurfaceContact {
             })
             .collect();
         let work = vec![[0.0; 2]; obstacles.len()];
+        let hints = obstacles
+            .iter()
+            .map(|o| match o.surface {
+                Surface::Lumen(_) => vec![Real::NAN; disc.points.len()],
+                _ => Vec::new(),
+            })
+            .collect();
         Self {
             obstacles,
             settings,
@@ -296,6 +311,7 @@ impl SurfaceContact {
             unresolved: Unresolved::default(),
             anchors,
             work,
+            hints,
             lengths: tributary_lengths(disc, &reference),
             samples: samples(model, disc),
             between: Between::default(),
@@ -427,7 +443,10 @@ impl SurfaceContact {
     /// The contact of the point at `x` on patch `patch` (collocation point `g`) with obstacle `k`; `None` where
     /// the surface has no normal there (a cylinder's axis).
     pub fn at(&self, k: usize, g: usize, patch: usize, x: &Vec3) -> Option<PointContact> {
-        let distance = self.obstacles[k].surface.distance(x, self.time)?;
+        let hint = self.hints[k].get(g).copied().filter(|u| !u.is_nan());
+        let distance = self.obstacles[k]
+            .surface
+            .distance_near(x, self.time, hint)?;
         let gap = distance.value - self.radius[patch];
         let (penalty, multiplier) = self.law(k, g);
         let delta = 0.5 * self.settings.regularisation;
@@ -548,6 +567,14 @@ impl PointTerm for SurfaceContact {
     }
 
     fn commit(&mut self, disc: &Discretisation, state: &State) {
+        for (k, hints) in self.hints.iter_mut().enumerate() {
+            let surface = &self.obstacles[k].surface;
+            for (g, hint) in hints.iter_mut().enumerate() {
+                let x = point_position(disc, &state.control, g);
+                let last = Some(*hint).filter(|u| !u.is_nan());
+                *hint = surface.parameter(&x, last).unwrap_or(Real::NAN);
+            }
+        }
         for k in 0..self.obstacles.len() {
             if self.anchors[k].is_empty() {
                 continue;
@@ -627,6 +654,9 @@ impl PointTerm for SurfaceContact {
             out.extend(a.iter().flat_map(|x| x.iter().copied()));
         }
         out.extend(self.work.iter().flatten());
+        for h in &self.hints {
+            out.extend_from_slice(h);
+        }
     }
 
     fn restore(&mut self, values: &[Real]) -> Result<(), usize> {
@@ -634,7 +664,8 @@ impl PointTerm for SurfaceContact {
         let expected = HEAD
             + self.multipliers.iter().map(Vec::len).sum::<usize>()
             + 3 * self.anchors.iter().map(Vec::len).sum::<usize>()
-            + 2 * self.work.len();
+            + 2 * self.work.len()
+            + self.hints.iter().map(Vec::len).sum::<usize>();
         if values.len() != expected {
             return Err(expected);
         }
@@ -671,8 +702,14 @@ impl PointTerm for SurfaceContact {
             }
             rest = tail;
         }
-        for (w, v) in self.work.iter_mut().zip(rest.chunks_exact(2)) {
+        let (work, mut rest) = rest.split_at(2 * self.work.len());
+        for (w, v) in self.work.iter_mut().zip(work.chunks_exact(2)) {
             *w = [v[0], v[1]];
+        }
+        for h in &mut self.hints {
+            let (mine, tail) = rest.split_at(h.len());
+            h.copy_from_slice(mine);
+            rest = tail;
         }
         Ok(())
     }
@@ -901,6 +938,43 @@ mod tests {
     /// `U(t)` of its end `bar.end` (y held; both ends' rotations held, which a straight rod on a plane does not
     /// load, to remove its free twist), the other end free, friction `μ` on the plane.
     fn rod_on_a_plane(friction: Real, w: Real, pull: TimeFunction) -> Model {
+        let table = Surface::Plane {
+            point: Vec3::zeros(),
+            normal: Vec3::z(),
+            offset: TimeFunction::constant(0.0),
+        };
+        rod_on(table, friction, w, pull)
+    }
+
+    /// Radius of the trough the sliding rod lies in instead of the plane.
+    const TROUGH: Real = 3.0;
+
+    /// The inside of a tube of radius `TROUGH` along x whose lowest generator is the plane's line z = 0, y = 0
+    /// under the sliding rod: a cylinder, or the same as a lumen around a straight centreline (x from −10 to 20,
+    /// beyond the rod and its slide).
+    fn trough(lumen: bool) -> Surface {
+        let point = Vec3::new(0.0, 0.0, TROUGH);
+        if !lumen {
+            return Surface::Cylinder {
+                point,
+                axis: Vec3::x(),
+                radius: TimeFunction::constant(TROUGH),
+            };
+        }
+        let knots = crate::math::KnotVector::clamped_uniform(3, 4).expect("a knot vector");
+        let points = (0..4)
+            .map(|i| point + Vec3::x() * (-10.0 + 10.0 * i as Real))
+            .collect();
+        let centreline = crate::math::NurbsCurve::try_bspline(knots, points).expect("a line");
+        let (lo, hi) = centreline.knots().domain();
+        Surface::Lumen(
+            crate::model::Lumen::try_new(centreline, vec![(lo, TROUGH), (hi, TROUGH)])
+                .expect("a lumen"),
+        )
+    }
+
+    /// [`rod_on_a_plane`] on the surface `table` instead, which must touch the rod's underside along its length.
+    fn rod_on(table: Surface, friction: Real, w: Real, pull: TimeFunction) -> Model {
         use crate::model::builder::{DistributedLoadSpec, PatchTarget};
         let material = ElasticLaw::try_new(E, 0.3).expect("E > 0");
         let section = CircularSection::try_new(D).expect("d > 0").into();
@@ -937,11 +1011,7 @@ mod tests {
         b.contact(Contact {
             obstacles: vec![Obstacle {
                 name: "table".into(),
-                surface: Surface::Plane {
-                    point: Vec3::zeros(),
-                    normal: Vec3::z(),
-                    offset: TimeFunction::constant(0.0),
-                },
+                surface: table,
                 wall: Wall::Rigid,
                 friction,
             }],
@@ -1017,7 +1087,8 @@ mod tests {
             ((measured - sliding) / sliding).abs() < 1e-7,
             "sliding: pull {measured}, Coulomb μ w L = {sliding}"
         );
-        // The term's saved state ends with each obstacle's friction work (last step, total).
+        // The term's saved state ends with each obstacle's friction work (last step, total), then a lumen's
+        // closest-point parameters (none here).
         let terms = &sim.checkpoint().snapshot.terms;
         let saved = terms.last().expect("the contact term's state");
         let step_work = saved[saved.len() - 2];
@@ -1032,6 +1103,45 @@ mod tests {
         continued.restore(&checkpoint).expect("restores");
         while continued.step().expect("converges").is_some() {}
         assert_eq!(sim.state(), continued.state(), "continued bit for bit");
+    }
+
+    /// Source: the sliding rod in a trough (the inside of a tube along it) instead of on the plane: the same
+    /// Coulomb limit `μ w L` when it slides (the pressure is still `w`, the slip along the generator; solver's
+    /// tolerance, 1e-7), and the lumen around a straight centreline gives the cylinder's run to round-off (every
+    /// control point within 1e-9 of the rod's length: the two distances agree to 1e-12, see
+    /// `crate::model::obstacle`'s tests; Newton's last iterate carries their difference).
+    #[test]
+    fn a_rod_sliding_in_a_straight_lumen_is_the_rod_in_the_cylinder() {
+        let (mu, w) = (0.3, 1.0);
+        let pull = TimeFunction::try_table(vec![(0.0, 0.0), (0.05, 0.01), (1.0, 1.0)])
+            .expect("increasing times");
+        let mut states = Vec::new();
+        for lumen in [false, true] {
+            let model = rod_on(trough(lumen), mu, w, pull.clone());
+            let end = model
+                .nodes
+                .iter()
+                .position(|n| n.name == "bar.end")
+                .expect("node bar.end");
+            let mut sim = Simulation::new(&model).expect("discretised");
+            sim.run(&mut [&mut NoObserver]).expect("slides");
+            let measured = sim.node_end_resultants(end)[0].0.x;
+            println!("trough (lumen: {lumen}): pull {measured:.9e}");
+            assert!(
+                ((measured - mu * w * ROD) / (mu * w * ROD)).abs() < 1e-7,
+                "pull {measured}, μ w L = {}",
+                mu * w * ROD
+            );
+            assert!(sim.warnings().is_empty(), "{:?}", sim.warnings());
+            states.push(sim.state().control.clone());
+        }
+        let worst = states[0]
+            .iter()
+            .zip(&states[1])
+            .map(|(a, b)| (a - b).norm())
+            .fold(0.0, Real::max);
+        println!("lumen against cylinder: largest difference {worst:e}");
+        assert!(worst < 1e-9 * ROD, "{worst}");
     }
 
     /// Source: the same rod without friction slides freely, so the pull it needs is zero (to the solver's
