@@ -27,8 +27,8 @@
 //! still above the tolerance then, the step is kept and the run's warnings say so (how many steps, the largest
 //! penetration, when first: [`PointTerm::warnings`], into summary.json and on stderr). The multipliers, the
 //! step's update count, that record, the friction anchors and work, a lumen's closest-point parameters and
-//! the record of penetration anywhere (below) are the term's state: the multipliers start the next step where this one left them, a roll-back
-//! restores them all, a checkpoint keeps them.
+//! the record of penetration anywhere (below) are the term's state: the multipliers start the next step where
+//! this one left them, a roll-back restores them all, a checkpoint keeps them.
 //!
 //! **Friction.** An obstacle with a Coulomb coefficient `μ > 0` ([`crate::model::Obstacle::friction`]) adds a
 //! tangential line force at every point it presses, regularised by a stick stiffness and a return map (the
