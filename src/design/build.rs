@@ -302,6 +302,7 @@ pub(crate) fn field_path(field: &Field, dto: &DesignDto) -> String {
                 ObstacleField::Schedule => format!("{base}.plane.offset"),
                 ObstacleField::Wall if o.wall.is_some() => format!("{base}.wall"),
                 ObstacleField::Wall => format!("{base}.{shape}"),
+                ObstacleField::Friction => format!("{base}.friction"),
             }
         }
         Field::ContactSettings if dto.contact.is_some() => "contact".into(),

@@ -12,6 +12,7 @@
 //!   - name: tube
 //!     cylinder: {point: [0, 0, 0], axis: [1, 0, 0], radius: 21}
 //!     wall: {E: 1.0, thickness: 0.5}   # compliant (width: default the wire's diameter); rigid without it
+//!     friction: 0.1               # Coulomb coefficient μ between the wires and this surface (default 0)
 //! contact: {penalty: 2500, tolerance: 0.006, regularisation: 0.0006, max_updates: 10}
 //! ```
 //!
@@ -25,6 +26,9 @@
 //! diameter (what a drawing of the wire cannot show); the law's transition band is a tenth of the tolerance;
 //! at most 10 augmented-Lagrange updates per step. A `programme` of `kind: crimp` adds its crimper after the
 //! design's obstacles.
+//!
+//! **Friction** is a property of an obstacle (`friction: μ`, the pair of surfaces that touch), so friction
+//! without contact cannot be written; the crimper of a crimp programme is frictionless.
 
 use super::dto::{ContactDto, DesignDto, ObstacleDto, Positive, ProgrammeKindDto, vec3};
 use super::issue::{Result, issue};
@@ -141,5 +145,6 @@ fn obstacle(o: &ObstacleDto, base: &str, diameter: Real) -> Result<Obstacle> {
         surface,
         wall,
         active: (from, until),
+        friction: o.friction.map_or(0.0, |f| f.0),
     })
 }

@@ -343,6 +343,9 @@ pub struct ObstacleDto {
     /// The time it is withdrawn \[time\] (default: never).
     #[serde(default)]
     pub until: Option<Positive>,
+    /// Coulomb friction coefficient μ between the wires and this surface (default 0, frictionless).
+    #[serde(default)]
+    pub friction: Option<NonNegative>,
 }
 
 /// A cylinder obstacle.

@@ -16,7 +16,7 @@ pub(crate) mod schedule;
 pub mod stent;
 pub(crate) mod temperature;
 
-pub use obstacle::{Contact, ContactSettings, Distance, Obstacle, Surface, Wall};
+pub use obstacle::{Contact, ContactSettings, Distance, Lumen, Obstacle, Surface, Wall};
 pub use programme::{DrivenNode, Programme, ProgrammeError, ProgrammeKind};
 pub use schedule::{ScheduleError, TimeFunction};
 pub use temperature::{Profile, TemperatureField};

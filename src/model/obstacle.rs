@@ -1,6 +1,7 @@
 //! Obstacles: surfaces the rods of a device touch (issue 33) — a cylinder that keeps the rods inside it (a
 //! crimper, a catheter sheath, a vessel idealised as a tube), a plane that keeps them on one side (a crush plate,
-//! a table) — with a rigid or a compliant wall, and the contact settings of a model.
+//! a table), a vessel's lumen around its centreline spline ([`Lumen`]) — with a rigid or a compliant wall (a
+//! lumen's: rigid), and the contact settings of a model.
 //!
 //! What an obstacle is, not how the solver enforces it: the geometry gives the signed distance of a point from
 //! the surface (positive on the side the rods belong to), its gradient and its Hessian
@@ -13,9 +14,12 @@
 //! wall it carries, of width `b` (the wall area per unit length of wire), so its line force per unit wire length is
 //! `k b` times the wall's displacement: the contact law's penalty becomes the physical `k b`, and the
 //! penetration is the wall's displacement, not an error (no augmented-Lagrange updates).
+//!
+//! **Friction.** Each obstacle has its Coulomb coefficient ([`Obstacle::friction`]): a point in contact carries
+//! a tangential line force of at most `μ p` opposing its slip over the surface (the solver's regularised law).
 
 use super::schedule::TimeFunction;
-use crate::math::{Mat3, Real, Vec3};
+use crate::math::{Mat3, NurbsCurve, Real, Vec3};
 
 /// A surface the rods touch, with its wall (module docs).
 #[derive(Debug, Clone, PartialEq, serde::Serialize)]
@@ -30,6 +34,11 @@ pub struct Obstacle {
     /// `from`, such as a vessel the programmed device is deployed in, or a sheath put over it) to `until`
     /// (withdrawn; `None`: never). `(0, None)` acts over the whole run.
     pub active: (Real, Option<Real>),
+    /// Coulomb friction coefficient `μ ≥ 0` between the rods and this surface (0: frictionless). Per obstacle,
+    /// not in [`ContactSettings`], because it belongs to the pair of materials that touch: one device meets a
+    /// polished crimper (μ ≈ 0.1), a sheath and a vessel wall, each with its own; the regularisation of the law
+    /// (its stick stiffness) is the solver's (`crate::solver::terms::contact`).
+    pub friction: Real,
 }
 
 impl Obstacle {
@@ -40,7 +49,14 @@ impl Obstacle {
             surface,
             wall,
             active: (0.0, None),
+            friction: 0.0,
         }
+    }
+
+    /// The same obstacle with the Coulomb friction coefficient `μ`.
+    pub fn with_friction(mut self, friction: Real) -> Self {
+        self.friction = friction;
+        self
     }
 
     /// Whether it acts in a step ending at `t`: after `from` (from the start, the initial state included, when
@@ -88,6 +104,193 @@ pub enum Surface {
         /// Displacement of the plane along its normal as a function of time \[length\].
         offset: TimeFunction,
     },
+    /// The lumen of a vessel: the tube around a centreline spline with a radius along it; the rods are kept
+    /// inside it ([`Lumen`]).
+    Lumen(Lumen),
+}
+
+/// The tube around a centreline spline `C(u)` of radius `R(u)` (a vessel's lumen): the distance of a point
+/// `x` inside is `R(u*) − |x − C(u*)|` with `u*` its closest point on the centreline (module docs of
+/// [`Lumen::distance`]).
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+pub struct Lumen {
+    /// The centreline.
+    centreline: NurbsCurve,
+    /// The radius `R(u)` at increasing curve parameters, linear between them and constant beyond the ends:
+    /// `(u, R)` \[1, length\].
+    radius: Vec<(Real, Real)>,
+    /// The first guesses of the closest-point search: the centreline sampled at `SEARCH_SAMPLES` points per
+    /// knot span, `(u, C(u))`, in increasing `u` (module docs of [`Lumen::distance`]).
+    #[serde(skip)]
+    samples: Vec<(Real, Vec3)>,
+}
+
+/// Centreline samples per knot span for the first guess of a lumen's closest point (module docs of
+/// [`Lumen::distance`]).
+const SEARCH_SAMPLES: usize = 8;
+
+impl Lumen {
+    /// The lumen around `centreline` of the radius table `radius` (`(u, R)` at increasing parameters of the
+    /// centreline, linear between them and constant beyond the ends): what the design layer builds from a
+    /// fitted centreline (`crate::geometry::fit::smooth_points`) and the file's radii at the parameters of its
+    /// points.
+    ///
+    /// # Errors
+    /// A sentence saying what is wrong: an empty table, parameters not increasing or outside the centreline's
+    /// domain, a radius not positive and finite.
+    pub fn try_new(centreline: NurbsCurve, radius: Vec<(Real, Real)>) -> Result<Self, String> {
+        let (lo, hi) = centreline.knots().domain();
+        if radius.is_empty() {
+            return Err("the lumen's radius table is empty".into());
+        }
+        for (i, &(u, r)) in radius.iter().enumerate() {
+            if !(u.is_finite() && (lo..=hi).contains(&u)) {
+                return Err(format!(
+                    "the lumen's radius table has the parameter {u} (entry {i}) outside the centreline's domain [{lo}, {hi}]"
+                ));
+            }
+            if !(r.is_finite() && r > 0.0) {
+                return Err(format!(
+                    "the lumen's radius at u = {u} (entry {i}) is {r}: it must be positive and finite"
+                ));
+            }
+            if i > 0 && u <= radius[i - 1].0 {
+                return Err(format!(
+                    "the lumen's radius table must have increasing parameters (entry {i}, u = {u}, follows u = {})",
+                    radius[i - 1].0
+                ));
+            }
+        }
+        let knots = centreline.knots().knots();
+        let mut samples = Vec::new();
+        for w in knots.windows(2) {
+            let (a, b) = (w[0], w[1]);
+            if !(b > a && a >= lo && b <= hi) {
+                continue;
+            }
+            for j in 0..SEARCH_SAMPLES {
+                let u = a + (b - a) * j as Real / SEARCH_SAMPLES as Real;
+                samples.push((u, centreline.point(u)));
+            }
+        }
+        samples.push((hi, centreline.point(hi)));
+        Ok(Self {
+            centreline,
+            radius,
+            samples,
+        })
+    }
+
+    /// The centreline.
+    pub fn centreline(&self) -> &NurbsCurve {
+        &self.centreline
+    }
+
+    /// The radius table `(u, R)`.
+    pub fn radius_table(&self) -> &[(Real, Real)] {
+        &self.radius
+    }
+
+    /// The radius `R(u)` and its derivative `dR/du` (linear between the table's entries, constant beyond).
+    pub fn radius(&self, u: Real) -> (Real, Real) {
+        let table = &self.radius;
+        let i = table.partition_point(|&(v, _)| v <= u);
+        if i == 0 {
+            return (table[0].1, 0.0);
+        }
+        if i == table.len() {
+            return (table[i - 1].1, 0.0);
+        }
+        let ((u0, r0), (u1, r1)) = (table[i - 1], table[i]);
+        let slope = (r1 - r0) / (u1 - u0);
+        (r0 + slope * (u - u0), slope)
+    }
+
+    /// The parameter of the point of the centreline closest to `x`: Newton's method on
+    /// `f(u) = (x − C(u))·C'(u) = 0` (`f' = −J`, `J = |C'|² − (x − C)·C''`) from `hint` (the point's parameter
+    /// at the last converged step) if given and it settles there, else from the nearest of the search samples.
+    /// `None` when the closest point is an end of the centreline (the point lies beyond the open tube's ends)
+    /// or Newton does not settle on a minimum (`J ≤ 0`: beyond a centre of curvature).
+    pub fn closest(&self, x: &Vec3, hint: Option<Real>) -> Option<Real> {
+        if let Some(u) = hint.and_then(|u| self.project(x, u)) {
+            return Some(u);
+        }
+        let start = self
+            .samples
+            .iter()
+            .min_by(|a, b| {
+                (a.1 - x)
+                    .norm_squared()
+                    .total_cmp(&(b.1 - x).norm_squared())
+            })
+            .map(|s| s.0)?;
+        self.project(x, start)
+    }
+
+    /// Newton's projection of `x` on the centreline from `u` ([`Lumen::closest`]).
+    fn project(&self, x: &Vec3, mut u: Real) -> Option<Real> {
+        let (lo, hi) = self.centreline.knots().domain();
+        let scale = hi - lo;
+        for _ in 0..50 {
+            let d = self.centreline.derivatives(u, 2);
+            let r = x - d[0];
+            let f = r.dot(&d[1]);
+            let j = d[1].norm_squared() - r.dot(&d[2]);
+            if !(j > 0.0) {
+                return None;
+            }
+            let next = (u + f / j).clamp(lo, hi);
+            let step = (next - u).abs();
+            u = next;
+            if step <= 1e-15 * scale {
+                return (u > lo && u < hi).then_some(u);
+            }
+        }
+        None
+    }
+
+    /// The signed distance of `x` from the lumen's wall (positive inside), its gradient and its Hessian; `None`
+    /// where [`Lumen::closest`] finds no closest point or `x` is on the centreline.
+    ///
+    /// With `u*` the closest parameter, `r = x − C(u*)`, `ρ = |r|`, `e = r/ρ` and `J = |C'|² − r·C''`, the
+    /// distance is `g = R(u*) − ρ`. By the stationarity `r·C' = 0` the implicit derivative of the closest point is
+    /// `∇u* = C'/J`, and
+    /// `∇g = −e + R' C'/J`, `∇²g = −(I − e eᵀ − C'C'ᵀ/J)/ρ + R' ∇²u*`,
+    /// `∇²u* = (C''C'ᵀ + C'C''ᵀ)/J² − (3 C'·C'' − r·C''') C'C'ᵀ/J³` (`R'' = 0` on the linear table; the
+    /// derivative of `J` along `u` is `3 C'·C'' − r·C'''` and across `x` is `−C''`). For a straight centreline
+    /// of unit speed and a constant radius these are the cylinder's ([`Surface::distance`]). The gradient is
+    /// unit only where `R' = 0` (a tapering lumen tilts its wall by `R' |∇u*|`); the contact law takes it as it
+    /// is, its tangent consistent with it.
+    ///
+    /// The first guess is `hint`, the point's closest parameter at the last converged step (the contact term
+    /// keeps one per point), from which Newton's method takes a few iterations as the point moves little per
+    /// step; without one, or where Newton does not settle from it, a linear scan of the centreline's samples
+    /// ([`SEARCH_SAMPLES`] per knot span). A sorted scan, not a k-d tree: a vessel's fitted centreline has a few
+    /// tens of spans, so the scan is a few hundred points, paid only at a point's first contact check and at
+    /// the checks between collocation points once per step; a tree would save little and add a dependency.
+    /// A hint can lead to a local, not global, closest point where a vessel folds back within one step's
+    /// motion; a fitted vessel centreline does not.
+    pub fn distance(&self, x: &Vec3, hint: Option<Real>) -> Option<Distance> {
+        let u = self.closest(x, hint)?;
+        let d = self.centreline.derivatives(u, 3);
+        let (c1, c2, c3) = (d[1], d[2], d[3]);
+        let r = x - d[0];
+        let rho = r.norm();
+        let (radius, slope) = self.radius(u);
+        if rho <= Real::EPSILON * radius {
+            return None;
+        }
+        let e = r / rho;
+        let j = c1.norm_squared() - r.dot(&c2);
+        let t = c1 * c1.transpose();
+        let dj = 3.0 * c1.dot(&c2) - r.dot(&c3);
+        let hess_u = (c2 * c1.transpose() + c1 * c2.transpose()) / (j * j) - t * (dj / (j * j * j));
+        Some(Distance {
+            value: radius - rho,
+            normal: -e + c1 * (slope / j),
+            hessian: -(Mat3::identity() - e * e.transpose() - t / j) / rho + hess_u * slope,
+        })
+    }
 }
 
 /// The signed distance of a point from a surface (positive on the rods' side), with its gradient (the unit
@@ -141,14 +344,33 @@ impl Surface {
                 normal: *normal,
                 hessian: Mat3::zeros(),
             }),
+            Surface::Lumen(lumen) => lumen.distance(x, None),
         }
     }
 
-    /// The radius of a cylinder at time `t` (`None` for a plane): the `R` of a compliant wall's stiffness.
+    /// [`Surface::distance`] with a lumen's closest-point search started from `hint` ([`Lumen::distance`]);
+    /// the other surfaces ignore it.
+    pub fn distance_near(&self, x: &Vec3, t: Real, hint: Option<Real>) -> Option<Distance> {
+        match self {
+            Surface::Lumen(lumen) => lumen.distance(x, hint),
+            _ => self.distance(x, t),
+        }
+    }
+
+    /// A lumen's closest parameter to `x` ([`Lumen::closest`]); `None` for the other surfaces.
+    pub fn parameter(&self, x: &Vec3, hint: Option<Real>) -> Option<Real> {
+        match self {
+            Surface::Lumen(lumen) => lumen.closest(x, hint),
+            _ => None,
+        }
+    }
+
+    /// The radius of a cylinder at time `t` (`None` for a plane and a lumen, whose radius varies along it): the
+    /// `R` of a compliant wall's stiffness.
     pub fn radius(&self, t: Real) -> Option<Real> {
         match self {
             Surface::Cylinder { radius, .. } => Some(radius.value(t)),
-            Surface::Plane { .. } => None,
+            Surface::Plane { .. } | Surface::Lumen(_) => None,
         }
     }
 
@@ -158,6 +380,7 @@ impl Surface {
             Surface::Cylinder { radius: f, .. } | Surface::Plane { offset: f, .. } => {
                 f.breakpoints().collect()
             }
+            Surface::Lumen(_) => Vec::new(),
         }
     }
 }
@@ -215,4 +438,167 @@ pub struct ContactSettings {
     pub tolerance: Real,
     /// Most augmented-Lagrange updates per step.
     pub max_updates: usize,
+}
+
+#[cfg(test)]
+mod tests {
+    use super::{Distance, Lumen, Surface};
+    use crate::geometry::primitives::arc;
+    use crate::math::{KnotVector, Mat3, NurbsCurve, Real, Vec3};
+    use crate::model::TimeFunction;
+
+    /// The largest entry of `a − b` over the largest of `b` (and 1e-300).
+    fn relative(a: &Mat3, b: &Mat3) -> Real {
+        (a - b).abs().max() / b.abs().max().max(1e-300)
+    }
+
+    /// The gradient and Hessian of `f` at `x` by central differences of step `h`.
+    fn differences(f: &dyn Fn(&Vec3) -> Real, x: &Vec3, h: Real) -> (Vec3, Mat3) {
+        let e = |i: usize| Vec3::ith(i, h);
+        let gradient = Vec3::from_fn(|i, _| (f(&(x + e(i))) - f(&(x - e(i)))) / (2.0 * h));
+        let hessian = Mat3::from_fn(|i, j| {
+            (f(&(x + e(i) + e(j))) - f(&(x + e(i) - e(j))) - f(&(x - e(i) + e(j)))
+                + f(&(x - e(i) - e(j))))
+                / (4.0 * h * h)
+        });
+        (gradient, hessian)
+    }
+
+    /// A straight cubic centreline from `a` to `b` (collinear control points, non-uniform on purpose: the
+    /// distance must not depend on the parametrisation).
+    fn straight(a: Vec3, b: Vec3) -> NurbsCurve {
+        let knots = KnotVector::clamped_uniform(3, 6).expect("a knot vector");
+        let points = [0.0, 0.1, 0.3, 0.6, 0.8, 1.0]
+            .iter()
+            .map(|&t| a + (b - a) * t)
+            .collect();
+        NurbsCurve::try_bspline(knots, points).expect("a curve")
+    }
+
+    /// Source: a straight lumen of constant radius is a cylinder, whose distance, normal and Hessian have their
+    /// own closed form ([`Surface::distance`] of a cylinder); the two must agree to round-off (1e-12) at points
+    /// inside it, near its wall and outside it, with an oblique axis.
+    #[test]
+    fn a_straight_lumen_is_the_cylinder() {
+        let (point, axis, radius) = (
+            Vec3::new(1.0, -2.0, 0.5),
+            Vec3::new(0.3, 0.4, 1.0).normalize(),
+            1.5,
+        );
+        let lumen = Lumen::try_new(
+            straight(point - axis * 10.0, point + axis * 10.0),
+            vec![(0.0, radius), (1.0, radius)],
+        )
+        .expect("a lumen");
+        let cylinder = Surface::Cylinder {
+            point,
+            axis,
+            radius: TimeFunction::constant(radius),
+        };
+        for x in [
+            Vec3::new(1.2, -1.9, 0.7),
+            Vec3::new(2.0, -3.0, 2.0),
+            Vec3::new(-1.0, 0.5, -3.0),
+            Vec3::new(3.0, -2.0, 0.0),
+        ] {
+            let a: Distance = lumen.distance(&x, None).expect("inside the tube's span");
+            let b = cylinder.distance(&x, 0.0).expect("off the axis");
+            assert!((a.value - b.value).abs() < 1e-12, "{a:?} {b:?}");
+            assert!((a.normal - b.normal).norm() < 1e-12, "{a:?} {b:?}");
+            assert!(relative(&a.hessian, &b.hessian) < 1e-12, "{a:?} {b:?}");
+        }
+    }
+
+    /// Source: a circular centreline of radius `Rc` (a NURBS arc, exact) with a constant radius `R` is a torus
+    /// section: distance `R − √((√(x² + y²) − Rc)² + z²)` (closed form). The lumen's value must be the closed
+    /// form's to round-off (1e-12), its gradient and Hessian those of the closed form by central differences
+    /// (step 1e-4: truncation ~1e-8, round-off ~1e-16/1e-8 = 1e-8 of the Hessian; tolerance 1e-6 relative).
+    #[test]
+    fn a_circular_lumen_is_the_torus() {
+        let (rc, radius) = (10.0, 2.0);
+        let centreline = arc(
+            Vec3::zeros(),
+            Vec3::new(rc, 0.0, 0.0),
+            Vec3::z(),
+            2.0 * std::f64::consts::FRAC_PI_3,
+            3,
+            9,
+        )
+        .expect("an arc");
+        let (lo, hi) = centreline.knots().domain();
+        let lumen = Lumen::try_new(centreline, vec![(lo, radius), (hi, radius)]).expect("a lumen");
+        let torus = |x: &Vec3| radius - ((x.x.hypot(x.y) - rc).powi(2) + x.z * x.z).sqrt();
+        for angle in [0.3_f64, 1.0, 1.7] {
+            for (dr, dz) in [(0.5, 0.2), (-1.2, 0.7), (0.1, -1.9), (2.5, 1.0)] {
+                let x = Vec3::new((rc + dr) * angle.cos(), (rc + dr) * angle.sin(), dz);
+                let d = lumen.distance(&x, None).expect("inside the arc's span");
+                assert!(
+                    (d.value - torus(&x)).abs() < 1e-12,
+                    "{} {}",
+                    d.value,
+                    torus(&x)
+                );
+                let (gradient, hessian) = differences(&torus, &x, 1e-4);
+                assert!((d.normal - gradient).norm() < 1e-6, "{d:?} {gradient:?}");
+                assert!(relative(&d.hessian, &hessian) < 1e-6, "{d:?} {hessian:?}");
+            }
+        }
+    }
+
+    /// Source: the gradient and Hessian of a tapering lumen (radius linear in the parameter over a circular
+    /// centreline, so `R' ≠ 0` and the closest point's own derivatives enter) are those of its distance by
+    /// central differences (the same step and tolerance as above), away from the radius table's kinks.
+    #[test]
+    fn a_tapering_lumens_gradient_and_hessian_are_its_distances() {
+        let centreline = arc(
+            Vec3::zeros(),
+            Vec3::new(8.0, 0.0, 0.0),
+            Vec3::z(),
+            2.0,
+            3,
+            12,
+        )
+        .expect("an arc");
+        let (lo, hi) = centreline.knots().domain();
+        let lumen = Lumen::try_new(centreline, vec![(lo, 2.5), (hi, 1.5)]).expect("a lumen");
+        let value = |x: &Vec3| lumen.distance(x, None).expect("inside").value;
+        for angle in [0.4_f64, 1.1, 1.6] {
+            for (dr, dz) in [(0.5, 0.2), (-1.0, 0.6), (0.3, -1.2)] {
+                let x = Vec3::new((8.0 + dr) * angle.cos(), (8.0 + dr) * angle.sin(), dz);
+                let d = lumen.distance(&x, None).expect("inside");
+                let (gradient, hessian) = differences(&value, &x, 1e-4);
+                assert!((d.normal - gradient).norm() < 1e-6, "{d:?} {gradient:?}");
+                assert!(relative(&d.hessian, &hessian) < 1e-6, "{d:?} {hessian:?}");
+            }
+        }
+    }
+
+    /// A point beyond the tube's ends has no closest interior point (no contact), and a bad table is refused
+    /// with its reason.
+    #[test]
+    fn a_lumen_ends_and_refuses_bad_tables() {
+        let lumen = Lumen::try_new(
+            straight(Vec3::zeros(), Vec3::new(0.0, 0.0, 10.0)),
+            vec![(0.0, 1.0)],
+        )
+        .expect("a lumen");
+        assert!(lumen.distance(&Vec3::new(0.1, 0.0, 12.0), None).is_none());
+        let inside = Vec3::new(0.1, 0.0, 5.0);
+        let u = lumen.closest(&inside, None).expect("inside the span");
+        // From a hint near the answer Newton lands on the same parameter; from a far one too.
+        for hint in [u + 1e-3, 0.05] {
+            let v = lumen.closest(&inside, Some(hint)).expect("inside");
+            assert!((u - v).abs() < 1e-12, "{u} from a scan, {v} from {hint}");
+        }
+        let curve = || straight(Vec3::zeros(), Vec3::new(0.0, 0.0, 10.0));
+        for (table, reason) in [
+            (vec![], "empty"),
+            (vec![(0.5, 1.0), (0.2, 1.0)], "increasing"),
+            (vec![(0.5, -1.0)], "positive"),
+            (vec![(2.0, 1.0)], "outside"),
+        ] {
+            let error = Lumen::try_new(curve(), table).expect_err("refused");
+            assert!(error.contains(reason), "{error}");
+        }
+    }
 }

@@ -152,22 +152,44 @@ pub(crate) fn contact(contact: &crate::model::Contact, model: &crate::model::Mod
                 ),
             ));
         }
-        let (direction, schedule) = match &obstacle.surface {
-            Surface::Cylinder { axis, radius, .. } => (axis, radius),
-            Surface::Plane { normal, offset, .. } => (normal, offset),
+        let direction = match &obstacle.surface {
+            Surface::Cylinder { axis, radius, .. } => Some((axis, radius)),
+            Surface::Plane { normal, offset, .. } => Some((normal, offset)),
+            Surface::Lumen(lumen) => {
+                let narrowest = lumen
+                    .radius_table()
+                    .iter()
+                    .map(|&(_, r)| r)
+                    .fold(Real::INFINITY, Real::min);
+                if !(narrowest > wire) {
+                    return Err(BuildError::new(
+                        at(ObstacleField::Schedule),
+                        format!(
+                            "the lumen's radius narrows to {narrowest}, not more than the wire's radius {wire}: no wire fits inside it"
+                        ),
+                    ));
+                }
+                if obstacle.wall != Wall::Rigid {
+                    return Err(BuildError::new(
+                        at(ObstacleField::Wall),
+                        "a lumen's wall must be rigid: its radius varies along it, and a compliant wall's stiffness E_w h / R² is not yet taken at the local radius".to_string(),
+                    ));
+                }
+                None
+            }
         };
-        if !((direction.norm() - 1.0).abs() <= 1e-9) {
-            return Err(BuildError::new(
-                at(ObstacleField::Direction),
-                format!(
-                    "the direction must be a unit vector (its length is {})",
-                    direction.norm()
-                ),
-            ));
-        }
-        if let Surface::Cylinder { .. } = obstacle.surface {
+        if let Some((direction, schedule)) = direction {
+            if !((direction.norm() - 1.0).abs() <= 1e-9) {
+                return Err(BuildError::new(
+                    at(ObstacleField::Direction),
+                    format!(
+                        "the direction must be a unit vector (its length is {})",
+                        direction.norm()
+                    ),
+                ));
+            }
             let (lo, _) = schedule.range();
-            if !(lo > wire) {
+            if matches!(obstacle.surface, Surface::Cylinder { .. }) && !(lo > wire) {
                 return Err(BuildError::new(
                     at(ObstacleField::Schedule),
                     format!(
@@ -175,6 +197,15 @@ pub(crate) fn contact(contact: &crate::model::Contact, model: &crate::model::Mod
                     ),
                 ));
             }
+        }
+        if !(obstacle.friction.is_finite() && obstacle.friction >= 0.0) {
+            return Err(BuildError::new(
+                at(ObstacleField::Friction),
+                format!(
+                    "the friction coefficient must be zero or positive and finite (it is {})",
+                    obstacle.friction
+                ),
+            ));
         }
         match obstacle.wall {
             Wall::Rigid => {}

@@ -109,6 +109,8 @@ pub enum ObstacleField {
     Schedule,
     /// Its wall.
     Wall,
+    /// Its friction coefficient.
+    Friction,
 }
 
 /// A part of a patch.

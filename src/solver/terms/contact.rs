@@ -26,8 +26,57 @@
 //! again from where it converged ([`PointTerm::augment`]); at most `max_updates` times. If the penetration is
 //! still above the tolerance then, the step is kept and the run's warnings say so (how many steps, the largest
 //! penetration, when first: [`PointTerm::warnings`], into summary.json and on stderr). The multipliers, the
-//! step's update count and that record are the term's state: the multipliers start the next step where this one
-//! left them, a roll-back restores all three, a checkpoint keeps them.
+//! step's update count, that record, the friction anchors and work, a lumen's closest-point parameters and
+//! the record of penetration anywhere (below) are the term's state: the multipliers start the next step where
+//! this one left them, a roll-back restores them all, a checkpoint keeps them.
+//!
+//! **Friction.** An obstacle with a Coulomb coefficient `μ > 0` ([`crate::model::Obstacle::friction`]) adds a
+//! tangential line force at every point it presses, regularised by a stick stiffness and a return map (the
+//! penalty regularisation of Coulomb's law, Wriggers, *Computational Contact Mechanics*, 2nd ed. 2006, §5.2 and
+//! §10.5, as in the penalty friction of beam contact codes; PyElastica regularises by a slip-velocity threshold
+//! instead, which needs a velocity a quasi-static step has not). Each point keeps an **anchor** `a`, the term's
+//! state. With `d = c − a`, the slip is its tangential part `s = d − n (n·d)`, the trial force `−ε_t s` with the
+//! stick stiffness `ε_t` = the law's penalty (`ε`, or `k b` for a compliant wall: the elastic slip before
+//! sliding, `μ p / ε_t`, is then of the order of the normal law's own penetration), and the limit `μ p`:
+//! - **stick**, `ε_t |s| ≤ μ p`: `q_t = −ε_t s`, `∂q_t/∂c = −ε_t ∂s/∂c`;
+//! - **slip**, beyond: `q_t = −μ p e`, `e = s/|s|`, `∂q_t/∂c = −μ (dp/dg) e nᵀ − (μ p/|s|)(I − e eᵀ) ∂s/∂c`;
+//!
+//! with `∂s/∂c = I − n nᵀ − (n·d) H − n (H d)ᵀ` (`H` the distance's Hessian, the derivative of `n`). The tangent
+//! is not symmetric (the collocated system is not anyway). In [`PointTerm::commit`] the anchor of a sliding
+//! point moves along `e` until the elastic slip is `μ p / ε_t`, `a ← c − (μ p/ε_t) e` (the return map), and the
+//! step's **friction work** `Σ_g l_g μ p (|s| − μ p/ε_t)` (the plastic slip times the limit, `l_g` the point's
+//! tributary length) is added up ([`SurfaceContact::friction_work`]); a sticking point keeps its anchor; a
+//! point without pressure takes its position as anchor, so a point that touches down slips from where it was
+//! at the last converged step. The anchors start at the reference positions; only frictional obstacles keep
+//! them. The anchor is a point in space: for the surfaces here (a cylinder's radius and a plane's offset move
+//! along their normals) a point that sticks while the surface moves has `d` along the normal, hence no slip;
+//! a point sliding across a moving cylinder's curvature picks up an error of the order of its slip times the
+//! radius change over the radius.
+//!
+//! **Lumen.** The distance from a vessel's lumen ([`crate::model::Lumen`]) needs the closest point on its
+//! centreline: each point's parameter at the last converged step is kept (term state, set in
+//! [`PointTerm::commit`], saved with the rest) and starts the Newton projection of the next step's iterations;
+//! a point without one (its first step) is searched from the centreline's samples.
+//!
+//! **Tributary lengths.** A line force acts per unit reference length; the force a point carries is its line
+//! force times its tributary length ([`SurfaceContact::lengths`]): half the chord to each neighbouring
+//! collocation point of its patch in the reference, a patch end's share given to the interior point next to it
+//! (the law does not act at the ends); they add up to the patch's reference chord polygon, its length for a
+//! straight rod.
+//!
+//! **Penetration anywhere.** The law acts at the collocation points alone: a crest between two of them (a
+//! crown between Greville points) can pass through a wall unresisted. After every converged step
+//! ([`PointTerm::commit`]) the gap is also checked at `SAMPLES_PER_SPAN` = 4 points per knot span of each
+//! patch (the midpoints of the span's quarters; a rod's shape between collocation points is polynomial in each
+//! span, and four samples bound a smooth crest's missed depth by `|g''| h²/8` with `h` a quarter span — a
+//! sixteenth of a span's curvature term — at four times the collocation points' cost, paid once per step, not
+//! per iteration), and the largest penetration into a rigid wall anywhere is found with where it is (obstacle,
+//! patch, curve parameter; [`SurfaceContact::penetration_anywhere`]). It does not drive the augmented-Lagrange
+//! updates: a multiplier acts only where the law does, so updating them cannot lift a crest between points
+//! (more updates would only press the points harder). A step whose penetration anywhere exceeds the tolerance
+//! is recorded (how many, the deepest with where and when, the first) and the run's warnings say so, advising
+//! to refine the patch there — unless the augmented-Lagrange warning already tells it: the collocation points'
+//! own penetration above the tolerance, and nothing deeper than it by more than the tolerance elsewhere.
 //!
 //! **Obstacles put in place later** ([`crate::model::Obstacle::active`]: a sheath, a vessel the programmed
 //! device is deployed in) are checked when they arrive: at the converged state of the step that ends at their
@@ -35,12 +84,20 @@
 //! when, where) and said in the run's warnings — the law would push it out in one step, which is not a
 //! deployment. (Obstacles in place from the start are checked by the model's builder, located in the design.)
 //!
-//! **Switching in and out.** The law is C¹, so Newton sees a continuous tangent as points enter and leave
-//! contact within the transition band `2δ`.
+//! **Switching in and out.** The normal law is C¹, so Newton sees a continuous tangent as points enter and
+//! leave contact within the transition band `2δ`. The friction force is continuous (stick and slip meet at
+//! `ε_t |s| = μ p`) but its tangent jumps there. Checked on the worst case we know: the crimped ring released
+//! in one step (every point leaves contact, the ring springs back 5 %) and pushed back in the next (every point
+//! enters again): Newton takes them in 3 and 2 iterations, with and without friction, no cut (test
+//! `a_ring_released_and_pushed_back_in_one_step_each_does_not_stall_newton`). So no line search and no
+//! active-set hysteresis are added: the C¹ law is what keeps Newton's tangent continuous, and a step that
+//! still fails is cut by the time stepping as any other.
 
 use super::{InteriorLoad, PointTerm, PointView};
-use crate::math::{Real, Vec3};
-use crate::model::{ContactSettings, Distance, Model, Obstacle, Wall};
+use crate::math::basis::nurbs_basis;
+use crate::math::quote::quoted;
+use crate::math::{Mat3, Real, Vec3};
+use crate::model::{ContactSettings, Distance, Model, Obstacle, Surface, Wall};
 use crate::solver::discretisation::{Discretisation, point_position};
 use crate::solver::state::State;
 
@@ -56,6 +113,57 @@ fn ramp(x: Real, delta: Real) -> (Real, Real) {
             (x + delta) / (2.0 * delta),
         )
     }
+}
+
+/// Sample points per knot span where the penetration is checked between the collocation points (module docs).
+pub const SAMPLES_PER_SPAN: usize = 4;
+
+/// The tributary reference length of every collocation point (module docs): half the chord to each neighbour
+/// of its patch, a patch end's share given to the interior point next to it (the law acts at interior points
+/// only), zero at the ends.
+fn tributary_lengths(disc: &Discretisation, reference: &[Vec3]) -> Vec<Real> {
+    let mut lengths = vec![0.0; disc.points.len()];
+    for range in &disc.patches {
+        let (first, last) = (range.offset, range.offset + range.n - 1);
+        for g in first..last {
+            let chord = (reference[g + 1] - reference[g]).norm();
+            // The chord's halves to its two points; an end's half to its interior neighbour.
+            let (a, b) = (g.max(first + 1), (g + 1).min(last - 1));
+            if a <= b {
+                lengths[a] += 0.5 * chord;
+                lengths[b] += 0.5 * chord;
+            }
+        }
+    }
+    lengths
+}
+
+/// The sample points of every patch (module docs): `SAMPLES_PER_SPAN` per non-empty knot span, at the
+/// midpoints of its equal parts.
+fn samples(model: &Model, disc: &Discretisation) -> Vec<Sample> {
+    let mut out = Vec::new();
+    for (patch, (p, range)) in model.patches.iter().zip(&disc.patches).enumerate() {
+        let knots = p.curve.knots();
+        let (lo, hi) = knots.domain();
+        let values = knots.knots();
+        for w in values.windows(2) {
+            let (a, b) = (w[0], w[1]);
+            if !(b > a && a >= lo && b <= hi) {
+                continue;
+            }
+            for j in 0..SAMPLES_PER_SPAN {
+                let u = a + (b - a) * (j as Real + 0.5) / SAMPLES_PER_SPAN as Real;
+                let table = nurbs_basis(knots, p.curve.weights(), u, 0);
+                out.push(Sample {
+                    patch,
+                    u,
+                    first: range.offset + table.first,
+                    basis: table.ders[0].clone(),
+                });
+            }
+        }
+    }
+    out
 }
 
 /// The contact of one point with one obstacle at the current iterate.
@@ -78,6 +186,8 @@ pub struct SurfaceContact {
     settings: ContactSettings,
     /// Wire radius per patch \[length\].
     radius: Vec<Real>,
+    /// Name of each patch (warnings).
+    patches: Vec<String>,
     /// The time the surfaces are at (the end of the step being solved).
     time: Real,
     /// Augmented-Lagrange multipliers per obstacle and collocation point \[force/length\].
@@ -87,6 +197,20 @@ pub struct SurfaceContact {
     /// Steps kept with the penetration above the tolerance after every update: how many, the largest
     /// penetration, the first step's time.
     unresolved: Unresolved,
+    /// Friction anchors per obstacle and collocation point \[length\] (module docs; empty for a frictionless
+    /// obstacle).
+    anchors: Vec<Vec<Vec3>>,
+    /// Friction work dissipated per obstacle: in the last committed step, and since the start \[force·length\].
+    work: Vec<[Real; 2]>,
+    /// A lumen's closest centreline parameter per obstacle and collocation point at the last converged step,
+    /// the first guess of its search (NaN: none; empty for the other surfaces; module docs).
+    hints: Vec<Vec<Real>>,
+    /// Tributary reference length of each collocation point \[length\] (module docs; zero at the patch ends).
+    lengths: Vec<Real>,
+    /// The sample points between the collocation points (module docs).
+    samples: Vec<Sample>,
+    /// Committed steps whose largest penetration anywhere exceeded the tolerance (module docs).
+    between: Between,
     /// Obstacles put in place (after the start) through the wires: how many, and the deepest.
     placed: Placed,
 }
@@ -100,6 +224,56 @@ struct Placed {
     obstacle: usize,
     time: Real,
     at: Vec3,
+}
+
+/// A point of a patch between its collocation points where the penetration is checked (module docs): its
+/// patch, curve parameter, and basis values `N` of the control points `first ..= first + p`.
+#[derive(Debug, Clone)]
+struct Sample {
+    patch: usize,
+    u: Real,
+    first: usize,
+    basis: Vec<Real>,
+}
+
+/// The largest penetration of the rods into a rigid wall anywhere along them, at the collocation points or
+/// between them (module docs).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Penetration {
+    /// The penetration (the gap's negative) \[length\]; positive into the wall.
+    pub depth: Real,
+    /// The obstacle's index.
+    pub obstacle: usize,
+    /// The patch's index.
+    pub patch: usize,
+    /// The parameter of the patch's curve where it is.
+    pub u: Real,
+}
+
+/// Committed steps whose penetration anywhere exceeded the tolerance: how many, the deepest (where, when), the
+/// first step's time.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+struct Between {
+    steps: usize,
+    deepest: Option<Penetration>,
+    deepest_time: Real,
+    first: Real,
+}
+
+/// The friction of one point at the current iterate (module docs): the tangential line force, its derivative
+/// with respect to the point's position, and the slip from the anchor.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Traction {
+    /// Tangential line force on the rod \[force/length\].
+    pub force: Vec3,
+    /// Its derivative with respect to the point's position \[force/length²\].
+    pub derivative: Mat3,
+    /// The slip `s` from the anchor (tangential) \[length\].
+    pub slip: Vec3,
+    /// The limit `μ p` \[force/length\].
+    pub limit: Real,
+    /// Whether the point slides (`ε_t |s| > μ p`) rather than sticks.
+    pub sliding: bool,
 }
 
 /// Steps that ran out of augmented-Lagrange updates (module docs).
@@ -124,16 +298,147 @@ impl SurfaceContact {
             .map(|p| 0.5 * model.sections[p.section].diameter())
             .collect();
         let multipliers = vec![vec![0.0; disc.points.len()]; obstacles.len()];
+        let reference: Vec<Vec3> = (0..disc.points.len())
+            .map(|g| point_position(disc, &disc.control0, g))
+            .collect();
+        let anchors = obstacles
+            .iter()
+            .map(|o| {
+                if o.friction > 0.0 {
+                    reference.clone()
+                } else {
+                    Vec::new()
+                }
+            })
+            .collect();
+        let work = vec![[0.0; 2]; obstacles.len()];
+        let hints = obstacles
+            .iter()
+            .map(|o| match o.surface {
+                Surface::Lumen(_) => vec![Real::NAN; disc.points.len()],
+                _ => Vec::new(),
+            })
+            .collect();
         Self {
             obstacles,
             settings,
             radius,
+            patches: model.patches.iter().map(|p| p.name.clone()).collect(),
             time: 0.0,
             multipliers,
             updates: 0,
             unresolved: Unresolved::default(),
+            anchors,
+            work,
+            hints,
+            lengths: tributary_lengths(disc, &reference),
+            samples: samples(model, disc),
+            between: Between::default(),
             placed: Placed::default(),
         }
+    }
+
+    /// The tributary reference length of each collocation point (module docs) \[length\]: a line force at
+    /// point `g` times `lengths()[g]`, summed, is the force on the rods.
+    pub fn lengths(&self) -> &[Real] {
+        &self.lengths
+    }
+
+    /// Friction work dissipated at obstacle `k` in the last committed step and since the start
+    /// \[force·length\] (module docs).
+    pub fn friction_work(&self, k: usize) -> (Real, Real) {
+        let [step, total] = self.work[k];
+        (step, total)
+    }
+
+    /// The friction of the point at `x` (collocation point `g`) with obstacle `k`, in contact `c` (module
+    /// docs); `None` for a frictionless obstacle or a point without pressure.
+    pub fn friction(&self, k: usize, g: usize, x: &Vec3, c: &PointContact) -> Option<Traction> {
+        let mu = self.obstacles[k].friction;
+        if mu == 0.0 || c.pressure == 0.0 {
+            return None;
+        }
+        let stick = self.law(k, g).0;
+        let (n, h) = (c.distance.normal, c.distance.hessian);
+        let d = x - self.anchors[k][g];
+        let normal = n.dot(&d);
+        let slip = d - n * normal;
+        // s = d − n (n·d), ∂n/∂x = H: ∂s/∂x = I − n nᵀ − (n·d) H − n (H d)ᵀ.
+        let ds = Mat3::identity() - n * n.transpose() - h * normal - n * (h * d).transpose();
+        let limit = mu * c.pressure;
+        let length = slip.norm();
+        if stick * length <= limit {
+            return Some(Traction {
+                force: -slip * stick,
+                derivative: -ds * stick,
+                slip,
+                limit,
+                sliding: false,
+            });
+        }
+        let e = slip / length;
+        // q = −μ p e with ∂p/∂x = (dp/dg) n and ∂e/∂s = (I − e eᵀ) / |s|.
+        let derivative = -e * n.transpose() * (mu * c.stiffness)
+            - (Mat3::identity() - e * e.transpose()) * ds * (limit / length);
+        Some(Traction {
+            force: -e * limit,
+            derivative,
+            slip,
+            limit,
+            sliding: true,
+        })
+    }
+
+    /// The largest penetration into a rigid wall anywhere along the rods of `state`: at the interior collocation
+    /// points and at the sample points between them (module docs); `None` where nothing penetrates.
+    pub fn penetration_anywhere(
+        &self,
+        disc: &Discretisation,
+        state: &State,
+    ) -> Option<Penetration> {
+        let mut deepest: Option<Penetration> = None;
+        let mut consider = |depth: Real, obstacle: usize, patch: usize, u: Real| {
+            if depth > 0.0 && deepest.is_none_or(|d| depth > d.depth) {
+                deepest = Some(Penetration {
+                    depth,
+                    obstacle,
+                    patch,
+                    u,
+                });
+            }
+        };
+        for (k, obstacle) in self.obstacles.iter().enumerate() {
+            if obstacle.wall != Wall::Rigid {
+                continue;
+            }
+            let gap = |x: &Vec3, patch: usize| {
+                obstacle
+                    .surface
+                    .distance(x, self.time)
+                    .map(|d| d.value - self.radius[patch])
+            };
+            for (g, point) in disc.points.iter().enumerate() {
+                if disc.is_end(g) {
+                    continue;
+                }
+                let x = point_position(disc, &state.control, g);
+                if let Some(gap) = gap(&x, point.patch) {
+                    consider(-gap, k, point.patch, point.u);
+                }
+            }
+            for sample in &self.samples {
+                let x: Vec3 = sample
+                    .basis
+                    .iter()
+                    .enumerate()
+                    .map(|(a, n)| state.control[sample.first + a] * *n)
+                    .sum();
+                if let Some(gap) = gap(&x, sample.patch) {
+                    consider(-gap, k, sample.patch, sample.u);
+                }
+            }
+        }
+        deepest
     }
 
     /// The obstacles.
@@ -163,7 +468,8 @@ impl SurfaceContact {
         if !obstacle.is_active(self.time) {
             return None;
         }
-        let distance = obstacle.surface.distance(x, self.time)?;
+        let hint = self.hints[k].get(g).copied().filter(|u| !u.is_nan());
+        let distance = obstacle.surface.distance_near(x, self.time, hint)?;
         let gap = distance.value - self.radius[patch];
         let (penalty, multiplier) = self.law(k, g);
         let delta = 0.5 * self.settings.regularisation;
@@ -202,33 +508,10 @@ impl SurfaceContact {
         }
         (worst, pressures)
     }
-}
 
-impl PointTerm for SurfaceContact {
-    fn name(&self) -> &'static str {
-        "surface contact"
-    }
-
-    fn interior(&self, at: &PointView<'_>, load: &mut InteriorLoad) {
-        let x = at.position();
-        for k in 0..self.obstacles.len() {
-            let Some(c) = self.at(k, at.g, at.point.patch, &x) else {
-                continue;
-            };
-            if c.pressure == 0.0 && c.stiffness == 0.0 {
-                continue;
-            }
-            let n = c.distance.normal;
-            load.add_force(n * c.pressure);
-            if at.tangent {
-                let dq = n * n.transpose() * c.stiffness + c.distance.hessian * c.pressure;
-                load.add_force_position(at.rotation_t * dq);
-            }
-        }
-    }
-
-    fn commit(&mut self, disc: &Discretisation, state: &State) {
-        // An obstacle put in place at this step's end must find the wires clear of it (module docs).
+    /// Records an obstacle put in place at the end of the step that converged at `state` with a wire deeper
+    /// through it than the tolerance (module docs).
+    fn record_placed(&mut self, disc: &Discretisation, state: &State) {
         let t = self.time;
         for (k, obstacle) in self.obstacles.iter().enumerate() {
             let from = obstacle.active.0;
@@ -255,6 +538,34 @@ impl PointTerm for SurfaceContact {
                 if depth > p.largest {
                     (p.largest, p.obstacle, p.time, p.at) = (depth, k, t, x);
                 }
+            }
+        }
+    }
+}
+
+impl PointTerm for SurfaceContact {
+    fn name(&self) -> &'static str {
+        "surface contact"
+    }
+
+    fn interior(&self, at: &PointView<'_>, load: &mut InteriorLoad) {
+        let x = at.position();
+        for k in 0..self.obstacles.len() {
+            let Some(c) = self.at(k, at.g, at.point.patch, &x) else {
+                continue;
+            };
+            if c.pressure == 0.0 && c.stiffness == 0.0 {
+                continue;
+            }
+            let n = c.distance.normal;
+            let friction = self.friction(k, at.g, &x, &c);
+            load.add_force(n * c.pressure + friction.map_or(Vec3::zeros(), |f| f.force));
+            if at.tangent {
+                let mut dq = n * n.transpose() * c.stiffness + c.distance.hessian * c.pressure;
+                if let Some(f) = friction {
+                    dq += f.derivative;
+                }
+                load.add_force_position(at.rotation_t * dq);
             }
         }
     }
@@ -286,10 +597,10 @@ impl PointTerm for SurfaceContact {
     }
 
     fn warnings(&self) -> Vec<String> {
-        let mut said = Vec::new();
+        let mut out = Vec::new();
         let p = &self.placed;
         if p.count > 0 {
-            said.push(format!(
+            out.push(format!(
                 "contact: {} obstacle(s) were put in place through the wires, the deepest `{}` at t = {} by {:.3e} at ({:.4}, {:.4}, {:.4}), beyond the penetration tolerance {:e}: the first step after it pushed the wires out at once; put it in place where the device is clear of it",
                 p.count,
                 self.obstacles[p.obstacle].name,
@@ -302,18 +613,97 @@ impl PointTerm for SurfaceContact {
             ));
         }
         let u = &self.unresolved;
-        if u.steps == 0 {
-            return said;
+        if u.steps > 0 {
+            out.push(format!(
+                "contact: in {} step(s) the penetration stayed above its tolerance {:e} after {} augmented-Lagrange update(s), by up to {:.3e} (first at t = {}): raise `max_updates` or the penalty",
+                u.steps, self.settings.tolerance, self.settings.max_updates, u.largest, u.first
+            ));
         }
-        said.push(format!(
-            "contact: in {} step(s) the penetration stayed above its tolerance {:e} after {} augmented-Lagrange update(s), by up to {:.3e} (first at t = {}): raise `max_updates` or the penalty",
-            u.steps, self.settings.tolerance, self.settings.max_updates, u.largest, u.first
-        ));
-        said
+        let b = &self.between;
+        if let Some(d) = b.deepest {
+            out.push(format!(
+                "contact: in {} step(s) the rods penetrated obstacle {} beyond the tolerance {:e} somewhere along them (checked at {SAMPLES_PER_SPAN} points per knot span besides the collocation points, where alone the law acts), by up to {:.3e} on patch {} at curve parameter u = {:.4} at t = {} (first at t = {}): refine the patch there",
+                b.steps,
+                quoted(&self.obstacles[d.obstacle].name),
+                self.settings.tolerance,
+                d.depth,
+                quoted(&self.patches[d.patch]),
+                d.u,
+                b.deepest_time,
+                b.first
+            ));
+        }
+        out
+    }
+
+    fn commit(&mut self, disc: &Discretisation, state: &State) {
+        self.record_placed(disc, state);
+        for (k, hints) in self.hints.iter_mut().enumerate() {
+            let surface = &self.obstacles[k].surface;
+            for (g, hint) in hints.iter_mut().enumerate() {
+                let x = point_position(disc, &state.control, g);
+                let last = Some(*hint).filter(|u| !u.is_nan());
+                *hint = surface.parameter(&x, last).unwrap_or(Real::NAN);
+            }
+        }
+        for k in 0..self.obstacles.len() {
+            if self.anchors[k].is_empty() {
+                continue;
+            }
+            let mut step = 0.0;
+            for (g, point) in disc.points.iter().enumerate() {
+                if disc.is_end(g) {
+                    continue;
+                }
+                let x = point_position(disc, &state.control, g);
+                let traction = self
+                    .at(k, g, point.patch, &x)
+                    .and_then(|c| self.friction(k, g, &x, &c));
+                match traction {
+                    // Free: the anchor follows the point, so a point that touches down slips from where it was.
+                    None => self.anchors[k][g] = x,
+                    // Return map: the anchor moves along the slip until the elastic part is `μ p / ε_t`; the
+                    // rest of the slip dissipates `μ p` per unit length.
+                    Some(f) if f.sliding => {
+                        let length = f.slip.norm();
+                        let elastic = f.limit / self.law(k, g).0;
+                        step += self.lengths[g] * f.limit * (length - elastic);
+                        self.anchors[k][g] = x - f.slip * (elastic / length);
+                    }
+                    Some(_) => {}
+                }
+            }
+            self.work[k] = [step, self.work[k][1] + step];
+        }
+        // Recorded unless the augmented-Lagrange record already tells it: the points' own penetration above the
+        // tolerance, and nothing deeper than it by more than the tolerance between them (module docs).
+        let tolerance = self.settings.tolerance;
+        let at_points = self.rigid_contact(disc, state).0;
+        if let Some(d) = self.penetration_anywhere(disc, state)
+            && d.depth > tolerance
+            && (at_points <= tolerance || d.depth - at_points > tolerance)
+        {
+            let b = &mut self.between;
+            if b.steps == 0 {
+                b.first = self.time;
+            }
+            b.steps += 1;
+            if b.deepest.is_none_or(|old| d.depth > old.depth) {
+                b.deepest = Some(d);
+                b.deepest_time = self.time;
+            }
+        }
     }
 
     fn save(&self, out: &mut Vec<Real>) {
         let u = &self.unresolved;
+        let b = &self.between;
+        let d = b.deepest.unwrap_or(Penetration {
+            depth: 0.0,
+            obstacle: 0,
+            patch: 0,
+            u: 0.0,
+        });
         let p = &self.placed;
         out.extend([
             self.time,
@@ -321,6 +711,13 @@ impl PointTerm for SurfaceContact {
             u.steps as Real,
             u.largest,
             u.first,
+            b.steps as Real,
+            d.depth,
+            d.obstacle as Real,
+            d.patch as Real,
+            d.u,
+            b.deepest_time,
+            b.first,
             p.count as Real,
             p.largest,
             p.obstacle as Real,
@@ -332,15 +729,26 @@ impl PointTerm for SurfaceContact {
         for m in &self.multipliers {
             out.extend_from_slice(m);
         }
+        for a in &self.anchors {
+            out.extend(a.iter().flat_map(|x| x.iter().copied()));
+        }
+        out.extend(self.work.iter().flatten());
+        for h in &self.hints {
+            out.extend_from_slice(h);
+        }
     }
 
     fn restore(&mut self, values: &[Real]) -> Result<(), usize> {
-        const HEAD: usize = 12;
-        let expected = HEAD + self.multipliers.iter().map(Vec::len).sum::<usize>();
+        const HEAD: usize = 19;
+        let expected = HEAD
+            + self.multipliers.iter().map(Vec::len).sum::<usize>()
+            + 3 * self.anchors.iter().map(Vec::len).sum::<usize>()
+            + 2 * self.work.len()
+            + self.hints.iter().map(Vec::len).sum::<usize>();
         if values.len() != expected {
             return Err(expected);
         }
-        // Counts are saved as reals: exact below 2^53.
+        // Counts and indices are saved as reals: exact below 2^53.
         self.time = values[0];
         self.updates = values[1] as usize;
         self.unresolved = Unresolved {
@@ -348,17 +756,45 @@ impl PointTerm for SurfaceContact {
             largest: values[3],
             first: values[4],
         };
+        let steps = values[5] as usize;
+        self.between = Between {
+            steps,
+            deepest: (steps > 0).then(|| Penetration {
+                depth: values[6],
+                obstacle: values[7] as usize,
+                patch: values[8] as usize,
+                u: values[9],
+            }),
+            deepest_time: values[10],
+            first: values[11],
+        };
         self.placed = Placed {
-            count: values[5] as usize,
-            largest: values[6],
-            obstacle: values[7] as usize,
-            time: values[8],
-            at: Vec3::new(values[9], values[10], values[11]),
+            count: values[12] as usize,
+            largest: values[13],
+            obstacle: values[14] as usize,
+            time: values[15],
+            at: Vec3::new(values[16], values[17], values[18]),
         };
         let mut rest = &values[HEAD..];
         for m in &mut self.multipliers {
             let (mine, tail) = rest.split_at(m.len());
             m.copy_from_slice(mine);
+            rest = tail;
+        }
+        for a in &mut self.anchors {
+            let (mine, tail) = rest.split_at(3 * a.len());
+            for (x, v) in a.iter_mut().zip(mine.chunks_exact(3)) {
+                *x = Vec3::new(v[0], v[1], v[2]);
+            }
+            rest = tail;
+        }
+        let (work, mut rest) = rest.split_at(2 * self.work.len());
+        for (w, v) in self.work.iter_mut().zip(work.chunks_exact(2)) {
+            *w = [v[0], v[1]];
+        }
+        for h in &mut self.hints {
+            let (mine, tail) = rest.split_at(h.len());
+            h.copy_from_slice(mine);
             rest = tail;
         }
         Ok(())
@@ -386,6 +822,12 @@ mod tests {
     /// and x = 0 (each end: the displacement normal to its plane, the out-of-plane displacement and every
     /// rotation held), elastic, 20 steps over t ∈ [0, 1], with `contact`.
     fn quarter_ring(contact: Contact) -> Model {
+        quarter_ring_held(contact, true, None)
+    }
+
+    /// [`quarter_ring`] whose ends hold their out-of-plane displacement (z, along the cylinders' axis) only
+    /// if `axial`, with a line load `push` along z if given.
+    fn quarter_ring_held(contact: Contact, axial: bool, push: Option<TimeFunction>) -> Model {
         let material = ElasticLaw::try_new(E, 0.3).expect("E > 0");
         let section = CircularSection::try_new(D).expect("d > 0").into();
         let mut b = ModelBuilder::new("ring", material, section);
@@ -402,15 +844,26 @@ mod tests {
         );
         let zero = || TimeFunction::constant(0.0);
         let symmetric = |node: &str, normal: usize| {
-            ConditionSpec::at(node)
-                .with_displacement(normal, zero())
-                .with_displacement(2, zero())
-                .with_rotation(0, zero())
+            let held = ConditionSpec::at(node).with_displacement(normal, zero());
+            let held = if axial {
+                held.with_displacement(2, zero())
+            } else {
+                held
+            };
+            held.with_rotation(0, zero())
                 .with_rotation(1, zero())
                 .with_rotation(2, zero())
         };
         b.condition(symmetric("ring.start", 1));
         b.condition(symmetric("ring.end", 0));
+        if let Some(push) = push {
+            let constant = TimeFunction::constant;
+            b.distributed_load(crate::model::builder::DistributedLoadSpec {
+                patches: crate::model::builder::PatchTarget::All,
+                force: [constant(0.0), constant(0.0), push],
+                couple: [constant(0.0), constant(0.0), constant(0.0)],
+            });
+        }
         b.time(TimeSpec::new(1.0, 0.05));
         b.contact(contact);
         b.build().expect("valid ring").model
@@ -563,6 +1016,440 @@ mod tests {
         // Both springs take a real share: the test would not tell a stiff wall from a rigid one otherwise.
         let wall_share = (expected + r - tube) / 0.5;
         assert!((0.2..0.8).contains(&wall_share), "{wall_share}");
+    }
+
+    /// A straight rod of length `L` along x lying on the plane z = 0 (its centreline a wire radius above it),
+    /// pressed by a distributed load `w` per unit length in −z and pulled along x by a prescribed displacement
+    /// `U(t)` of its end `bar.end` (y held; both ends' rotations held, which a straight rod on a plane does not
+    /// load, to remove its free twist), the other end free, friction `μ` on the plane.
+    fn rod_on_a_plane(friction: Real, w: Real, pull: TimeFunction) -> Model {
+        let table = Surface::Plane {
+            point: Vec3::zeros(),
+            normal: Vec3::z(),
+            offset: TimeFunction::constant(0.0),
+        };
+        rod_on(table, friction, w, pull)
+    }
+
+    /// Radius of the trough the sliding rod lies in instead of the plane.
+    const TROUGH: Real = 3.0;
+
+    /// The inside of a tube of radius `TROUGH` along x whose lowest generator is the plane's line z = 0, y = 0
+    /// under the sliding rod: a cylinder, or the same as a lumen around a straight centreline (x from −10 to 20,
+    /// beyond the rod and its slide).
+    fn trough(lumen: bool) -> Surface {
+        let point = Vec3::new(0.0, 0.0, TROUGH);
+        if !lumen {
+            return Surface::Cylinder {
+                point,
+                axis: Vec3::x(),
+                radius: TimeFunction::constant(TROUGH),
+            };
+        }
+        let knots = crate::math::KnotVector::clamped_uniform(3, 4).expect("a knot vector");
+        let points = (0..4)
+            .map(|i| point + Vec3::x() * (-10.0 + 10.0 * i as Real))
+            .collect();
+        let centreline = crate::math::NurbsCurve::try_bspline(knots, points).expect("a line");
+        let (lo, hi) = centreline.knots().domain();
+        Surface::Lumen(
+            crate::model::Lumen::try_new(centreline, vec![(lo, TROUGH), (hi, TROUGH)])
+                .expect("a lumen"),
+        )
+    }
+
+    /// [`rod_on_a_plane`] on the surface `table` instead, which must touch the rod's underside along its length.
+    fn rod_on(table: Surface, friction: Real, w: Real, pull: TimeFunction) -> Model {
+        use crate::model::builder::{DistributedLoadSpec, PatchTarget};
+        let material = ElasticLaw::try_new(E, 0.3).expect("E > 0");
+        let section = CircularSection::try_new(D).expect("d > 0").into();
+        let mut b = ModelBuilder::new("sliding rod", material, section);
+        let z = D / 2.0;
+        b.patch(
+            "bar",
+            PatchShape::Line {
+                from: Vec3::new(0.0, 0.0, z),
+                to: Vec3::new(ROD, 0.0, z),
+            },
+            4,
+            24,
+        );
+        let zero = || TimeFunction::constant(0.0);
+        let rotations = |c: ConditionSpec| {
+            c.with_rotation(0, zero())
+                .with_rotation(1, zero())
+                .with_rotation(2, zero())
+        };
+        b.condition(rotations(ConditionSpec::at("bar.start")));
+        b.condition(rotations(
+            ConditionSpec::at("bar.end")
+                .with_displacement(0, pull)
+                .with_displacement(1, zero()),
+        ));
+        let constant = TimeFunction::constant;
+        b.distributed_load(DistributedLoadSpec {
+            patches: PatchTarget::All,
+            force: [constant(0.0), constant(0.0), constant(-w)],
+            couple: [constant(0.0), constant(0.0), constant(0.0)],
+        });
+        b.time(TimeSpec::new(1.0, 0.05));
+        b.contact(Contact {
+            obstacles: vec![Obstacle::new("table", table, Wall::Rigid).with_friction(friction)],
+            settings: SLIDING,
+        });
+        b.build().expect("valid rod").model
+    }
+
+    /// Length of the sliding rod.
+    const ROD: Real = 10.0;
+
+    /// The sliding rod's contact settings: a soft penalty (`ε = 10`, also the stick stiffness) so that the
+    /// sticking rod is a bar on a foundation of moderate `βL` that the discretisation resolves, and augmented
+    /// Lagrange to take the normal penetration `w/ε` out.
+    const SLIDING: ContactSettings = ContactSettings {
+        penalty: 10.0,
+        regularisation: 1e-4,
+        tolerance: 1e-8,
+        max_updates: 10,
+    };
+
+    /// Source: Coulomb friction regularised by a stick stiffness `ε_t` (module docs). A rod of `EA` on a plane
+    /// under the line load `w` (pressure `p = w` at every point) with friction `μ`, its far end free, its end
+    /// `x = L` pulled by `U`:
+    /// - **sticking** (every point's elastic slip below `μ w / ε_t`): a bar on a Winkler foundation of stiffness
+    ///   `ε_t`, `EA u'' = ε_t u`, `u'(0) = 0`, `u(L) = U`, so `u = U cosh(βx)/cosh(βL)`, `β = √(ε_t/EA)`, and
+    ///   the pull `N(L) = EA β U tanh(βL)` (the same closed form as the spring test of `terms::tests`). Here
+    ///   `U = 0.01`, `ε_t U = 0.1 < μ w = 0.3`: every point sticks. Tolerance 1e-5 relative: degree-4
+    ///   collocation on 24 points (`βh ≈ 0.1`) resolves the exponential profile to about `(βh)⁴ ≈ 1e-4` of
+    ///   its curvature's scale and far better in the end force; a missing friction is a 100 % error;
+    /// - **sliding** (every point past its elastic slip): `N' = μ w` at every interior point and `N(0) = 0`,
+    ///   so `N(L) = μ w L` — Coulomb's law for the whole rod — exactly in the spline space (a linear `N`):
+    ///   tolerance the solver's, 1e-7 relative;
+    /// - and in steady sliding every point moves by the step's `ΔU`, so the step's friction work is
+    ///   `μ w L ΔU` (the tributary lengths add up to `L` on a straight rod): same tolerance.
+    ///
+    /// The run is checkpointed while sliding and continued from the checkpoint in a fresh simulation: the anchors
+    /// are the term's state, so the two end bit for bit.
+    #[test]
+    fn a_rod_on_a_plane_sticks_below_coulombs_limit_and_slides_at_it() {
+        let (mu, w) = (0.3, 1.0);
+        let pull = TimeFunction::try_table(vec![(0.0, 0.0), (0.05, 0.01), (1.0, 1.0)])
+            .expect("increasing times");
+        let model = rod_on_a_plane(mu, w, pull);
+        let end = model
+            .nodes
+            .iter()
+            .position(|n| n.name == "bar.end")
+            .expect("node bar.end");
+        let mut sim = Simulation::new(&model).expect("discretised");
+        let reaction = |sim: &Simulation| -> Real { sim.node_end_resultants(end)[0].0.x };
+        sim.step().expect("the first step converges");
+        let area = std::f64::consts::PI * D * D / 4.0;
+        let ea = E * area;
+        let beta = (SLIDING.penalty / ea).sqrt();
+        let sticking = ea * beta * 0.01 * (beta * ROD).tanh();
+        // The rod's end at x = L (outward tangent +x) acts on its node with N(L) in x.
+        let measured = reaction(&sim);
+        println!("sticking: pull {measured:.9e}, closed form {sticking:.9e}");
+        assert!(
+            ((measured - sticking) / sticking).abs() < 1e-5,
+            "sticking: pull {measured}, closed form {sticking}"
+        );
+        for _ in 0..9 {
+            sim.step().expect("converges");
+        }
+        let checkpoint = sim.checkpoint();
+        while sim.step().expect("converges").is_some() {}
+        let sliding = mu * w * ROD;
+        let measured = reaction(&sim);
+        println!("sliding: pull {measured:.9e}, Coulomb {sliding:.9e}");
+        assert!(
+            ((measured - sliding) / sliding).abs() < 1e-7,
+            "sliding: pull {measured}, Coulomb μ w L = {sliding}"
+        );
+        // The term's saved state ends with each obstacle's friction work (last step, total), then a lumen's
+        // closest-point parameters (none here).
+        let terms = &sim.checkpoint().snapshot.terms;
+        let saved = terms.last().expect("the contact term's state");
+        let step_work = saved[saved.len() - 2];
+        let expected = mu * w * ROD * 0.05 * (1.0 - 0.01) / 0.95;
+        println!("friction work of the last step {step_work:.9e}, μ w L ΔU = {expected:.9e}");
+        assert!(
+            ((step_work - expected) / expected).abs() < 1e-7,
+            "friction work {step_work}, μ w L ΔU = {expected}"
+        );
+        assert!(sim.warnings().is_empty(), "{:?}", sim.warnings());
+        let mut continued = Simulation::new(&model).expect("discretised");
+        continued.restore(&checkpoint).expect("restores");
+        while continued.step().expect("converges").is_some() {}
+        assert_eq!(sim.state(), continued.state(), "continued bit for bit");
+    }
+
+    /// Source: the sliding rod in a trough (the inside of a tube along it) instead of on the plane: the same
+    /// Coulomb limit `μ w L` when it slides (the pressure is still `w`, the slip along the generator; solver's
+    /// tolerance, 1e-7), and the lumen around a straight centreline gives the cylinder's run to round-off (every
+    /// control point within 1e-9 of the rod's length: the two distances agree to 1e-12, see
+    /// `crate::model::obstacle`'s tests; Newton's last iterate carries their difference).
+    #[test]
+    fn a_rod_sliding_in_a_straight_lumen_is_the_rod_in_the_cylinder() {
+        let (mu, w) = (0.3, 1.0);
+        let pull = TimeFunction::try_table(vec![(0.0, 0.0), (0.05, 0.01), (1.0, 1.0)])
+            .expect("increasing times");
+        let mut states = Vec::new();
+        for lumen in [false, true] {
+            let model = rod_on(trough(lumen), mu, w, pull.clone());
+            let end = model
+                .nodes
+                .iter()
+                .position(|n| n.name == "bar.end")
+                .expect("node bar.end");
+            let mut sim = Simulation::new(&model).expect("discretised");
+            sim.run(&mut [&mut NoObserver]).expect("slides");
+            let measured = sim.node_end_resultants(end)[0].0.x;
+            println!("trough (lumen: {lumen}): pull {measured:.9e}");
+            assert!(
+                ((measured - mu * w * ROD) / (mu * w * ROD)).abs() < 1e-7,
+                "pull {measured}, μ w L = {}",
+                mu * w * ROD
+            );
+            assert!(sim.warnings().is_empty(), "{:?}", sim.warnings());
+            states.push(sim.state().control.clone());
+        }
+        let worst = states[0]
+            .iter()
+            .zip(&states[1])
+            .map(|(a, b)| (a - b).norm())
+            .fold(0.0, Real::max);
+        println!("lumen against cylinder: largest difference {worst:e}");
+        assert!(worst < 1e-9 * ROD, "{worst}");
+    }
+
+    /// Source: the same rod without friction slides freely, so the pull it needs is zero (to the solver's
+    /// tolerance, against the `μ w L = 3` above): friction is what carried the load there.
+    #[test]
+    fn without_friction_the_rod_slides_for_nothing() {
+        let pull = TimeFunction::try_table(vec![(0.0, 0.0), (1.0, 0.2)]).expect("a ramp");
+        let model = rod_on_a_plane(0.0, 1.0, pull);
+        let end = model
+            .nodes
+            .iter()
+            .position(|n| n.name == "bar.end")
+            .expect("node bar.end");
+        let mut sim = Simulation::new(&model).expect("discretised");
+        // Nothing holds the rod along x but its pulled end: a frictionless run must still converge.
+        while sim.step().expect("converges").is_some() {}
+        let pull = sim.node_end_resultants(end)[0].0.x;
+        assert!(pull.abs() < 1e-6, "pull {pull}");
+    }
+
+    /// Source: contact acts at the collocation points alone, so a crest between them can pass through a wall
+    /// unresisted; the term's check at `SAMPLES_PER_SPAN` points per knot span must find it. An arc of radius
+    /// `R0` over 60° (degree 2, 4 control points: collocation points at u = 0, 0.25, 0.75, 1), its apex at u =
+    /// 0.5 on the y axis, and a plate (normal −y) moved by t = 1 to `δ = 0.05` through the apex: at the
+    /// collocation points the wire stays ≈ `R0 (1 − cos 15°) − δ ≈ 0.29` clear, so the law sees nothing, while
+    /// the apex penetrates by `δ` (closed form). The samples nearest the apex (u = 0.4375, 0.5625) are about
+    /// 3.75° from it, where the arc has dropped `R0 (1 − cos 3.75°) ≈ 0.021`, so the reported depth lies in
+    /// `[δ − 0.03, δ]` (the bound of sampling at that spacing) and at a sample, not a collocation point; and a
+    /// committed step with it says so in the run's warnings, with the patch and where.
+    #[test]
+    fn a_crest_between_collocation_points_is_found_and_warned_about() {
+        use crate::solver::discretisation::Discretisation;
+        use crate::solver::state::State;
+        use crate::solver::terms::PointTerm;
+        use crate::solver::terms::contact::SurfaceContact;
+        let delta = 0.05;
+        let r = D / 2.0;
+        let material = ElasticLaw::try_new(E, 0.3).expect("E > 0");
+        let section = CircularSection::try_new(D).expect("d > 0").into();
+        let mut b = ModelBuilder::new("crest", material, section);
+        let start = Vec3::new(R0 * 0.5, R0 * 0.75_f64.sqrt(), 0.0);
+        b.patch(
+            "arc",
+            PatchShape::Arc {
+                centre: Vec3::zeros(),
+                start,
+                axis: Vec3::z(),
+                angle: std::f64::consts::FRAC_PI_3,
+            },
+            2,
+            4,
+        );
+        b.condition(ConditionSpec::clamp("arc.start"));
+        let plate = Obstacle::new(
+            "plate",
+            Surface::Plane {
+                point: Vec3::new(0.0, R0 + r + 0.5, 0.0),
+                normal: -Vec3::y(),
+                offset: TimeFunction::try_table(vec![(0.0, 0.0), (1.0, 0.5 + delta)])
+                    .expect("a ramp"),
+            },
+            Wall::Rigid,
+        );
+        let settings = ContactSettings {
+            penalty: 1e3,
+            regularisation: 1e-4,
+            tolerance: 1e-3,
+            max_updates: 10,
+        };
+        b.contact(Contact {
+            obstacles: vec![plate.clone()],
+            settings,
+        });
+        let model = b.build().expect("clear at the start").model;
+        let disc = Discretisation::new(&model).expect("discretised");
+        let state = State::reference(&disc);
+        let mut term = SurfaceContact::new(&model, &disc, vec![plate], settings);
+        term.prepare(1.0);
+        let (at_points, _) = term.rigid_contact(&disc, &state);
+        assert_eq!(at_points, 0.0, "the collocation points are clear");
+        let found = term
+            .penetration_anywhere(&disc, &state)
+            .expect("the crest penetrates");
+        println!("crest: depth {:.6} at u = {}", found.depth, found.u);
+        assert!(
+            (delta - 0.03..=delta).contains(&found.depth),
+            "depth {}",
+            found.depth
+        );
+        assert!((found.u - 0.5).abs() < 0.1, "at u = {}", found.u);
+        assert!(
+            disc.points.iter().all(|p| p.u != found.u),
+            "at a sample, not a collocation point"
+        );
+        assert!(term.warnings().is_empty());
+        term.commit(&disc, &state);
+        let warnings = term.warnings();
+        assert_eq!(warnings.len(), 1, "{warnings:?}");
+        assert!(
+            warnings[0].contains("somewhere along them")
+                && warnings[0].contains("`arc`")
+                && warnings[0].contains("at t = 1"),
+            "{}",
+            warnings[0]
+        );
+    }
+
+    /// The quarter ring of `quarter_ring` with its ends free along the axis z (the symmetry planes hold only
+    /// their normal displacement and the rotations), crimped by a rigid cylinder with friction `mu` that touches
+    /// it at the start, shrinks by 0.5 by t = 0.5 and holds; from t = 0.5 a line load along the axis grows to
+    /// `axial` at t = 1. Nothing but friction holds the ring along z.
+    fn ring_pushed_along_the_axis(mu: Real, axial: Real) -> Model {
+        let r = D / 2.0;
+        let mut crimper = cylinder(R0 + r, R0 + r - 0.5, Wall::Rigid);
+        crimper.friction = mu;
+        if let Surface::Cylinder { radius, .. } = &mut crimper.surface {
+            *radius = TimeFunction::try_table(vec![
+                (0.0, R0 + r),
+                (0.5, R0 + r - 0.5),
+                (1.0, R0 + r - 0.5),
+            ])
+            .expect("increasing times");
+        }
+        let push = TimeFunction::try_table(vec![(0.0, 0.0), (0.5, 0.0), (1.0, axial)])
+            .expect("increasing times");
+        quarter_ring_held(
+            Contact {
+                obstacles: vec![crimper],
+                settings: RING,
+            },
+            false,
+            Some(push),
+        )
+    }
+
+    /// The ring tests' contact settings.
+    const RING: ContactSettings = ContactSettings {
+        penalty: 1e3,
+        regularisation: 1e-4,
+        tolerance: 1e-6,
+        max_updates: 10,
+    };
+
+    /// Source: friction removes the rigid-body motion a cylinder leaves a device (here the translation along
+    /// its axis). The crimped ring (pressure `p ≈ 0.98` per unit length at the end, from the ring test above)
+    /// pushed along the axis by `w = 0.05` per unit length, below `μ p ≈ 0.2`, sticks: every point carries
+    /// `q_t = −ε_t s = w`, so the ring translates rigidly by the elastic slip `w/ε_t = 5e-5` (closed form of the
+    /// regularised law; uniform, so no bending), to the solver's tolerance (1e-6 relative). Without friction
+    /// nothing balances the load and the step fails (no equilibrium exists); what we saw before this test:
+    /// with no load along the axis the frictionless ring also "converges" (the free mode has a zero right-hand
+    /// side), so the load is what tells the two apart.
+    #[test]
+    fn friction_holds_a_crimped_ring_against_a_push_along_the_axis() {
+        let w = 0.05;
+        let model = ring_pushed_along_the_axis(0.2, w);
+        let mut sim = Simulation::new(&model).expect("discretised");
+        sim.run(&mut [&mut NoObserver]).expect("held by friction");
+        let disc = sim.discretisation();
+        let expected = w / RING.penalty;
+        for g in 0..disc.points.len() {
+            let z = point_position(disc, &sim.state().control, g).z;
+            assert!(
+                (z - expected).abs() <= 1e-6 * expected,
+                "point {g}: z = {z:e}, elastic slip w/ε = {expected:e}"
+            );
+        }
+        let model = ring_pushed_along_the_axis(0.0, w);
+        let mut sim = Simulation::new(&model).expect("discretised");
+        assert!(
+            sim.run(&mut [&mut NoObserver]).is_err(),
+            "a frictionless ring pushed along the axis has no equilibrium"
+        );
+    }
+
+    /// Switching in and out (module docs): the crimped ring released in one step (the crimper opens by 0.8, every
+    /// point leaves contact and the ring springs back 0.5) and pushed back in the next (every point enters
+    /// again, 5 % hoop strain in one step), with and without friction. Newton (no line search; the law is C¹)
+    /// must take both without a cut or a rejected step, in at most 8 iterations each (measured: 3 and 2), and
+    /// the ring must end pressed to the crimper's radius as in the ring test.
+    #[test]
+    fn a_ring_released_and_pushed_back_in_one_step_each_does_not_stall_newton() {
+        let r = D / 2.0;
+        let mut crimper = cylinder(R0 + r + 0.2, R0 + r - 0.5, Wall::Rigid);
+        if let Surface::Cylinder { radius, .. } = &mut crimper.surface {
+            *radius = TimeFunction::try_table(vec![
+                (0.0, R0 + r + 0.2),
+                (0.5, R0 + r - 0.5),
+                (0.55, R0 + r + 0.3),
+                (0.6, R0 + r - 0.5),
+                (1.0, R0 + r - 0.5),
+            ])
+            .expect("increasing times");
+        }
+        for mu in [0.0, 0.2] {
+            let model = quarter_ring(Contact {
+                obstacles: vec![Obstacle {
+                    friction: mu,
+                    ..crimper.clone()
+                }],
+                settings: RING,
+            });
+            let mut sim = Simulation::new(&model).expect("discretised");
+            while let Some(step) = sim.step().expect("every step converges") {
+                if step.time > 0.5 && step.time < 0.65 {
+                    println!(
+                        "μ = {mu}, t = {:.2}: {} iterations",
+                        step.time, step.newton.iterations
+                    );
+                }
+                assert!(
+                    step.cuts == 0 && step.rejected == 0 && step.newton.iterations <= 8,
+                    "μ = {mu}, t = {}: {} cuts, {} rejected, {} iterations",
+                    step.time,
+                    step.cuts,
+                    step.rejected,
+                    step.newton.iterations
+                );
+            }
+            let disc = sim.discretisation();
+            for g in 0..disc.points.len() {
+                let x = point_position(disc, &sim.state().control, g);
+                let rho = (x.x * x.x + x.y * x.y).sqrt();
+                assert!(
+                    (rho - (R0 - 0.5)).abs() <= RING.tolerance,
+                    "μ = {mu}, point {g}: radius {rho}"
+                );
+            }
+        }
     }
 
     /// The ramp is C¹ at both ends of its transition and is the identity beyond it: the law's continuity that

@@ -124,7 +124,8 @@ fn contact(model: &Model, disc: &Discretisation) -> SurfaceContact {
                 thickness: 0.1,
                 width: 0.2,
             },
-        ),
+        )
+        .with_friction(0.4),
         Obstacle::new(
             "plane",
             Surface::Plane {
@@ -133,7 +134,8 @@ fn contact(model: &Model, disc: &Discretisation) -> SurfaceContact {
                 offset: constant(-0.1),
             },
             Wall::Rigid,
-        ),
+        )
+        .with_friction(0.3),
     ];
     let settings = ContactSettings {
         penalty: 1e3,
@@ -154,6 +156,7 @@ fn the_tangent_tests_contact_covers_every_branch_of_its_law() {
     let contact = contact(&model, &disc);
     let state = deformed_state(&disc, 0);
     let (mut clear, mut band, mut linear) = (0, 0, 0);
+    let (mut sticking, mut sliding) = ([0; 2], [0; 2]);
     let mut pressed = [false; 2];
     for (g, point) in disc.points.iter().enumerate() {
         if disc.is_end(g) {
@@ -165,6 +168,13 @@ fn the_tangent_tests_contact_covers_every_branch_of_its_law() {
                 continue;
             };
             *pressed |= c.pressure > 0.0;
+            if let Some(f) = contact.friction(k, g, &x, &c) {
+                if f.sliding {
+                    sliding[k] += 1;
+                } else {
+                    sticking[k] += 1;
+                }
+            }
             if c.stiffness == 0.0 {
                 clear += 1;
             } else if c.stiffness > -contact.law(k, g).0 {
@@ -179,6 +189,11 @@ fn the_tangent_tests_contact_covers_every_branch_of_its_law() {
         "clear {clear}, band {band}, linear {linear}"
     );
     assert_eq!(pressed, [true, true]);
+    println!("sticking {sticking:?}, sliding {sliding:?}");
+    assert!(
+        sticking.iter().chain(&sliding).all(|&n| n > 0),
+        "sticking {sticking:?}, sliding {sliding:?}"
+    );
 }
 
 /// The gauge of the tests: a translation and a rotation-like row on the free end of the leg (node 2) and the
