@@ -174,3 +174,39 @@ pub(crate) fn run_peaks(model: &Model, text: &str) -> Vec<ObstaclePeaks> {
     }
     peaks
 }
+
+/// What the charts keep of contact at one state ([`crate::io::run_charts`]).
+#[derive(Debug, Clone, PartialEq)]
+pub(crate) struct ContactSample {
+    /// Time of the state \[s\].
+    pub time: Real,
+    /// Per obstacle, in the model's order.
+    pub obstacles: Vec<ObstacleSample>,
+}
+
+/// What the charts keep of one obstacle at one state.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct ObstacleSample {
+    /// Magnitude of the total contact force \[force\].
+    pub force: Real,
+    /// A cylinder's radial force \[force\].
+    pub radial_force: Option<Real>,
+    /// A cylinder's diameter `2R(t)` at the state \[length\].
+    pub diameter: Option<Real>,
+}
+
+/// The chart sample of `report` for `model` at `time`.
+pub(crate) fn sample(model: &Model, report: &ContactReport, time: Real) -> ContactSample {
+    ContactSample {
+        time,
+        obstacles: obstacles(model)
+            .iter()
+            .zip(&report.obstacles)
+            .map(|(o, r)| ObstacleSample {
+                force: r.force.norm(),
+                radial_force: r.radial_force,
+                diameter: o.surface.radius(report.time).map(|r| 2.0 * r),
+            })
+            .collect(),
+    }
+}

@@ -157,7 +157,7 @@ pub(crate) fn damaged(name: &str, problem: Problem) -> RunError {
 mod tests {
     // Source: each recorder's own contract — the position it encodes for a checkpoint decodes to the same
     // values (floats by their bits), and bytes left over or cut short are refused.
-    use super::charts::{decode_samples, encode_sample};
+    use super::charts::{decode_position, encode_sample};
     use super::history::decode_history;
     use crate::io::checkpoint::Encoder;
     use crate::io::history::HistoryPosition;
@@ -203,8 +203,9 @@ mod tests {
         };
         let mut e = Encoder::default();
         e.list(std::slice::from_ref(&sample), encode_sample);
-        let back = decode_samples(&e.0).expect("valid");
+        let (back, contact) = decode_position(&e.0).expect("valid");
         assert_eq!(back, vec![sample]);
+        assert!(contact.is_empty());
         assert_eq!(
             back[0].load_factor.map(Real::to_bits),
             Some((-0.0 as Real).to_bits())
