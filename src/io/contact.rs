@@ -22,7 +22,13 @@ pub(crate) fn column_name(obstacle: &Obstacle) -> String {
     obstacle
         .name
         .chars()
-        .map(|c| if matches!(c, ',' | '"' | '\n' | '\r') { '_' } else { c })
+        .map(|c| {
+            if matches!(c, ',' | '"' | '\n' | '\r') {
+                '_'
+            } else {
+                c
+            }
+        })
         .collect()
 }
 
@@ -154,9 +160,8 @@ pub(crate) fn run_peaks(model: &Model, text: &str) -> Vec<ObstaclePeaks> {
             continue;
         };
         for (p, [force, radial, penetration]) in peaks.iter_mut().zip(&columns) {
-            let components: Option<Vec<Real>> = (0..3)
-                .map(|c| number(force.map(|f| f + c)))
-                .collect();
+            let components: Option<Vec<Real>> =
+                (0..3).map(|c| number(force.map(|f| f + c))).collect();
             if let Some(f) = components {
                 Peak::keep(
                     &mut p.peak_force,

@@ -64,7 +64,11 @@ impl RunCharts {
 
     /// Continues the charts of a resumed run with the states (and their contact) recorded up to its
     /// checkpoint.
-    pub(crate) fn resumed(mut self, samples: Vec<StateSample>, contact: Vec<ContactSample>) -> Self {
+    pub(crate) fn resumed(
+        mut self,
+        samples: Vec<StateSample>,
+        contact: Vec<ContactSample>,
+    ) -> Self {
         self.samples = samples;
         self.contact = contact;
         self
@@ -321,7 +325,9 @@ impl RunCharts {
         let (name, units) = (model.name(), model.units);
         let force = units.force();
         let mut against_time = LineChart::new(
-            format!("{name}: contact force (cylinders: radial, positive pressing; planes: magnitude)"),
+            format!(
+                "{name}: contact force (cylinders: radial, positive pressing; planes: magnitude)"
+            ),
             "time [s]",
             format!("force [{force}]"),
         );

@@ -66,11 +66,15 @@ pub(super) fn temperature_color(t: Real, lo: Real, hi: Real) -> String {
 /// array contents). Written by hand: the centrelines are recorded at every step and dominate the recording
 /// time.
 pub(super) fn scene_update(id: &str, nanoseconds: u64, lines: &str, triangles: &str) -> String {
-    scene_update_of(&[entity(id, nanoseconds, &Primitives {
-        lines,
-        triangles,
-        ..Primitives::default()
-    })])
+    scene_update_of(&[entity(
+        id,
+        nanoseconds,
+        &Primitives {
+            lines,
+            triangles,
+            ..Primitives::default()
+        },
+    )])
 }
 
 /// A `foxglove.SceneUpdate` replacing `entities` (each from [`entity`]).

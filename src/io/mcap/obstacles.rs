@@ -51,7 +51,10 @@ impl ObstacleDrawing {
             .flat_map(|p| p.curve.points().iter().copied())
             .collect();
         let (lo, hi) = points.iter().fold(
-            (Vec3::repeat(Real::INFINITY), Vec3::repeat(Real::NEG_INFINITY)),
+            (
+                Vec3::repeat(Real::INFINITY),
+                Vec3::repeat(Real::NEG_INFINITY),
+            ),
             |(lo, hi), p| (lo.inf(p), hi.sup(p)),
         );
         let size = if points.is_empty() {
@@ -182,7 +185,7 @@ mod tests {
             -Vec3::z(),
             Vec3::x(),
             Vec3::new(1.0, -2.0, 0.5).normalize(),
-            Vec3::new(0.0, 1e-9, -1.0).normalize(),
+            Vec3::new(0.0, 1e-6, -1.0).normalize(),
         ] {
             let q = z_onto(&to);
             let (v, w) = (Vec3::new(q[0], q[1], q[2]), q[3]);

@@ -4,9 +4,9 @@
 use super::{Finishing, Recorder, RecorderKind, damaged};
 use crate::io::checkpoint::{Decoder, Encoder, Problem};
 use crate::io::configurations::{CENTRELINE_SAMPLES, MAX_ROWS};
+use crate::io::contact::{ContactSample, ObstacleSample};
 use crate::io::render::PANEL_WIDTH;
 use crate::io::run_charts::RunCharts;
-use crate::io::contact::{ContactSample, ObstacleSample};
 use crate::io::state::{StateSample, load_channels};
 use crate::io::summary::{FinalState, RunSummaryFile};
 use crate::math::Real;
@@ -27,7 +27,9 @@ pub(super) const CHARTS: RecorderKind = RecorderKind {
     },
     resume: |_, sim, position| {
         let (samples, contact) = decode_position(position).map_err(|p| damaged("charts/", p))?;
-        Ok(Box::new(RunCharts::new(sim.model()).resumed(samples, contact)))
+        Ok(Box::new(
+            RunCharts::new(sim.model()).resumed(samples, contact),
+        ))
     },
     estimate: |s| DiskPart::new("charts", estimated_bytes(s) as u64),
 };
@@ -138,7 +140,7 @@ fn decode_sample(d: &mut Decoder<'_>) -> Result<StateSample, Problem> {
     })
 }
 
-fn encode_contact(e: &mut Encoder, s: &ContactSample) {
+pub(super) fn encode_contact(e: &mut Encoder, s: &ContactSample) {
     e.f64(s.time);
     e.list(&s.obstacles, |e, o| {
         e.f64(o.force);

@@ -45,7 +45,7 @@ pub(super) const HISTORY: RecorderKind = RecorderKind {
             position,
             &setup.design.output.strain_limits,
         )
-            .map_err(|e| RunError::context(format!("cannot continue {}", path.display()), e))?;
+        .map_err(|e| RunError::context(format!("cannot continue {}", path.display()), e))?;
         Ok(Box::new(writer))
     },
     estimate: |s| {
@@ -91,7 +91,15 @@ fn row_bytes(model: &Model, strain_limits: &[Option<Real>]) -> Real {
         None => 0.0,
     };
     let contact = 102.0 * model.contact.as_ref().map_or(0, |c| c.obstacles.len()) as Real;
-    17.0 + 60.0 * model.probes.len() as Real + 11.0 + 3.0 + 11.0 + 3.0 + recovery + peaks + contact + 1.0
+    17.0 + 60.0 * model.probes.len() as Real
+        + 11.0
+        + 3.0
+        + 11.0
+        + 3.0
+        + recovery
+        + peaks
+        + contact
+        + 1.0
 }
 
 pub(super) fn decode_history(bytes: &[u8]) -> Result<HistoryPosition, Problem> {
