@@ -3,12 +3,12 @@
 //! `tests/data/good_small.yaml`, whose model is replaced (the design language has no contact yet). And the same
 //! design without contact writes none of them.
 
-use crate::model::{Contact, ContactSettings, Model, Wall};
+use crate::model::Model;
 use crate::run::{Folder, Interrupt, Lines, RunSettings, run};
 use crate::solver::Simulation;
 use crate::solver::simulation::NoObserver;
 use crate::solver::terms::contact::ContactReport;
-use crate::solver::terms::contact::tests::{D, R0, cylinder, quarter_ring};
+use crate::solver::terms::contact::report::tests::{CRIMPED, SETTINGS, crimped_ring};
 use base64::Engine;
 use std::path::{Path, PathBuf};
 
@@ -41,20 +41,6 @@ fn run_into(dir: &Path, model: Model) -> serde_json::Value {
     .expect("the run completes");
     let text = std::fs::read_to_string(dir.join("summary.json")).expect("summary");
     serde_json::from_str(&text).expect("JSON")
-}
-
-/// The ring crimped from 0.2 clear of its wires to 0.5 into them over t ∈ [0, 1].
-fn crimped_ring() -> Model {
-    let r = D / 2.0;
-    quarter_ring(Contact {
-        obstacles: vec![cylinder(R0 + r + 0.2, R0 + r - 0.5, Wall::Rigid)],
-        settings: ContactSettings {
-            penalty: 1e3,
-            regularisation: 1e-4,
-            tolerance: 1e-6,
-            max_updates: 10,
-        },
-    })
 }
 
 /// The float values of the field file's point array `name` (VTK inline binary: a UInt64 byte count, then the
@@ -138,7 +124,7 @@ fn a_crimped_ring_writes_its_contact_into_every_output() {
         peaks["largest_penetration"]["value"]
             .as_f64()
             .expect("value")
-            <= 1e-6
+            <= SETTINGS.tolerance
     );
     assert!(peaks["peak_force"]["value"].as_f64().expect("value") > 0.0);
 
@@ -168,7 +154,7 @@ fn a_crimped_ring_writes_its_contact_into_every_output() {
     let entity = &last_obstacle.expect("an obstacle message")["entities"][0];
     assert_eq!(entity["id"], "obstacle.crimper");
     let diameter = entity["cylinders"][0]["size"]["x"].as_f64().expect("size");
-    let expected = 2.0 * (R0 + D / 2.0 - 0.5);
+    let expected = 2.0 * CRIMPED;
     assert!((diameter - expected).abs() <= 1e-5 * expected, "{diameter}");
     let line = &last_lines.expect("centrelines")["entities"][0]["lines"][0];
     let colors = line["colors"].as_array().expect("colours");

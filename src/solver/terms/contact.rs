@@ -32,7 +32,7 @@
 //! **Switching in and out.** The law is C¹, so Newton sees a continuous tangent as points enter and leave
 //! contact within the transition band `2δ`.
 
-mod report;
+pub(crate) mod report;
 
 pub use report::{ContactReport, ObstacleReport};
 
@@ -286,7 +286,7 @@ impl PointTerm for SurfaceContact {
 }
 
 #[cfg(test)]
-pub(crate) mod tests {
+mod tests {
     use super::ramp;
     use crate::material::{CircularSection, ElasticLaw};
     use crate::math::{Real, Vec3};
@@ -298,14 +298,14 @@ pub(crate) mod tests {
     use std::f64::consts::FRAC_PI_2;
 
     /// Reference radius, wire diameter, Young's modulus of the ring tests.
-    pub(crate) const R0: Real = 10.0;
-    pub(crate) const D: Real = 0.5;
-    pub(crate) const E: Real = 1000.0;
+    pub(super) const R0: Real = 10.0;
+    pub(super) const D: Real = 0.5;
+    pub(super) const E: Real = 1000.0;
 
     /// A quarter of a circular ring of radius `R0` in the plane z = 0, its ends on the symmetry planes y = 0
     /// and x = 0 (each end: the displacement normal to its plane, the out-of-plane displacement and every
     /// rotation held), elastic, 20 steps over t ∈ [0, 1], with `contact`.
-    pub(crate) fn quarter_ring(contact: Contact) -> Model {
+    pub(super) fn quarter_ring(contact: Contact) -> Model {
         let material = ElasticLaw::try_new(E, 0.3).expect("E > 0");
         let section = CircularSection::try_new(D).expect("d > 0").into();
         let mut b = ModelBuilder::new("ring", material, section);
@@ -337,7 +337,7 @@ pub(crate) mod tests {
     }
 
     /// A cylinder around the z axis whose radius goes linearly from `from` at t = 0 to `to` at t = 1.
-    pub(crate) fn cylinder(from: Real, to: Real, wall: Wall) -> Obstacle {
+    pub(super) fn cylinder(from: Real, to: Real, wall: Wall) -> Obstacle {
         Obstacle {
             name: "crimper".into(),
             surface: Surface::Cylinder {
