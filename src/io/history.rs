@@ -25,6 +25,8 @@
 //! (the largest fibre stretch `λ − 1` over the collocation points),
 //! `surface_strain_patch` (the patch's name) and `surface_strain_s` (the reference arc length from the patch's
 //! start, length unit).
+//! With contact (`model.contact`), the contact columns of each obstacle follow ([`super::contact`]: the total
+//! force, its radial part for a cylinder, the points in contact, the largest penetration, the friction work).
 //! Rows are flushed as they are written, so an interrupted run leaves a valid file up to its last step; a row
 //! that cannot be written whole (a full disk) is cut off again, so the file always ends with a complete row.
 
@@ -156,6 +158,8 @@ pub struct HistoryWriter {
     warnings: Vec<String>,
     /// The row where the surface strain peaked so far.
     peak: Option<SurfaceStrainPeak>,
+    /// The peaks of the contact columns so far (empty without contact).
+    contact: Vec<super::contact::ObstaclePeaks>,
     path: PathBuf,
     /// `None` once a write failed.
     out: Option<BufWriter<File>>,
@@ -218,6 +222,7 @@ impl HistoryWriter {
                 sim.model().material_names[m]
             ));
         }
+        header.push_str(&super::contact::header(sim.model()));
         writeln!(out, "{header}")?;
         out.flush()?;
         Ok(Self {
@@ -225,6 +230,7 @@ impl HistoryWriter {
             limits,
             warnings: Vec::new(),
             peak: None,
+            contact: super::contact::no_peaks(sim.model()),
             path: path.to_path_buf(),
             complete: header.len() as u64 + 1,
             out: Some(out),
@@ -241,6 +247,7 @@ impl HistoryWriter {
     /// The I/O error, or [`std::io::ErrorKind::InvalidData`] when the file is shorter than the checkpoint says.
     pub fn resume(
         path: &Path,
+        model: &crate::model::Model,
         position: HistoryPosition,
         strain_limits: &[Option<f64>],
     ) -> std::io::Result<Self> {
@@ -255,12 +262,14 @@ impl HistoryWriter {
         let mut text = String::new();
         std::io::Read::read_to_string(&mut file, &mut text)?;
         let peak = run_peak_surface_strain(&text);
+        let contact = super::contact::run_peaks(model, &text);
         std::io::Seek::seek(&mut file, std::io::SeekFrom::End(0))?;
         Ok(Self {
             exceeded: vec![false; limits.len()],
             limits,
             warnings: Vec::new(),
             peak,
+            contact,
             path: path.to_path_buf(),
             complete: position.bytes,
             out: Some(BufWriter::new(file)),
@@ -297,6 +306,11 @@ impl HistoryWriter {
     /// Where the surface strain peaked over the rows written.
     pub fn peak_surface_strain(&self) -> Option<&SurfaceStrainPeak> {
         self.peak.as_ref()
+    }
+
+    /// The peaks of the contact columns over the rows written, per obstacle (empty without contact).
+    pub fn contact_peaks(&self) -> &[super::contact::ObstaclePeaks] {
+        &self.contact
     }
 
     /// The warnings found since the last call (a material's strain limit exceeded: each said once).
@@ -402,6 +416,11 @@ impl HistoryWriter {
                     100.0 * limit
                 ));
             }
+        }
+        let contact = sim.contact();
+        super::contact::push_row(&mut line, contact.as_ref());
+        if let Some(report) = &contact {
+            super::contact::keep_peaks(&mut self.contact, report, t);
         }
         let Some(out) = &mut self.out else {
             return ControlFlow::Break(());

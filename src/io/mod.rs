@@ -8,6 +8,7 @@ pub mod centreline;
 pub mod chart;
 pub(crate) mod checkpoint;
 pub(crate) mod configurations;
+pub(crate) mod contact;
 pub(crate) mod formats;
 pub mod history;
 pub(crate) mod input;

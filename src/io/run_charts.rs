@@ -15,9 +15,14 @@
 //!   load–displacement curves, through limit points);
 //! * `newton.svg` — Newton iterations per step against time (every run);
 //! * `step_size.svg` — the step size and the time-error estimate over the tolerance against time, on log axes
-//!   (error-controlled runs, `time.tolerance`).
+//!   (error-controlled runs, `time.tolerance`);
+//! * `contact_force.svg` — per obstacle the contact force against time: a cylinder's radial force (positive:
+//!   the wires press on it), a plane's total force magnitude (models with contact; [`super::contact`]);
+//! * `contact_diameter.svg` — per cylinder its radial force against its diameter `2R(t)` (the crimper's curve
+//!   of a bench test: loading and unloading; models with a cylinder).
 
 use super::chart::{ChartError, LineChart, Series, write_svg};
+use super::contact::ContactSample;
 use super::run_folder::Manifest;
 use super::state::{LoadChannel, StateSample, load_channels};
 use crate::math::Real;
@@ -30,6 +35,8 @@ use std::path::{Path, PathBuf};
 pub(crate) struct RunCharts {
     channels: Vec<LoadChannel>,
     samples: Vec<StateSample>,
+    /// The contact of each state (empty without contact).
+    contact: Vec<ContactSample>,
 }
 
 impl RunCharts {
@@ -41,6 +48,7 @@ impl RunCharts {
         Self {
             channels: load_channels(model),
             samples: Vec::new(),
+            contact: Vec::new(),
         }
     }
 
@@ -49,9 +57,20 @@ impl RunCharts {
         &self.samples
     }
 
-    /// Continues the charts of a resumed run with the states recorded up to its checkpoint.
-    pub(crate) fn resumed(mut self, samples: Vec<StateSample>) -> Self {
+    /// The contact of the states recorded so far (empty without contact).
+    pub(crate) fn contact_samples(&self) -> &[ContactSample] {
+        &self.contact
+    }
+
+    /// Continues the charts of a resumed run with the states (and their contact) recorded up to its
+    /// checkpoint.
+    pub(crate) fn resumed(
+        mut self,
+        samples: Vec<StateSample>,
+        contact: Vec<ContactSample>,
+    ) -> Self {
         self.samples = samples;
+        self.contact = contact;
         self
     }
 
@@ -291,6 +310,61 @@ impl RunCharts {
                 charts.push(("step_size.svg", steps));
             }
         }
+        charts.extend(self.contact_charts(model));
+        charts
+    }
+
+    /// The contact charts (module docs): none without contact samples.
+    fn contact_charts(&self, model: &Model) -> Vec<(&'static str, LineChart)> {
+        let Some(contact) = &model.contact else {
+            return Vec::new();
+        };
+        if self.contact.is_empty() {
+            return Vec::new();
+        }
+        let (name, units) = (model.name(), model.units);
+        let force = units.force();
+        let mut against_time = LineChart::new(
+            format!(
+                "{name}: contact force (cylinders: radial, positive pressing; planes: magnitude)"
+            ),
+            "time [s]",
+            format!("force [{force}]"),
+        );
+        let mut against_diameter = LineChart::new(
+            format!("{name}: radial force against the cylinder's diameter"),
+            format!("diameter 2R [{}]", units.length()),
+            format!("radial force [{force}]"),
+        );
+        for (k, obstacle) in contact.obstacles.iter().enumerate() {
+            let of = |s: &ContactSample| s.obstacles.get(k).copied();
+            let over_time: Vec<(Real, Real)> = self
+                .contact
+                .iter()
+                .filter_map(|s| of(s).map(|o| (s.time, o.radial_force.unwrap_or(o.force))))
+                .collect();
+            let label = match obstacle.surface {
+                crate::model::Surface::Cylinder { .. } | crate::model::Surface::Lumen(_) => {
+                    format!("{} radial", obstacle.name)
+                }
+                crate::model::Surface::Plane { .. } => format!("{} |F|", obstacle.name),
+            };
+            against_time.series.push(Series::new(label, over_time));
+            let curve: Vec<(Real, Real)> = self
+                .contact
+                .iter()
+                .filter_map(|s| of(s).and_then(|o| Some((o.diameter?, o.radial_force?))))
+                .collect();
+            if !curve.is_empty() {
+                against_diameter
+                    .series
+                    .push(Series::new(obstacle.name.clone(), curve));
+            }
+        }
+        let mut charts = vec![("contact_force.svg", against_time)];
+        if !against_diameter.series.is_empty() {
+            charts.push(("contact_diameter.svg", against_diameter));
+        }
         charts
     }
 
@@ -326,16 +400,26 @@ impl RunCharts {
     }
 }
 
+impl RunCharts {
+    /// Keeps the state of `sim` (and its contact, with contact).
+    fn keep(&mut self, sim: &Simulation<'_>, report: Option<&StepReport>) {
+        self.samples
+            .push(StateSample::of(sim, &self.channels, report));
+        if let Some(contact) = sim.contact() {
+            self.contact
+                .push(super::contact::sample(sim.model(), &contact, sim.time()));
+        }
+    }
+}
+
 impl Observer for RunCharts {
     fn start(&mut self, sim: &Simulation<'_>) -> ControlFlow<()> {
-        self.samples
-            .push(StateSample::of(sim, &self.channels, None));
+        self.keep(sim, None);
         ControlFlow::Continue(())
     }
 
     fn step(&mut self, sim: &Simulation<'_>, report: &StepReport) -> ControlFlow<()> {
-        self.samples
-            .push(StateSample::of(sim, &self.channels, Some(report)));
+        self.keep(sim, Some(report));
         ControlFlow::Continue(())
     }
 }

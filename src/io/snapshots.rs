@@ -389,6 +389,7 @@ impl SnapshotWriter {
                 &target,
                 model,
                 &sim.point_fields(),
+                sim.contact().as_ref(),
                 &sim.probe_points(),
                 time,
             )

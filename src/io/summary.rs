@@ -372,6 +372,10 @@ pub struct RunSummaryFile {
     /// Materials whose `strain_limit` the surface strain exceeded, as `run` said (each once).
     #[serde(skip_serializing_if = "Vec::is_empty")]
     pub strain_limit_warnings: Vec<String>,
+    /// Per obstacle of a model with contact, the peak force and radial force and the largest penetration over
+    /// the run, with when (`history.csv`'s contact columns; [`super::contact`]).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub contact: Vec<super::contact::ObstaclePeaks>,
 }
 
 /// What error-controlled stepping did (`summary.json` `time_error_control`).
@@ -505,6 +509,7 @@ impl RunSummaryFile {
             notices: Vec::new(),
             peak_surface_strain: None,
             strain_limit_warnings: Vec::new(),
+            contact: Vec::new(),
         }
     }
 

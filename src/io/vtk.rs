@@ -8,7 +8,10 @@
 //! bending 2, bending 3), `force` and `moment` (material, section frame `d1, d2, d3`), `force_spatial` and
 //! `moment_spatial` (global), `viscous_strain` and `viscous_curvature`, `temperature`, `log10_shift_factor`
 //! (NaN where relaxation is frozen or the material has no shift), `surface_strain` (the section's most stretched fibre)
-//! and `arc_length`; cell data `patch` and `material` (indices into the model's patches, in the order
+//! and `arc_length`, and with contact per obstacle `<name>` `contact_gap@<name>` (the gap: distance from the
+//! surface minus the wire radius, negative in penetration; NaN on a cylinder's axis) and
+//! `contact_pressure@<name>` (the line pressure per unit reference length; at the patch ends as the contact
+//! report measures it, `crate::solver::terms::contact::ContactReport`); cell data `patch` and `material` (indices into the model's patches, in the order
 //! `stentkit check` lists them, and into its materials: `material` first, then the named `materials`); field
 //! data `TimeValue` (the simulated time, which ParaView reads) and `probe_point` (per probe of the design, in
 //! `history.csv`'s order, the point it sits on; −1 for a probe between collocation points). Every point array
@@ -29,20 +32,25 @@
 use crate::math::{Real, Vec3};
 use crate::model::Model;
 use crate::solver::PointFields;
+use crate::solver::terms::contact::ContactReport;
 use base64::Engine;
 use std::fmt::Write as _;
 use std::path::Path;
 
 /// One point array: name, unit, component names and the values (tuple-major).
 struct Array {
-    name: &'static str,
+    name: String,
     unit: String,
     components: &'static [&'static str],
     values: Vec<Real>,
 }
 
-/// The point arrays of `fields`, in the order written.
-fn point_arrays(model: &Model, fields: &[PointFields]) -> Vec<Array> {
+/// The point arrays of `fields` and of `contact` (its gap and pressure per obstacle), in the order written.
+fn point_arrays(
+    model: &Model,
+    fields: &[PointFields],
+    contact: Option<&ContactReport>,
+) -> Vec<Array> {
     let u = model.units;
     let (length, force, moment) = (u.length(), u.force(), u.moment());
     let per_length = format!("1/{length}");
@@ -51,8 +59,8 @@ fn point_arrays(model: &Model, fields: &[PointFields]) -> Vec<Array> {
     let curvature_parts: &'static [&'static str] = &["twist", "bending 2", "bending 3"];
     let force_parts: &'static [&'static str] = &["axial", "shear 2", "shear 3"];
     let moment_parts: &'static [&'static str] = &["torque", "bending 2", "bending 3"];
-    let vector = |name, unit: &str, components, get: fn(&PointFields) -> Vec3| Array {
-        name,
+    let vector = |name: &str, unit: &str, components, get: fn(&PointFields) -> Vec3| Array {
+        name: name.to_string(),
         unit: unit.to_string(),
         components,
         values: fields
@@ -63,13 +71,13 @@ fn point_arrays(model: &Model, fields: &[PointFields]) -> Vec<Array> {
             })
             .collect(),
     };
-    let scalar = |name, unit: &str, get: fn(&PointFields) -> Real| Array {
-        name,
+    let scalar = |name: &str, unit: &str, get: fn(&PointFields) -> Real| Array {
+        name: name.to_string(),
         unit: unit.to_string(),
         components: &[],
         values: fields.iter().map(get).collect(),
     };
-    vec![
+    let mut arrays = vec![
         vector("displacement", length, xyz, |f| f.displacement),
         vector("rotation", "rad", xyz, |f| f.rotation),
         vector("strain", "1", strain_parts, |f| f.strain),
@@ -86,7 +94,23 @@ fn point_arrays(model: &Model, fields: &[PointFields]) -> Vec<Array> {
         scalar("log10_shift_factor", "1", |f| f.log10_shift),
         scalar("surface_strain", "1", |f| f.surface_strain),
         scalar("arc_length", length, |f| f.arc_length),
-    ]
+    ];
+    let obstacles = model.contact.iter().flat_map(|c| &c.obstacles);
+    for (obstacle, o) in obstacles.zip(contact.iter().flat_map(|r| &r.obstacles)) {
+        let name = super::contact::column_name(obstacle);
+        for (quantity, unit, values) in [
+            ("gap", length.to_string(), &o.gap),
+            ("pressure", format!("{force}/{length}"), &o.pressure),
+        ] {
+            arrays.push(Array {
+                name: format!("contact_{quantity}@{name}"),
+                unit,
+                components: &[],
+                values: values.clone(),
+            });
+        }
+    }
+    arrays
 }
 
 /// Base64 of a UInt64 byte count followed by the little-endian bytes of `bytes` (VTK's inline binary block).
@@ -120,6 +144,7 @@ pub(crate) fn escape(text: &str) -> String {
 pub fn polydata(
     model: &Model,
     fields: &[PointFields],
+    contact: Option<&ContactReport>,
     probe_points: &[Option<usize>],
     time: Real,
 ) -> String {
@@ -182,12 +207,12 @@ pub fn polydata(
         x,
         "      <PointData Vectors=\"displacement\" Scalars=\"surface_strain\">"
     );
-    for array in point_arrays(model, fields) {
+    for array in point_arrays(model, fields, contact) {
         let count = array.components.len().max(1);
         let _ = write!(
             x,
             "        <DataArray type=\"Float64\" Name=\"{}\" NumberOfComponents=\"{count}\"",
-            array.name
+            escape(&array.name)
         );
         for (i, c) in array.components.iter().enumerate() {
             let _ = write!(x, " ComponentName{i}=\"{}\"", escape(c));
@@ -237,12 +262,13 @@ pub fn write_polydata(
     path: &Path,
     model: &Model,
     fields: &[PointFields],
+    contact: Option<&ContactReport>,
     probe_points: &[Option<usize>],
     time: Real,
 ) -> std::io::Result<()> {
     super::atomic::write_bytes_atomically(
         path,
-        polydata(model, fields, probe_points, time).as_bytes(),
+        polydata(model, fields, contact, probe_points, time).as_bytes(),
     )
 }
 

@@ -66,9 +66,46 @@ pub(super) fn temperature_color(t: Real, lo: Real, hi: Real) -> String {
 /// array contents). Written by hand: the centrelines are recorded at every step and dominate the recording
 /// time.
 pub(super) fn scene_update(id: &str, nanoseconds: u64, lines: &str, triangles: &str) -> String {
+    scene_update_of(&[entity(
+        id,
+        nanoseconds,
+        &Primitives {
+            lines,
+            triangles,
+            ..Primitives::default()
+        },
+    )])
+}
+
+/// A `foxglove.SceneUpdate` replacing `entities` (each from [`entity`]).
+pub(super) fn scene_update_of(entities: &[String]) -> String {
+    format!(r#"{{"deletions":[],"entities":[{}]}}"#, entities.join(","))
+}
+
+/// The primitives of an entity, each the JSON contents of its array (empty: none).
+#[derive(Default)]
+pub(super) struct Primitives<'a> {
+    /// `CubePrimitive`s.
+    pub(super) cubes: &'a str,
+    /// `CylinderPrimitive`s.
+    pub(super) cylinders: &'a str,
+    /// `LinePrimitive`s.
+    pub(super) lines: &'a str,
+    /// `TriangleListPrimitive`s.
+    pub(super) triangles: &'a str,
+}
+
+/// A `foxglove.SceneEntity` `id` at `nanoseconds` with `primitives`.
+pub(super) fn entity(id: &str, nanoseconds: u64, primitives: &Primitives<'_>) -> String {
     let (sec, nsec) = (nanoseconds / 1_000_000_000, nanoseconds % 1_000_000_000);
+    let Primitives {
+        cubes,
+        cylinders,
+        lines,
+        triangles,
+    } = primitives;
     format!(
-        r#"{{"deletions":[],"entities":[{{"timestamp":{{"sec":{sec},"nsec":{nsec}}},"frame_id":"{FRAME_ID}","id":"{id}","lifetime":{{"sec":0,"nsec":0}},"frame_locked":false,"metadata":[],"arrows":[],"cubes":[],"spheres":[],"cylinders":[],"lines":[{lines}],"triangles":[{triangles}],"texts":[],"models":[]}}]}}"#
+        r#"{{"timestamp":{{"sec":{sec},"nsec":{nsec}}},"frame_id":"{FRAME_ID}","id":"{id}","lifetime":{{"sec":0,"nsec":0}},"frame_locked":false,"metadata":[],"arrows":[],"cubes":[{cubes}],"spheres":[],"cylinders":[{cylinders}],"lines":[{lines}],"triangles":[{triangles}],"texts":[],"models":[]}}"#
     )
 }
 
@@ -117,8 +154,8 @@ fn push_coordinate(out: &mut String, x: Real, decimals: usize) {
     }
 }
 
-/// Appends a `foxglove.Point3`.
-fn push_point(out: &mut String, p: &Vec3, decimals: usize) {
+/// Appends a `foxglove.Point3` (or `Vector3`).
+pub(super) fn push_point(out: &mut String, p: &Vec3, decimals: usize) {
     out.push_str("{\"x\":");
     push_coordinate(out, p.x, decimals);
     out.push_str(",\"y\":");

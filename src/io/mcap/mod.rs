@@ -4,9 +4,10 @@
 //! | topic | schema | when | content |
 //! |---|---|---|---|
 //! | `/state` | `stentkit.State` | every step and the initial state | time, step size, temperature, loads, Newton iterations and residuals, step cuts, probe displacements, recovery measures |
-//! | `/centrelines` | `foxglove.SceneUpdate` | every step | entity `centrelines`: one `LINE_STRIP` per rod of the full device (mirrored back), coloured by temperature |
+//! | `/centrelines` | `foxglove.SceneUpdate` | every step | entity `centrelines`: one `LINE_STRIP` per rod of the full device (mirrored back), coloured by temperature; with contact, the samples touching an obstacle in green (`mcap/obstacles.rs`) |
 //! | `/device` | `foxglove.SceneUpdate` | snapshot steps | entity `device`: the full device's closed tube mesh (`TriangleListPrimitive` with indices) |
 //! | `/vessel` | `foxglove.SceneUpdate` | once, at the start (a stent on a file centreline) | entity `vessel`: the vessel's centreline (`LINE_STRIP`) and its lumen (a translucent closed tube) |
+//! | `/obstacles` | `foxglove.SceneUpdate` | every step (a model with contact) | entity `obstacle.<name>` per obstacle: a cylinder (`CylinderPrimitive`, its diameter following its schedule) or a plane (a large thin square `CubePrimitive`), translucent (`mcap/obstacles.rs`) |
 //!
 //! The design file is attached (`application/yaml`), and a metadata record `stentkit` holds the version, the
 //! command line, the design name and the units. Log times are the simulated time in nanoseconds (1 s of
@@ -24,6 +25,7 @@
 //! [`coordinate_decimals`], [`path_key`], [`scene_update_schema`] and [`FRAME_ID`] are re-exported here.
 
 mod format;
+mod obstacles;
 mod schema;
 
 pub(crate) use format::{coordinate_decimals, path_key};
@@ -33,7 +35,7 @@ use super::output::{RecordingSettings, RunDesign, SnapshotSettings};
 use super::snapshots::SnapshotSchedule;
 use super::state::{LoadChannel, StateSample, load_channels};
 use crate::math::Real;
-use crate::post::device::{current_device_shapes, device_centrelines, device_tube_mesh};
+use crate::post::device::{current_device_shapes, device_rods, device_tube_mesh};
 use crate::solver::{Observer, Simulation, StepReport};
 use format::{IDENTITY_POSE, color, number, push_points, scene_update, temperature_color};
 use schema::{StateKeys, state_schema};
@@ -54,6 +56,8 @@ pub(crate) const CENTRELINE_TOPIC: &str = "/centrelines";
 pub(crate) const DEVICE_TOPIC: &str = "/device";
 /// Topic of the vessel a stent sits on (a centreline read from a file): one message at the start.
 pub(crate) const VESSEL_TOPIC: &str = "/vessel";
+/// Topic of the obstacles of a model with contact: one message per state.
+pub(crate) const OBSTACLE_TOPIC: &str = "/obstacles";
 
 /// What the recording says about the run that made it.
 #[derive(Debug, Clone, PartialEq)]
@@ -136,6 +140,8 @@ pub struct McapRecorder {
     device_channel: Option<u16>,
     /// The vessel's channel, until its one message is written.
     vessel_channel: Option<u16>,
+    /// The obstacles' channel and drawing (a model with contact).
+    obstacles: Option<(u16, obstacles::ObstacleDrawing)>,
     channels: Vec<LoadChannel>,
     keys: StateKeys,
     schedule: SnapshotSchedule,
@@ -271,6 +277,15 @@ impl McapRecorder {
             ),
             None => None,
         };
+        let obstacles = match obstacles::ObstacleDrawing::new(model) {
+            Some(drawing) => Some((
+                writer
+                    .add_channel(scene_schema, OBSTACLE_TOPIC, "json", &no_metadata)
+                    .map_err(write_error)?,
+                drawing,
+            )),
+            None => None,
+        };
         let thickness = (0..model.patches.len())
             .flat_map(|k| {
                 let d = model.sections[model.patches[k].section].diameter();
@@ -284,6 +299,7 @@ impl McapRecorder {
             centreline_channel,
             device_channel,
             vessel_channel,
+            obstacles,
             channels,
             keys,
             schedule: SnapshotSchedule::new(snapshots, model),
@@ -345,6 +361,7 @@ impl McapRecorder {
             (STATE_TOPIC, Some(self.state_channel)),
             (CENTRELINE_TOPIC, Some(self.centreline_channel)),
             (DEVICE_TOPIC, self.device_channel),
+            (OBSTACLE_TOPIC, self.obstacles.as_ref().map(|(id, _)| *id)),
         ]
         .into_iter()
         .filter_map(|(topic, id)| id.map(|id| (topic, id)))
@@ -473,13 +490,39 @@ impl McapRecorder {
         message
     }
 
-    fn centreline_message(&self, sim: &Simulation<'_>, log_time: u64) -> String {
+    /// The centrelines at `log_time`; with contact at time `contact_time`, each sample touching an obstacle
+    /// coloured ([`obstacles::TOUCH_COLOR`]), the others by temperature.
+    fn centreline_message(
+        &self,
+        sim: &Simulation<'_>,
+        log_time: u64,
+        contact_time: Option<Real>,
+    ) -> String {
         let shapes = current_device_shapes(sim, self.settings.centreline_points);
         let (lo, hi) = self.temperature_range;
         let color = temperature_color(sim.model().temperature().value(sim.schedule_time()), lo, hi);
-        let mut lines = String::new();
-        for (i, (points, thickness)) in device_centrelines(sim.model(), &shapes)
+        // Per patch, the per-sample colours (JSON array contents; empty: the line's colour throughout).
+        let colors: Vec<String> = shapes
             .iter()
+            .enumerate()
+            .map(|(k, shape)| match (&self.obstacles, contact_time) {
+                (Some((_, drawing)), Some(t)) => shape
+                    .points
+                    .iter()
+                    .map(|x| {
+                        if drawing.touches(k, x, t) {
+                            obstacles::TOUCH_COLOR
+                        } else {
+                            &color
+                        }
+                    })
+                    .collect::<Vec<&str>>()
+                    .join(","),
+                _ => String::new(),
+            })
+            .collect();
+        let mut lines = String::new();
+        for (i, ((k, points), thickness)) in device_rods(sim.model(), &shapes)
             .zip(&self.thickness)
             .enumerate()
         {
@@ -488,9 +531,10 @@ impl McapRecorder {
             }
             let _ = write!(
                 lines,
-                r#"{{"type":0,"pose":{IDENTITY_POSE},"thickness":{thickness},"scale_invariant":false,"color":{color},"colors":[],"indices":[],"points":"#
+                r#"{{"type":0,"pose":{IDENTITY_POSE},"thickness":{thickness},"scale_invariant":false,"color":{color},"colors":[{}],"indices":[],"points":"#,
+                colors[k]
             );
-            push_points(&mut lines, points, self.decimals);
+            push_points(&mut lines, &points, self.decimals);
             lines.push('}');
         }
         scene_update("centrelines", log_time, &lines, "")
@@ -573,8 +617,13 @@ impl McapRecorder {
         let sample = StateSample::of(sim, &self.channels, report);
         let state = self.state_message(&sample).to_string();
         self.write(self.state_channel, log_time, state.as_bytes())?;
-        let centrelines = self.centreline_message(sim, log_time);
+        let contact_time = sim.contact().map(|c| c.time);
+        let centrelines = self.centreline_message(sim, log_time, contact_time);
         self.write(self.centreline_channel, log_time, centrelines.as_bytes())?;
+        if let (Some((channel, drawing)), Some(t)) = (&self.obstacles, contact_time) {
+            let message = drawing.message(t, log_time, self.decimals);
+            self.write(*channel, log_time, message.as_bytes())?;
+        }
         if let (Some(channel), Some(vessel)) = (self.vessel_channel.take(), &sim.model().vessel) {
             let message = self.vessel_message(vessel, log_time)?;
             self.write(channel, log_time, message.as_bytes())?;

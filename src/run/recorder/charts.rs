@@ -4,6 +4,7 @@
 use super::{Finishing, Recorder, RecorderKind, damaged};
 use crate::io::checkpoint::{Decoder, Encoder, Problem};
 use crate::io::configurations::{CENTRELINE_SAMPLES, MAX_ROWS};
+use crate::io::contact::{ContactSample, ObstacleSample};
 use crate::io::render::PANEL_WIDTH;
 use crate::io::run_charts::RunCharts;
 use crate::io::state::{StateSample, load_channels};
@@ -21,12 +22,14 @@ pub(super) const CHARTS: RecorderKind = RecorderKind {
     name: "charts",
     create: |_, sim| Ok(Box::new(RunCharts::new(sim.model()))),
     check_resume: |_, position, _| {
-        decode_samples(position).map_err(|p| damaged("charts/", p))?;
+        decode_position(position).map_err(|p| damaged("charts/", p))?;
         Ok(())
     },
     resume: |_, sim, position| {
-        let samples = decode_samples(position).map_err(|p| damaged("charts/", p))?;
-        Ok(Box::new(RunCharts::new(sim.model()).resumed(samples)))
+        let (samples, contact) = decode_position(position).map_err(|p| damaged("charts/", p))?;
+        Ok(Box::new(
+            RunCharts::new(sim.model()).resumed(samples, contact),
+        ))
     },
     estimate: |s| DiskPart::new("charts", estimated_bytes(s) as u64),
 };
@@ -72,7 +75,8 @@ fn estimated_bytes(s: &Sizing<'_>) -> Real {
 
 /// The charts a run draws and the number of series in them (io::run_charts): temperature (1), probe
 /// displacements (3 per probe) and their normalised overlay (3 per probe, a load per channel, the
-/// temperature), recovery (4) and Δr (1) with a programme, Newton iterations (1).
+/// temperature), recovery (4) and Δr (1) with a programme, Newton iterations (1), the contact force (1 per
+/// obstacle) and the radial force against the diameter (1 per obstacle, charged for every obstacle).
 fn chart_counts(model: &Model) -> (Real, Real) {
     let probes = model.probes.len() as Real;
     let mut charts = 2.0;
@@ -84,6 +88,10 @@ fn chart_counts(model: &Model) -> (Real, Real) {
     if model.programme.is_some() {
         charts += 2.0;
         series += 5.0;
+    }
+    if let Some(contact) = &model.contact {
+        charts += 2.0;
+        series += 2.0 * contact.obstacles.len() as Real;
     }
     (charts, series)
 }
@@ -132,11 +140,43 @@ fn decode_sample(d: &mut Decoder<'_>) -> Result<StateSample, Problem> {
     })
 }
 
-pub(super) fn decode_samples(bytes: &[u8]) -> Result<Vec<StateSample>, Problem> {
+pub(super) fn encode_contact(e: &mut Encoder, s: &ContactSample) {
+    e.f64(s.time);
+    e.list(&s.obstacles, |e, o| {
+        e.f64(o.force);
+        e.option(o.radial_force.as_ref(), |e, v| e.f64(*v));
+        e.option(o.diameter.as_ref(), |e, v| e.f64(*v));
+    });
+}
+
+fn decode_contact(d: &mut Decoder<'_>) -> Result<ContactSample, Problem> {
+    Ok(ContactSample {
+        time: d.f64()?,
+        obstacles: d.list(10, |d| {
+            Ok(ObstacleSample {
+                force: d.f64()?,
+                radial_force: d.option(|d| d.f64())?,
+                diameter: d.option(|d| d.f64())?,
+            })
+        })?,
+    })
+}
+
+/// The charts' position: the states, then — only with contact, so that a position without stays as it was —
+/// the contact of each state.
+pub(super) fn decode_position(
+    bytes: &[u8],
+) -> Result<(Vec<StateSample>, Vec<ContactSample>), Problem> {
     let mut d = Decoder::new(bytes);
     let samples = d.list(64, decode_sample)?;
+    // Bytes left after the states: the contact samples follow.
+    let contact = if d.finish().is_ok() {
+        Vec::new()
+    } else {
+        d.list(16, decode_contact)?
+    };
     d.finish()?;
-    Ok(samples)
+    Ok((samples, contact))
 }
 
 impl Recorder for RunCharts {
@@ -147,6 +187,9 @@ impl Recorder for RunCharts {
     fn position(&self) -> Vec<u8> {
         let mut e = Encoder::default();
         e.list(self.samples(), encode_sample);
+        if !self.contact_samples().is_empty() {
+            e.list(self.contact_samples(), encode_contact);
+        }
         e.0
     }
 

@@ -36,11 +36,16 @@ pub(super) const HISTORY: RecorderKind = RecorderKind {
             ))
         })
     },
-    resume: |setup, _, position| {
+    resume: |setup, sim, position| {
         let position = decode_history(position).map_err(|p| damaged("history.csv", p))?;
         let path = setup.folder.dir().join(HISTORY_FILE);
-        let writer = HistoryWriter::resume(&path, position, &setup.design.output.strain_limits)
-            .map_err(|e| RunError::context(format!("cannot continue {}", path.display()), e))?;
+        let writer = HistoryWriter::resume(
+            &path,
+            sim.model(),
+            position,
+            &setup.design.output.strain_limits,
+        )
+        .map_err(|e| RunError::context(format!("cannot continue {}", path.display()), e))?;
         Ok(Box::new(writer))
     },
     estimate: |s| {
@@ -60,7 +65,9 @@ const HISTORY_FILE: &str = "history.csv";
 /// Bytes of a `history.csv` row (io::history's formats at their longest): time (17), three displacements per
 /// probe (20 each), temperature (11), iterations (3), residual (10), cuts (3), the recovery ratios (18 each)
 /// and Δr (17) of a programme, the largest node displacement (16), the peak surface strain (16), its patch
-/// (the longest name) and arc length (16), one peak per material with a strain limit (16), the line end.
+/// (the longest name) and arc length (16), one peak per material with a strain limit (16), per obstacle of a
+/// model with contact its force components and radial force (17 each), points (6), penetration and friction
+/// work (14 each), the line end.
 fn row_bytes(model: &Model, strain_limits: &[Option<Real>]) -> Real {
     let name = model
         .patches
@@ -74,7 +81,16 @@ fn row_bytes(model: &Model, strain_limits: &[Option<Real>]) -> Real {
         Some(p) => 36.0 + if p.is_radial() { 18.0 } else { 0.0 },
         None => 0.0,
     };
-    17.0 + 60.0 * model.probes.len() as Real + 11.0 + 3.0 + 11.0 + 3.0 + recovery + peaks + 1.0
+    let contact = 102.0 * model.contact.as_ref().map_or(0, |c| c.obstacles.len()) as Real;
+    17.0 + 60.0 * model.probes.len() as Real
+        + 11.0
+        + 3.0
+        + 11.0
+        + 3.0
+        + recovery
+        + peaks
+        + contact
+        + 1.0
 }
 
 pub(super) fn decode_history(bytes: &[u8]) -> Result<HistoryPosition, Problem> {
@@ -108,6 +124,7 @@ impl Recorder for HistoryWriter {
 
     fn summarise(&self, summary: &mut RunSummaryFile, _: &Simulation<'_>) {
         summary.peak_surface_strain = self.peak_surface_strain().cloned();
+        summary.contact = self.contact_peaks().to_vec();
     }
 
     fn finish(&mut self, _: &Simulation<'_>, f: &mut Finishing<'_>) {

@@ -16,6 +16,8 @@
 //! writer in [`crate::io`]), its `mod` line and one line in [`RECORDERS`].
 
 mod charts;
+#[cfg(test)]
+mod contact_tests;
 mod history;
 mod recording;
 mod snapshots;
@@ -157,9 +159,10 @@ pub(crate) fn damaged(name: &str, problem: Problem) -> RunError {
 mod tests {
     // Source: each recorder's own contract — the position it encodes for a checkpoint decodes to the same
     // values (floats by their bits), and bytes left over or cut short are refused.
-    use super::charts::{decode_samples, encode_sample};
+    use super::charts::{decode_position, encode_contact, encode_sample};
     use super::history::decode_history;
     use crate::io::checkpoint::Encoder;
+    use crate::io::contact::{ContactSample, ObstacleSample};
     use crate::io::history::HistoryPosition;
     use crate::io::state::StateSample;
     use crate::math::{Real, Vec3};
@@ -203,8 +206,31 @@ mod tests {
         };
         let mut e = Encoder::default();
         e.list(std::slice::from_ref(&sample), encode_sample);
-        let back = decode_samples(&e.0).expect("valid");
-        assert_eq!(back, vec![sample]);
+        let (back, contact) = decode_position(&e.0).expect("valid");
+        assert_eq!(back, vec![sample.clone()]);
+        assert!(contact.is_empty());
+        // With contact, its samples follow the states.
+        let contact = ContactSample {
+            time: 0.1,
+            obstacles: vec![
+                ObstacleSample {
+                    force: 2.5,
+                    radial_force: Some(-0.0),
+                    diameter: Some(19.5),
+                },
+                ObstacleSample {
+                    force: 1.0,
+                    radial_force: None,
+                    diameter: None,
+                },
+            ],
+        };
+        e.list(std::slice::from_ref(&contact), encode_contact);
+        assert_eq!(
+            decode_position(&e.0).expect("valid"),
+            (vec![sample.clone()], vec![contact])
+        );
+        assert!(decode_position(&e.0[..e.0.len() - 1]).is_err());
         assert_eq!(
             back[0].load_factor.map(Real::to_bits),
             Some((-0.0 as Real).to_bits())

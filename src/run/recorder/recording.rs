@@ -90,8 +90,16 @@ const MESH_COMPRESSION: Real = 4.5;
 /// indexes (about 12 kB for the straight stent).
 const RECORDING_FIXED_BYTES: Real = 20_000.0;
 
+/// Compressed bytes of an obstacle's entity in a `/obstacles` message (a primitive of about 400 bytes of JSON
+/// that changes only in its size or position: charged at the state messages' compression).
+const OBSTACLE_BYTES: Real = 100.0;
+
+/// Compressed bytes of a centreline sample's colour with contact (the same two colour texts repeated): 1.
+const SAMPLE_COLOR_BYTES: Real = 1.0;
+
 /// `run.mcap` of a recording the design turns on: a state and the centrelines at every state, a mesh at every
-/// snapshot, the vessel once, the fixed records and the design's text.
+/// snapshot, the vessel once, the obstacles at every state (a model with contact), the fixed records and the
+/// design's text.
 fn estimated_bytes(s: &Sizing<'_>) -> Real {
     let design = s.design;
     let model = s.model();
@@ -134,7 +142,15 @@ fn estimated_bytes(s: &Sizing<'_>) -> Real {
         }
         None => 0.0,
     };
-    s.states * (centrelines + state)
+    let obstacles = match &model.contact {
+        Some(contact) => {
+            contact.obstacles.len() as Real * OBSTACLE_BYTES
+                + MESSAGE_BYTES
+                + (unique + mirrored) * SAMPLE_COLOR_BYTES
+        }
+        None => 0.0,
+    };
+    s.states * (centrelines + state + obstacles)
         + meshes
         + vessel
         + RECORDING_FIXED_BYTES

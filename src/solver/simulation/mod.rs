@@ -77,6 +77,7 @@ mod arclength;
 pub(crate) mod checkpoint;
 mod clock;
 mod constitutive;
+mod contact;
 pub(crate) mod fields;
 mod measures;
 mod newton;

@@ -93,6 +93,10 @@
 //! active-set hysteresis are added: the C¹ law is what keeps Newton's tangent continuous, and a step that
 //! still fails is cut by the time stepping as any other.
 
+pub(crate) mod report;
+
+pub use report::{ContactReport, ObstacleReport};
+
 use super::{InteriorLoad, PointTerm, PointView};
 use crate::math::basis::nurbs_basis;
 use crate::math::quote::quoted;
@@ -548,6 +552,10 @@ impl PointTerm for SurfaceContact {
         "surface contact"
     }
 
+    fn as_any(&self) -> Option<&dyn std::any::Any> {
+        Some(self)
+    }
+
     fn interior(&self, at: &PointView<'_>, load: &mut InteriorLoad) {
         let x = at.position();
         for k in 0..self.obstacles.len() {
@@ -814,14 +822,14 @@ mod tests {
     use std::f64::consts::FRAC_PI_2;
 
     /// Reference radius, wire diameter, Young's modulus of the ring tests.
-    const R0: Real = 10.0;
-    const D: Real = 0.5;
-    const E: Real = 1000.0;
+    pub(super) const R0: Real = 10.0;
+    pub(super) const D: Real = 0.5;
+    pub(super) const E: Real = 1000.0;
 
     /// A quarter of a circular ring of radius `R0` in the plane z = 0, its ends on the symmetry planes y = 0
     /// and x = 0 (each end: the displacement normal to its plane, the out-of-plane displacement and every
     /// rotation held), elastic, 20 steps over t ∈ [0, 1], with `contact`.
-    fn quarter_ring(contact: Contact) -> Model {
+    pub(super) fn quarter_ring(contact: Contact) -> Model {
         quarter_ring_held(contact, true, None)
     }
 
@@ -870,7 +878,7 @@ mod tests {
     }
 
     /// A cylinder around the z axis whose radius goes linearly from `from` at t = 0 to `to` at t = 1.
-    fn cylinder(from: Real, to: Real, wall: Wall) -> Obstacle {
+    pub(super) fn cylinder(from: Real, to: Real, wall: Wall) -> Obstacle {
         Obstacle::new(
             "crimper",
             Surface::Cylinder {

@@ -76,6 +76,12 @@ pub trait PointTerm: Sync {
     /// A short name for diagnostics and tests.
     fn name(&self) -> &'static str;
 
+    /// The term itself, for a typed accessor of the simulation that reads what the term reports to the run's
+    /// outputs (`Simulation::contact` reads the contact term's report); the default: nothing to read.
+    fn as_any(&self) -> Option<&dyn std::any::Any> {
+        None
+    }
+
     /// Adds this term's load (and, when `at.tangent`, its derivatives) at an interior collocation point.
     fn interior(&self, at: &PointView<'_>, load: &mut InteriorLoad);
 

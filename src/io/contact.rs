@@ -1,0 +1,217 @@
+//! What the run folder says of contact (issue 33 item 4), for a model with contact and nothing at all for one
+//! without: the `history.csv` columns per obstacle, their peaks over the run for `summary.json`, and the names
+//! the other outputs give an obstacle. The numbers are the contact term's report
+//! ([`crate::solver::terms::contact::ContactReport`], through [`crate::solver::Simulation::contact`]).
+//!
+//! **Columns** (after every other column, per obstacle `<name>` in the model's order; the file's convention for
+//! a quantity per part, as `recovery_ratio_mean@<material>`): `contact_force_x@<name>`, `contact_force_y@<name>`,
+//! `contact_force_z@<name>` (the total force the obstacle exerts on the rods [force]), for a cylinder
+//! `contact_radial_force@<name>` (its inward radial part: positive when the wires press on the cylinder
+//! [force]), `contact_points@<name>` (collocation points with a positive pressure), `contact_penetration@<name>`
+//! (the largest penetration [length]) and `contact_friction_work@<name>` ([force·length]; 0 until friction
+//! exists). Of the model as simulated: a symmetry-reduced model's share.
+
+use crate::math::Real;
+use crate::model::{Model, Obstacle, Surface};
+use crate::solver::terms::contact::ContactReport;
+use serde::Serialize;
+
+/// An obstacle's name as it appears in a column or array name: a comma, quote or line break (which would
+/// break the CSV) becomes `_`.
+pub(crate) fn column_name(obstacle: &Obstacle) -> String {
+    obstacle
+        .name
+        .chars()
+        .map(|c| {
+            if matches!(c, ',' | '"' | '\n' | '\r') {
+                '_'
+            } else {
+                c
+            }
+        })
+        .collect()
+}
+
+/// The obstacles of `model` (none without contact).
+fn obstacles(model: &Model) -> &[Obstacle] {
+    model.contact.as_ref().map_or(&[], |c| &c.obstacles)
+}
+
+/// The contact columns of `history.csv` (module docs), each with its leading comma; empty without contact.
+pub(crate) fn header(model: &Model) -> String {
+    let mut header = String::new();
+    for o in obstacles(model) {
+        let name = column_name(o);
+        for quantity in ["force_x", "force_y", "force_z"] {
+            header.push_str(&format!(",contact_{quantity}@{name}"));
+        }
+        if matches!(o.surface, Surface::Cylinder { .. }) {
+            header.push_str(&format!(",contact_radial_force@{name}"));
+        }
+        for quantity in ["points", "penetration", "friction_work"] {
+            header.push_str(&format!(",contact_{quantity}@{name}"));
+        }
+    }
+    header
+}
+
+/// Appends the contact columns of `report` to a row of `history.csv` (nothing without a report).
+pub(crate) fn push_row(line: &mut String, report: Option<&ContactReport>) {
+    for o in report.iter().flat_map(|r| &r.obstacles) {
+        line.push_str(&format!(
+            ",{:.9e},{:.9e},{:.9e}",
+            o.force.x, o.force.y, o.force.z
+        ));
+        if let Some(radial) = o.radial_force {
+            line.push_str(&format!(",{radial:.9e}"));
+        }
+        line.push_str(&format!(
+            ",{},{:.6e},{:.6e}",
+            o.points, o.penetration, o.friction_work
+        ));
+    }
+}
+
+/// A largest value over the run and when it was reached.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct Peak {
+    /// The value (unit of its quantity).
+    pub value: Real,
+    /// When \[s\].
+    pub time: Real,
+}
+
+impl Peak {
+    /// Keeps `value` at `time` if it is larger than the peak so far (the first of equal values).
+    fn keep(peak: &mut Option<Peak>, value: Real, time: Real) {
+        if value.is_finite() && peak.is_none_or(|p| value > p.value) {
+            *peak = Some(Peak { value, time });
+        }
+    }
+}
+
+/// Contact with one obstacle over a run (`summary.json`'s `contact`).
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct ObstaclePeaks {
+    /// The obstacle's name.
+    pub obstacle: String,
+    /// The largest magnitude of the total contact force \[force\].
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub peak_force: Option<Peak>,
+    /// For a cylinder, the largest radial force (positive: the wires press on it) \[force\].
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub peak_radial_force: Option<Peak>,
+    /// The largest penetration \[length\].
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub largest_penetration: Option<Peak>,
+}
+
+/// The peaks of every obstacle of `model` over the rows seen so far (empty without contact).
+pub(crate) fn no_peaks(model: &Model) -> Vec<ObstaclePeaks> {
+    obstacles(model)
+        .iter()
+        .map(|o| ObstaclePeaks {
+            obstacle: o.name.clone(),
+            peak_force: None,
+            peak_radial_force: None,
+            largest_penetration: None,
+        })
+        .collect()
+}
+
+/// Takes the row of `report` at `time` into `peaks` (made by [`no_peaks`] for the same model).
+pub(crate) fn keep_peaks(peaks: &mut [ObstaclePeaks], report: &ContactReport, time: Real) {
+    for (p, o) in peaks.iter_mut().zip(&report.obstacles) {
+        Peak::keep(&mut p.peak_force, o.force.norm(), time);
+        if let Some(radial) = o.radial_force {
+            Peak::keep(&mut p.peak_radial_force, radial, time);
+        }
+        Peak::keep(&mut p.largest_penetration, o.penetration, time);
+    }
+}
+
+/// The peaks of `model`'s obstacles over the rows of `history.csv` (its text): a resumed run's summary covers
+/// the steps before its checkpoint too. A column the file lacks leaves its peak out.
+pub(crate) fn run_peaks(model: &Model, text: &str) -> Vec<ObstaclePeaks> {
+    let mut peaks = no_peaks(model);
+    let mut lines = text.lines();
+    let Some(header) = lines.next() else {
+        return peaks;
+    };
+    let header: Vec<&str> = header.split(',').collect();
+    let column = |quantity: &str, o: &Obstacle| {
+        let name = format!("contact_{quantity}@{}", column_name(o));
+        header.iter().position(|h| *h == name)
+    };
+    let columns: Vec<[Option<usize>; 3]> = obstacles(model)
+        .iter()
+        .map(|o| {
+            [
+                column("force_x", o),
+                column("radial_force", o),
+                column("penetration", o),
+            ]
+        })
+        .collect();
+    for line in lines {
+        let fields: Vec<&str> = line.split(',').collect();
+        let number = |k: Option<usize>| fields.get(k?)?.parse::<Real>().ok();
+        let Some(time) = number(Some(0)) else {
+            continue;
+        };
+        for (p, [force, radial, penetration]) in peaks.iter_mut().zip(&columns) {
+            let components: Option<Vec<Real>> =
+                (0..3).map(|c| number(force.map(|f| f + c))).collect();
+            if let Some(f) = components {
+                Peak::keep(
+                    &mut p.peak_force,
+                    crate::math::Vec3::new(f[0], f[1], f[2]).norm(),
+                    time,
+                );
+            }
+            if let Some(r) = number(*radial) {
+                Peak::keep(&mut p.peak_radial_force, r, time);
+            }
+            if let Some(d) = number(*penetration) {
+                Peak::keep(&mut p.largest_penetration, d, time);
+            }
+        }
+    }
+    peaks
+}
+
+/// What the charts keep of contact at one state ([`crate::io::run_charts`]).
+#[derive(Debug, Clone, PartialEq)]
+pub(crate) struct ContactSample {
+    /// Time of the state \[s\].
+    pub time: Real,
+    /// Per obstacle, in the model's order.
+    pub obstacles: Vec<ObstacleSample>,
+}
+
+/// What the charts keep of one obstacle at one state.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct ObstacleSample {
+    /// Magnitude of the total contact force \[force\].
+    pub force: Real,
+    /// A cylinder's radial force \[force\].
+    pub radial_force: Option<Real>,
+    /// A cylinder's diameter `2R(t)` at the state \[length\].
+    pub diameter: Option<Real>,
+}
+
+/// The chart sample of `report` for `model` at `time`.
+pub(crate) fn sample(model: &Model, report: &ContactReport, time: Real) -> ContactSample {
+    ContactSample {
+        time,
+        obstacles: obstacles(model)
+            .iter()
+            .zip(&report.obstacles)
+            .map(|(o, r)| ObstacleSample {
+                force: r.force.norm(),
+                radial_force: r.radial_force,
+                diameter: o.surface.radius(report.time).map(|r| 2.0 * r),
+            })
+            .collect(),
+    }
+}

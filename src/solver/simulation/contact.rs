@@ -1,0 +1,26 @@
+//! The contact of the current state, for the run's outputs: [`Simulation::contact`].
+//!
+//! Why an accessor of the simulation: the recorders (history, snapshots, recording, charts) see a run only
+//! through the [`Simulation`] their observer calls are given, and what contact did is not a function of the
+//! state alone — the pressure at a point depends on the term's augmented-Lagrange multipliers and the surfaces
+//! on the time the term was prepared for — so the contact term, which owns both, makes the report, and the
+//! simulation hands it over with the state and the integration weights it keeps.
+
+use super::Simulation;
+use crate::solver::terms::contact::{ContactReport, SurfaceContact};
+
+impl Simulation<'_> {
+    /// The contact of the current (last converged) state with every obstacle of the model
+    /// ([`crate::solver::terms::contact::ContactReport`]); `None` for a model without contact.
+    pub fn contact(&self) -> Option<ContactReport> {
+        let term = self
+            .terms
+            .iter()
+            .find_map(|t| t.as_any()?.downcast_ref::<SurfaceContact>())?;
+        Some(term.report(
+            &self.disc,
+            &self.solution.state,
+            self.measures.point_weights(self.model, &self.disc),
+        ))
+    }
+}
