@@ -90,12 +90,14 @@ pub(crate) fn build(dto: &DesignDto, default_name: &str, temporary_shape: bool) 
         UnitsDto::MmNMpa => 1e-3,
     };
     let mut notes = Vec::new();
+    let mut vessel = None;
     if let Some(s) = &dto.stent {
-        let (device, said, vessel) = super::family::device(s, metres_per_unit)?;
+        let (device, said, file_vessel) = super::family::device(s, metres_per_unit)?;
         notes.extend(said);
-        if let Some(v) = vessel {
-            builder.vessel(v);
+        if let Some(v) = &file_vessel {
+            builder.vessel(v.clone());
         }
+        vessel = file_vessel;
         builder.stent(device, stent::mesh(s, dto.mesh.as_ref())?);
         if let Some(m) = &s.materials {
             builder.stent_materials(stent::materials(m, &material_names)?);
@@ -104,7 +106,7 @@ pub(crate) fn build(dto: &DesignDto, default_name: &str, temporary_shape: bool) 
     if let Some(p) = &dto.programme {
         builder.programme(stent::programme(p, metres_per_unit)?);
     }
-    if let Some(c) = super::contact::contact(dto, section.diameter())? {
+    if let Some(c) = super::contact::contact(dto, section.diameter(), vessel.as_ref())? {
         builder.contact(c);
     }
     if temporary_shape {
@@ -289,17 +291,21 @@ pub(crate) fn field_path(field: &Field, dto: &DesignDto) -> String {
             };
             let shape = if o.cylinder.is_some() {
                 "cylinder"
-            } else {
+            } else if o.plane.is_some() {
                 "plane"
+            } else {
+                "lumen"
             };
             match field {
                 ObstacleField::Name => format!("{base}.name"),
                 ObstacleField::Direction if o.cylinder.is_some() => format!("{base}.cylinder.axis"),
-                ObstacleField::Direction => format!("{base}.plane.normal"),
+                ObstacleField::Direction if o.plane.is_some() => format!("{base}.plane.normal"),
+                ObstacleField::Direction => format!("{base}.lumen"),
                 ObstacleField::Schedule if o.cylinder.is_some() => {
                     format!("{base}.cylinder.radius")
                 }
-                ObstacleField::Schedule => format!("{base}.plane.offset"),
+                ObstacleField::Schedule if o.plane.is_some() => format!("{base}.plane.offset"),
+                ObstacleField::Schedule => format!("{base}.lumen"),
                 ObstacleField::Wall if o.wall.is_some() => format!("{base}.wall"),
                 ObstacleField::Wall => format!("{base}.{shape}"),
                 ObstacleField::Friction => format!("{base}.friction"),

@@ -9,6 +9,9 @@
 //!     until: 2.4                  # withdrawn at t = 2.4 (default: never)
 //!   - name: plate
 //!     plane: {point: [0, 0, -6], normal: [0, 0, 1], offset: [[0, 0], [1, 2]]}
+//!   - name: vessel
+//!     lumen: {}                   # the lumen of the stent's vessel file (`stent.centreline.file`)
+//!     from: 2.25
 //!   - name: tube
 //!     cylinder: {point: [0, 0, 0], axis: [1, 0, 0], radius: 21}
 //!     wall: {E: 1.0, thickness: 0.5}   # compliant (width: default the wire's diameter); rigid without it
@@ -32,12 +35,19 @@
 
 use super::dto::{ContactDto, DesignDto, ObstacleDto, Positive, ProgrammeKindDto, vec3};
 use super::issue::{Result, issue};
+use crate::geometry::fit::smooth_points;
 use crate::math::{Real, Vec3};
-use crate::model::{Contact, ContactSettings, Obstacle, Surface, TimeFunction, Wall};
+use crate::model::{
+    Contact, ContactSettings, Lumen, Obstacle, Surface, TimeFunction, Vessel, Wall,
+};
 
 /// The contact of a design (`None` when it has no obstacle, no `contact` block and no crimper); `diameter` is
-/// the design's wire diameter.
-pub(crate) fn contact(dto: &DesignDto, diameter: Real) -> Result<Option<Contact>> {
+/// the design's wire diameter, `vessel` the vessel of its file centreline.
+pub(crate) fn contact(
+    dto: &DesignDto,
+    diameter: Real,
+    vessel: Option<&Vessel>,
+) -> Result<Option<Contact>> {
     let crimp = dto
         .programme
         .as_ref()
@@ -55,7 +65,7 @@ pub(crate) fn contact(dto: &DesignDto, diameter: Real) -> Result<Option<Contact>
         .obstacles
         .iter()
         .enumerate()
-        .map(|(k, o)| obstacle(o, &format!("obstacles[{k}]"), diameter))
+        .map(|(k, o)| obstacle(o, &format!("obstacles[{k}]"), diameter, vessel))
         .collect::<Result<Vec<_>>>()?;
     Ok(Some(Contact {
         obstacles,
@@ -88,16 +98,58 @@ fn unit(v: &super::dto::Vector, path: String) -> Result<Vec3> {
     }
 }
 
+/// The lumen of `vessel` as a surface: its sampled centreline (the file's smoothing spline at up to 1000
+/// points, `super::vessel`) fitted again within a thousandth of the smallest lumen radius, by chord length
+/// (`smooth_points`), and its radius at each sample's chord parameter.
+fn lumen(vessel: Option<&Vessel>, path: &str) -> Result<Lumen> {
+    let Some((vessel, radii)) = vessel.and_then(|v| v.radius.as_ref().map(|r| (v, r))) else {
+        return Err(issue(
+            path,
+            "a lumen needs the stent's vessel: a `stent.centreline.file` whose points carry the lumen radius",
+        ));
+    };
+    let smallest = radii.iter().copied().fold(Real::INFINITY, Real::min);
+    let fit = smooth_points(&vessel.points, 1e-3 * smallest).map_err(|e| {
+        issue(
+            path,
+            format!("the vessel's centreline could not be fitted: {e}"),
+        )
+    })?;
+    let mut chord = vec![0.0];
+    for w in vessel.points.windows(2) {
+        chord.push(chord[chord.len() - 1] + (w[1] - w[0]).norm());
+    }
+    let total = chord[chord.len() - 1];
+    let table = chord
+        .iter()
+        .zip(radii)
+        .map(|(c, &r)| (c / total, r))
+        .collect();
+    Lumen::try_new(fit.curve, table).map_err(|e| issue(path, e))
+}
+
 /// One obstacle of the list, at `base` (`obstacles[k]`).
-fn obstacle(o: &ObstacleDto, base: &str, diameter: Real) -> Result<Obstacle> {
+fn obstacle(
+    o: &ObstacleDto,
+    base: &str,
+    diameter: Real,
+    vessel: Option<&Vessel>,
+) -> Result<Obstacle> {
     let time_function = |f, key: &str| super::build::time_function(f, &format!("{base}.{key}"));
-    let surface = match (&o.cylinder, &o.plane) {
-        (Some(c), None) => Surface::Cylinder {
+    let surface = match (&o.cylinder, &o.plane, &o.lumen) {
+        (None, None, Some(l)) => {
+            let lumen = lumen(vessel, &format!("{base}.lumen"))?;
+            Surface::Lumen(match &l.scale {
+                Some(f) => lumen.with_scale(time_function(f, "lumen.scale")?),
+                None => lumen,
+            })
+        }
+        (Some(c), None, None) => Surface::Cylinder {
             point: vec3(&c.point),
             axis: unit(&c.axis, format!("{base}.cylinder.axis"))?,
             radius: time_function(&c.radius, "cylinder.radius")?,
         },
-        (None, Some(p)) => Surface::Plane {
+        (None, Some(p), None) => Surface::Plane {
             point: vec3(&p.point),
             normal: unit(&p.normal, format!("{base}.plane.normal"))?,
             offset: match &p.offset {
@@ -108,7 +160,7 @@ fn obstacle(o: &ObstacleDto, base: &str, diameter: Real) -> Result<Obstacle> {
         _ => {
             return Err(issue(
                 base,
-                "give exactly one surface: `cylinder` or `plane`",
+                "give exactly one surface: `cylinder`, `plane` or `lumen`",
             ));
         }
     };

@@ -320,8 +320,8 @@ pub struct DesignDto {
     pub output: Option<OutputDto>,
 }
 
-/// An obstacle: a named surface (give exactly one of `cylinder` or `plane`) with its wall and the times it
-/// acts between.
+/// An obstacle: a named surface (give exactly one of `cylinder`, `plane` or `lumen`) with its wall and the times
+/// it acts between.
 #[derive(Debug, Clone, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct ObstacleDto {
@@ -333,6 +333,10 @@ pub struct ObstacleDto {
     /// A plane that keeps the rods on the side its normal points to (a crush plate, a table).
     #[serde(default)]
     pub plane: Option<PlaneDto>,
+    /// The lumen of the stent's vessel (a `stent.centreline.file` with its lumen radius): the rods are kept
+    /// inside it.
+    #[serde(default)]
+    pub lumen: Option<LumenDto>,
     /// A compliant wall (a thin elastic tube acting as a radial foundation of stiffness `E h / R²`); without
     /// it the wall is rigid.
     #[serde(default)]
@@ -358,6 +362,15 @@ pub struct CylinderDto {
     pub axis: Vector,
     /// Its radius \[length\]: a number or a table `[[t, r], …]` (a crimper closes and opens).
     pub radius: TimeFn,
+}
+
+/// The vessel's lumen as an obstacle.
+#[derive(Debug, Clone, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct LumenDto {
+    /// A factor on the lumen radius: a number or a table `[[t, f], …]` (default 1).
+    #[serde(default)]
+    pub scale: Option<TimeFn>,
 }
 
 /// A plane obstacle.

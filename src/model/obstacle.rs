@@ -123,6 +123,9 @@ pub struct Lumen {
     /// knot span, `(u, C(u))`, in increasing `u` (module docs of [`Lumen::distance`]).
     #[serde(skip)]
     samples: Vec<(Real, Vec3)>,
+    /// A factor on the radius as a function of time (1 for a vessel; a crimper tube around a curved
+    /// centreline closes and opens through it).
+    scale: TimeFunction,
 }
 
 /// Centreline samples per knot span for the first guess of a lumen's closest point (module docs of
@@ -178,7 +181,19 @@ impl Lumen {
             centreline,
             radius,
             samples,
+            scale: TimeFunction::constant(1.0),
         })
+    }
+
+    /// The same tube with its radius scaled by `scale(t)` (a crimper around a curved centreline).
+    pub fn with_scale(mut self, scale: TimeFunction) -> Self {
+        self.scale = scale;
+        self
+    }
+
+    /// The factor on the radius as a function of time.
+    pub fn scale(&self) -> &TimeFunction {
+        &self.scale
     }
 
     /// The centreline.
@@ -270,13 +285,17 @@ impl Lumen {
     /// the checks between collocation points once per step; a tree would save little and add a dependency.
     /// A hint can lead to a local, not global, closest point where a vessel folds back within one step's
     /// motion; a fitted vessel centreline does not.
-    pub fn distance(&self, x: &Vec3, hint: Option<Real>) -> Option<Distance> {
+    ///
+    /// At time `t` the radius is `R(u)` times the tube's scale ([`Lumen::with_scale`]).
+    pub fn distance(&self, x: &Vec3, hint: Option<Real>, t: Real) -> Option<Distance> {
         let u = self.closest(x, hint)?;
         let d = self.centreline.derivatives(u, 3);
         let (c1, c2, c3) = (d[1], d[2], d[3]);
         let r = x - d[0];
         let rho = r.norm();
+        let factor = self.scale.value(t);
         let (radius, slope) = self.radius(u);
+        let (radius, slope) = (radius * factor, slope * factor);
         if rho <= Real::EPSILON * radius {
             return None;
         }
@@ -344,7 +363,7 @@ impl Surface {
                 normal: *normal,
                 hessian: Mat3::zeros(),
             }),
-            Surface::Lumen(lumen) => lumen.distance(x, None),
+            Surface::Lumen(lumen) => lumen.distance(x, None, t),
         }
     }
 
@@ -352,7 +371,7 @@ impl Surface {
     /// the other surfaces ignore it.
     pub fn distance_near(&self, x: &Vec3, t: Real, hint: Option<Real>) -> Option<Distance> {
         match self {
-            Surface::Lumen(lumen) => lumen.distance(x, hint),
+            Surface::Lumen(lumen) => lumen.distance(x, hint, t),
             _ => self.distance(x, t),
         }
     }
@@ -380,7 +399,7 @@ impl Surface {
             Surface::Cylinder { radius: f, .. } | Surface::Plane { offset: f, .. } => {
                 f.breakpoints().collect()
             }
-            Surface::Lumen(_) => Vec::new(),
+            Surface::Lumen(lumen) => lumen.scale.breakpoints().collect(),
         }
     }
 }
@@ -501,7 +520,9 @@ mod tests {
             Vec3::new(-1.0, 0.5, -3.0),
             Vec3::new(3.0, -2.0, 0.0),
         ] {
-            let a: Distance = lumen.distance(&x, None).expect("inside the tube's span");
+            let a: Distance = lumen
+                .distance(&x, None, 0.0)
+                .expect("inside the tube's span");
             let b = cylinder.distance(&x, 0.0).expect("off the axis");
             assert!((a.value - b.value).abs() < 1e-12, "{a:?} {b:?}");
             assert!((a.normal - b.normal).norm() < 1e-12, "{a:?} {b:?}");
@@ -531,7 +552,9 @@ mod tests {
         for angle in [0.3_f64, 1.0, 1.7] {
             for (dr, dz) in [(0.5, 0.2), (-1.2, 0.7), (0.1, -1.9), (2.5, 1.0)] {
                 let x = Vec3::new((rc + dr) * angle.cos(), (rc + dr) * angle.sin(), dz);
-                let d = lumen.distance(&x, None).expect("inside the arc's span");
+                let d = lumen
+                    .distance(&x, None, 0.0)
+                    .expect("inside the arc's span");
                 assert!(
                     (d.value - torus(&x)).abs() < 1e-12,
                     "{} {}",
@@ -561,11 +584,11 @@ mod tests {
         .expect("an arc");
         let (lo, hi) = centreline.knots().domain();
         let lumen = Lumen::try_new(centreline, vec![(lo, 2.5), (hi, 1.5)]).expect("a lumen");
-        let value = |x: &Vec3| lumen.distance(x, None).expect("inside").value;
+        let value = |x: &Vec3| lumen.distance(x, None, 0.0).expect("inside").value;
         for angle in [0.4_f64, 1.1, 1.6] {
             for (dr, dz) in [(0.5, 0.2), (-1.0, 0.6), (0.3, -1.2)] {
                 let x = Vec3::new((8.0 + dr) * angle.cos(), (8.0 + dr) * angle.sin(), dz);
-                let d = lumen.distance(&x, None).expect("inside");
+                let d = lumen.distance(&x, None, 0.0).expect("inside");
                 let (gradient, hessian) = differences(&value, &x, 1e-4);
                 assert!((d.normal - gradient).norm() < 1e-6, "{d:?} {gradient:?}");
                 assert!(relative(&d.hessian, &hessian) < 1e-6, "{d:?} {hessian:?}");
@@ -582,7 +605,11 @@ mod tests {
             vec![(0.0, 1.0)],
         )
         .expect("a lumen");
-        assert!(lumen.distance(&Vec3::new(0.1, 0.0, 12.0), None).is_none());
+        assert!(
+            lumen
+                .distance(&Vec3::new(0.1, 0.0, 12.0), None, 0.0)
+                .is_none()
+        );
         let inside = Vec3::new(0.1, 0.0, 5.0);
         let u = lumen.closest(&inside, None).expect("inside the span");
         // From a hint near the answer Newton lands on the same parameter; from a far one too.
