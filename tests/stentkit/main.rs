@@ -8,6 +8,7 @@ mod arguments;
 mod centreline;
 mod checkpoint;
 mod cli;
+mod contact;
 mod design_errors;
 mod designs;
 mod diamond;
