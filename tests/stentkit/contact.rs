@@ -176,17 +176,21 @@ impl ZRing {
 /// ratio times `cos θ` within 0.5 % of 1: the 2 % at N = 42 is the curvature, not contact or the solver.
 #[test]
 fn a_z_ring_crimped_by_a_cylinder_matches_the_open_stent_calculator_within_its_assumptions() {
+    // Model over calculator for `struts` struts at `degrees`, and that times cos θ.
+    let ratios = |struts: usize, degrees: Real| {
+        let theta = degrees.to_radians();
+        let ratio = ZRing::new(struts, theta).force_ratio();
+        (ratio, ratio * theta.cos())
+    };
     let mut previous: Option<Real> = None;
     for degrees in [5.0, 10.0, 20.0, 30.0, 40.0, 50.0] {
-        let theta: Real = degrees * PI / 180.0;
-        let ratio = ZRing::new(42, theta).force_ratio();
-        let projected = ratio * theta.cos();
+        let (ratio, projected) = ratios(42, degrees);
         assert!(
             (projected - 1.0).abs() <= 0.03,
             "θ = {degrees}°: model/calculator {ratio:.4}, times cos θ {projected:.4}"
         );
         assert!(
-            (ratio - 1.0).abs() <= 1.0 / theta.cos() - 1.0 + 0.03,
+            (ratio - 1.0).abs() <= 1.0 / degrees.to_radians().cos() - 1.0 + 0.03,
             "θ = {degrees}°: model/calculator {ratio:.4}"
         );
         if let Some(p) = previous {
@@ -195,9 +199,7 @@ fn a_z_ring_crimped_by_a_cylinder_matches_the_open_stent_calculator_within_its_a
         previous = Some(ratio);
     }
     for degrees in [10.0, 30.0] {
-        let theta: Real = degrees * PI / 180.0;
-        let ratio = ZRing::new(336, theta).force_ratio();
-        let projected = ratio * theta.cos();
+        let (ratio, projected) = ratios(336, degrees);
         assert!(
             (projected - 1.0).abs() <= 0.005,
             "N = 336, θ = {degrees}°: model/calculator {ratio:.4}, times cos θ {projected:.4}"

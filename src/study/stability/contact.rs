@@ -48,7 +48,7 @@ const MESH: (usize, usize) = (4, 12);
 /// thousandth of the wire's radius. The crimper moves 460 to 1800 times as far in one step of the map, so
 /// points cross the band within a step: the case the map is about.
 const BAND: Real = 3e-4;
-/// The crest whose axial displacement is held: the joint 30° from the first symmetry plane, off both planes,
+/// The joint whose axial displacement is held: the one 30° from the first symmetry plane, off both planes,
 /// whose components are global ([`crimped_crown`] checks it).
 const HELD: &str = "c1_n2";
 
@@ -63,7 +63,7 @@ pub struct ContactCase {
 
 /// One crown of the straight stent (quarter model, its wires p = 4, n = 12), elastic at the rubbery modulus,
 /// inside a rigid crimper around its axis (x1) that closes, holds and opens ([`CRIMP`], [`SCHEDULE`]), with the
-/// case's time step and penalty. The crown is held only by its symmetry planes and, at one crest, in its axial
+/// case's time step and penalty. The crown is held only by its symmetry planes and, at one joint, in its axial
 /// displacement (a frictionless crimper leaves the axial translation free and puts no axial force on the crown).
 ///
 /// # Errors
@@ -223,14 +223,16 @@ pub fn contact_report(map: &SolverMap) -> MapReport {
     let [closed, opens, open] = SCHEDULE;
     let _ = write!(
         summary,
-        "One crown of the straight stent (6 peaks, R = {} mm, 0.6 mm wire, quarter model, p = {}, n = {}), elastic at the PLA's rubbery modulus, inside a rigid crimper that closes from {CLEAR} mm outside its wires to {CRIMP} mm inside them by {closed} s, holds, and opens from {opens} s back to the start by {open} s; contact band and penetration tolerance {BAND} mm, at most 10 augmented-Lagrange updates a step. The contact law is C¹ across its band, and Newton has neither a line search nor an active-set hysteresis. While the crimper closes, points enter contact in steps in which the crimper moves 460 to 1800 times the band: with the penalties 0.1 and 1 N/mm² Newton converges at every step without a cut (its failed attempts there are the retries with a fresh factorisation, about one a step); at 10 N/mm² the longer steps are cut to a half or a quarter. Opening is where it stalls: in the first iterate of a step the crimper has moved away from the points it held, they leave the band, the tangent loses their contact stiffness, and the crown springs back in one linearised step through the crimper (at h = 0.05 s, 1 N/mm², 1.25 s: a first increment of 0.6 of a wire's length, the residual rising from 5e-4 to 74); the next iterate meets a penetration of the order of the step's travel times the penalty. The steps are then cut to about 1e-4 s (the crimper's travel in a step about twice the band) and the run crawls through the opening, or fails there: at its start with the stiff penalty, or late in it (1.85 … 2.14 s; the crimper leaves the crown at 2.16 s). One run passes the opening at its nominal step (h = 0.1 s, 0.1 N/mm²): luck of where its steps land, not a setting to rely on.\n\n",
+        "One crown of the straight stent (6 peaks, R = {} mm, {WIRE} mm wire, quarter model, p = {}, n = {}), elastic at the PLA's rubbery modulus, inside a rigid crimper that closes from {CLEAR} mm outside its wires to {CRIMP} mm inside them by {closed} s, holds, and opens from {opens} s back to the start by {open} s; contact band and penetration tolerance {BAND} mm, at most 10 augmented-Lagrange updates a step. The contact law is C¹ across its band, and Newton has neither a line search nor an active-set hysteresis. While the crimper closes, points enter contact in steps in which the crimper moves 460 to 1800 times the band: with the penalties 0.1 and 1 N/mm² Newton converges at every step without a cut (its failed attempts there are the retries with a fresh factorisation, about one a step); at 10 N/mm² the longer steps are cut to a half or a quarter. Opening is where it stalls: in the first iterate of a step the crimper has moved away from the points it held, they leave the band, the tangent loses their contact stiffness, and the crown springs back in one linearised step through the crimper (at h = 0.05 s, 1 N/mm², 1.25 s: a first increment of 0.6 of a wire's length, the residual rising from 5e-4 to 74); the next iterate meets a penetration of the order of the step's travel times the penalty. The steps are then cut to about 1e-4 s (the crimper's travel in a step about twice the band) and the run crawls through the opening, or fails there: at its start with the stiff penalty, or late in it (1.85 … 2.14 s; the crimper leaves the crown at 2.16 s). One run passes the opening at its nominal step (h = 0.1 s, 0.1 N/mm²): luck of where its steps land, not a setting to rely on.\n\n",
         CROWN.radius, MESH.0, MESH.1,
     );
     MapReport {
         name: map.name,
         csv: solver_csv(
             map,
-            "one crown of the straight stent (elastic; the PLA's rubbery modulus) crimped by a rigid cylinder 5 mm inside its wires over 1 s; held to 1.25 s; opened by 2.25 s",
+            &format!(
+                "one crown of the straight stent (elastic; the PLA's rubbery modulus) crimped by a rigid cylinder {CRIMP} mm inside its wires over {closed} s; held to {opens} s; opened by {open} s"
+            ),
         ),
         chart: solver_chart(
             map,

@@ -17,8 +17,12 @@
 //! * **coarse** — the elastic 45° bend and roll-up on coarse and fine meshes, by load steps and by arc length
 //!   (issue 18): where load steps fail, whether the coarse model's own path has a limit point there (the largest
 //!   load factor before it falls), and how far its end state is from the fine model's.
+//! * **contact** ([`contact`]) — one crown of the straight stent crimped by a rigid cylinder, held and released
+//!   (issue 33), at several time steps and contact penalties: points entering contact while the crimper closes
+//!   and leaving it while it opens; failed attempts and the smallest step in each phase.
 //!
-//! The last four are [`scenarios`] run through [`newton::newton_run`], which records what the solver did.
+//! bend45, heating, release and coarse are [`scenarios`] run through [`newton::newton_run`], which records what
+//! the solver did; contact is built in code ([`contact::crimped_crown`]) and run the same way.
 
 pub mod contact;
 pub mod material;
@@ -151,10 +155,9 @@ impl Default for StabilityStudy {
 pub type ReadDesign = dyn Fn(&str, &Path) -> Result<Box<dyn VariedDesign>, StudyError>;
 
 /// Runs every map of `study` whose list is not empty, in the order material, bend45, heating, release, coarse,
-/// contact. Each
-/// finished map is handed to `done` (which writes it), so the maps finished before a failure are kept; the text
-/// of `stability.md` (a title and every map's paragraph) is returned. `read` reads the embedded designs the maps
-/// vary; `progress` is told about each run.
+/// contact. Each finished map is handed to `done` (which writes it), so the maps finished before a failure are
+/// kept; the text of `stability.md` (a title and every map's paragraph) is returned. `read` reads the embedded
+/// designs the maps vary; `progress` is told about each run.
 ///
 /// # Errors
 /// The first error of a map (an out-of-range setting, a refused design) or of `done`.
