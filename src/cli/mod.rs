@@ -461,7 +461,8 @@ pub(crate) enum StudyCommand {
     },
     /// Stability map: where each integrator rings (h/τ on one Maxwell branch, held and cooled) and where
     /// Newton needs step cuts or fails (load steps of the 45° bend, heating per step of the loaded arch, the
-    /// release snap of a two-crown stent). Writes a CSV and an SVG per map and stability.md.
+    /// release snap of a two-crown stent, coarse models, a crown crimped and released by a cylinder). Writes a
+    /// CSV and an SVG per map and stability.md.
     ///
     /// Example: stentkit study stability -o runs/stability
     Stability {
@@ -472,11 +473,11 @@ pub(crate) enum StudyCommand {
         /// refused, exit status 2; other files in the folder are never touched).
         #[arg(long)]
         force: bool,
-        /// Maps to draw: any of material, bend45, heating, release, coarse.
+        /// Maps to draw: any of material, bend45, heating, release, coarse, contact.
         #[arg(
             long,
             value_delimiter = ',',
-            default_value = "material,bend45,heating,release,coarse",
+            default_value = "material,bend45,heating,release,coarse,contact",
             value_parser = arguments::one_of(study::MAPS)
         )]
         maps: Vec<String>,

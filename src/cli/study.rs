@@ -118,7 +118,9 @@ pub(crate) fn degree_and_points(text: &str) -> Result<(usize, usize), String> {
 }
 
 /// The maps `study stability --maps` draws.
-pub(crate) const MAPS: &[&str] = &["material", "bend45", "heating", "release", "coarse"];
+pub(crate) const MAPS: &[&str] = &[
+    "material", "bend45", "heating", "release", "coarse", "contact",
+];
 
 /// Refuses (exit status 2, naming `argument`) a study run of `design` changed by `variant` whose time steps
 /// would need more memory than a design may ([`crate::design::size::MemoryEstimate::with_steps`]: the
@@ -249,9 +251,9 @@ pub(crate) fn time(
     Ok(())
 }
 
-/// `stentkit study stability`: the maps named in `maps` (any of material, bend45, heating, release, coarse), each
-/// written as `<map>.csv` and `<map>.svg` as soon as it is done, then `stability.md`, into the folder `output`
-/// (its files replaced only with `--force`).
+/// `stentkit study stability`: the maps named in `maps` (any of material, bend45, heating, release, coarse,
+/// contact), each written as `<map>.csv` and `<map>.svg` as soon as it is done, then `stability.md`, into the
+/// folder `output` (its files replaced only with `--force`).
 pub(crate) fn stability_maps(output: Target<'_>, maps: &[String]) -> anyhow::Result<()> {
     let Target {
         path: output,
@@ -279,6 +281,9 @@ pub(crate) fn stability_maps(output: Target<'_>, maps: &[String]) -> anyhow::Res
     }
     if !wanted("coarse") {
         study.coarse.clear();
+    }
+    if !wanted("contact") {
+        study.contact.clear();
     }
     create(output)?;
     let summary = stability(

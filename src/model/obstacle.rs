@@ -287,8 +287,14 @@ impl Lumen {
     /// motion; a fitted vessel centreline does not.
     ///
     /// At time `t` the radius is `R(u)` times the tube's scale ([`Lumen::with_scale`]).
+    ///
+    /// Beyond the centreline's ends (no interior closest point) the tube goes on straight along its end
+    /// tangent with its end radius: the distance is the cylinder's ([`Surface::distance`]) around the end's
+    /// tangent line, so a crown at the end of a vessel segment is kept inside it rather than let through.
     pub fn distance(&self, x: &Vec3, hint: Option<Real>, t: Real) -> Option<Distance> {
-        let u = self.closest(x, hint)?;
+        let Some(u) = self.closest(x, hint) else {
+            return self.beyond_ends(x, t);
+        };
         let d = self.centreline.derivatives(u, 3);
         let (c1, c2, c3) = (d[1], d[2], d[3]);
         let r = x - d[0];
@@ -308,6 +314,38 @@ impl Lumen {
             value: radius - rho,
             normal: -e + c1 * (slope / j),
             hessian: -(Mat3::identity() - e * e.transpose() - t / j) / rho + hess_u * slope,
+        })
+    }
+}
+
+impl Lumen {
+    /// The distance from the straight continuation of the tube beyond the end of its centreline nearer to
+    /// `x` ([`Lumen::distance`]), when `x` lies beyond that end's cross-section; `None` otherwise.
+    fn beyond_ends(&self, x: &Vec3, t: Real) -> Option<Distance> {
+        let (lo, hi) = self.centreline.knots().domain();
+        let ends = [(lo, -1.0), (hi, 1.0)];
+        let (u, outward) = ends.into_iter().min_by(|a, b| {
+            let da = (self.centreline.point(a.0) - x).norm_squared();
+            let db = (self.centreline.point(b.0) - x).norm_squared();
+            da.total_cmp(&db)
+        })?;
+        let d = self.centreline.derivatives(u, 1);
+        let axis = d[1].normalize();
+        let r = x - d[0];
+        if r.dot(&axis) * outward < 0.0 {
+            return None;
+        }
+        let perp = r - axis * axis.dot(&r);
+        let rho = perp.norm();
+        let radius = self.radius(u).0 * self.scale.value(t);
+        if rho <= Real::EPSILON * radius {
+            return None;
+        }
+        let e = perp / rho;
+        Some(Distance {
+            value: radius - rho,
+            normal: -e,
+            hessian: -(Mat3::identity() - axis * axis.transpose() - e * e.transpose()) / rho,
         })
     }
 }
@@ -596,8 +634,9 @@ mod tests {
         }
     }
 
-    /// A point beyond the tube's ends has no closest interior point (no contact), and a bad table is refused
-    /// with its reason.
+    /// A point beyond the tube's ends has no closest interior point; the tube goes on straight there with its
+    /// end radius (the point 0.1 off the axis, 2 beyond the end: 1 − 0.1 from the wall, normal −x, as the
+    /// cylinder's); and a bad table is refused with its reason.
     #[test]
     fn a_lumen_ends_and_refuses_bad_tables() {
         let lumen = Lumen::try_new(
@@ -605,10 +644,14 @@ mod tests {
             vec![(0.0, 1.0)],
         )
         .expect("a lumen");
+        let beyond = Vec3::new(0.1, 0.0, 12.0);
+        assert!(lumen.closest(&beyond, None).is_none());
+        let d = lumen
+            .distance(&beyond, None, 0.0)
+            .expect("the straight continuation");
         assert!(
-            lumen
-                .distance(&Vec3::new(0.1, 0.0, 12.0), None, 0.0)
-                .is_none()
+            (d.value - 0.9).abs() < 1e-12 && (d.normal + Vec3::x()).norm() < 1e-12,
+            "{d:?}"
         );
         let inside = Vec3::new(0.1, 0.0, 5.0);
         let u = lumen.closest(&inside, None).expect("inside the span");

@@ -310,3 +310,47 @@ pub fn series_bar_elongation(spans: &[CantileverSpan], area: Real, force: Real) 
         .map(|s| force * s.length / (s.modulus * area))
         .sum()
 }
+
+/// A Z-ring as the open-stent calculator sees it: `struts` straight struts of length `L` (crown centre to crown
+/// centre) and bending stiffness `EI` in the plane of the unrolled pattern, parallel to the axis at the diameter
+/// `crimp` (the tube they are cut from), made at the diameter `set`.
+#[derive(Debug, Clone, Copy)]
+pub struct OpenStentRing {
+    /// Number of struts `N_struts`.
+    pub struts: usize,
+    /// Strut length `L_strut` [length].
+    pub length: Real,
+    /// Bending stiffness `E I` of a strut in the plane of the pattern [force·length²].
+    pub bending: Real,
+    /// Diameter at which the ring is made, `D_set` [length].
+    pub set: Real,
+    /// Diameter at which the struts are parallel, `D_crimp` [length].
+    pub crimp: Real,
+}
+
+impl OpenStentRing {
+    /// The strut angle to the axis at diameter `d` [rad]: `θ = asin(π (d − D_crimp) / (N L))` (the
+    /// circumference beyond the tube's is shared by the `N` struts' circumferential spans `L sin θ`).
+    pub fn strut_angle(&self, d: Real) -> Real {
+        (std::f64::consts::PI * (d - self.crimp) / (self.struts as Real * self.length)).asin()
+    }
+
+    /// The total radial force [force] of the ring held at the diameter `d < D_set`, as the open-stent calculator
+    /// computes it (C. Bonsignore, `stent-calculator.py`, 2010, github.com/cbonsig/open-stent: "Strut Angles
+    /// and Deflections", "Force and Strain Calculations", "Pressure and Stiffness"). Each strut is a guided
+    /// beam (one end clamped, the other free to translate but not to rotate; Machinery's Handbook, the
+    /// calculator's source) whose crowns turn by `Δθ = θ_set − θ_d`, so its end moves across it by
+    /// `δ = 2 L sin(Δθ/2)` and it carries `F = 12 E I δ / L³`; the calculator takes this force as the ring's
+    /// hoop force (`F_hoop = F_total`) and the radial force of the ring as `2π F_hoop` (Laplace's law for a
+    /// thin ring: its `RF_trf = 2π RF_hoop` per unit length). Transcribed from the formulas, not the code;
+    /// the calculator's section property (Roark's annular sector for a laser-cut strut) is replaced by the
+    /// caller's `EI`. Its assumptions: a flat pattern (the ring's curvature left out), straight struts joined
+    /// by rigid crowns, slender Euler–Bernoulli struts, small strain, and `F_hoop = F` (the force across the
+    /// strut taken as the hoop force, true as `θ → 0`).
+    pub fn radial_force(&self, d: Real) -> Real {
+        let turn = self.strut_angle(self.set) - self.strut_angle(d);
+        let across = 2.0 * self.length * (turn / 2.0).sin();
+        let hoop = 12.0 * self.bending * across / self.length.powi(3);
+        2.0 * std::f64::consts::PI * hoop
+    }
+}

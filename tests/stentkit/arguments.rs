@@ -155,7 +155,8 @@ fn arguments_wrong_by_themselves_exit_2_naming_the_argument() {
             ["study", "stability", "--maps", "bogus", "-o", study]
                 .map(String::from)
                 .to_vec(),
-            "--maps `bogus`: must be one of material, bend45, heating, release, coarse".into(),
+            "--maps `bogus`: must be one of material, bend45, heating, release, coarse, contact"
+                .into(),
         ),
         (
             ["run", bend, "--checkpoint-every", "nan", "-o", study]

@@ -8,6 +8,7 @@ mod arguments;
 mod centreline;
 mod checkpoint;
 mod cli;
+mod contact;
 mod crimp;
 mod design_errors;
 mod designs;

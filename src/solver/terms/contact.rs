@@ -412,7 +412,7 @@ impl SurfaceContact {
             }
         };
         for (k, obstacle) in self.obstacles.iter().enumerate() {
-            if obstacle.wall != Wall::Rigid {
+            if obstacle.wall != Wall::Rigid || !obstacle.is_active(self.time) {
                 continue;
             }
             let gap = |x: &Vec3, patch: usize| {

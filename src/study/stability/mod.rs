@@ -1,7 +1,7 @@
 //! The stability study: where each method fails and what the program does there (DESIGN §4, §6;
 //! `stentkit study stability`).
 //!
-//! Four maps, each a CSV, an SVG chart and a paragraph of `stability.md` ([`MapReport`]):
+//! Six maps, each a CSV, an SVG chart and a paragraph of `stability.md` ([`MapReport`]):
 //!
 //! * **material** ([`material`]) — one Maxwell branch (`E∞ = E₁ = 1`) after a unit strain jump, for `h/τ` from
 //!   `1e-2` to `1e4`, with the rod's own integrators, held at constant temperature or held while cooling, against
@@ -17,9 +17,14 @@
 //! * **coarse** — the elastic 45° bend and roll-up on coarse and fine meshes, by load steps and by arc length
 //!   (issue 18): where load steps fail, whether the coarse model's own path has a limit point there (the largest
 //!   load factor before it falls), and how far its end state is from the fine model's.
+//! * **contact** ([`contact`]) — one crown of the straight stent crimped by a rigid cylinder, held and released
+//!   (issue 33), at several time steps and contact penalties: points entering contact while the crimper closes
+//!   and leaving it while it opens; failed attempts and the smallest step in each phase.
 //!
-//! The last four are [`scenarios`] run through [`newton::newton_run`], which records what the solver did.
+//! bend45, heating, release and coarse are [`scenarios`] run through [`newton::newton_run`], which records what
+//! the solver did; contact is built in code ([`contact::crimped_crown`]) and run the same way.
 
+pub mod contact;
 pub mod material;
 pub mod newton;
 pub mod scenarios;
@@ -64,10 +69,12 @@ pub struct StabilityStudy {
     pub release: Vec<scenarios::ReleaseCase>,
     /// `(design, p, n)` of the coarse-model map.
     pub coarse: Vec<(scenarios::CoarseDesign, usize, usize)>,
+    /// The runs of the crimped crown.
+    pub contact: Vec<contact::ContactCase>,
 }
 
 impl Default for StabilityStudy {
-    /// The default maps (about a minute on one core).
+    /// The default maps (about a minute on one core, and a minute and a half more for the contact map).
     fn default() -> Self {
         Self {
             ratios: (-4..=8).map(|k| 10f64.powf(k as Real / 2.0)).collect(),
@@ -123,6 +130,21 @@ impl Default for StabilityStudy {
                     (Rollup, 6, 30),
                 ]
             },
+            // The stiff penalty at the shortest step is left out: it crawls through the opening at 2.4e-5 s
+            // steps for minutes before it fails, which the longer steps show in under a second.
+            contact: [
+                (0.1, 0.1),
+                (0.1, 1.0),
+                (0.1, 10.0),
+                (0.05, 0.1),
+                (0.05, 1.0),
+                (0.05, 10.0),
+                (0.025, 0.1),
+                (0.025, 1.0),
+            ]
+            .into_iter()
+            .map(|(h, penalty)| contact::ContactCase { h, penalty })
+            .collect(),
         }
     }
 }
@@ -132,10 +154,10 @@ impl Default for StabilityStudy {
 /// `study` sits below `design`.
 pub type ReadDesign = dyn Fn(&str, &Path) -> Result<Box<dyn VariedDesign>, StudyError>;
 
-/// Runs every map of `study` whose list is not empty, in the order material, bend45, heating, release, coarse. Each
-/// finished map is handed to `done` (which writes it), so the maps finished before a failure are kept; the text
-/// of `stability.md` (a title and every map's paragraph) is returned. `read` reads the embedded designs the maps
-/// vary; `progress` is told about each run.
+/// Runs every map of `study` whose list is not empty, in the order material, bend45, heating, release, coarse,
+/// contact. Each finished map is handed to `done` (which writes it), so the maps finished before a failure are
+/// kept; the text of `stability.md` (a title and every map's paragraph) is returned. `read` reads the embedded
+/// designs the maps vary; `progress` is told about each run.
 ///
 /// # Errors
 /// The first error of a map (an out-of-range setting, a refused design) or of `done`.
@@ -181,6 +203,12 @@ pub fn stability<E: From<StudyError>>(
     if !study.coarse.is_empty() {
         let map = scenarios::coarse_map(&study.coarse, read, &mut progress)?;
         let report = scenarios::coarse_report(&map);
+        done(&report)?;
+        summary.push_str(&report.summary);
+    }
+    if !study.contact.is_empty() {
+        let map = contact::contact_map(&study.contact, &mut progress)?;
+        let report = contact::contact_report(&map);
         done(&report)?;
         summary.push_str(&report.summary);
     }

@@ -5,6 +5,7 @@
 use crate::math::Real;
 use crate::model::Model;
 use crate::post::chart::{LineChart, Scale, Series};
+use crate::solver::simulation::NoObserver;
 use crate::solver::{NewtonReport, Observer, Simulation, SolverError, StepReport};
 use std::fmt::Write as _;
 use std::ops::ControlFlow;
@@ -98,17 +99,26 @@ pub struct SolverMap {
 /// # Errors
 /// The solver's when the model cannot be discretised or analysed (before any step).
 pub fn newton_run(model: &Model) -> Result<NewtonRun, SolverError> {
+    newton_run_with(model, &mut NoObserver)
+}
+
+/// [`newton_run`], with `also` told of every step too (what a map records beyond Newton's counts).
+///
+/// # Errors
+/// The solver's when the model cannot be discretised or analysed (before any step).
+pub fn newton_run_with(model: &Model, also: &mut dyn Observer) -> Result<NewtonRun, SolverError> {
     let started = Instant::now();
     let mut sim = Simulation::new(model)?;
     let mut watch = Watch(NewtonRun {
         smallest_step: Real::INFINITY,
         ..NewtonRun::default()
     });
-    let result = sim.run(&mut [&mut watch]);
+    let result = sim.run(&mut [&mut watch, also]);
     let mut run = watch.0;
     run.wall = started.elapsed().as_secs_f64();
     run.notices = sim.notices().to_vec();
-    run.notices.extend(sim.stabilisation_warnings());
+    // The stabilisation's warnings and the point terms' (contact left above its penetration tolerance).
+    run.notices.extend(sim.warnings());
     run.stabilisation = model.solver().stabilisation.map(|_| *sim.stabilisation());
     run.final_probe = model
         .probes
