@@ -92,6 +92,20 @@ pub struct Patch {
     pub fit_error: Option<Real>,
 }
 
+impl Patch {
+    /// Points of the reference centreline at `8 n + 1` evenly spaced parameters (`n` control points, ends
+    /// included): dense enough to follow every bend of the spline, for checks of the whole wire against a
+    /// surface (an obstacle the wires start through, a crimper's reach).
+    pub fn dense_points(&self) -> impl Iterator<Item = Vec3> + '_ {
+        let samples = 8 * self.curve.num_points();
+        let (lo, hi) = self.curve.knots().domain();
+        (0..=samples).map(move |i| {
+            self.curve
+                .point(lo + (hi - lo) * i as Real / samples as Real)
+        })
+    }
+}
+
 /// Which end of a patch.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, serde::Serialize)]
 pub enum End {

@@ -594,8 +594,7 @@ pub fn programme(
 }
 
 /// The crimper of a crimp programme ([`crate::model::ProgrammeKind::Crimp`]): a rigid cylinder around the stent's
-/// straight axis whose radius starts 2 % clear of the device's outermost wire (the patches sampled at eight
-/// points per control point), holds there until the ramp starts, closes linearly over the ramp until the wires'
+/// straight axis whose radius starts 2 % clear of the device's outermost wire ([`Patch::dense_points`]), holds there until the ramp starts, closes linearly over the ramp until the wires'
 /// reach is `R − Δr` (`R` the largest crown radius; its radius `R − Δr + d/2`, `d` the thickest wire), holds
 /// until the release and opens back over `open`. A crimper is a straight cylinder: a stent on a curved
 /// centreline is refused.
@@ -633,12 +632,7 @@ pub fn crimper(
     for patch in patches {
         let r = 0.5 * sections[patch.section].diameter();
         wire = wire.max(r);
-        let samples = 8 * patch.curve.num_points();
-        let (lo, hi) = patch.curve.knots().domain();
-        for i in 0..=samples {
-            let x = patch
-                .curve
-                .point(lo + (hi - lo) * i as Real / samples as Real);
+        for x in patch.dense_points() {
             reach = reach.max(off_axis(&x) + r);
         }
     }

@@ -234,12 +234,7 @@ pub(crate) fn contact(contact: &crate::model::Contact, model: &crate::model::Mod
         // in place later is checked by the solver when it is: `crate::solver::terms::contact`).
         for patch in model.patches.iter().filter(|_| obstacle.is_active(0.0)) {
             let r = 0.5 * model.sections[patch.section].diameter();
-            let samples = 8 * patch.curve.num_points();
-            let (lo, hi) = patch.curve.knots().domain();
-            for i in 0..=samples {
-                let x = patch
-                    .curve
-                    .point(lo + (hi - lo) * i as Real / samples as Real);
+            for x in patch.dense_points() {
                 let Some(d) = obstacle.surface.distance(&x, 0.0) else {
                     continue;
                 };
