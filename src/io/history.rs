@@ -25,7 +25,7 @@
 //! (the largest fibre stretch `λ − 1` over the collocation points),
 //! `surface_strain_patch` (the patch's name) and `surface_strain_s` (the reference arc length from the patch's
 //! start, length unit).
-//! With contact (`model.contact`), the contact columns of each obstacle follow ([`super::contact`]: the total
+//! With contact (`model.contact`), the contact columns of each obstacle follow (`crate::io::contact`: the total
 //! force, its radial part for a cylinder, the points in contact, the largest penetration, the friction work).
 //! Rows are flushed as they are written, so an interrupted run leaves a valid file up to its last step; a row
 //! that cannot be written whole (a full disk) is cut off again, so the file always ends with a complete row.

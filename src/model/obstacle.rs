@@ -280,7 +280,7 @@ impl Lumen {
     /// The first guess is `hint`, the point's closest parameter at the last converged step (the contact term
     /// keeps one per point), from which Newton's method takes a few iterations as the point moves little per
     /// step; without one, or where Newton does not settle from it, a linear scan of the centreline's samples
-    /// ([`SEARCH_SAMPLES`] per knot span). A sorted scan, not a k-d tree: a vessel's fitted centreline has a few
+    /// (`SEARCH_SAMPLES` = 8 per knot span). A sorted scan, not a k-d tree: a vessel's fitted centreline has a few
     /// tens of spans, so the scan is a few hundred points, paid only at a point's first contact check and at
     /// the checks between collocation points once per step; a tree would save little and add a dependency.
     /// A hint can lead to a local, not global, closest point where a vessel folds back within one step's
