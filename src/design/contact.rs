@@ -20,12 +20,14 @@
 //! ```
 //!
 //! A name of our own for each surface, because the words a designer uses (crimper, sheath, vessel, plate) are
-//! roles, not shapes: the shape is the key (`cylinder`, `plane`), the role is the name, which the outputs use.
+//! roles, not shapes: the shape is the key (`cylinder`, `plane`, `lumen`), the role is the name, which the outputs use.
 //!
 //! **Defaults** (stentkit's choice, stated in `contact`'s schema): the penalty is the design material's
 //! instantaneous modulus `E_inf + Σ E_α` — a line force per unit wire length per unit penetration has the
-//! units of a modulus, and this one makes the penalty's compliance comparable to the wire's own radial
-//! compliance, so Newton sees no new stiffness scale; the tolerance on penetration is 1 % of the wire
+//! units of a modulus, and the instantaneous one is the stiffest the material gets, so the penalty alone keeps
+//! a penetration below `q / E0` for a line force `q` (the augmented-Lagrange updates remove the rest); a
+//! softer penalty converges in fewer Newton iterations where many points touch (the contact map of `stentkit
+//! study stability`), and a design may give one; the tolerance on penetration is 1 % of the wire
 //! diameter (what a drawing of the wire cannot show); the law's transition band is a tenth of the tolerance;
 //! at most 10 augmented-Lagrange updates per step. A `programme` of `kind: crimp` adds its crimper after the
 //! design's obstacles.
