@@ -23,16 +23,6 @@ use crate::model::builder::*;
 use crate::model::temperature::FieldError;
 use crate::model::*;
 
-/// A design function of time as a model's, its table's errors at `path`.
-pub(crate) fn time_function(f: &TimeFn, path: &str) -> Result<TimeFunction> {
-    match f {
-        TimeFn::Constant(v) => Ok(TimeFunction::constant(*v)),
-        TimeFn::Table(points) => {
-            TimeFunction::try_table(points.clone()).map_err(|e| issue(path, e.to_string()))
-        }
-    }
-}
-
 /// A design built and validated by [`build`].
 #[derive(Debug, Clone)]
 pub(crate) struct Built {

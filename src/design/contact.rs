@@ -137,7 +137,7 @@ fn obstacle(
     diameter: Real,
     vessel: Option<&Vessel>,
 ) -> Result<Obstacle> {
-    let time_function = |f, key: &str| super::build::time_function(f, &format!("{base}.{key}"));
+    let time_function = |f, key: &str| super::dto::time_function(f, &format!("{base}.{key}"));
     let surface = match (&o.cylinder, &o.plane, &o.lumen) {
         (None, None, Some(l)) => {
             let lumen = lumen(vessel, &format!("{base}.lumen"))?;

@@ -1343,3 +1343,15 @@ pub struct TemporaryDto {
     #[serde(default)]
     pub align: Option<bool>,
 }
+
+/// A design function of time as a model's, its table's errors at `path`.
+pub(crate) fn time_function(
+    f: &TimeFn,
+    path: &str,
+) -> super::issue::Result<crate::model::TimeFunction> {
+    match f {
+        TimeFn::Constant(v) => Ok(crate::model::TimeFunction::constant(*v)),
+        TimeFn::Table(points) => crate::model::TimeFunction::try_table(points.clone())
+            .map_err(|e| super::issue::issue(path, e.to_string())),
+    }
+}
