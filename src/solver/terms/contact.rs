@@ -930,12 +930,7 @@ mod tests {
     #[test]
     fn a_ring_crimped_by_a_rigid_cylinder_is_uniformly_pressed_to_its_radius() {
         let r = D / 2.0;
-        let settings = ContactSettings {
-            penalty: 1e3,
-            regularisation: 1e-4,
-            tolerance: 1e-6,
-            max_updates: 10,
-        };
+        let settings = RING;
         let crimped = R0 + r - 0.5;
         let (radii, hoop, warnings) = crimp(cylinder(R0 + r + 0.2, crimped, Wall::Rigid), settings);
         assert!(warnings.is_empty(), "{warnings:?}");
@@ -966,10 +961,8 @@ mod tests {
     fn a_crimp_left_above_its_penetration_tolerance_is_warned_about() {
         let r = D / 2.0;
         let settings = ContactSettings {
-            penalty: 1e3,
-            regularisation: 1e-4,
-            tolerance: 1e-6,
             max_updates: 0,
+            ..RING
         };
         let (_, _, warnings) = crimp(cylinder(R0 + r + 0.2, R0 + r - 0.5, Wall::Rigid), settings);
         assert_eq!(warnings.len(), 1, "{warnings:?}");
@@ -998,12 +991,7 @@ mod tests {
     fn a_ring_in_a_compliant_tube_balances_as_two_springs_in_series() {
         let r = D / 2.0;
         let (modulus, thickness, width) = (100.0, 1.0, 2.0);
-        let settings = ContactSettings {
-            penalty: 1e3,
-            regularisation: 1e-4,
-            tolerance: 1e-6,
-            max_updates: 10,
-        };
+        let settings = RING;
         let wall = Wall::Compliant {
             modulus,
             thickness,
@@ -1294,10 +1282,8 @@ mod tests {
             Wall::Rigid,
         );
         let settings = ContactSettings {
-            penalty: 1e3,
-            regularisation: 1e-4,
             tolerance: 1e-3,
-            max_updates: 10,
+            ..RING
         };
         b.contact(Contact {
             obstacles: vec![plate.clone()],
@@ -1365,8 +1351,8 @@ mod tests {
         )
     }
 
-    /// The ring tests' contact settings.
-    const RING: ContactSettings = ContactSettings {
+    /// The ring tests' contact settings (penalty 1e3, transition 1e-4, penetration tolerance 1e-6, 10 updates).
+    pub(crate) const RING: ContactSettings = ContactSettings {
         penalty: 1e3,
         regularisation: 1e-4,
         tolerance: 1e-6,

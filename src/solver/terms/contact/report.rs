@@ -150,21 +150,14 @@ fn largest_penetration(gaps: &[Real]) -> Real {
 
 #[cfg(test)]
 pub(crate) mod tests {
+    pub(crate) use super::super::tests::RING as SETTINGS;
     use super::super::tests::{D, E, R0, cylinder, quarter_ring};
     use crate::math::{Real, Vec3};
-    use crate::model::{Contact, ContactSettings, Model, Wall};
+    use crate::model::{Contact, Model, Wall};
     use crate::solver::Simulation;
     use crate::solver::discretisation::point_position;
     use crate::solver::simulation::NoObserver;
     use std::f64::consts::{FRAC_PI_2, PI};
-
-    /// The contact settings of the crimps here: penalty 1e3, transition 1e-4, penetration tolerance 1e-6.
-    pub(crate) const SETTINGS: ContactSettings = ContactSettings {
-        penalty: 1e3,
-        regularisation: 1e-4,
-        tolerance: 1e-6,
-        max_updates: 10,
-    };
 
     /// The radius the crimper reaches at t = 1, from 0.2 clear of the wires at t = 0: 0.5 into them.
     pub(crate) const CRIMPED: Real = R0 + D / 2.0 - 0.5;
