@@ -335,19 +335,24 @@ impl Lumen {
         if r.dot(&axis) * outward < 0.0 {
             return None;
         }
-        let perp = r - axis * axis.dot(&r);
-        let rho = perp.norm();
-        let radius = self.radius(u).0 * self.scale.value(t);
-        if rho <= Real::EPSILON * radius {
-            return None;
-        }
-        let e = perp / rho;
-        Some(Distance {
-            value: radius - rho,
-            normal: -e,
-            hessian: -(Mat3::identity() - axis * axis.transpose() - e * e.transpose()) / rho,
-        })
+        cylinder_distance(&r, &axis, self.radius(u).0 * self.scale.value(t))
     }
+}
+
+/// The distance from the inside of a cylinder of `radius` around the line along the unit `axis` through the
+/// point from which `d` is measured ([`Surface::distance`]); `None` on the axis.
+fn cylinder_distance(d: &Vec3, axis: &Vec3, radius: Real) -> Option<Distance> {
+    let perp = d - axis * axis.dot(d);
+    let rho = perp.norm();
+    if rho <= Real::EPSILON * radius.abs().max(1.0) {
+        return None;
+    }
+    let e = perp / rho;
+    Some(Distance {
+        value: radius - rho,
+        normal: -e,
+        hessian: -(Mat3::identity() - axis * axis.transpose() - e * e.transpose()) / rho,
+    })
 }
 
 /// The signed distance of a point from a surface (positive on the rods' side), with its gradient (the unit
@@ -376,22 +381,7 @@ impl Surface {
                 point,
                 axis,
                 radius,
-            } => {
-                let d = x - point;
-                let perp = d - axis * axis.dot(&d);
-                let rho = perp.norm();
-                let r = radius.value(t);
-                if rho <= Real::EPSILON * r.abs().max(1.0) {
-                    return None;
-                }
-                let e = perp / rho;
-                let projector = Mat3::identity() - axis * axis.transpose() - e * e.transpose();
-                Some(Distance {
-                    value: r - rho,
-                    normal: -e,
-                    hessian: -projector / rho,
-                })
-            }
+            } => cylinder_distance(&(x - point), axis, radius.value(t)),
             Surface::Plane {
                 point,
                 normal,
