@@ -8,7 +8,7 @@
 use super::builder::checks::{FIT_WARNING_FRACTION, check_discretisation};
 use super::builder::field::{BuildError, Field, ProgrammeField, Result, StentField};
 use super::{
-    Component, DrivenNode, End, Node, NodeConditions, Obstacle, Patch, PatchEnd, Programme,
+    Component, DrivenNode, End, Lumen, Node, NodeConditions, Obstacle, Patch, PatchEnd, Programme,
     ProgrammeKind, TimeFunction,
 };
 use crate::geometry::GeometryError;
@@ -593,11 +593,13 @@ pub fn programme(
     Ok(programme)
 }
 
-/// The crimper of a crimp programme ([`crate::model::ProgrammeKind::Crimp`]): a rigid cylinder around the stent's
-/// straight axis whose radius starts 2 % clear of the device's outermost wire ([`Patch::dense_points`]), holds there until the ramp starts, closes linearly over the ramp until the wires'
-/// reach is `R − Δr` (`R` the largest crown radius; its radius `R − Δr + d/2`, `d` the thickest wire), holds
-/// until the release and opens back over `open`. A crimper is a straight cylinder: a stent on a curved
-/// centreline is refused.
+/// The crimper of a crimp programme ([`crate::model::ProgrammeKind::Crimp`]): a rigid tube around the stent's
+/// axis whose radius starts 2 % clear of the device's outermost wire ([`Patch::dense_points`]), holds there
+/// until the ramp starts, closes linearly over the ramp until the wires' reach is `R − Δr` (`R` the largest
+/// crown radius; its radius `R − Δr + d/2`, `d` the thickest wire), holds until the release and opens back
+/// over `open`. Around a straight axis it is a cylinder; around a curved one, the tube of that radius around
+/// the permanent centreline between the first and the last crown ([`crimper_tube`]), continued straight
+/// beyond (a curved crimping tube, or a mandrel-guided crimp: the device is compacted onto its own axis).
 pub fn crimper(
     programme: &Programme,
     stent: &GeneratedStent,
@@ -618,22 +620,27 @@ pub fn crimper(
         let d = x - point;
         (d - axis * axis.dot(&d)).norm()
     };
-    if nodes.iter().any(|n| {
-        n.axis_tangent.normalize().cross(&axis).norm() > 1e-9
-            || off_axis(&n.axis_point) > 1e-9 * scale
-    }) {
-        return Err(BuildError::new(
-            at(),
-            "a crimper is a straight cylinder: `kind: crimp` needs a stent on a straight centreline",
-        ));
-    }
+    let straight = nodes.iter().all(|n| {
+        n.axis_tangent.normalize().cross(&axis).norm() <= 1e-9
+            && off_axis(&n.axis_point) <= 1e-9 * scale
+    });
+    // The curved crimper is a tube of radius 1 scaled by the radius schedule.
+    let tube = if straight {
+        None
+    } else {
+        Some(crimper_tube(stent).map_err(|e| BuildError::new(at(), e))?)
+    };
+    let distance_from_axis = |x: &Vec3| match &tube {
+        None => off_axis(x),
+        Some(t) => t.distance(x, None, 0.0).map_or(0.0, |d| 1.0 - d.value),
+    };
     let mut reach: Real = 0.0;
     let mut wire: Real = 0.0;
     for patch in patches {
         let r = 0.5 * sections[patch.section].diameter();
         wire = wire.max(r);
         for x in patch.dense_points() {
-            reach = reach.max(off_axis(&x) + r);
+            reach = reach.max(distance_from_axis(&x) + r);
         }
     }
     let start = 1.02 * reach;
@@ -650,13 +657,44 @@ pub fn crimper(
     table.dedup_by(|b, a| a.0 == b.0 && a.1 == b.1);
     let radius = TimeFunction::try_table(table)
         .map_err(|e| BuildError::new(Field::Programme(ProgrammeField::Release), e.to_string()))?;
-    Ok(Obstacle::new(
-        "crimper",
-        crate::model::Surface::Cylinder {
+    let surface = match tube {
+        None => crate::model::Surface::Cylinder {
             point,
             axis,
             radius,
         },
-        crate::model::Wall::Rigid,
-    ))
+        Some(tube) => crate::model::Surface::Lumen(tube.with_scale(radius)),
+    };
+    Ok(Obstacle::new("crimper", surface, crate::model::Wall::Rigid))
+}
+
+/// Samples of the axis per largest crown radius of its length, for the curved crimper's centreline.
+const TUBE_SAMPLES_PER_RADIUS: Real = 8.0;
+
+/// The tube of radius 1 around the permanent axis of a curved stent, from its first crown's station to its
+/// last (a crown's radius either side of a single one): the axis sampled at [`TUBE_SAMPLES_PER_RADIUS`] points
+/// per largest crown radius (at least 17) and fitted by the fewest-control-point cubic within 1e-5 of that
+/// radius (`crate::geometry::fit::smooth_points`).
+fn crimper_tube(stent: &GeneratedStent) -> std::result::Result<Lumen, String> {
+    let stations = &stent.geometry.stations;
+    let radius = stent.family.radius_range().1;
+    let (mut a, mut b) = (
+        stations.iter().copied().fold(Real::INFINITY, Real::min),
+        stations.iter().copied().fold(Real::NEG_INFINITY, Real::max),
+    );
+    if !(b > a) {
+        (a, b) = (a - radius, b + radius);
+    }
+    let n = ((TUBE_SAMPLES_PER_RADIUS * (b - a) / radius).ceil() as usize).max(16);
+    let s: Vec<Real> = (0..=n)
+        .map(|i| a + (b - a) * i as Real / n as Real)
+        .collect();
+    let points = stent
+        .family
+        .axis_points(&s)
+        .map_err(|e| format!("the crimper's axis: {e}"))?;
+    let fit = crate::geometry::fit::smooth_points(&points, 1e-5 * radius)
+        .map_err(|e| format!("the crimper's axis could not be fitted: {e}"))?;
+    let lo = fit.curve.knots().domain().0;
+    Lumen::try_new(fit.curve, vec![(lo, 1.0)])
 }

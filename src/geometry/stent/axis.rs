@@ -190,6 +190,12 @@ impl Axis {
     }
 }
 
+/// The points of the centreline `spec` at the arc lengths `s` ([`super::StentFamily::axis_points`]).
+pub(super) fn points(spec: &CentrelineSpec, s: &[Real]) -> Result<Vec<Vec3>, GeometryError> {
+    let axis = Axis::new(spec)?;
+    Ok(s.iter().map(|&s| axis.frame(s).0).collect())
+}
+
 impl StentSpec {
     /// Crown stations on `axis`.
     pub(super) fn stations(&self, axis: &Axis) -> Result<Vec<Real>, GeometryError> {

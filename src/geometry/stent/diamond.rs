@@ -335,6 +335,10 @@ impl StentFamily for DiamondSpec {
         (self.radius, self.radius)
     }
 
+    fn axis_points(&self, s: &[Real]) -> Result<Vec<Vec3>, GeometryError> {
+        super::axis::points(&self.centreline, s)
+    }
+
     fn crowns(&self) -> usize {
         self.rings
     }

@@ -66,6 +66,13 @@ pub trait StentFamily: std::fmt::Debug + Send + Sync {
     /// The smallest and largest crown radius \[length\].
     fn radius_range(&self) -> (Real, Real);
 
+    /// The points of the device's axis (its permanent centreline) at the arc lengths `s` (a bounded
+    /// centreline continues straight beyond its ends): what a crimper around a curved device follows.
+    ///
+    /// # Errors
+    /// [`GeometryError::InvalidStent`] for an invalid centreline.
+    fn axis_points(&self, s: &[Real]) -> Result<Vec<Vec3>, GeometryError>;
+
     /// The number of crowns (rings), which a design's per-crown materials count.
     fn crowns(&self) -> usize;
 
@@ -110,6 +117,10 @@ impl StentFamily for StentSpec {
 
     fn radius_range(&self) -> (Real, Real) {
         StentSpec::radius_range(self)
+    }
+
+    fn axis_points(&self, s: &[Real]) -> Result<Vec<Vec3>, GeometryError> {
+        super::axis::points(&self.centreline, s)
     }
 
     fn crowns(&self) -> usize {
