@@ -5,9 +5,9 @@
 //!
 //! **Columns** (after every other column, per obstacle `<name>` in the model's order; the file's convention for
 //! a quantity per part, as `recovery_ratio_mean@<material>`): `contact_force_x@<name>`, `contact_force_y@<name>`,
-//! `contact_force_z@<name>` (the total force the obstacle exerts on the rods [force]), for a cylinder
-//! `contact_radial_force@<name>` (its inward radial part: positive when the wires press on the cylinder
-//! [force]), `contact_points@<name>` (collocation points with a positive pressure), `contact_penetration@<name>`
+//! `contact_force_z@<name>` (the total force the obstacle exerts on the rods [force]), for a cylinder and a
+//! lumen `contact_radial_force@<name>` (its radial part, the sum of the pressures' magnitudes: positive when
+//! the wires press on the wall [force]), `contact_points@<name>` (collocation points with a positive pressure), `contact_penetration@<name>`
 //! (the largest penetration [length]) and `contact_friction_work@<name>` ([force·length]; 0 until friction
 //! exists). Of the model as simulated: a symmetry-reduced model's share.
 
@@ -45,7 +45,7 @@ pub(crate) fn header(model: &Model) -> String {
         for quantity in ["force_x", "force_y", "force_z"] {
             header.push_str(&format!(",contact_{quantity}@{name}"));
         }
-        if matches!(o.surface, Surface::Cylinder { .. }) {
+        if matches!(o.surface, Surface::Cylinder { .. } | Surface::Lumen(_)) {
             header.push_str(&format!(",contact_radial_force@{name}"));
         }
         for quantity in ["points", "penetration", "friction_work"] {
@@ -98,7 +98,7 @@ pub struct ObstaclePeaks {
     /// The largest magnitude of the total contact force \[force\].
     #[serde(skip_serializing_if = "Option::is_none")]
     pub peak_force: Option<Peak>,
-    /// For a cylinder, the largest radial force (positive: the wires press on it) \[force\].
+    /// For a cylinder and a lumen, the largest radial force (positive: the wires press on it) \[force\].
     #[serde(skip_serializing_if = "Option::is_none")]
     pub peak_radial_force: Option<Peak>,
     /// The largest penetration \[length\].
@@ -194,7 +194,7 @@ pub(crate) struct ContactSample {
 pub(crate) struct ObstacleSample {
     /// Magnitude of the total contact force \[force\].
     pub force: Real,
-    /// A cylinder's radial force \[force\].
+    /// A cylinder's or a lumen's radial force \[force\].
     pub radial_force: Option<Real>,
     /// A cylinder's diameter `2R(t)` at the state \[length\].
     pub diameter: Option<Real>,

@@ -3,6 +3,7 @@
 //! about for not recovering, and the largest node displacement. Computation only: `io` records these, `study`
 //! and `sweep` judge by them.
 
+use crate::math::quote::quoted;
 use crate::math::{Real, Vec3};
 use crate::model::ProbeLocation;
 use crate::solver::Simulation;
@@ -99,7 +100,24 @@ pub fn recovery_warning(sim: &Simulation<'_>) -> Option<String> {
         ""
     };
     let damped = sim.stabilisation().damped_steps;
-    let cause = if damped > 0 {
+    // Obstacles that press on the device at the end (a vessel it opened against) hold it short of its
+    // permanent shape: that is the result, not a failure to recover.
+    let held: Vec<String> = match (sim.contact(), &model.contact) {
+        (Some(report), Some(contact)) => report
+            .obstacles
+            .iter()
+            .zip(&contact.obstacles)
+            .filter(|(r, _)| r.points > 0)
+            .map(|(r, o)| format!("{} at {} points", quoted(&o.name), r.points))
+            .collect(),
+        _ => Vec::new(),
+    };
+    let cause = if !held.is_empty() {
+        format!(
+            "obstacles press on it at the end ({}): a device held by a wall stops short of its permanent shape, and this is its recovery as they hold it (history.csv's contact columns give their forces)",
+            held.join(", ")
+        )
+    } else if damped > 0 {
         format!(
             "this run was damped in {damped} steps (`solver.stabilisation`), and damping can hold a device away from equilibrium: see the stabilisation's numbers in summary.json and the final snapshot"
         )
