@@ -96,7 +96,9 @@ pub(crate) fn build(dto: &DesignDto, default_name: &str, temporary_shape: bool) 
     if let Some(p) = &dto.programme {
         builder.programme(stent::programme(p, metres_per_unit)?);
     }
-    if let Some(c) = super::contact::contact(dto, section.diameter(), vessel.as_ref())? {
+    let contact = super::contact::contact(dto, &section, vessel.as_ref())?;
+    let has_contact = contact.is_some();
+    if let Some(c) = contact {
         builder.contact(c);
     }
     if temporary_shape {
@@ -134,7 +136,7 @@ pub(crate) fn build(dto: &DesignDto, default_name: &str, temporary_shape: bool) 
     if let Some(f) = &dto.temperature_field {
         builder.temperature_field(temperature_field(f)?);
     }
-    builder.solver(solver_settings(dto.solver.as_ref()));
+    builder.solver(solver_settings(dto.solver.as_ref(), has_contact));
     for (k, p) in dto.output.iter().flat_map(|o| o.probes.iter()).enumerate() {
         let base = format!("output.probes[{k}]");
         let at = match (&p.node, &p.patch, &p.u) {
@@ -857,8 +859,14 @@ fn time_spec(t: &TimeDto) -> Result<TimeSpec> {
     })
 }
 
-fn solver_settings(s: Option<&SolverDto>) -> SolverSettings {
-    let mut out = SolverSettings::default();
+/// The design's solver settings over the defaults (those of a model with contact when `contact`,
+/// [`SolverSettings::for_contact`]).
+fn solver_settings(s: Option<&SolverDto>, contact: bool) -> SolverSettings {
+    let mut out = if contact {
+        SolverSettings::for_contact()
+    } else {
+        SolverSettings::default()
+    };
     if let Some(s) = s {
         if let Some(Positive(t)) = s.tolerance {
             out.tolerance = t;

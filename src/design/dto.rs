@@ -406,8 +406,8 @@ pub struct WallDto {
 #[derive(Debug, Clone, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct ContactDto {
-    /// Penalty \[force/length²\]: line force per unit wire length per unit penetration (default: the design
-    /// material's instantaneous modulus `E_inf + Σ E_α`).
+    /// Penalty \[force/length²\]: line force per unit wire length per unit penetration (default: `E_inf I / d⁴`,
+    /// the wire's bending stiffness at the scale of its diameter with the relaxed modulus).
     #[serde(default)]
     pub penalty: Option<Positive>,
     /// Width of the law's quadratic transition \[length\] (default: a tenth of `tolerance`).

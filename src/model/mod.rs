@@ -463,6 +463,7 @@ pub struct SolverSettings {
     /// last step's increment scaled by the step-size ratio), except right after a schedule breakpoint. Off by
     /// default: on the straight stent it saves factorisations (738 → 414) but costs iterations (4187 → 4675) and
     /// moves Δr after the release by 4e-5 mm, 40 times further from a tight Newton reference than without it.
+    /// On by default in a model with contact ([`SolverSettings::for_contact`]).
     pub extrapolate: bool,
     /// The linear solver.
     pub linear: LinearMethod,
@@ -488,6 +489,23 @@ impl Default for SolverSettings {
             linear: LinearMethod::Block,
             path: PathControl::Time,
             stabilisation: None,
+        }
+    }
+}
+
+impl SolverSettings {
+    /// The defaults of a model with contact: [`SolverSettings::default`] with `extrapolate` on. An obstacle
+    /// that moves (a crimper closing or opening) moves its contact points in every step; started from the last
+    /// converged state, Newton's first iterate has them a whole step's travel through the surface (or clear of
+    /// it), the law's force there is far from the answer and the first increments overshoot. Extrapolated, the
+    /// points start near where the surface will hold them. Measured on `designs/straight_stent_crimped.yaml`
+    /// (1301 steps of 2.5 ms, penalty 4 N/mm²): from the last state, 4587 Newton iterations and 3436
+    /// factorisations, each step's closing iterations first raising the residual (3.4e-3 → 1e-2); extrapolated,
+    /// 4084 iterations and 238 factorisations, 2.8× less wall time.
+    pub fn for_contact() -> Self {
+        Self {
+            extrapolate: true,
+            ..Self::default()
         }
     }
 }

@@ -404,6 +404,29 @@ impl Surface {
         }
     }
 
+    /// The value alone of [`Surface::distance_near`] (no normal, no Hessian: what the checks of a gap need);
+    /// `None` where that is `None`.
+    pub fn distance_value(&self, x: &Vec3, t: Real, hint: Option<Real>) -> Option<Real> {
+        match self {
+            Surface::Cylinder {
+                point,
+                axis,
+                radius,
+            } => {
+                let d = x - point;
+                let rho = (d - axis * axis.dot(&d)).norm();
+                let r = radius.value(t);
+                (rho > Real::EPSILON * r.abs().max(1.0)).then_some(r - rho)
+            }
+            Surface::Plane {
+                point,
+                normal,
+                offset,
+            } => Some(normal.dot(&(x - point)) - offset.value(t)),
+            Surface::Lumen(lumen) => lumen.distance(x, hint, t).map(|d| d.value),
+        }
+    }
+
     /// A lumen's closest parameter to `x` ([`Lumen::closest`]); `None` for the other surfaces.
     pub fn parameter(&self, x: &Vec3, hint: Option<Real>) -> Option<Real> {
         match self {

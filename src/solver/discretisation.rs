@@ -205,3 +205,18 @@ pub(crate) fn point_position(disc: &Discretisation, control: &[Vec3], g: usize) 
         .map(|(a, b)| control[point.first + a] * b[0])
         .sum()
 }
+
+/// The change `Σ N_j δp_j` of the position at collocation point `g` under the increment `delta` of the solver's
+/// unknowns (six per control point, the translation first).
+pub(crate) fn point_translation(disc: &Discretisation, delta: &[Real], g: usize) -> Vec3 {
+    let point = &disc.points[g];
+    point
+        .basis
+        .iter()
+        .enumerate()
+        .map(|(a, b)| {
+            let j = 6 * (point.first + a);
+            Vec3::new(delta[j], delta[j + 1], delta[j + 2]) * b[0]
+        })
+        .sum()
+}

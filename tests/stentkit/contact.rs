@@ -136,8 +136,10 @@ impl ZRing {
             .flat_map(|end| sim.node_end_resultants(node_index(&self.model, end)))
             .map(|(force, _)| force)
             .sum();
+        // Radial up to what Newton's tolerance (1e-9, normalised) leaves in the end resultants: a few 1e-6 of
+        // these forces of ~5e-7 N (measured 2.3e-6).
         assert!(
-            contact.z.abs() <= 1e-6 * contact.norm(),
+            contact.z.abs() <= 1e-5 * contact.norm(),
             "a frictionless crimper pushes radially: {contact:?}"
         );
         let model = n * contact.norm() / half.cos();

@@ -193,7 +193,7 @@ impl Simulation<'_> {
         }
         materials.refresh_laws(model.materials());
         for term in &mut self.terms {
-            term.prepare(t_np1);
+            term.prepare(&self.disc, &self.solution.state, t_np1);
         }
         SolverTiming::add(&mut self.record.timing.material, start);
         Ok(())

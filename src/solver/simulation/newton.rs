@@ -156,6 +156,7 @@ impl Simulation<'_> {
                 }
             }
             self.record_increment(&mut report)?;
+            let limited = self.limit_step();
             self.solution
                 .state
                 .apply_increment(&self.disc, &self.work.delta);
@@ -172,8 +173,34 @@ impl Simulation<'_> {
                     *a += d;
                 }
             }
-            previous = if fresh_tangent { Real::INFINITY } else { r };
+            // After a limited step the tangent has changed (a contact began): it is assembled afresh.
+            previous = if fresh_tangent || limited {
+                Real::INFINITY
+            } else {
+                r
+            };
+            if limited {
+                report.limited += 1;
+            }
         }
+    }
+
+    /// Scales the Newton increment in `self.work.delta` by the smallest fraction the point terms allow
+    /// ([`crate::solver::terms::PointTerm::step_limit`]: a contact that the tangent does not see yet stops the
+    /// step where it begins to act); whether it was limited. The increment's norm was recorded before: it is
+    /// Newton's measure of the iterate's error, which the limit does not change.
+    fn limit_step(&mut self) -> bool {
+        let alpha = self
+            .terms
+            .iter()
+            .map(|t| t.step_limit(&self.disc, &self.solution.state, &self.work.delta))
+            .fold(1.0, Real::min);
+        if alpha < 1.0 {
+            for d in &mut self.work.delta {
+                *d *= alpha;
+            }
+        }
+        alpha < 1.0
     }
 
     /// Counts the increment in `self.work.delta` as one more iteration of `report` with its normalised norm, or

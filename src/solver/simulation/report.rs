@@ -25,6 +25,9 @@ pub struct NewtonReport {
     /// [`super::ROUND_OFF_TOLERANCE`]) was not met, the residual stopped falling, and the iterate met the stopping rule
     /// at [`super::ROUND_OFF_TOLERANCE`] (see the module docs).
     pub at_round_off: bool,
+    /// Iterations whose increment a point term limited (a contact that began within it,
+    /// [`crate::solver::terms::PointTerm::step_limit`]).
+    pub limited: u32,
 }
 
 /// One converged time step, as reported to observers.

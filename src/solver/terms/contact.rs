@@ -21,14 +21,19 @@
 //! **Tangent.** `∂q/∂c = (dp/dg) n nᵀ + p ∇²g` with `dp/dg = −ε Φ'(λ/ε − g)`; the balance law takes `Rᵀ q`, whose
 //! derivative under the rotation is the assembly's (module docs of [`super`]).
 //!
-//! **Augmented Lagrange (Uzawa).** After a step converged, if the largest penetration at a rigid wall exceeds
-//! the settings' tolerance, every point's multiplier becomes its pressure, `λ ← p(g)`, and the step is solved
-//! again from where it converged ([`PointTerm::augment`]); at most `max_updates` times. If the penetration is
+//! **Augmented Lagrange (Uzawa).** Every step starts with one update: each point's multiplier becomes its
+//! pressure at the converged state the step starts from, `λ ← p(g)` ([`PointTerm::prepare`]). A point in
+//! contact so carries its pressure into the next step (the penalty then only has to answer the change), and a
+//! point that lifts off loses its multiplier within a step or two: a multiplier kept from an earlier contact
+//! would push a point away from `λ/ε` off the wall, far beyond the tolerance with a soft penalty. After a step
+//! converged, if the largest penetration at a rigid wall exceeds the settings' tolerance, every point's
+//! multiplier becomes its pressure again and the step is solved again from where it converged
+//! ([`PointTerm::augment`]); at most `max_updates` times. If the penetration is
 //! still above the tolerance then, the step is kept and the run's warnings say so (how many steps, the largest
 //! penetration, when first: [`PointTerm::warnings`], into summary.json and on stderr). The multipliers, the
 //! step's update count, that record, the friction anchors and work, a lumen's closest-point parameters and
-//! the record of penetration anywhere (below) are the term's state: the multipliers start the next step where
-//! this one left them, a roll-back restores them all, a checkpoint keeps them.
+//! the record of penetration anywhere (below) are the term's state: the multipliers start the next step from
+//! this one's pressures, a roll-back restores them all, a checkpoint keeps them.
 //!
 //! **Friction.** An obstacle with a Coulomb coefficient `μ > 0` ([`crate::model::Obstacle::friction`]) adds a
 //! tangential line force at every point it presses, regularised by a stick stiffness and a return map (the
@@ -84,14 +89,31 @@
 //! when, where) and said in the run's warnings — the law would push it out in one step, which is not a
 //! deployment. (Obstacles in place from the start are checked by the model's builder, located in the design.)
 //!
-//! **Switching in and out.** The normal law is C¹, so Newton sees a continuous tangent as points enter and
-//! leave contact within the transition band `2δ`. The friction force is continuous (stick and slip meet at
-//! `ε_t |s| = μ p`) but its tangent jumps there. Checked on the worst case we know: the crimped ring released
-//! in one step (every point leaves contact, the ring springs back 5 %) and pushed back in the next (every point
-//! enters again): Newton takes them in 3 and 2 iterations, with and without friction, no cut (test
-//! `a_ring_released_and_pushed_back_in_one_step_each_does_not_stall_newton`). So no line search and no
-//! active-set hysteresis are added: the C¹ law is what keeps Newton's tangent continuous, and a step that
-//! still fails is cut by the time stepping as any other.
+//! **Switching in and out.** Three things keep Newton going where points enter and leave contact, each
+//! measured on the contact map of `stentkit study stability` (one crown crimped by a cylinder closing 5 mm
+//! inside it and opening again, 8 cases of time step and penalty) and on `designs/straight_stent_crimped.yaml`:
+//! - **A C¹ law**: the tangent is continuous across the band `2δ` (the friction force is continuous too, its
+//!   tangent jumps between stick and slip).
+//! - **An extrapolated start**: a model with contact starts each step's iteration from the last step's
+//!   increment ([`crate::model::SolverSettings::for_contact`]), so a point that a moving surface carries starts
+//!   near where the surface will hold it rather than a whole step's travel through it.
+//! - **A step limit** ([`PointTerm::step_limit`], applied to every Newton increment): a point the law does not
+//!   act on at the current iterate (no stiffness in the tangent) cannot be stopped by the linear solve, and an
+//!   opening crimper lets a crimped device spring back in one linearised step far through it (the map: a first
+//!   increment of 0.6 of a wire's length, the next iterate meeting a penalty force of the step's whole travel).
+//!   The increment is scaled so that no such point goes beyond the middle of the law's band (`g = λ/ε`, where
+//!   the law's stiffness is half the penalty; the gap along the scaled increment, interpolated linearly), and
+//!   the next iteration assembles a fresh tangent with that point in it. IPC's filtered line search
+//!   (Li et al., *Incremental Potential Contact*, 2020) limits a step to where the first contact begins in the
+//!   same way; a penalty law can let the point into its band, where its stiffness is. The increment's norm
+//!   that the stopping rule reads is Newton's, before the limit; [`crate::solver::NewtonReport::limited`]
+//!   counts the limited iterations.
+//!
+//! On the map, with all three every case converges without a cut (docs/speed.md's table); with the
+//! extrapolated start and without the limit, the penalty 1 N/mm² cuts 8 to 10 times while opening at every
+//! time step and h = 0.05 s with 10 N/mm² fails there; with neither (the map had a ninth case then, 0.025 s at
+//! 10 N/mm²), 6 of the 9 failed and 2 crawled through the opening with 606 and 849 cuts. No active-set
+//! hysteresis is added: with the limit, a point enters the tangent as soon as it enters the band.
 
 pub(crate) mod report;
 
@@ -102,7 +124,7 @@ use crate::math::basis::nurbs_basis;
 use crate::math::quote::quoted;
 use crate::math::{Mat3, Real, Vec3};
 use crate::model::{ContactSettings, Distance, Model, Obstacle, Surface, Wall};
-use crate::solver::discretisation::{Discretisation, point_position};
+use crate::solver::discretisation::{Discretisation, point_position, point_translation};
 use crate::solver::state::State;
 
 /// The C¹ ramp `Φ(x)` of the contact law and its derivative (module docs), with half-width `delta`.
@@ -217,6 +239,10 @@ pub struct SurfaceContact {
     between: Between,
     /// Obstacles put in place (after the start) through the wires: how many, and the deepest.
     placed: Placed,
+    /// Each point's pressure `(obstacle, point, p)` at the last committed state, which the next step's Uzawa
+    /// update takes ([`PointTerm::prepare`]); `None` before the first commit and after a checkpoint's state was
+    /// restored (found again from the state then). Not state: a roll-back returns to the committed state.
+    committed: Option<Vec<(usize, usize, Real)>>,
 }
 
 /// Obstacles put in place through the wires (module docs): how many, and where the deepest went in.
@@ -339,6 +365,7 @@ impl SurfaceContact {
             samples: samples(model, disc),
             between: Between::default(),
             placed: Placed::default(),
+            committed: None,
         }
     }
 
@@ -418,8 +445,8 @@ impl SurfaceContact {
             let gap = |x: &Vec3, patch: usize| {
                 obstacle
                     .surface
-                    .distance(x, self.time)
-                    .map(|d| d.value - self.radius[patch])
+                    .distance_value(x, self.time, None)
+                    .map(|d| d - self.radius[patch])
             };
             for (g, point) in disc.points.iter().enumerate() {
                 if disc.is_end(g) {
@@ -472,7 +499,7 @@ impl SurfaceContact {
         if !obstacle.is_active(self.time) {
             return None;
         }
-        let hint = self.hints[k].get(g).copied().filter(|u| !u.is_nan());
+        let hint = self.hint(k, g);
         let distance = obstacle.surface.distance_near(x, self.time, hint)?;
         let gap = distance.value - self.radius[patch];
         let (penalty, multiplier) = self.law(k, g);
@@ -511,6 +538,33 @@ impl SurfaceContact {
             }
         }
         (worst, pressures)
+    }
+
+    /// A lumen's closest-point parameter of point `g` at the last converged step (obstacle `k`), if it has one.
+    fn hint(&self, k: usize, g: usize) -> Option<Real> {
+        self.hints[k].get(g).copied().filter(|u| !u.is_nan())
+    }
+
+    /// The largest penetration at the rigid walls over the interior collocation points of `state`: the first
+    /// value of [`SurfaceContact::rigid_contact`], from the distances alone (no law, no normal).
+    fn rigid_penetration(&self, disc: &Discretisation, state: &State) -> Real {
+        let mut worst: Real = 0.0;
+        for (k, obstacle) in self.obstacles.iter().enumerate() {
+            if obstacle.wall != Wall::Rigid || !obstacle.is_active(self.time) {
+                continue;
+            }
+            for (g, point) in disc.points.iter().enumerate() {
+                if disc.is_end(g) {
+                    continue;
+                }
+                let x = point_position(disc, &state.control, g);
+                let hint = self.hint(k, g);
+                if let Some(d) = obstacle.surface.distance_value(&x, self.time, hint) {
+                    worst = worst.max(self.radius[point.patch] - d);
+                }
+            }
+        }
+        worst
     }
 
     /// Records an obstacle put in place at the end of the step that converged at `state` with a wire deeper
@@ -578,13 +632,65 @@ impl PointTerm for SurfaceContact {
         }
     }
 
-    fn prepare(&mut self, t: Real) {
+    fn prepare(&mut self, disc: &Discretisation, state: &State, t: Real) {
+        // One Uzawa update between steps (module docs): the pressures of the converged state, at its time (as
+        // the commit of that state found them, or found again after a checkpoint was restored).
+        let pressures = match &self.committed {
+            Some(p) => p.clone(),
+            None => self.rigid_contact(disc, state).1,
+        };
+        for (k, g, pressure) in pressures {
+            self.multipliers[k][g] = pressure;
+        }
         self.time = t;
         self.updates = 0;
     }
 
+    fn step_limit(&self, disc: &Discretisation, state: &State, delta: &[Real]) -> Real {
+        let delta_half = 0.5 * self.settings.regularisation;
+        let mut alpha: Real = 1.0;
+        for (g, point) in disc.points.iter().enumerate() {
+            if disc.is_end(g) {
+                continue;
+            }
+            let x = point_position(disc, &state.control, g);
+            let mut step: Option<Vec3> = None;
+            for (k, obstacle) in self.obstacles.iter().enumerate() {
+                if !obstacle.is_active(self.time) {
+                    continue;
+                }
+                let hint = self.hint(k, g);
+                let Some(distance) = obstacle.surface.distance_value(&x, self.time, hint) else {
+                    continue;
+                };
+                let gap = distance - self.radius[point.patch];
+                let (penalty, multiplier) = self.law(k, g);
+                // Only a point the law does not act on yet (`λ/ε − g ≤ −δ`): its contact is not in the tangent.
+                // The stop is the middle of the law's band, where its stiffness is half the penalty.
+                let stop = multiplier / penalty;
+                if gap < stop + delta_half {
+                    continue;
+                }
+                let dx = *step.get_or_insert_with(|| point_translation(disc, delta, g));
+                // The distance moves by at most |dx|: a point that cannot reach the stop is not searched.
+                if gap - dx.norm() >= stop {
+                    continue;
+                }
+                let Some(moved) = obstacle.surface.distance_value(&(x + dx), self.time, hint)
+                else {
+                    continue;
+                };
+                let moved = moved - self.radius[point.patch];
+                if moved < stop {
+                    alpha = alpha.min((gap - stop) / (gap - moved));
+                }
+            }
+        }
+        alpha
+    }
+
     fn augment(&mut self, disc: &Discretisation, state: &State) -> bool {
-        let (worst, pressures) = self.rigid_contact(disc, state);
+        let worst = self.rigid_penetration(disc, state);
         if worst <= self.settings.tolerance {
             return false;
         }
@@ -598,7 +704,7 @@ impl PointTerm for SurfaceContact {
             return false;
         }
         self.updates += 1;
-        for (k, g, pressure) in pressures {
+        for (k, g, pressure) in self.rigid_contact(disc, state).1 {
             self.multipliers[k][g] = pressure;
         }
         true
@@ -686,7 +792,8 @@ impl PointTerm for SurfaceContact {
         // Recorded unless the augmented-Lagrange record already tells it: the points' own penetration above the
         // tolerance, and nothing deeper than it by more than the tolerance between them (module docs).
         let tolerance = self.settings.tolerance;
-        let at_points = self.rigid_contact(disc, state).0;
+        let (at_points, pressures) = self.rigid_contact(disc, state);
+        self.committed = Some(pressures);
         if let Some(d) = self.penetration_anywhere(disc, state)
             && d.depth > tolerance
             && (at_points <= tolerance || d.depth - at_points > tolerance)
@@ -757,6 +864,7 @@ impl PointTerm for SurfaceContact {
             return Err(expected);
         }
         // Counts and indices are saved as reals: exact below 2^53.
+        self.committed = None;
         self.time = values[0];
         self.updates = values[1] as usize;
         self.unresolved = Unresolved {
@@ -817,8 +925,9 @@ mod tests {
     use crate::model::builder::{ConditionSpec, ModelBuilder, PatchShape, TimeSpec};
     use crate::model::{Contact, ContactSettings, Model, Obstacle, Surface, TimeFunction, Wall};
     use crate::solver::Simulation;
-    use crate::solver::discretisation::point_position;
+    use crate::solver::discretisation::{Discretisation, point_position};
     use crate::solver::simulation::NoObserver;
+    use crate::solver::state::State;
     use std::f64::consts::FRAC_PI_2;
 
     /// Reference radius, wire diameter, Young's modulus of the ring tests.
@@ -878,6 +987,42 @@ mod tests {
     }
 
     /// A cylinder around the z axis whose radius goes linearly from `from` at t = 0 to `to` at t = 1.
+    /// Source: the step limit's rule (module docs), worked out for the quarter ring (radius `R0`, wire radius
+    /// `D/2`) inside a fixed cylinder of radius `R0 + D/2 + 0.5`: every point is 0.5 clear of it, outside the
+    /// law's band. An increment that scales the control points by 1.1 moves every point of the ring radially out
+    /// by `0.1 R0 = 1` (a NURBS curve follows an affine map of its control points), through the wall to a gap of
+    /// −0.5; the limit stops the deepest at the band's middle, `g = λ/ε = 0`: the fraction `0.5 / 1`. Two fifths
+    /// of that increment stop short of the wall (no limit); with the cylinder 2δ/4 clear (the point inside the band,
+    /// its stiffness in the tangent) the increment is not limited either.
+    #[test]
+    fn the_step_limit_stops_a_point_not_yet_in_contact_in_the_middle_of_the_band() {
+        use crate::solver::terms::PointTerm;
+        let limit = |clearance: Real, scale: Real| {
+            let outer = R0 + 0.5 * D + clearance;
+            let obstacle = cylinder(outer, outer, Wall::Rigid);
+            let contact = Contact {
+                obstacles: vec![obstacle.clone()],
+                settings: RING,
+            };
+            let model = quarter_ring(contact);
+            let disc = Discretisation::new(&model).expect("discretised");
+            let state = State::reference(&disc);
+            let mut term = super::SurfaceContact::new(&model, &disc, vec![obstacle], RING);
+            term.prepare(&disc, &state, 0.5);
+            let mut delta = vec![0.0; disc.num_unknowns()];
+            for (j, p) in state.control.iter().enumerate() {
+                for i in 0..3 {
+                    delta[6 * j + i] = (scale - 1.0) * p[i];
+                }
+            }
+            term.step_limit(&disc, &state, &delta)
+        };
+        let alpha = limit(0.5, 1.1);
+        assert!((alpha - 0.5).abs() < 1e-9, "limited to {alpha}");
+        assert_eq!(limit(0.5, 1.04), 1.0, "short of the wall");
+        assert_eq!(limit(0.25 * RING.regularisation, 1.1), 1.0, "in the band");
+    }
+
     pub(super) fn cylinder(from: Real, to: Real, wall: Wall) -> Obstacle {
         Obstacle::new(
             "crimper",
@@ -953,10 +1098,13 @@ mod tests {
         );
     }
 
-    /// The same crimp without augmented-Lagrange updates: the penalty alone leaves a penetration of about
-    /// `q/ε ≈ 1e-3` in every step of contact, above the 1e-6 tolerance, and the run says so in its warnings
-    /// instead of completing silently; the warning names the largest penetration, which lies between the
-    /// tolerance and the penalty's estimate with a margin of ten (q ≈ 0.98 at the end, ε = 1e3).
+    /// The same crimp without augmented-Lagrange updates within a step: only the update between steps
+    /// ([`PointTerm::prepare`]) carries each step's pressure into the next, so a step leaves the penetration of
+    /// its change of pressure over the penalty, `Δq/ε`, above the 1e-6 tolerance, and the run says so in its
+    /// warnings instead of completing silently. The pressure rises to `q ≈ 0.98` (the ring test) over the ~14.3
+    /// steps of 0.05 s from first contact (the crimper, closing 0.7 in 1 s, meets the ring at t = 0.2/0.7),
+    /// `Δq ≈ 0.069`, `Δq/ε ≈ 6.9e-5` with ε = 1e3: the warning's largest penetration within a factor of 3 of
+    /// it.
     #[test]
     fn a_crimp_left_above_its_penetration_tolerance_is_warned_about() {
         let r = D / 2.0;
@@ -977,7 +1125,7 @@ mod tests {
             .and_then(|t| t.split_whitespace().next())
             .and_then(|t| t.parse().ok())
             .expect("the largest penetration in the warning");
-        assert!((1e-4..1e-2).contains(&largest), "{largest}");
+        assert!((2.3e-5..2.1e-4).contains(&largest), "{largest}");
     }
 
     /// Source: the same ring pressed into a compliant tube: the wall is a foundation of line stiffness
@@ -1293,7 +1441,7 @@ mod tests {
         let disc = Discretisation::new(&model).expect("discretised");
         let state = State::reference(&disc);
         let mut term = SurfaceContact::new(&model, &disc, vec![plate], settings);
-        term.prepare(1.0);
+        term.time = 1.0;
         let (at_points, _) = term.rigid_contact(&disc, &state);
         assert_eq!(at_points, 0.0, "the collocation points are clear");
         let found = term
@@ -1392,9 +1540,13 @@ mod tests {
 
     /// Switching in and out (module docs): the crimped ring released in one step (the crimper opens by 0.8, every
     /// point leaves contact and the ring springs back 0.5) and pushed back in the next (every point enters
-    /// again, 5 % hoop strain in one step), with and without friction. Newton (no line search; the law is C¹)
-    /// must take both without a cut or a rejected step, in at most 8 iterations each (measured: 3 and 2), and
-    /// the ring must end pressed to the crimper's radius as in the ring test.
+    /// again, 5 % hoop strain in one step), with and without friction. Newton must take every step without a
+    /// cut or a rejected step, and the ring must end pressed to the crimper's radius as in the ring test. The
+    /// iterations, counted with the augmented-Lagrange re-solves of the step (its tolerance here is 1e-6, a
+    /// thousandth of the penalty's penetration): measured 3 for the release, 15 (μ = 0) and 17 (μ = 0.2) for the
+    /// push back, where points the first increment carries through the band are stopped in its middle by the
+    /// step limit, an iteration each time, and 7 to 9 in the steps where the closing crimper first touches; the
+    /// bound is 20.
     #[test]
     fn a_ring_released_and_pushed_back_in_one_step_each_does_not_stall_newton() {
         let r = D / 2.0;
@@ -1426,7 +1578,7 @@ mod tests {
                     );
                 }
                 assert!(
-                    step.cuts == 0 && step.rejected == 0 && step.newton.iterations <= 8,
+                    step.cuts == 0 && step.rejected == 0 && step.newton.iterations <= 20,
                     "μ = {mu}, t = {}: {} cuts, {} rejected, {} iterations",
                     step.time,
                     step.cuts,

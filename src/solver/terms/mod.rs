@@ -89,9 +89,11 @@ pub trait PointTerm: Sync {
     /// derivatives). The default adds nothing.
     fn end(&self, _at: &PointView<'_>, _load: &mut EndLoad) {}
 
-    /// A step (or an attempt at one) to time `t` begins: a term that depends on time (a moving surface) takes
-    /// it here. The default ignores it.
-    fn prepare(&mut self, _t: Real) {}
+    /// A step (or an attempt at one) from the converged `state` to time `t` begins: a term that depends on time
+    /// (a moving surface) takes it here, and one that keeps multipliers updates them from `state`. Every attempt
+    /// of a step starts from the term's state saved at the step's start, so this is called with the same
+    /// arguments on the same term state each time. The default ignores it.
+    fn prepare(&mut self, _disc: &Discretisation, _state: &State, _t: Real) {}
 
     /// A step converged at `state`, not yet committed: a term that enforces a condition by augmented-Lagrange
     /// updates (contact) updates its multipliers and returns `true` if the step must be solved again with them.
@@ -100,6 +102,14 @@ pub trait PointTerm: Sync {
     /// saved state ([`PointTerm::save`]), so a roll-back of the step undoes it. The default changes nothing.
     fn augment(&mut self, _disc: &Discretisation, _state: &State) -> bool {
         false
+    }
+
+    /// The fraction `α ∈ (0, 1]` of the Newton increment `delta` (laid out as the solver's unknowns: six per
+    /// control point, translations first) that this term lets the iteration take from `state`: a term whose
+    /// load the tangent at `state` cannot see coming (a contact not yet touched) limits the step to where it
+    /// starts to act. The default takes the whole increment.
+    fn step_limit(&self, _disc: &Discretisation, _state: &State, _delta: &[Real]) -> Real {
+        1.0
     }
 
     /// What the run's result must be read with, from this term (e.g. contact left above its tolerance); the
