@@ -598,7 +598,7 @@ pub fn programme(
 /// until the ramp starts, closes linearly over the ramp until the wires' reach is `R − Δr` (`R` the largest
 /// crown radius; its radius `R − Δr + d/2`, `d` the thickest wire), holds until the release and opens back
 /// over `open`. Around a straight axis it is a cylinder; around a curved one, the tube of that radius around
-/// the permanent centreline between the first and the last crown ([`crimper_tube`]), continued straight
+/// the permanent centreline between the first and the last crown, continued straight
 /// beyond (a curved crimping tube, or a mandrel-guided crimp: the device is compacted onto its own axis).
 pub fn crimper(
     programme: &Programme,

@@ -173,12 +173,7 @@ impl Simulation<'_> {
                     *a += d;
                 }
             }
-            // After a limited step the tangent has changed (a contact began): it is assembled afresh.
-            previous = if fresh_tangent || limited {
-                Real::INFINITY
-            } else {
-                r
-            };
+            previous = if fresh_tangent { Real::INFINITY } else { r };
             if limited {
                 report.limited += 1;
             }

@@ -102,12 +102,13 @@
 //!   opening crimper lets a crimped device spring back in one linearised step far through it (the map: a first
 //!   increment of 0.6 of a wire's length, the next iterate meeting a penalty force of the step's whole travel).
 //!   The increment is scaled so that no such point goes beyond the middle of the law's band (`g = λ/ε`, where
-//!   the law's stiffness is half the penalty; the gap along the scaled increment, interpolated linearly), and
-//!   the next iteration assembles a fresh tangent with that point in it. IPC's filtered line search
-//!   (Li et al., *Incremental Potential Contact*, 2020) limits a step to where the first contact begins in the
-//!   same way; a penalty law can let the point into its band, where its stiffness is. The increment's norm
-//!   that the stopping rule reads is Newton's, before the limit; [`crate::solver::NewtonReport::limited`]
-//!   counts the limited iterations.
+//!   the law's stiffness is half the penalty; the gap along the scaled increment, interpolated linearly); the
+//!   iteration then goes on by the chord method's rule (a factorisation is kept while it contracts the residual
+//!   fast enough: a fresh tangent after every limited step cost more iterations on the map, up to 23 in a
+//!   step against 11). IPC's filtered line search (Li et al., *Incremental Potential Contact*, 2020) limits a
+//!   step to where the first contact begins in the same way; a penalty law can let the point into its band,
+//!   where its stiffness is. The increment's norm that the stopping rule reads is Newton's, before the limit;
+//!   [`crate::solver::NewtonReport::limited`] counts the limited iterations.
 //!
 //! On the map, with all three every case converges without a cut (docs/speed.md's table); with the
 //! extrapolated start and without the limit, the penalty 1 N/mm² cuts 8 to 10 times while opening at every
@@ -986,14 +987,13 @@ mod tests {
         b.build().expect("valid ring").model
     }
 
-    /// A cylinder around the z axis whose radius goes linearly from `from` at t = 0 to `to` at t = 1.
     /// Source: the step limit's rule (module docs), worked out for the quarter ring (radius `R0`, wire radius
     /// `D/2`) inside a fixed cylinder of radius `R0 + D/2 + 0.5`: every point is 0.5 clear of it, outside the
     /// law's band. An increment that scales the control points by 1.1 moves every point of the ring radially out
     /// by `0.1 R0 = 1` (a NURBS curve follows an affine map of its control points), through the wall to a gap of
-    /// −0.5; the limit stops the deepest at the band's middle, `g = λ/ε = 0`: the fraction `0.5 / 1`. Two fifths
-    /// of that increment stop short of the wall (no limit); with the cylinder 2δ/4 clear (the point inside the band,
-    /// its stiffness in the tangent) the increment is not limited either.
+    /// −0.5; the limit stops the deepest at the band's middle, `g = λ/ε = 0`: the fraction `0.5 / 1`. Two
+    /// fifths of that increment stop short of the wall (no limit); with the cylinder 2δ/4 clear (the point inside
+    /// the band, its stiffness in the tangent) the increment is not limited either.
     #[test]
     fn the_step_limit_stops_a_point_not_yet_in_contact_in_the_middle_of_the_band() {
         use crate::solver::terms::PointTerm;
@@ -1023,6 +1023,7 @@ mod tests {
         assert_eq!(limit(0.25 * RING.regularisation, 1.1), 1.0, "in the band");
     }
 
+    /// A cylinder around the z axis whose radius goes linearly from `from` at t = 0 to `to` at t = 1.
     pub(super) fn cylinder(from: Real, to: Real, wall: Wall) -> Obstacle {
         Obstacle::new(
             "crimper",
