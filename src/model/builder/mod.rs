@@ -442,7 +442,7 @@ impl Model {
             &solver,
             &self.materials,
             &self.material_names,
-            self.programme.is_some() || time.tolerance.is_some(),
+            self.programme.is_some() || time.tolerance.is_some() || self.contact.is_some(),
             &self.nodes,
         )?;
         self.time = time;
@@ -904,7 +904,7 @@ impl ModelBuilder {
             &self.solver,
             &self.materials,
             &self.material_names,
-            programme.is_some() || time.tolerance.is_some(),
+            programme.is_some() || time.tolerance.is_some() || self.contact.is_some(),
             &nodes,
         )?;
         let probes = self.probes(&patches, &nodes)?;
@@ -1241,7 +1241,7 @@ fn check_solver(s: &SolverSettings) -> Result<()> {
 
 /// Arc-length continuation follows a load-driven path of a rate-independent model: every material elastic (a
 /// viscoelastic response depends on time, which the load factor replaces), no programme, no error-controlled
-/// time steps and no releases (they are about times). Its settings: an end load factor that is finite and not 0, at least one increment, a
+/// time steps, no contact and no releases (they are about times). Its settings: an end load factor that is finite and not 0, at least one increment, a
 /// target of at least one iteration and a growth of at least 1.
 fn check_path(
     s: &SolverSettings,
@@ -1270,7 +1270,7 @@ fn check_path(
         ));
     }
     if timed {
-        return path("arc-length continuation follows loads, and a programme (heating, release, recovery) or `time.tolerance` (the time-error control) is about times: use `path: time`".into());
+        return path("arc-length continuation follows loads, and a programme (heating, release, recovery), `time.tolerance` (the time-error control) or contact (its surfaces move on schedules in time, its step limit and multiplier updates act per time step) is about times: use `path: time`".into());
     }
     if let Some(node) = nodes.iter().find(|n| {
         n.conditions.components.iter().any(|c| {

@@ -156,7 +156,9 @@ impl Simulation<'_> {
                 }
             }
             self.record_increment(&mut report)?;
-            let limited = self.limit_step();
+            // The first increment answers the step's change of loads and surfaces with the tangent of its start: a
+            // point a moving surface reaches within the step is not in it (module docs of the contact term).
+            let limited = report.iterations == 1 && self.limit_step();
             self.solution
                 .state
                 .apply_increment(&self.disc, &self.work.delta);
@@ -182,7 +184,7 @@ impl Simulation<'_> {
 
     /// Scales the Newton increment in `self.work.delta` by the smallest fraction the point terms allow
     /// ([`crate::solver::terms::PointTerm::step_limit`]: a contact that the tangent does not see yet stops the
-    /// step where it begins to act); whether it was limited. The increment's norm was recorded before: it is
+    /// step where it begins to act); whether it was limited. Called for the first increment of each solve. The increment's norm was recorded before: it is
     /// Newton's measure of the iterate's error, which the limit does not change.
     fn limit_step(&mut self) -> bool {
         let alpha = self

@@ -107,7 +107,8 @@ pub trait PointTerm: Sync {
     /// The fraction `α ∈ (0, 1]` of the Newton increment `delta` (laid out as the solver's unknowns: six per
     /// control point, translations first) that this term lets the iteration take from `state`: a term whose
     /// load the tangent at `state` cannot see coming (a contact not yet touched) limits the step to where it
-    /// starts to act. The default takes the whole increment.
+    /// starts to act. Asked for the first increment of each Newton solve. The default takes the whole
+    /// increment.
     fn step_limit(&self, _disc: &Discretisation, _state: &State, _delta: &[Real]) -> Real {
         1.0
     }
