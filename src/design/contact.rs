@@ -31,14 +31,13 @@
 //! penetration below its tolerance. A penalty orders of magnitude above the structure's stiffness makes every
 //! point that touches a step for Newton: measured on `designs/straight_stent_crimped.yaml` (1301 steps of
 //! 2.5 ms, with the extrapolated start a model with contact has and the step limit), this default (3.96 N/mm²)
-//! and 30 N/mm² finish without a cut (248 and 278 factorisations) and agree within 1e-3 in the crimp force
+//! and 30 N/mm² finish without a cut (262 and 279 factorisations) and agree within 1e-3 in the crimp force
 //! (0.1666 N) and the final recovery ratio (0.0141); the instantaneous modulus (2394 MPa, the default before)
-//! takes 14 cuts and 732 factorisations, crimps 1 % harder and ends its recovery at 0.0084 (0.4 % of the
-//! stroke apart, where the recovery is fastest); started from the last state and without the step limit it
-//! took 1632 cuts and 2545 steps. A design may give its own. The tolerance on penetration is 1 % of
-//! the wire diameter (what a drawing of the wire cannot show); the law's transition band is a tenth of the
-//! tolerance; at most 10 augmented-Lagrange updates per step besides the one between steps. A `programme` of `kind: crimp` adds its crimper after the
-//! design's obstacles.
+//! gets the same force and recovery with 18 cuts and 603 factorisations; started from the last state and
+//! without the step limit it took 1632 cuts and 2545 steps. A design may give its own. The tolerance on
+//! penetration is 1 % of the wire diameter (what a drawing of the wire cannot show); the law's transition band
+//! is a tenth of the tolerance; at most 10 augmented-Lagrange updates per step besides the one between steps.
+//! A `programme` of `kind: crimp` adds its crimper after the design's obstacles.
 //!
 //! **Friction** is a property of an obstacle (`friction: μ`, the pair of surfaces that touch), so friction
 //! without contact cannot be written; the crimper of a crimp programme is frictionless.
