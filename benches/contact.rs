@@ -15,20 +15,11 @@
 //! makes the contact table of docs/speed.md from. An asset measured again needs a new entry in
 //! `assets/provenance.json` (date, machine, command, sha256), or the script refuses it.
 
-use std::ops::ControlFlow;
 use std::path::Path;
 use std::time::Instant;
 use stentkit::design::load_design;
-use stentkit::solver::{Observer, RunSummary, Simulation, StepReport};
-
-/// Watches nothing: the run to its end.
-struct Quiet;
-
-impl Observer for Quiet {
-    fn step(&mut self, _: &Simulation<'_>, _: &StepReport) -> ControlFlow<()> {
-        ControlFlow::Continue(())
-    }
-}
+use stentkit::solver::simulation::NoObserver;
+use stentkit::solver::{RunSummary, Simulation};
 
 /// The shortest of three runs of `design`: its wall time \[s\] and its summary.
 fn run(root: &Path, design: &str) -> (f64, RunSummary) {
@@ -40,7 +31,7 @@ fn run(root: &Path, design: &str) -> (f64, RunSummary) {
         let start = Instant::now();
         let mut sim = Simulation::new(&model).expect("discretised");
         let summary = sim
-            .run(&mut [&mut Quiet])
+            .run(&mut [&mut NoObserver])
             .unwrap_or_else(|e| panic!("{design}: {e}"));
         let wall = start.elapsed().as_secs_f64();
         if best.as_ref().is_none_or(|(w, _)| wall < *w) {

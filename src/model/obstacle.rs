@@ -339,14 +339,18 @@ impl Lumen {
     }
 }
 
+/// The part of `d` normal to the unit `axis` and its length `ρ`; `None` on the axis (`ρ` within round-off of 0
+/// against `radius`), where a cylinder's distance has no gradient.
+fn off_axis(d: &Vec3, axis: &Vec3, radius: Real) -> Option<(Vec3, Real)> {
+    let perp = d - axis * axis.dot(d);
+    let rho = perp.norm();
+    (rho > Real::EPSILON * radius.abs().max(1.0)).then_some((perp, rho))
+}
+
 /// The distance from the inside of a cylinder of `radius` around the line along the unit `axis` through the
 /// point from which `d` is measured ([`Surface::distance`]); `None` on the axis.
 fn cylinder_distance(d: &Vec3, axis: &Vec3, radius: Real) -> Option<Distance> {
-    let perp = d - axis * axis.dot(d);
-    let rho = perp.norm();
-    if rho <= Real::EPSILON * radius.abs().max(1.0) {
-        return None;
-    }
+    let (perp, rho) = off_axis(d, axis, radius)?;
     let e = perp / rho;
     Some(Distance {
         value: radius - rho,
@@ -413,10 +417,8 @@ impl Surface {
                 axis,
                 radius,
             } => {
-                let d = x - point;
-                let rho = (d - axis * axis.dot(&d)).norm();
                 let r = radius.value(t);
-                (rho > Real::EPSILON * r.abs().max(1.0)).then_some(r - rho)
+                off_axis(&(x - point), axis, r).map(|(_, rho)| r - rho)
             }
             Surface::Plane {
                 point,

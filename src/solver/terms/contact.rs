@@ -244,8 +244,8 @@ pub struct SurfaceContact {
     /// Obstacles put in place (after the start) through the wires: how many, and the deepest.
     placed: Placed,
     /// Each point's pressure `(obstacle, point, p)` at the last committed state, which the next step's Uzawa
-    /// update takes ([`PointTerm::prepare`]); `None` before the first commit and after a checkpoint's state was
-    /// restored (found again from the state then). Not state: a roll-back returns to the committed state.
+    /// update takes ([`PointTerm::prepare`]); `None` before the first commit and after the term's state was
+    /// restored (found from the state then). Not state: a roll-back returns to the committed state.
     committed: Option<Vec<(usize, usize, Real)>>,
 }
 
@@ -656,11 +656,10 @@ impl PointTerm for SurfaceContact {
     fn prepare(&mut self, disc: &Discretisation, state: &State, t: Real) {
         // One Uzawa update between steps (module docs): the pressures of the converged state, at its time (as
         // the commit of that state found them, or found again after a checkpoint was restored).
-        let pressures = match &self.committed {
-            Some(p) => p.clone(),
-            None => self.rigid_contact(disc, state).1,
-        };
-        for (k, g, pressure) in pressures {
+        if self.committed.is_none() {
+            self.committed = Some(self.rigid_contact(disc, state).1);
+        }
+        for &(k, g, pressure) in self.committed.iter().flatten() {
             self.multipliers[k][g] = pressure;
         }
         self.time = t;
@@ -668,7 +667,6 @@ impl PointTerm for SurfaceContact {
     }
 
     fn step_limit(&self, disc: &Discretisation, state: &State, delta: &[Real]) -> Real {
-        let delta_half = 0.5 * self.settings.regularisation;
         let mut alpha: Real = 1.0;
         for (g, point) in disc.points.iter().enumerate() {
             if disc.is_end(g) {
@@ -685,13 +683,13 @@ impl PointTerm for SurfaceContact {
                     continue;
                 };
                 let gap = distance - self.radius[point.patch];
-                let (penalty, multiplier) = self.law(k, g);
-                // Only a point the law does not act on yet (`λ/ε − g ≤ −δ`): its contact is not in the tangent.
-                // The stop is the middle of the law's band, where its stiffness is half the penalty.
-                let stop = multiplier / penalty;
-                if gap < stop + delta_half {
+                // Only a point the law does not act on yet (no stiffness): its contact is not in the tangent.
+                if self.pressure(k, g, gap).1 != 0.0 {
                     continue;
                 }
+                // The stop is the middle of the law's band, where its stiffness is half the penalty.
+                let (penalty, multiplier) = self.law(k, g);
+                let stop = multiplier / penalty;
                 let dx = *step.get_or_insert_with(|| point_translation(disc, delta, g));
                 // The distance moves by at most |dx|: a point that cannot reach the stop is not searched.
                 if gap - dx.norm() >= stop {

@@ -53,8 +53,8 @@ pub struct ContactReport {
 pub struct ObstacleReport {
     /// The total force the obstacle exerts on the rods, `Σ w p n` \[force\].
     pub force: Vec3,
-    /// For a cylinder and a lumen, the inward radial part of that force: positive when the wires press on the cylinder
-    /// \[force\]; `None` for a plane.
+    /// For a cylinder and a lumen, the inward radial part of that force: positive when the wires press on the
+    /// wall \[force\]; `None` for a plane.
     pub radial_force: Option<Real>,
     /// Collocation points with a positive pressure.
     pub points: usize,
