@@ -760,7 +760,7 @@ pub struct StabilisationDto {
     #[serde(default)]
     pub dissipated_fraction: Option<Positive>,
     /// The run's dissipated energy over its largest strain energy, and a damped step's damping force over the
-    /// loads and reactions, above which a warning is given (default 0.05; below 1).
+    /// loads, reactions and walls' contact, above which a warning is given (default 0.05; below 1).
     #[serde(default)]
     pub limit: Option<Positive>,
     /// A damping factor c [1/time] given outright instead of the energy rule.

@@ -413,8 +413,8 @@ pub struct StabilisationSummary {
     pub ratio: Real,
     /// The largest ratio of one step's dissipated energy to the strain energy at its end.
     pub largest_step_ratio: Real,
-    /// The largest share of the damping force among the forces on the device (loads, reactions and the
-    /// damping) of a damped step: 0 quasi-static, 1 when the damping alone balanced the loads or the motion
+    /// The largest share of the damping force among the forces on the device (loads, reactions, walls' contact
+    /// and the damping) of a damped step: 0 quasi-static, 1 when the damping alone balanced the loads or the motion
     /// ([`crate::solver::simulation::stabilisation`], *The force*).
     pub largest_force_share: Real,
     /// The time of the step with that share \[s\] (0 when no step was damped).

@@ -412,7 +412,7 @@ impl Default for ArcLengthSettings {
 /// made ten times larger while the damped step still fails. The damping stays on while a step dissipates more
 /// than that fraction, and the dissipated energy is reported per step and for the run, with a warning when
 /// it exceeds `limit` of the largest strain energy the run reached, or when a damped step's damping force is
-/// more than `limit` of the loads and reactions on the device (the result is then not quasi-static;
+/// more than `limit` of the loads, reactions and walls' contact on the device (the result is then not quasi-static;
 /// `crate::solver::simulation::stabilisation`).
 #[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
 pub struct StabilisationSettings {

@@ -39,10 +39,14 @@
 //! ```
 //! against what acts on the device from outside, the loads and reactions,
 //! ```text
-//! E = Σ_nodes (|Σ_e σ R N_e| + |Σ_e σ R M_e| / ℓ) + Σ_g w_g (|n̄| + |m̄| / ℓ),
+//! E = Σ_nodes (|Σ_e σ R N_e| + |Σ_e σ R M_e| / ℓ) + Σ_g w_g Σ_terms (|n̄_t| + |m̄_t| / ℓ),
 //! ```
 //! (the rod ends' resultants at a node equal its load at free components and its reaction at prescribed ones; a
-//! joint's cancel), couples turned into forces over the model size `ℓ` (the bounding-box diagonal of the
+//! joint's cancel; `n̄_t`, `m̄_t` the force and couple densities of each of the simulation's point terms on its
+//! own, [`crate::solver::terms`]: the distributed loads, and the contact of a wall, which is a reaction too —
+//! added up term by term, so that a load and the wall that bears it do not cancel; without the contact, a
+//! device the crimper holds would be judged against its node reactions alone), couples turned into forces
+//! over the model size `ℓ` (the bounding-box diagonal of the
 //! reference control points, the lever of the largest couple a force can make on it). The step's share is
 //! `D / max(D, E)`: 0 for a quasi-static step, 1 when the damping balances the loads by itself (a load the
 //! structure does not carry) or opposes the motion alone (a free device springing back). Above `limit` — the
@@ -59,6 +63,7 @@ use crate::model::StabilisationSettings;
 use crate::solver::assembly::{Actions, point_strains};
 use crate::solver::state::State;
 use crate::solver::terms::damping::Damping;
+use crate::solver::terms::{InteriorLoad, PointView};
 
 /// How many times a damped step that still fails has its factor multiplied by [`ESCALATION`] before it is cut.
 pub(crate) const MAX_ESCALATIONS: usize = 3;
@@ -144,7 +149,7 @@ impl StabiliserState {
         }
         if self.largest_force_share > limit {
             out.push(format!(
-                "in {} of the {} damped steps the damping force was more than {limit} of the forces on the device from outside (its loads and reactions), up to {:.3e} of them at t = {}: there the damping, not the structure, carried the load, and the result is not quasi-static ({advice})",
+                "in {} of the {} damped steps the damping force was more than {limit} of the forces on the device from outside (its loads, reactions and walls), up to {:.3e} of them at t = {}: there the damping, not the structure, carried the load, and the result is not quasi-static ({advice})",
                 self.steps_above_force_limit,
                 self.damped_steps,
                 self.largest_force_share,
@@ -235,19 +240,38 @@ impl Simulation<'_> {
 
     /// The damping force's share `D / max(D, E)` of the forces on the device in the current state, under the
     /// damping `d` and the loads at time `t` (module docs, *The force*); 0 when nothing acts.
-    fn damping_force_share(&self, t: Real, d: Damping<'_>) -> Real {
+    pub(crate) fn damping_force_share(&self, t: Real, d: Damping<'_>) -> Real {
         let disc = &self.disc;
         let weights = self.point_weights();
         let lever = disc.length_scale;
         let actions = Actions::at(self.model, t, &self.releases.ramps);
+        let state = &self.solution.state;
         let (mut damping, mut external) = (0.0, 0.0);
         for (g, point) in disc.points.iter().enumerate() {
             let w = weights[g];
-            external += w
-                * (actions.dist_force[point.patch].norm()
-                    + actions.dist_couple[point.patch].norm() / lever);
+            let view = PointView {
+                disc,
+                state,
+                actions: &actions,
+                g,
+                point,
+                shape: &disc.shapes[point.shape],
+                rotation_t: state.rotation[g].transpose(),
+                tangent: false,
+            };
+            // Each term on its own: a load and the contact that bears it are both forces from outside.
+            for term in &self.terms {
+                let mut load = InteriorLoad::default();
+                term.interior(&view, &mut load);
+                let couple = load.couple.unwrap_or_else(Vec3::zeros)
+                    + load
+                        .material_couple
+                        .map_or_else(Vec3::zeros, |m| state.rotation[g] * m);
+                external +=
+                    w * (load.force.unwrap_or_else(Vec3::zeros).norm() + couple.norm() / lever);
+            }
             let (area, inertia) = Damping::masses(&disc.shapes[point.shape]);
-            let (dx, theta) = d.motion(disc, &self.solution.state, g);
+            let (dx, theta) = d.motion(disc, state, g);
             damping +=
                 w * d.rate * (area * dx.norm() + inertia.component_mul(&theta).norm() / lever);
         }

@@ -71,7 +71,8 @@
 //!
 //! **Penetration anywhere.** The law acts at the collocation points alone: a crest between two of them (a
 //! crown between Greville points) can pass through a wall unresisted. After every converged step
-//! ([`PointTerm::commit`]) the gap is also checked at `SAMPLES_PER_SPAN` = 4 points per knot span of each
+//! ([`PointTerm::commit`]) the gap is also checked at the patch ends (nodes, where the law does not act: a
+//! crown's tip where crowns are split there) and at `SAMPLES_PER_SPAN` = 4 points per knot span of each
 //! patch (the midpoints of the span's quarters; a rod's shape between collocation points is polynomial in each
 //! span, and four samples bound a smooth crest's missed depth by `|g''| h²/8` with `h` a quarter span — a
 //! sixteenth of a span's curvature term — at four times the collocation points' cost, paid once per step, not
@@ -81,7 +82,15 @@
 //! (more updates would only press the points harder). A step whose penetration anywhere exceeds the tolerance
 //! is recorded (how many, the deepest with where and when, the first) and the run's warnings say so, advising
 //! to refine the patch there — unless the augmented-Lagrange warning already tells it: the collocation points'
-//! own penetration above the tolerance, and nothing deeper than it by more than the tolerance elsewhere.
+//! own penetration above the tolerance, and nothing deeper than it by more than the tolerance elsewhere. The
+//! collocation points' gaps there are those the commit's Uzawa record finds (one scan; a lumen's from each
+//! point's closest-point parameter, as the law finds them).
+//!
+//! **Speed.** Most points touch nothing at most iterations, so the assembly asks a cylinder or a plane for its
+//! distance alone first and computes the normal, Hessian and law only for a point within the law's band; the
+//! commit scans the collocation points once for the Uzawa record and the check between points. The share of
+//! the contact term in the crimped straight stent's solver time is measured by `scripts/contact_share.sh`
+//! (the README's contact section, *Speed*).
 //!
 //! **Obstacles put in place later** ([`crate::model::Obstacle::active`]: a sheath, a vessel the programmed
 //! device is deployed in) are checked when they arrive: at the converged state of the step that ends at their
@@ -168,28 +177,31 @@ fn tributary_lengths(disc: &Discretisation, reference: &[Vec3]) -> Vec<Real> {
     lengths
 }
 
-/// The sample points of every patch (module docs): `SAMPLES_PER_SPAN` per non-empty knot span, at the
-/// midpoints of its equal parts.
+/// The sample points of every patch (module docs): its two ends, and `SAMPLES_PER_SPAN` per non-empty knot
+/// span at the midpoints of its equal parts.
 fn samples(model: &Model, disc: &Discretisation) -> Vec<Sample> {
     let mut out = Vec::new();
     for (patch, (p, range)) in model.patches.iter().zip(&disc.patches).enumerate() {
         let knots = p.curve.knots();
         let (lo, hi) = knots.domain();
-        let values = knots.knots();
-        for w in values.windows(2) {
+        let mut sample = |u: Real| {
+            let table = nurbs_basis(knots, p.curve.weights(), u, 0);
+            out.push(Sample {
+                patch,
+                u,
+                first: range.offset + table.first,
+                basis: table.ders[0].clone(),
+            });
+        };
+        sample(lo);
+        sample(hi);
+        for w in knots.knots().windows(2) {
             let (a, b) = (w[0], w[1]);
             if !(b > a && a >= lo && b <= hi) {
                 continue;
             }
             for j in 0..SAMPLES_PER_SPAN {
-                let u = a + (b - a) * (j as Real + 0.5) / SAMPLES_PER_SPAN as Real;
-                let table = nurbs_basis(knots, p.curve.weights(), u, 0);
-                out.push(Sample {
-                    patch,
-                    u,
-                    first: range.offset + table.first,
-                    basis: table.ders[0].clone(),
-                });
+                sample(a + (b - a) * (j as Real + 0.5) / SAMPLES_PER_SPAN as Real);
             }
         }
     }
@@ -282,6 +294,29 @@ pub struct Penetration {
     pub patch: usize,
     /// The parameter of the patch's curve where it is.
     pub u: Real,
+}
+
+impl Penetration {
+    /// `current`, or the penetration `depth` of obstacle `obstacle` at curve parameter `u` of patch `patch` where
+    /// that is positive and deeper.
+    fn deeper(
+        current: Option<Penetration>,
+        depth: Real,
+        obstacle: usize,
+        patch: usize,
+        u: Real,
+    ) -> Option<Penetration> {
+        if depth > 0.0 && current.is_none_or(|d| depth > d.depth) {
+            Some(Penetration {
+                depth,
+                obstacle,
+                patch,
+                u,
+            })
+        } else {
+            current
+        }
+    }
 }
 
 /// Committed steps whose penetration anywhere exceeded the tolerance: how many, the deepest (where, when), the
@@ -431,45 +466,37 @@ impl SurfaceContact {
         disc: &Discretisation,
         state: &State,
     ) -> Option<Penetration> {
-        let mut deepest: Option<Penetration> = None;
-        let mut consider = |depth: Real, obstacle: usize, patch: usize, u: Real| {
-            if depth > 0.0 && deepest.is_none_or(|d| depth > d.depth) {
-                deepest = Some(Penetration {
-                    depth,
-                    obstacle,
-                    patch,
-                    u,
-                });
-            }
-        };
-        for (k, obstacle) in self.obstacles.iter().enumerate() {
-            if obstacle.wall != Wall::Rigid || !obstacle.is_active(self.time) {
-                continue;
-            }
-            let gap = |x: &Vec3, patch: usize| {
-                obstacle
+        self.penetration_between(state, self.rigid_contact(disc, state).0)
+    }
+
+    /// The deeper of `deepest` (the collocation points' own, [`SurfaceContact::rigid_contact`]) and the largest
+    /// penetration into a rigid wall at the sample points of `state` between the collocation points.
+    fn penetration_between(
+        &self,
+        state: &State,
+        mut deepest: Option<Penetration>,
+    ) -> Option<Penetration> {
+        let walls: Vec<usize> = (self.obstacles.iter().enumerate())
+            .filter(|(_, o)| o.wall == Wall::Rigid && o.is_active(self.time))
+            .map(|(k, _)| k)
+            .collect();
+        if walls.is_empty() {
+            return deepest;
+        }
+        for sample in &self.samples {
+            let x: Vec3 = sample
+                .basis
+                .iter()
+                .enumerate()
+                .map(|(a, n)| state.control[sample.first + a] * *n)
+                .sum();
+            for &k in &walls {
+                if let Some(d) = self.obstacles[k]
                     .surface
-                    .distance_value(x, self.time, None)
-                    .map(|d| d - self.radius[patch])
-            };
-            for (g, point) in disc.points.iter().enumerate() {
-                if disc.is_end(g) {
-                    continue;
-                }
-                let x = point_position(disc, &state.control, g);
-                if let Some(gap) = gap(&x, point.patch) {
-                    consider(-gap, k, point.patch, point.u);
-                }
-            }
-            for sample in &self.samples {
-                let x: Vec3 = sample
-                    .basis
-                    .iter()
-                    .enumerate()
-                    .map(|(a, n)| state.control[sample.first + a] * *n)
-                    .sum();
-                if let Some(gap) = gap(&x, sample.patch) {
-                    consider(-gap, k, sample.patch, sample.u);
+                    .distance_value(&x, self.time, None)
+                {
+                    let depth = self.radius[sample.patch] - d;
+                    deepest = Penetration::deeper(deepest, depth, k, sample.patch, sample.u);
                 }
             }
         }
@@ -485,6 +512,9 @@ impl SurfaceContact {
     /// multiplier).
     pub(crate) fn law(&self, k: usize, g: usize) -> (Real, Real) {
         let obstacle = &self.obstacles[k];
+        if obstacle.wall == Wall::Rigid {
+            return (self.settings.penalty, self.multipliers[k][g]);
+        }
         match obstacle
             .surface
             .radius(self.time)
@@ -525,62 +555,86 @@ impl SurfaceContact {
         })
     }
 
-    /// The gap (distance from the surface minus the wire radius; `None` where it has none or the obstacle is not
-    /// in place) of every interior collocation point of `state` at every rigid wall, `(obstacle, point, gap)`:
-    /// the distances alone (no normal, no Hessian), as [`SurfaceContact::at`] finds them.
-    fn rigid_gaps<'a>(
-        &'a self,
-        disc: &'a Discretisation,
-        state: &'a State,
-    ) -> impl Iterator<Item = (usize, usize, Option<Real>)> + 'a {
-        self.obstacles
-            .iter()
-            .enumerate()
-            .filter(|(_, o)| o.wall == Wall::Rigid)
-            .flat_map(move |(k, obstacle)| {
-                disc.points
-                    .iter()
-                    .enumerate()
-                    .filter(move |&(g, _)| !disc.is_end(g))
-                    .map(move |(g, point)| {
-                        let x = point_position(disc, &state.control, g);
-                        let gap = obstacle
-                            .is_active(self.time)
-                            .then(|| {
-                                obstacle
-                                    .surface
-                                    .distance_value(&x, self.time, self.hint(k, g))
-                            })
-                            .flatten()
-                            .map(|d| d - self.radius[point.patch]);
-                        (k, g, gap)
-                    })
-            })
+    /// Whether obstacle `k` certainly does nothing to the point at `x` (collocation point `g` on `patch`): not
+    /// in place, or a cylinder or plane whose distance alone (without the normal and Hessian that
+    /// [`SurfaceContact::at`] computes) puts the point beyond the law's band or on the axis. The assembly asks this
+    /// first at every point of every iteration, where most points touch nothing (module docs, *Speed*); a lumen's
+    /// distance costs its closest-point search either way, so it is not asked twice.
+    fn out_of_reach(&self, k: usize, g: usize, patch: usize, x: &Vec3) -> bool {
+        let obstacle = &self.obstacles[k];
+        if !obstacle.is_active(self.time) {
+            return true;
+        }
+        if matches!(obstacle.surface, Surface::Lumen(_)) {
+            return false;
+        }
+        obstacle
+            .surface
+            .distance_value(x, self.time, None)
+            .is_none_or(|d| self.pressure(k, g, d - self.radius[patch]) == (0.0, 0.0))
     }
 
-    /// The largest penetration at the rigid walls (most negative gap, as a positive length; 0 if none) over
-    /// the interior collocation points of `state` (where the law acts), and each such point's pressure
-    /// `(obstacle, point, p)`.
+    /// Calls `visit(obstacle, point, gap)` with the gap (distance from the surface minus the wire radius; `None`
+    /// where it has none or the obstacle is not in place) of every interior collocation point of `state` at
+    /// every rigid wall: the distances alone (no normal, no Hessian), as [`SurfaceContact::at`] finds them. A
+    /// point's position is computed once for all the walls, and not at all while none is in place.
+    fn rigid_gaps(
+        &self,
+        disc: &Discretisation,
+        state: &State,
+        mut visit: impl FnMut(usize, usize, Option<Real>),
+    ) {
+        let rigid: Vec<(usize, bool)> = (self.obstacles.iter().enumerate())
+            .filter(|(_, o)| o.wall == Wall::Rigid)
+            .map(|(k, o)| (k, o.is_active(self.time)))
+            .collect();
+        let any = rigid.iter().any(|&(_, active)| active);
+        for (g, point) in disc.points.iter().enumerate() {
+            if disc.is_end(g) {
+                continue;
+            }
+            let x = any.then(|| point_position(disc, &state.control, g));
+            for &(k, active) in &rigid {
+                let gap = x
+                    .filter(|_| active)
+                    .and_then(|x| {
+                        self.obstacles[k]
+                            .surface
+                            .distance_value(&x, self.time, self.hint(k, g))
+                    })
+                    .map(|d| d - self.radius[point.patch]);
+                visit(k, g, gap);
+            }
+        }
+    }
+
+    /// The largest penetration at the rigid walls over the interior collocation points of `state` (where the
+    /// law acts; `None` if none), and each such point's pressure `(obstacle, point, p)`.
     fn rigid_contact(
         &self,
         disc: &Discretisation,
         state: &State,
-    ) -> (Real, Vec<(usize, usize, Real)>) {
-        let mut worst: Real = 0.0;
+    ) -> (Option<Penetration>, Vec<(usize, usize, Real)>) {
+        let mut deepest = None;
         let mut pressures = Vec::new();
-        for (k, g, gap) in self.rigid_gaps(disc, state) {
-            worst = worst.max(gap.map_or(0.0, |gap| -gap));
+        self.rigid_gaps(disc, state, |k, g, gap| {
+            let point = &disc.points[g];
+            if let Some(gap) = gap {
+                deepest = Penetration::deeper(deepest, -gap, k, point.patch, point.u);
+            }
             pressures.push((k, g, gap.map_or(0.0, |gap| self.pressure(k, g, gap).0)));
-        }
-        (worst, pressures)
+        });
+        (deepest, pressures)
     }
 
-    /// The largest penetration at the rigid walls over the interior collocation points of `state`: the first
-    /// value of [`SurfaceContact::rigid_contact`], without the pressures.
+    /// The largest penetration at the rigid walls over the interior collocation points of `state` (0 if none):
+    /// the depth of [`SurfaceContact::rigid_contact`]'s first value, without the pressures.
     fn rigid_penetration(&self, disc: &Discretisation, state: &State) -> Real {
-        self.rigid_gaps(disc, state)
-            .filter_map(|(_, _, gap)| gap)
-            .fold(0.0, |worst, gap| worst.max(-gap))
+        let mut worst: Real = 0.0;
+        self.rigid_gaps(disc, state, |_, _, gap| {
+            worst = worst.max(gap.map_or(0.0, |gap| -gap));
+        });
+        worst
     }
 
     /// A lumen's closest-point parameter of point `g` at the last converged step (obstacle `k`), if it has one.
@@ -634,6 +688,9 @@ impl PointTerm for SurfaceContact {
     fn interior(&self, at: &PointView<'_>, load: &mut InteriorLoad) {
         let x = at.position();
         for k in 0..self.obstacles.len() {
+            if self.out_of_reach(k, at.g, at.point.patch, &x) {
+                continue;
+            }
             let Some(c) = self.at(k, at.g, at.point.patch, &x) else {
                 continue;
             };
@@ -755,7 +812,7 @@ impl PointTerm for SurfaceContact {
         let b = &self.between;
         if let Some(d) = b.deepest {
             out.push(format!(
-                "contact: in {} step(s) the rods penetrated obstacle {} beyond the tolerance {:e} somewhere along them (checked at {SAMPLES_PER_SPAN} points per knot span besides the collocation points, where alone the law acts), by up to {:.3e} on patch {} at curve parameter u = {:.4} at t = {} (first at t = {}): refine the patch there",
+                "contact: in {} step(s) the rods penetrated obstacle {} beyond the tolerance {:e} somewhere along them (checked at the patch ends and {SAMPLES_PER_SPAN} points per knot span besides the collocation points, where alone the law acts), by up to {:.3e} on patch {} at curve parameter u = {:.4} at t = {} (first at t = {}): refine the patch there",
                 b.steps,
                 quoted(&self.obstacles[d.obstacle].name),
                 self.settings.tolerance,
@@ -813,7 +870,9 @@ impl PointTerm for SurfaceContact {
         let tolerance = self.settings.tolerance;
         let (at_points, pressures) = self.rigid_contact(disc, state);
         self.committed = Some(pressures);
-        if let Some(d) = self.penetration_anywhere(disc, state)
+        let anywhere = self.penetration_between(state, at_points);
+        let at_points = at_points.map_or(0.0, |d| d.depth);
+        if let Some(d) = anywhere
             && d.depth > tolerance
             && (at_points <= tolerance || d.depth - at_points > tolerance)
         {
@@ -1387,6 +1446,41 @@ mod tests {
         assert!(worst < 1e-9 * ROD, "{worst}");
     }
 
+    /// Source: equilibrium. Automatic stabilisation judges a damped step by the damping's force against what acts
+    /// on the device from outside (module docs of `simulation::stabilisation`, *The force*), and a wall's contact
+    /// is such a force: the frictionless rod pressed on the plane by the line load `w` (nothing pulled) bears
+    /// `w` from the plane at every point, so the loads and the plane give `|n̄| = w` each per unit length, and
+    /// the node resultants vanish (the rod lies flat: no axial force, no moment). A damping opposing a uniform
+    /// motion `δ` along the rod is `(c/h) A δ` per unit length, so its share is `(c/h) A δ / (2 w)`, here 1 %.
+    /// The law acts at the interior points only, so the end points' weights (under a span of 24 on this
+    /// degree-4 rod: at most 4.2 % of its length) carry the load but no contact: tolerance 5 %. Without the
+    /// contact in the reckoning the share is twice as large, a 100 % error (the judgement before this check).
+    #[test]
+    fn a_damping_beside_a_wall_is_judged_against_the_wall_s_reaction_too() {
+        use crate::solver::terms::damping::Damping;
+        let w = 1.0;
+        let model = rod_on_a_plane(0.0, w, TimeFunction::constant(0.0));
+        let mut sim = Simulation::new(&model).expect("discretised");
+        sim.run(&mut [&mut NoObserver]).expect("the rod settles");
+        let area = std::f64::consts::PI * D * D / 4.0;
+        let (share, delta) = (0.01, 1e-3);
+        let rate = share * 2.0 * w / (area * delta);
+        let mut previous = sim.state().clone();
+        for c in &mut previous.control {
+            c.x -= delta;
+        }
+        let damping = Damping {
+            previous: &previous,
+            rate,
+        };
+        let measured = sim.damping_force_share(sim.time(), damping);
+        println!("damping force share beside the plane {measured:.6e}, closed form {share:.6e}");
+        assert!(
+            ((measured - share) / share).abs() < 0.05,
+            "share {measured}, closed form {share}"
+        );
+    }
+
     /// Source: the same rod without friction slides freely, so the pull it needs is zero (to the solver's
     /// tolerance, against the `μ w L = 3` above): friction is what carried the load there.
     #[test]
@@ -1462,7 +1556,7 @@ mod tests {
         let mut term = SurfaceContact::new(&model, &disc, vec![plate], settings);
         term.time = 1.0;
         let (at_points, _) = term.rigid_contact(&disc, &state);
-        assert_eq!(at_points, 0.0, "the collocation points are clear");
+        assert!(at_points.is_none(), "the collocation points are clear");
         let found = term
             .penetration_anywhere(&disc, &state)
             .expect("the crest penetrates");
