@@ -280,9 +280,13 @@ impl Lumen {
     /// The first guess is `hint`, the point's closest parameter at the last converged step (the contact term
     /// keeps one per point), from which Newton's method takes a few iterations as the point moves little per
     /// step; without one, or where Newton does not settle from it, a linear scan of the centreline's samples
-    /// (`SEARCH_SAMPLES` = 8 per knot span). A sorted scan, not a k-d tree: a vessel's fitted centreline has a few
-    /// tens of spans, so the scan is a few hundred points, paid only at a point's first contact check and at
-    /// the checks between collocation points once per step; a tree would save little and add a dependency.
+    /// (`SEARCH_SAMPLES` = 8 per knot span). A linear scan, not the spatial index (a k-d tree) the issue proposed:
+    /// a vessel's fitted centreline has a few tens of spans, so the scan is a few hundred points, paid only where
+    /// a point has no hint (its first contact check) or Newton does not settle from it; the contact term starts
+    /// every other search from a hint (the point's own, or for a check between collocation points its nearest
+    /// point's). Measured with perf on `designs/aorta_stent_in_vessel.yaml` (2026-11-27), while the checks
+    /// between points still scanned every step: the scan was 0.1 % of the run's samples against 18.5 % for the
+    /// Newton projections, so a tree could save at most that 0.1 % and would add a dependency.
     /// A hint can lead to a local, not global, closest point where a vessel folds back within one step's
     /// motion; a fitted vessel centreline does not.
     ///

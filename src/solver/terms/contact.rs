@@ -84,7 +84,8 @@
 //! to refine the patch there — unless the augmented-Lagrange warning already tells it: the collocation points'
 //! own penetration above the tolerance, and nothing deeper than it by more than the tolerance elsewhere. The
 //! collocation points' gaps there are those the commit's Uzawa record finds (one scan; a lumen's from each
-//! point's closest-point parameter, as the law finds them).
+//! point's closest-point parameter, as the law finds them), and a sample's closest point on a lumen is searched
+//! from that of the collocation point nearest to it along its patch.
 //!
 //! **Speed.** Most points touch nothing at most iterations, so the assembly asks a cylinder or a plane for its
 //! distance alone first and computes the normal, Hessian and law only for a point within the law's band; the
@@ -184,13 +185,18 @@ fn samples(model: &Model, disc: &Discretisation) -> Vec<Sample> {
     for (patch, (p, range)) in model.patches.iter().zip(&disc.patches).enumerate() {
         let knots = p.curve.knots();
         let (lo, hi) = knots.domain();
+        let points = &disc.points[range.offset..range.offset + range.n];
         let mut sample = |u: Real| {
             let table = nurbs_basis(knots, p.curve.weights(), u, 0);
+            let near = (points.iter().enumerate())
+                .min_by(|a, b| (a.1.u - u).abs().total_cmp(&(b.1.u - u).abs()))
+                .map_or(range.offset, |(i, _)| range.offset + i);
             out.push(Sample {
                 patch,
                 u,
                 first: range.offset + table.first,
                 basis: table.ders[0].clone(),
+                near,
             });
         };
         sample(lo);
@@ -273,13 +279,15 @@ struct Placed {
 }
 
 /// A point of a patch between its collocation points where the penetration is checked (module docs): its
-/// patch, curve parameter, and basis values `N` of the control points `first ..= first + p`.
+/// patch, curve parameter, basis values `N` of the control points `first ..= first + p`, and the collocation
+/// point nearest to it along the patch (whose closest point on a lumen starts its search).
 #[derive(Debug, Clone)]
 struct Sample {
     patch: usize,
     u: Real,
     first: usize,
     basis: Vec<Real>,
+    near: usize,
 }
 
 /// The largest penetration of the rods into a rigid wall anywhere along them, at the collocation points or
@@ -491,9 +499,10 @@ impl SurfaceContact {
                 .map(|(a, n)| state.control[sample.first + a] * *n)
                 .sum();
             for &k in &walls {
+                let hint = self.hint(k, sample.near);
                 if let Some(d) = self.obstacles[k]
                     .surface
-                    .distance_value(&x, self.time, None)
+                    .distance_value(&x, self.time, hint)
                 {
                     let depth = self.radius[sample.patch] - d;
                     deepest = Penetration::deeper(deepest, depth, k, sample.patch, sample.u);
