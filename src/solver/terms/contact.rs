@@ -21,20 +21,19 @@
 //! **Tangent.** `∂q/∂c = (dp/dg) n nᵀ + p ∇²g` with `dp/dg = −ε Φ'(λ/ε − g)`; the balance law takes `Rᵀ q`, whose
 //! derivative under the rotation is the assembly's (module docs of [`super`]).
 //!
-//! **Augmented Lagrange (Uzawa).** Every step starts with one update: each point's multiplier becomes its
-//! pressure at the converged state the step starts from, `λ ← p(g)` ([`PointTerm::prepare`]). A point in
-//! contact so carries its pressure into the next step (the penalty then only has to answer the change), and a
-//! point that lifts off loses its multiplier within a step or two: a multiplier kept from an earlier contact
-//! would push a point away from `λ/ε` off the wall, far beyond the tolerance with a soft penalty. After a step
-//! converged, if the largest penetration at a rigid wall exceeds the settings' tolerance — at the collocation
-//! points, or between them (below) by no more than the tolerance beyond the deepest point, so that lifting the
-//! points lifts it under the tolerance — every point's multiplier becomes its pressure again and the step is
-//! solved again from where it converged ([`PointTerm::augment`]); at most `max_updates` times. If the penetration is
-//! still above the tolerance then, the step is kept and the run's warnings say so (how many steps, the largest
-//! penetration, when first: [`PointTerm::warnings`], into summary.json and on stderr). The multipliers, the
-//! step's update count, that record, the friction anchors and work, a lumen's closest-point parameters and
-//! the record of penetration anywhere (below) are the term's state: the multipliers start the next step from
-//! this one's pressures, a roll-back restores them all, a checkpoint keeps them.
+//! **Augmented Lagrange (Uzawa).** Every step starts with one update: each point's multiplier becomes its pressure at
+//! the converged state the step starts from, `λ ← p(g)` ([`PointTerm::prepare`]). A point in contact so carries its
+//! pressure into the next step (the penalty then only has to answer the change), and a point that lifts off loses its
+//! multiplier within a step or two: a multiplier kept from an earlier contact would push a point away from `λ/ε` off
+//! the wall, far beyond the tolerance with a soft penalty. After a step converged, if the largest penetration at a
+//! rigid wall exceeds the settings' tolerance — at the collocation points, or between them (below) by no more than the
+//! tolerance beyond the deepest point, so that lifting the points lifts it under the tolerance — every point's
+//! multiplier becomes its pressure again and the step is solved again from where it converged ([`PointTerm::augment`]);
+//! at most `max_updates` times. If the penetration is still above the tolerance then, the step is kept and the run's
+//! warnings say so (how many steps, the largest penetration, when first: [`PointTerm::warnings`], into summary.json and
+//! on stderr). The multipliers, the step's update count, that record, the friction anchors and work, a lumen's
+//! closest-point parameters and the record of penetration anywhere (below) are the term's state: the multipliers start
+//! the next step from this one's pressures, a roll-back restores them all, a checkpoint keeps them.
 //!
 //! **Friction.** An obstacle with a Coulomb coefficient `μ > 0` ([`crate::model::Obstacle::friction`]) adds a
 //! tangential line force at every point it presses, regularised by a stick stiffness and a return map (the
@@ -70,33 +69,31 @@
 //! (the law does not act at the ends); they add up to the patch's reference chord polygon, its length for a
 //! straight rod.
 //!
-//! **Penetration anywhere.** The law acts at the collocation points alone: a crest between two of them (a
-//! crown between Greville points) can pass through a wall unresisted. After every converged step
-//! ([`PointTerm::commit`]) the gap is also checked at the patch ends (nodes, where the law does not act: a
-//! crown's tip where crowns are split there) and at `SAMPLES_PER_SPAN` = 4 points per knot span of each
-//! patch (the midpoints of the span's quarters; a rod's shape between collocation points is polynomial in each
-//! span, and four samples bound a smooth crest's missed depth by `|g''| h²/8` with `h` a quarter span — a
-//! sixteenth of a span's curvature term — at four times the collocation points' cost, paid once per step, not
-//! per iteration), and the largest penetration into a rigid wall anywhere is found with where it is (obstacle,
-//! patch, curve parameter; [`SurfaceContact::penetration_anywhere`]). It drives the augmented-Lagrange updates
-//! as far as they can help: a multiplier acts only where the law does, but updating them brings the points
-//! towards zero gap, and a crest no deeper than the deepest point by more than the tolerance comes out under
-//! it with them; a crest deeper than that needs a finer patch, and the updates do not chase it (on
-//! `designs/aorta_stent_in_vessel.yaml` at p = 5, n = 24 the updates left crests 7.6e-3 through the wall
-//! against the tolerance 4e-3; at n = 30 nothing is left above it). A step whose penetration anywhere exceeds the tolerance
-//! is recorded (how many, the deepest with where and when, the first) and the run's warnings say so, advising
-//! to refine the patch there — unless the augmented-Lagrange warning already tells it: the collocation points'
-//! own penetration above the tolerance, and nothing deeper than it by more than the tolerance elsewhere. The
-//! collocation points' gaps there are those the commit's Uzawa record finds (one scan; a lumen's from each
-//! point's closest-point parameter, as the law finds them), and a sample's closest point on a lumen is searched
-//! from that of the collocation point nearest to it along its patch.
+//! **Penetration anywhere.** The law acts at the collocation points alone: a crest between two of them (a crown between
+//! Greville points) can pass through a wall unresisted. After every converged step ([`PointTerm::commit`]) the gap is
+//! also checked at the patch ends (nodes, where the law does not act: a crown's tip where crowns are split there) and
+//! at `SAMPLES_PER_SPAN` = 4 points per knot span of each patch (the midpoints of the span's quarters; a rod's shape
+//! between collocation points is polynomial in each span, and four samples bound a smooth crest's missed depth by
+//! `|g''| h²/8` with `h` a quarter span — a sixteenth of a span's curvature term — at four times the collocation
+//! points' cost, paid once per step, not per iteration), and the largest penetration into a rigid wall anywhere is
+//! found with where it is (obstacle, patch, curve parameter; [`SurfaceContact::penetration_anywhere`]). It drives the
+//! augmented-Lagrange updates as far as they can help: a multiplier acts only where the law does, but updating them
+//! brings the points towards zero gap, and a crest no deeper than the deepest point by more than the tolerance comes
+//! out under it with them; a crest deeper than that needs a finer patch, and the updates do not chase it (on
+//! `designs/aorta_stent_in_vessel.yaml` at p = 5, n = 24 the updates left crests 7.6e-3 through the wall against the
+//! tolerance 4e-3; at n = 30 nothing is left above it). A step whose penetration anywhere exceeds the tolerance is
+//! recorded (how many, the deepest with where and when, the first) and the run's warnings say so, advising to refine
+//! the patch there — unless the augmented-Lagrange warning already tells it: the collocation points' own penetration
+//! above the tolerance, and nothing deeper than it by more than the tolerance elsewhere. The collocation points' gaps
+//! there are those the commit's Uzawa record finds (one scan; a lumen's from each point's closest-point parameter, as
+//! the law finds them), and a sample's closest point on a lumen is searched from that of the collocation point nearest
+//! to it along its patch.
 //!
-//! **Speed.** Most points touch nothing at most iterations, so the assembly asks a cylinder or a plane for its
-//! distance alone first and computes the normal, Hessian and law only for a point within the law's band; the
-//! commit scans the collocation points once for the Uzawa record and takes the check between points that the
-//! last augmented-Lagrange decision made on the same state. The share of
-//! the contact term in the crimped straight stent's solver time is measured by `scripts/contact_share.sh`
-//! (the README's contact section, *Speed*).
+//! **Speed.** Most points touch nothing at most iterations, so the assembly asks a cylinder or a plane for its distance
+//! alone first and computes the normal, Hessian and law only for a point within the law's band; the commit scans the
+//! collocation points once for the Uzawa record and takes the check between points that the last augmented-Lagrange
+//! decision made on the same state. The share of the contact term in the crimped straight stent's solver time is
+//! measured by `scripts/contact_share.sh` (the README's contact section, *Speed*).
 //!
 //! **Obstacles put in place later** ([`crate::model::Obstacle::active`]: a sheath, a vessel the programmed
 //! device is deployed in) are checked when they arrive: at the converged state of the step that ends at their
@@ -629,34 +626,35 @@ impl SurfaceContact {
     }
 
     /// The largest penetration at the rigid walls over the interior collocation points of `state` (where the
-    /// law acts; `None` if none): the first value of [`SurfaceContact::rigid_contact`], without the pressures.
-    fn rigid_points(&self, disc: &Discretisation, state: &State) -> Option<Penetration> {
+    /// law acts; `None` if none), and each such point's pressure `(obstacle, point, p)` into `pressures` if
+    /// given.
+    fn rigid_points(
+        &self,
+        disc: &Discretisation,
+        state: &State,
+        mut pressures: Option<&mut Vec<(usize, usize, Real)>>,
+    ) -> Option<Penetration> {
         let mut deepest = None;
         self.rigid_gaps(disc, state, |k, g, gap| {
             if let Some(gap) = gap {
                 let point = &disc.points[g];
                 deepest = Penetration::deeper(deepest, -gap, k, point.patch, point.u);
             }
+            if let Some(out) = pressures.as_deref_mut() {
+                out.push((k, g, gap.map_or(0.0, |gap| self.pressure(k, g, gap).0)));
+            }
         });
         deepest
     }
 
-    /// The largest penetration at the rigid walls over the interior collocation points of `state` (where the
-    /// law acts; `None` if none), and each such point's pressure `(obstacle, point, p)`.
+    /// [`SurfaceContact::rigid_points`] with the pressures.
     fn rigid_contact(
         &self,
         disc: &Discretisation,
         state: &State,
     ) -> (Option<Penetration>, Vec<(usize, usize, Real)>) {
-        let mut deepest = None;
         let mut pressures = Vec::new();
-        self.rigid_gaps(disc, state, |k, g, gap| {
-            let point = &disc.points[g];
-            if let Some(gap) = gap {
-                deepest = Penetration::deeper(deepest, -gap, k, point.patch, point.u);
-            }
-            pressures.push((k, g, gap.map_or(0.0, |gap| self.pressure(k, g, gap).0)));
-        });
+        let deepest = self.rigid_points(disc, state, Some(&mut pressures));
         (deepest, pressures)
     }
 
@@ -791,7 +789,7 @@ impl PointTerm for SurfaceContact {
 
     fn augment(&mut self, disc: &Discretisation, state: &State) -> bool {
         let tolerance = self.settings.tolerance;
-        let at_points = self.rigid_points(disc, state);
+        let at_points = self.rigid_points(disc, state, None);
         let worst = at_points.map_or(0.0, |d| d.depth);
         self.checked = None;
         if worst <= tolerance {
