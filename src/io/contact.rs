@@ -3,13 +3,13 @@
 //! the other outputs give an obstacle. The numbers are the contact term's report
 //! ([`crate::solver::terms::contact::ContactReport`], through [`crate::solver::Simulation::contact`]).
 //!
-//! **Columns** (after every other column, per obstacle `<name>` in the model's order; the file's convention for
-//! a quantity per part, as `recovery_ratio_mean@<material>`): `contact_force_x@<name>`, `contact_force_y@<name>`,
-//! `contact_force_z@<name>` (the total force the obstacle exerts on the rods [force]), for a cylinder and a
-//! lumen `contact_radial_force@<name>` (its radial part, the sum of the pressures' magnitudes: positive when
-//! the wires press on the wall [force]), `contact_points@<name>` (collocation points with a positive pressure), `contact_penetration@<name>`
-//! (the largest penetration [length]) and `contact_friction_work@<name>` ([force·length]; 0 until friction
-//! exists). Of the model as simulated: a symmetry-reduced model's share.
+//! **Columns** (after every other column, per obstacle `<name>` in the model's order; the file's convention for a
+//! quantity per part, as `recovery_ratio_mean@<material>`): `contact_force_x@<name>`, `contact_force_y@<name>`,
+//! `contact_force_z@<name>` (the total force the obstacle exerts on the rods [force]), for a cylinder and a lumen
+//! `contact_radial_force@<name>` (its radial part, the sum of the pressures' magnitudes: positive when the wires press
+//! on the wall [force]), `contact_points@<name>` (collocation points with a positive pressure),
+//! `contact_penetration@<name>` (the largest penetration [length]) and `contact_friction_work@<name>` ([force·length];
+//! 0 for a frictionless obstacle). Of the model as simulated: a symmetry-reduced model's share.
 
 use crate::math::Real;
 use crate::model::{Model, Obstacle, Surface};

@@ -206,17 +206,15 @@ pub(crate) fn point_position(disc: &Discretisation, control: &[Vec3], g: usize) 
         .sum()
 }
 
-/// The change `Σ N_j δp_j` of the position at collocation point `g` under the increment `delta` of the solver's
-/// unknowns (six per control point, the translation first).
-pub(crate) fn point_translation(disc: &Discretisation, delta: &[Real], g: usize) -> Vec3 {
+/// The increment `delta` of the solver's unknowns (six per control point, the translation first) at collocation
+/// point `g`: its translation `Σ N_a δp_a` and rotation `Σ N_a δθ_a` (basis values `N_a`).
+pub(crate) fn point_increment(disc: &Discretisation, delta: &[Real], g: usize) -> (Vec3, Vec3) {
     let point = &disc.points[g];
-    point
-        .basis
-        .iter()
-        .enumerate()
-        .map(|(a, b)| {
-            let j = 6 * (point.first + a);
-            Vec3::new(delta[j], delta[j + 1], delta[j + 2]) * b[0]
-        })
-        .sum()
+    let (mut dx, mut theta) = (Vec3::zeros(), Vec3::zeros());
+    for (a, row) in point.basis.iter().enumerate() {
+        let j = 6 * (point.first + a);
+        dx += Vec3::new(delta[j], delta[j + 1], delta[j + 2]) * row[0];
+        theta += Vec3::new(delta[j + 3], delta[j + 4], delta[j + 5]) * row[0];
+    }
+    (dx, theta)
 }

@@ -1240,9 +1240,9 @@ fn check_solver(s: &SolverSettings) -> Result<()> {
 }
 
 /// Arc-length continuation follows a load-driven path of a rate-independent model: every material elastic (a
-/// viscoelastic response depends on time, which the load factor replaces), no programme, no error-controlled
-/// time steps, no contact and no releases (they are about times). Its settings: an end load factor that is finite and not 0, at least one increment, a
-/// target of at least one iteration and a growth of at least 1.
+/// viscoelastic response depends on time, which the load factor replaces), no programme, no error-controlled time
+/// steps, no contact and no releases (they are about times). Its settings: an end load factor that is finite and
+/// not 0, at least one increment, a target of at least one iteration and a growth of at least 1.
 fn check_path(
     s: &SolverSettings,
     materials: &[MaterialLaw],

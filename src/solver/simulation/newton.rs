@@ -183,9 +183,9 @@ impl Simulation<'_> {
     }
 
     /// Scales the Newton increment in `self.work.delta` by the smallest fraction the point terms allow
-    /// ([`crate::solver::terms::PointTerm::step_limit`]: a contact that the tangent does not see yet stops the
-    /// step where it begins to act); whether it was limited. Called for the first increment of each solve. The increment's norm was recorded before: it is
-    /// Newton's measure of the iterate's error, which the limit does not change.
+    /// ([`crate::solver::terms::PointTerm::step_limit`]: a contact that the tangent does not see yet stops the step
+    /// where it begins to act); whether it was limited. Called for the first increment of each solve. The increment's
+    /// norm was recorded before: it is Newton's measure of the iterate's error, which the limit does not change.
     fn limit_step(&mut self) -> bool {
         let alpha = self
             .terms

@@ -61,6 +61,7 @@ use super::Simulation;
 use crate::math::{Real, Vec3};
 use crate::model::StabilisationSettings;
 use crate::solver::assembly::{Actions, point_strains};
+use crate::solver::discretisation::point_increment;
 use crate::solver::state::State;
 use crate::solver::terms::damping::Damping;
 use crate::solver::terms::{InteriorLoad, PointView};
@@ -333,7 +334,7 @@ impl Simulation<'_> {
                     let n = self.disc.num_unknowns();
                     let first = &self.stabiliser.first_increment;
                     let motion = if first.len() >= n {
-                        self.motion_measure(|g| interpolate(&self.disc, first, g))
+                        self.motion_measure(|g| point_increment(&self.disc, first, g))
                     } else {
                         0.0
                     };
@@ -410,20 +411,4 @@ impl Simulation<'_> {
             force_share,
         })
     }
-}
-
-/// The increment `delta`'s translation and rotation at collocation point `g` (basis values `N_a`).
-fn interpolate(
-    disc: &crate::solver::discretisation::Discretisation,
-    delta: &[Real],
-    g: usize,
-) -> (Vec3, Vec3) {
-    let point = &disc.points[g];
-    let (mut dx, mut theta) = (Vec3::zeros(), Vec3::zeros());
-    for (a, row) in point.basis.iter().enumerate() {
-        let j = 6 * (point.first + a);
-        dx += Vec3::new(delta[j], delta[j + 1], delta[j + 2]) * row[0];
-        theta += Vec3::new(delta[j + 3], delta[j + 4], delta[j + 5]) * row[0];
-    }
-    (dx, theta)
 }

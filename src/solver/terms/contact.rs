@@ -140,7 +140,7 @@ use crate::math::basis::nurbs_basis;
 use crate::math::quote::quoted;
 use crate::math::{Mat3, Real, Vec3};
 use crate::model::{ContactSettings, Distance, Model, Obstacle, Surface, Wall};
-use crate::solver::discretisation::{Discretisation, point_position, point_translation};
+use crate::solver::discretisation::{Discretisation, point_increment, point_position};
 use crate::solver::state::State;
 
 /// The C¹ ramp `Φ(x)` of the contact law and its derivative (module docs), with half-width `delta`.
@@ -769,7 +769,7 @@ impl PointTerm for SurfaceContact {
                 // The stop is the middle of the law's band, where its stiffness is half the penalty.
                 let (penalty, multiplier) = self.law(k, g);
                 let stop = multiplier / penalty;
-                let dx = *step.get_or_insert_with(|| point_translation(disc, delta, g));
+                let dx = *step.get_or_insert_with(|| point_increment(disc, delta, g).0);
                 // The distance moves by at most |dx|: a point that cannot reach the stop is not searched.
                 if gap - dx.norm() >= stop {
                     continue;
