@@ -129,7 +129,8 @@ fn load_let_go(f: &TimeFunction) -> Option<(Real, Real)> {
 
 impl Model {
     /// A crimper programme's let-go: the crimper opening from the release, with its radius schedule (whose
-    /// breakpoints before the release are the programming).
+    /// breakpoints before the release are the programming; around a curved axis the factor on its tube's
+    /// radius).
     fn crimper_let_go(&self) -> Option<((Real, Real), &TimeFunction)> {
         let programme = self.programme.as_ref()?;
         let super::ProgrammeKind::Crimp { obstacle, open, .. } = programme.kind else {
@@ -137,10 +138,13 @@ impl Model {
         };
         let release = programme.release?;
         let crimper = self.contact.as_ref()?.obstacles.get(obstacle)?;
-        let super::Surface::Cylinder { radius, .. } = &crimper.surface else {
-            return None;
+        // A cylinder's radius, or the scale on a curved crimper tube's radius (the same schedule's shape).
+        let schedule = match &crimper.surface {
+            super::Surface::Cylinder { radius, .. } => radius,
+            super::Surface::Lumen(tube) => tube.scale(),
+            super::Surface::Plane { .. } => return None,
         };
-        Some(((release, release + open), radius))
+        Some(((release, release + open), schedule))
     }
 
     /// The model's shape-memory cycle, if it has one (see [`crate::model::cycle`]). An arc-length path has

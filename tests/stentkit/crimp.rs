@@ -120,7 +120,7 @@ fn a_crimp_programme_builds_its_crimper_and_prescribes_nothing() {
 /// the arc's plane at angle ψ, `O + 101 (cos ψ, 0, sin ψ)`, is `r(t) − 1` inside the tube of radius `r(t)`; the
 /// tube is closed at t = 1.5 s to R − Δr + d/2 = 5.3 and starts at least 2 % clear of the crowns' reach
 /// 20.3 (the radial bridges reach further). The axis is fitted within 1e-5 of the crown radius (2e-4): the
-/// tolerance covers it.
+/// tolerance covers it. The cycle's events are the tube's schedule's, as for a cylinder.
 #[test]
 fn a_curved_stent_is_crimped_by_a_tube_around_its_own_axis() {
     let path =
@@ -148,6 +148,12 @@ fn a_curved_stent_is_crimped_by_a_tube_around_its_own_axis() {
         }
     }
     assert!(!model.programme.as_ref().expect("a programme").prescribes());
+    // Its cycle, as the straight crimper's: programmed when the tube has closed (1.5 s), fixed at the release
+    // (2.25 s), released when it is open (2.25 + 0.15 s) — what the recovery warning and the snapshots' events
+    // read.
+    let cycle = model.cycle().expect("a cycle");
+    assert_eq!((cycle.programmed, cycle.fixed), (Some(1.5), 2.25));
+    assert!((cycle.released - 2.4).abs() < 1e-12, "{}", cycle.released);
 }
 
 /// Contact with every material integrator (issue 33): the crimped straight stent (two crowns) crimped at 90 °C
