@@ -17,7 +17,7 @@ import sys
 from pathlib import Path
 
 # The layers of src/lib.rs, lowest first: a module may import from its own layer and the ones before it.
-LAYERS = ["math", "geometry", "material", "model", "solver", "post", "study", "io", "design", "run", "sweep", "cli"]
+LAYERS = ["math", "geometry", "material", "model", "solver", "post", "study", "io", "design", "run", "bench", "sweep", "cli"]
 
 PATH = re.compile(r"\b(crate|super|self)((?:::[A-Za-z_][A-Za-z0-9_]*)+)")
 TEST_MODULE = re.compile(r"#\[cfg\(test\)\]\s*mod\s+([a-z_]+)\s*\{")

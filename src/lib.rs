@@ -7,7 +7,7 @@
 //! ## Layers
 //!
 //! Dependencies point one way, left to right never imported from the right: `math → geometry → material → model →
-//! solver → post → study → io → design → run → sweep → cli`, and no two modules import each other, directly or
+//! solver → post → study → io → design → run → bench → sweep → cli`, and no two modules import each other, directly or
 //! through others (`scripts/module_cycles.py`, run by CI, checks both from the source). `math`, `geometry`,
 //! `material`, `model`, `solver` and `post` are pure: no files, no printing, no serde. `study` writes no file and
 //! prints nothing either: it varies built models and returns its charts as descriptions ([`post::chart`]) that `cli`
@@ -31,6 +31,7 @@
 //! | [`io`] | file formats: writers of STL/OBJ/3MF/VTK, the MCAP recording, the run folder, checkpoints, charts; centreline readers; a run's output settings |
 //! | [`design`] | the YAML design language: DTOs, validation with line and column, device families' YAML, `--set` overrides, the translation into [`model::builder`] calls |
 //! | [`run`] | a run of a design into its run folder: the recorders ([`run::recorder::RECORDERS`]), summary, heartbeat, checkpoints, resume, the disk check; interruption and console passed in |
+//! | [`bench`] | the virtual bench: a design's radial-force test as a run of a crimp, its table and chart |
 //! | [`sweep`] | families of variants of a design: swept parameters, the sweep folder and its variants' states, their metrics, `sweep.csv` and charts, the Slurm batch script |
 //! | [`cli`] | the `stentkit` command line |
 //!
@@ -51,6 +52,7 @@
 // below and the re-exports after them); everything else is `pub(crate)`. Every public item has a doc comment.
 #![warn(missing_docs, unreachable_pub)]
 
+pub mod bench;
 pub mod cli;
 pub mod design;
 pub mod geometry;

@@ -3,6 +3,7 @@
 //! and `schema` (the JSON Schema of the design format). The only module that uses `anyhow` and prints.
 
 pub(crate) mod arguments;
+pub(crate) mod bench;
 pub mod check;
 pub(crate) mod disk;
 pub(crate) mod drawing;
@@ -35,6 +36,33 @@ pub(crate) struct Cli {
     /// What to do.
     #[command(subcommand)]
     pub command: Command,
+}
+
+/// The tests of `stentkit bench`.
+#[derive(Debug, Subcommand)]
+pub(crate) enum BenchTest {
+    /// The radial force (ASTM F3067): the device at the bench's temperature in a rigid crimper closing from
+    /// just outside it to `bench.min_diameter` and opening again at `bench.rate`; writes `radial.csv` (diameter,
+    /// branch, force in N, N per length, kPa, mmHg) and `charts/radial_force.svg` into the run folder and prints
+    /// the smallest diameter reached and the forces at the vessel's diameter.
+    ///
+    /// Example: stentkit bench radial designs/straight_stent.yaml --set bench.temperature=90
+    Radial {
+        /// The design file (YAML).
+        design: PathBuf,
+        /// Run folder (default: `runs/<design name>-radial`).
+        #[arg(short, long)]
+        output: Option<PathBuf>,
+        /// Replace an earlier run in the run folder (only the files it wrote are removed).
+        #[arg(long)]
+        force: bool,
+        /// No progress bar; the results are printed.
+        #[arg(short, long)]
+        quiet: bool,
+        /// Override a field of the design, `bench:` included: `PATH=VALUE` (`--set bench.rate=0.5`).
+        #[arg(long = "set", value_name = "PATH=VALUE", value_parser = arguments::set_override())]
+        set: Vec<SetOverride>,
+    },
 }
 
 /// The subcommands.
@@ -102,6 +130,16 @@ pub(crate) enum Command {
         /// and checked as if written in the file.
         #[arg(long = "set", value_name = "PATH=VALUE", value_parser = arguments::set_override())]
         set: Vec<SetOverride>,
+    },
+    /// The virtual bench: a test a stent engineer runs on the device, as a run of the design (`bench radial`:
+    /// the radial force in a closing and opening crimper). The design's `bench:` block sets it (`--set
+    /// bench.temperature=90`); the run folder gets the bench's table and chart besides a run's files.
+    ///
+    /// Example: stentkit bench radial designs/straight_stent.yaml -o runs/straight_stent-radial
+    Bench {
+        /// Which test.
+        #[command(subcommand)]
+        test: BenchTest,
     },
     /// Write the full device's tube mesh in any state of a finished run: at a time, or at an event of its
     /// shape-memory cycle (initial, programmed, fixed, released, final). The run's design (summary.json's
@@ -614,6 +652,16 @@ pub fn main() -> ExitCode {
                 sets: set,
             },
         ),
+        Command::Bench {
+            test:
+                BenchTest::Radial {
+                    design,
+                    output,
+                    force,
+                    quiet,
+                    set,
+                },
+        } => bench::radial(&design, output, force, quiet, set),
         Command::Export {
             run_dir,
             time,

@@ -38,6 +38,8 @@ pub(crate) struct Built {
     pub memory: MemoryEstimate,
     /// The steps the run takes when no step is cut ([`Model::planned_steps`]).
     pub steps: StepPlan,
+    /// The virtual bench's settings as written.
+    pub bench: super::BenchSpec,
 }
 
 /// Builds and validates the model (with `temporary_shape`, the device in its programme's temporary shape,
@@ -229,6 +231,37 @@ pub(crate) fn build(dto: &DesignDto, default_name: &str, temporary_shape: bool) 
         notes,
         memory,
         steps: plan,
+        bench: bench(dto.bench.as_ref())?,
+    })
+}
+
+/// The `bench` block, checked: a finite temperature, at least two diameters per branch.
+fn bench(dto: Option<&super::dto::BenchDto>) -> Result<super::BenchSpec> {
+    let Some(b) = dto else {
+        return Ok(super::BenchSpec::default());
+    };
+    if let Some(t) = b.temperature
+        && !t.is_finite()
+    {
+        return Err(issue(
+            "bench.temperature",
+            format!("{t} °C is not a temperature"),
+        ));
+    }
+    if let Some(n) = b.diameters
+        && n < 2
+    {
+        return Err(issue(
+            "bench.diameters",
+            format!("{n} diameters per branch: at least 2 make a curve"),
+        ));
+    }
+    Ok(super::BenchSpec {
+        temperature: b.temperature,
+        rate: b.rate.map(|r| r.0),
+        min_diameter: b.min_diameter.map(|d| d.0),
+        vessel_diameter: b.vessel_diameter.map(|d| d.0),
+        diameters: b.diameters,
     })
 }
 

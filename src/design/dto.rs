@@ -318,6 +318,33 @@ pub struct DesignDto {
     /// Outputs.
     #[serde(default)]
     pub output: Option<OutputDto>,
+    /// The virtual bench's settings (`stentkit bench radial`; every one optional): read by the bench
+    /// commands only, a run ignores them.
+    #[serde(default)]
+    pub bench: Option<BenchDto>,
+}
+
+/// The virtual bench's settings (module docs of `crate::bench`).
+#[derive(Debug, Clone, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct BenchDto {
+    /// Temperature of the test \[°C\] (default 37, body temperature).
+    #[serde(default)]
+    pub temperature: Option<f64>,
+    /// Rate of the crimper's diameter \[length/time\] (default 0.1 mm/s).
+    #[serde(default)]
+    pub rate: Option<Positive>,
+    /// The smallest diameter the crimper closes to \[length\] (default: the programme's crimped or contracted
+    /// outer diameter `2 (R − Δr) + d`, or half the device's outer diameter without a programme).
+    #[serde(default)]
+    pub min_diameter: Option<Positive>,
+    /// The vessel's diameter, where the chronic outward force is read \[length\] (default: a vessel file's
+    /// mean lumen diameter; none without one).
+    #[serde(default)]
+    pub vessel_diameter: Option<Positive>,
+    /// Diameters recorded on each branch, closing and opening (default 30, at least 2).
+    #[serde(default)]
+    pub diameters: Option<usize>,
 }
 
 /// An obstacle: a named surface (give exactly one of `cylinder`, `plane` or `lumen`) with its wall and the times

@@ -62,6 +62,24 @@ pub struct Design {
     pub overrides: Vec<String>,
     /// Where it was read from.
     pub path: PathBuf,
+    /// The virtual bench's settings as written (`bench:`; `crate::bench` resolves the defaults).
+    pub bench: BenchSpec,
+}
+
+/// The `bench` block of a design as written: `None` where it gives no value (`crate::bench` resolves the
+/// defaults, some of which need the model).
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct BenchSpec {
+    /// Temperature of the test \[°C\].
+    pub temperature: Option<f64>,
+    /// Rate of the crimper's diameter \[length/time\].
+    pub rate: Option<f64>,
+    /// The smallest diameter the crimper closes to \[length\].
+    pub min_diameter: Option<f64>,
+    /// The vessel's diameter, where the chronic outward force is read \[length\].
+    pub vessel_diameter: Option<f64>,
+    /// Diameters recorded per branch.
+    pub diameters: Option<usize>,
 }
 
 impl RunDesign for Design {
@@ -445,6 +463,7 @@ pub fn parse_design_with(
         source,
         overrides: overrides.sets.iter().map(|s| s.argument.clone()).collect(),
         path: file,
+        bench: built.bench,
     })
 }
 

@@ -5,6 +5,7 @@ mod common;
 
 mod arc_length;
 mod arguments;
+mod bench;
 mod centreline;
 mod checkpoint;
 mod cli;
