@@ -31,7 +31,7 @@
 //! | [`io`] | file formats: writers of STL/OBJ/3MF/VTK, the MCAP recording, the run folder, checkpoints, charts; centreline readers; a run's output settings |
 //! | [`design`] | the YAML design language: DTOs, validation with line and column, device families' YAML, `--set` overrides, the translation into [`model::builder`] calls |
 //! | [`run`] | a run of a design into its run folder: the recorders ([`run::recorder::RECORDERS`]), summary, heartbeat, checkpoints, resume, the disk check; interruption and console passed in |
-//! | [`bench`] | the virtual bench: a design's radial-force test as a run of a crimp, its table and chart |
+//! | [`bench`](mod@bench) | the virtual bench: a design's radial-force test as a run of a crimp, its table and chart |
 //! | [`sweep`] | families of variants of a design: swept parameters, the sweep folder and its variants' states, their metrics, `sweep.csv` and charts, the Slurm batch script |
 //! | [`cli`] | the `stentkit` command line |
 //!
