@@ -606,7 +606,22 @@ def contact_speed():
     return head + "\n" + text
 
 
+def bench_speed():
+    """README: what `stentkit bench radial` costs on the straight stent."""
+    asset = "assets/bench_speed.csv"
+    head = stamp(asset)
+    data, _ = rows(asset)
+    body = [
+        [f"`bench {r['bench']}`", f"`{r['design']}`", f"{float(r['wall_s']):.2f} s", r["diameters_per_branch"]]
+        for r in data
+    ]
+    text = table(["command", "design", "wall time (whole command)", "diameters per branch"], body)
+    text += "\nTarget: the straight stent's quarter model, closing and opening over 60 diameters, under 30 s.\n"
+    return head + "\n" + text
+
+
 GENERATORS = {
+    "bench-speed": bench_speed,
     "contact-map": contact_map,
     "contact-speed": contact_speed,
     "curved-sensitivity": curved_sensitivity,
