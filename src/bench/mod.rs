@@ -158,7 +158,7 @@ pub fn radial_design(
     if !(min_diameter > wire && min_diameter < 2.0 * start) {
         return Err(unfit(format!(
             "bench.min_diameter: the crimper would close to {min_diameter} {}, which must lie between the wire's \
-             diameter {wire} and the crimper's start {} (2 % clear of the device)",
+             diameter {wire} and the crimper's start {:.4} (2 % clear of the device)",
             units.length(),
             2.0 * start
         )));

@@ -231,12 +231,14 @@ pub(crate) fn build(dto: &DesignDto, default_name: &str, temporary_shape: bool) 
         notes,
         memory,
         steps: plan,
-        bench: bench(dto.bench.as_ref())?,
+        bench: bench(dto.bench.as_ref(), section.diameter())?,
     })
 }
 
-/// The `bench` block, checked: a finite temperature, at least two diameters per branch.
-fn bench(dto: Option<&super::dto::BenchDto>) -> Result<super::BenchSpec> {
+/// The `bench` block, checked: a finite temperature, at least two diameters per branch, a smallest diameter
+/// above the design's wire diameter `wire` (a crimper closed to the wire's own diameter would leave the
+/// wire's centreline on the axis).
+fn bench(dto: Option<&super::dto::BenchDto>, wire: Real) -> Result<super::BenchSpec> {
     let Some(b) = dto else {
         return Ok(super::BenchSpec::default());
     };
@@ -254,6 +256,17 @@ fn bench(dto: Option<&super::dto::BenchDto>) -> Result<super::BenchSpec> {
         return Err(issue(
             "bench.diameters",
             format!("{n} diameters per branch: at least 2 make a curve"),
+        ));
+    }
+    if let Some(d) = b.min_diameter
+        && d.0 <= wire
+    {
+        return Err(issue(
+            "bench.min_diameter",
+            format!(
+                "{} is not above the wire's diameter {}: the crimper cannot close onto the axis",
+                d.0, wire
+            ),
         ));
     }
     Ok(super::BenchSpec {

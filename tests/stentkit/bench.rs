@@ -161,3 +161,29 @@ fn a_quarter_model_on_the_radial_bench_gives_the_full_devices_force() {
     );
     assert!(((a - b) / b).abs() < 1e-3, "quarter × 4 {a}, full {b}");
 }
+
+/// A bench the device does not fit is refused before anything runs (exit status 2), naming the design file and
+/// the field: a smallest diameter above the crimper's start (the device's outer diameter 40.6 and 2 %).
+#[test]
+fn a_smallest_diameter_above_the_device_is_refused_and_nothing_is_written() {
+    let dir = TempDir::new("bench-refused");
+    let out_dir = dir.join("run");
+    let (design, _) = small_bench(&[]);
+    let out = Command::new(env!("CARGO_BIN_EXE_stentkit"))
+        .args(["bench", "radial"])
+        .arg(&design)
+        .arg("-o")
+        .arg(&out_dir)
+        .args(["--set", "bench.min_diameter=50"])
+        .output()
+        .expect("stentkit runs");
+    let stderr = String::from_utf8_lossy(&out.stderr).into_owned();
+    assert_eq!(out.status.code(), Some(2), "{stderr}");
+    assert!(
+        stderr
+            .contains("straight_stent.yaml: bench.min_diameter: the crimper would close to 50 mm")
+            && stderr.contains("41.4120"),
+        "{stderr}"
+    );
+    assert!(!out_dir.exists());
+}
