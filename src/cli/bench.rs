@@ -67,7 +67,11 @@ pub(crate) fn radial(
         &signals::INTERRUPT,
         &mut console,
     );
-    // A run that stopped early still gives the table up to where it got.
+    // A run refused before it started wrote nothing, and the folder (an earlier run's) is left as it is; a run
+    // that stopped early still gives the table up to where it got.
+    if let Err(e @ crate::run::RunError::Refused(_)) = completed {
+        return Err(command_error(e));
+    }
     let lines = crate::bench::write_radial_outputs(&dir, &bench, &design.model);
     match (completed, lines) {
         (Ok(c), Ok(lines)) => {

@@ -128,6 +128,17 @@ fn the_radial_bench_records_both_branches_and_its_force_is_the_contact_on_the_wh
     assert!(opening.len() >= 5, "{table}");
     assert!(opening.windows(2).all(|w| w[1].0 > w[0].0), "{opening:?}");
     assert!((opening.last().expect("open").0 - closing[0].0).abs() < 1e-9);
+    // The same folder again without --force is refused, and the earlier bench's table is left as it was.
+    let again = Command::new(env!("CARGO_BIN_EXE_stentkit"))
+        .args(&args)
+        .args(["--set", "bench.min_diameter=35"])
+        .output()
+        .expect("stentkit runs");
+    assert_eq!(again.status.code(), Some(2));
+    assert_eq!(
+        std::fs::read_to_string(out_dir.join("radial.csv")).expect("radial.csv"),
+        table
+    );
     let (model_design, bench) = radial_design(&design, &overrides(&sets)).expect("the bench");
     let expected = closed_force_from_pressures(&model_design, &bench);
     assert!(
