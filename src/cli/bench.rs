@@ -51,11 +51,8 @@ pub(crate) fn radial(
         output.unwrap_or_else(|| Path::new("runs").join(format!("{}-radial", design.model.name())));
     let settings = RunSettings {
         quiet,
-        ..RunSettings::new(command_line())
-    };
-    let settings = RunSettings {
         started,
-        ..settings
+        ..RunSettings::new(command_line())
     };
     let completed = crate::run::run(
         &design,
