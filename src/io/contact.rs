@@ -104,6 +104,59 @@ pub struct ObstaclePeaks {
     /// The largest penetration \[length\].
     #[serde(skip_serializing_if = "Option::is_none")]
     pub largest_penetration: Option<Peak>,
+    /// How the wires lie on it at the last converged step (the end of a completed run; [`Apposition`]).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub apposition: Option<Apposition>,
+}
+
+/// How the wires lie on an obstacle at one state (`summary.json`'s `contact[].apposition`; the contact report's
+/// module docs, *Apposition*).
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Apposition {
+    /// The time of the state \[s\].
+    pub time: Real,
+    /// The share of the wires' length in contact, in \[0, 1\].
+    pub contact_fraction: Real,
+    /// The largest gap of a wire from the surface, with where.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub largest_gap: Option<Located>,
+    /// The largest line pressure \[force/length\].
+    pub peak_pressure: Real,
+    /// The mean line pressure over the length in contact \[force/length\].
+    pub mean_pressure: Real,
+}
+
+/// A value at a point of a wire.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Located {
+    /// The value.
+    pub value: Real,
+    /// The patch's name.
+    pub patch: String,
+    /// The curve parameter on it, in \[0, 1\].
+    pub u: Real,
+}
+
+/// The apposition of every obstacle in `report` (of `model`), in the model's order.
+pub(crate) fn appositions(model: &Model, report: &ContactReport) -> Vec<Apposition> {
+    report
+        .obstacles
+        .iter()
+        .map(|o| {
+            let a = &o.apposition;
+            Apposition {
+                time: report.time,
+                contact_fraction: a.contact_fraction,
+                largest_gap: a.largest_gap.map(|(value, patch, u)| Located {
+                    value,
+                    patch: model.patches[patch].name.clone(),
+                    u,
+                }),
+                peak_pressure: a.peak_pressure,
+                mean_pressure: a.mean_pressure,
+            }
+        })
+        .collect()
 }
 
 /// The peaks of every obstacle of `model` over the rows seen so far (empty without contact).
@@ -115,6 +168,7 @@ pub(crate) fn no_peaks(model: &Model) -> Vec<ObstaclePeaks> {
             peak_force: None,
             peak_radial_force: None,
             largest_penetration: None,
+            apposition: None,
         })
         .collect()
 }

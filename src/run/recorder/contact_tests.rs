@@ -127,6 +127,27 @@ fn a_crimped_ring_writes_its_contact_into_every_output() {
             <= SETTINGS.tolerance
     );
     assert!(peaks["peak_force"]["value"].as_f64().expect("value") > 0.0);
+    // The apposition at the end is the report's, to the last bits (serde_json reads a number back within an
+    // ulp or two without its `float_roundtrip` feature: 1e-15 relative).
+    let a = &peaks["apposition"];
+    let same = |json: &serde_json::Value, x: f64| {
+        json.as_f64()
+            .is_some_and(|v| (v - x).abs() <= 1e-15 * x.abs())
+    };
+    assert_eq!(a["time"], 1.0);
+    assert!(
+        same(&a["contact_fraction"], o.apposition.contact_fraction),
+        "{a}"
+    );
+    assert!(same(&a["mean_pressure"], o.apposition.mean_pressure), "{a}");
+    assert!(same(&a["peak_pressure"], o.apposition.peak_pressure), "{a}");
+    let (gap, patch, u) = o.apposition.largest_gap.expect("a gap");
+    assert!(same(&a["largest_gap"]["value"], gap), "{a}");
+    assert_eq!(
+        a["largest_gap"]["patch"],
+        model.patches[patch].name.as_str()
+    );
+    assert!(same(&a["largest_gap"]["u"], u), "{a}");
 
     let snapshots = summary["snapshots"].as_array().expect("snapshots");
     let vtp = snapshots.last().expect("a snapshot")["vtp"]

@@ -122,9 +122,15 @@ impl Recorder for HistoryWriter {
         self.take_warnings()
     }
 
-    fn summarise(&self, summary: &mut RunSummaryFile, _: &Simulation<'_>) {
+    fn summarise(&self, summary: &mut RunSummaryFile, sim: &Simulation<'_>) {
         summary.peak_surface_strain = self.peak_surface_strain().cloned();
         summary.contact = self.contact_peaks().to_vec();
+        if let Some(report) = sim.contact() {
+            let now = crate::io::contact::appositions(sim.model(), &report);
+            for (peaks, a) in summary.contact.iter_mut().zip(now) {
+                peaks.apposition = Some(a);
+            }
+        }
     }
 
     fn finish(&mut self, _: &Simulation<'_>, f: &mut Finishing<'_>) {

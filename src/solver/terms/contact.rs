@@ -133,7 +133,7 @@
 
 pub(crate) mod report;
 
-pub use report::{ContactReport, ObstacleReport};
+pub use report::{Apposition, ContactReport, ObstacleReport};
 
 use super::{InteriorLoad, PointTerm, PointView};
 use crate::math::basis::nurbs_basis;

@@ -32,6 +32,13 @@
 //! compliant wall the wall's displacement, not an error). Extra sample points between the collocation points
 //! (a crest between two points) add their gaps in [`largest_penetration`], the one place that takes the
 //! maximum. The **friction work** is zero until the contact law has friction.
+//!
+//! **Apposition** (issue 34 item 3: how a device lies on a vessel wall) is read off the same points and weights:
+//! the share of the wires' length in contact `Σ_{p>0} w_g / Σ w_g`, the largest gap of a collocation point from
+//! the surface (the largest malapposition; where: its patch and curve parameter), and the largest and the mean
+//! line pressure over the length in contact, `Σ w p / Σ_{p>0} w` (per unit reference length of wire, as the law's
+//! pressure; over the contact width of the wire's diameter it is a wall pressure). Of the model as simulated:
+//! the shares and pressures of a symmetry-reduced model are the device's.
 
 use super::SurfaceContact;
 use crate::math::{Real, Vec3};
@@ -69,6 +76,24 @@ pub struct ObstacleReport {
     /// The pressure at every collocation point, per unit reference length (module docs for the patch ends)
     /// \[force/length\].
     pub pressure: Vec<Real>,
+    /// How the wires lie on the surface (module docs, *Apposition*).
+    pub apposition: Apposition,
+}
+
+/// How the wires lie on a surface at a state (module docs, *Apposition*): the share of their length in contact,
+/// the widest gap of a wire from the surface and where, and the line pressure on it.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Apposition {
+    /// The wires' length in contact (the collocation points' trapezoidal weights where the pressure is positive)
+    /// over their whole length, in \[0, 1\].
+    pub contact_fraction: Real,
+    /// The largest finite gap of a wire from the surface (the largest malapposition) \[length\], with the patch
+    /// and curve parameter of its collocation point; `None` when no point has a gap (a plane's far side).
+    pub largest_gap: Option<(Real, usize, Real)>,
+    /// The largest line pressure \[force/length\] (0 when nothing touches).
+    pub peak_pressure: Real,
+    /// The mean line pressure over the length in contact \[force/length\] (0 when nothing touches).
+    pub mean_pressure: Real,
 }
 
 impl SurfaceContact {
@@ -99,7 +124,9 @@ impl SurfaceContact {
         let (mut gap, mut pressure) = (vec![Real::NAN; n], vec![0.0; n]);
         let mut force = Vec3::zeros();
         let mut radial = 0.0;
+        let (mut touching, mut total) = (0.0, 0.0);
         for (g, x) in positions.iter().enumerate() {
+            total += weights[g];
             let patch = disc.points[g].patch;
             let Some(c) = self.at(k, law_point(disc, g), patch, x) else {
                 continue;
@@ -108,7 +135,24 @@ impl SurfaceContact {
             pressure[g] = c.pressure;
             force += c.distance.normal * (weights[g] * c.pressure);
             radial += weights[g] * c.pressure;
+            if c.pressure > 0.0 {
+                touching += weights[g];
+            }
         }
+        let largest_gap = (gap.iter().enumerate())
+            .filter(|(_, g)| g.is_finite())
+            .max_by(|a, b| a.1.total_cmp(b.1))
+            .map(|(g, &value)| (value, disc.points[g].patch, disc.points[g].u));
+        let apposition = Apposition {
+            contact_fraction: if total > 0.0 { touching / total } else { 0.0 },
+            largest_gap,
+            peak_pressure: pressure.iter().fold(0.0, |m: Real, &p| m.max(p)),
+            mean_pressure: if touching > 0.0 {
+                radial / touching
+            } else {
+                0.0
+            },
+        };
         let radial_force = match self.obstacles[k].surface {
             Surface::Cylinder { .. } | Surface::Lumen(_) => Some(radial),
             Surface::Plane { .. } => None,
@@ -121,6 +165,7 @@ impl SurfaceContact {
             friction_work: self.friction_work(k).1,
             gap,
             pressure,
+            apposition,
         }
     }
 }
@@ -263,6 +308,35 @@ pub(crate) mod tests {
             o.friction_work, 0.0,
             "a frictionless crimper dissipates nothing"
         );
+        // Apposition: the whole ring presses on the crimper with the uniform pressure; its widest gap is its
+        // smallest penetration (the gaps were checked above).
+        let a = &o.apposition;
+        assert_eq!(a.contact_fraction, 1.0);
+        assert!((a.mean_pressure - q_closed).abs() <= 1e-8 * q_closed);
+        assert!((a.peak_pressure - q_closed).abs() <= 1e-8 * q_closed);
+        let widest = o.gap.iter().copied().fold(Real::NEG_INFINITY, Real::max);
+        assert_eq!(a.largest_gap.map(|(g, _, _)| g), Some(widest));
+    }
+
+    /// Source: geometry. The same ring inside a cylinder 0.2 clear of its wires touches nothing: no length in
+    /// contact, no pressure, and every point's gap is the clearance (to round-off: the ring is exact).
+    #[test]
+    fn a_ring_clear_of_its_cylinder_reports_no_apposition_and_its_clearance() {
+        let clear = R0 + D / 2.0 + 0.2;
+        let model = quarter_ring(Contact {
+            obstacles: vec![cylinder(clear, clear, Wall::Rigid)],
+            settings: SETTINGS,
+        });
+        let sim = Simulation::new(&model).expect("discretised");
+        let report = sim.contact().expect("a model with contact reports it");
+        let a = &report.obstacles[0].apposition;
+        assert_eq!(
+            (a.contact_fraction, a.peak_pressure, a.mean_pressure),
+            (0.0, 0.0, 0.0)
+        );
+        let (gap, patch, u) = a.largest_gap.expect("every point has a gap");
+        assert!((gap - 0.2).abs() <= 1e-12 * R0, "{gap}");
+        assert!(patch == 0 && (0.0..=1.0).contains(&u));
     }
 
     /// A model without contact has no report: nothing for the outputs to write.
