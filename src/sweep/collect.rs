@@ -90,6 +90,40 @@ const AFTER_RATIOS: [Column; 5] = [
     ("final_displacement", Unit::Length, |m| m.final_displacement),
 ];
 
+/// The apposition columns of `model`'s obstacles (none without contact): per obstacle `<name>` the share of the
+/// wires' length in contact, the largest gap (`length`: the length unit's suffix) and the mean line pressure.
+fn apposition_columns(model: Option<&crate::model::Model>, length: &str) -> Vec<MetricColumn> {
+    let Some(model) = model else {
+        return Vec::new();
+    };
+    let names = model.contact.as_ref().map_or(Vec::new(), |c| {
+        c.obstacles
+            .iter()
+            .map(crate::io::contact::column_name)
+            .collect()
+    });
+    let line_pressure = format!(" (N/{})", model.units.length());
+    let mut columns = Vec::new();
+    for (k, name) in names.into_iter().enumerate() {
+        type Pick = fn(&super::metrics::AppositionMetrics) -> Option<Real>;
+        let quantities: [(&str, String, Pick); 3] = [
+            ("contact_fraction", String::new(), |a| a.contact_fraction),
+            ("largest_gap", length.to_string(), |a| a.largest_gap),
+            ("mean_line_pressure", line_pressure.clone(), |a| {
+                a.mean_pressure
+            }),
+        ];
+        for (quantity, unit, pick) in quantities {
+            columns.push(MetricColumn {
+                name: format!("{quantity}@{name}"),
+                unit,
+                get: Box::new(move |m: &Metrics| m.apposition.get(k).and_then(pick)),
+            });
+        }
+    }
+    columns
+}
+
 /// Reads every variant of the sweep in `dir` and writes `sweep.csv` and `charts/` (module docs). The recovery
 /// ratio is taken at `times`, or by default halfway between the release and the end and at the end (the end
 /// alone for a design without a release).
@@ -158,6 +192,10 @@ pub fn collect(dir: &SweepDir, times: Option<&[Real]>) -> Result<Collected, Swee
             get: Box::new(move |m: &Metrics| m.recovery_at.get(k).copied().flatten()),
         }))
         .chain(AFTER_RATIOS.iter().map(fixed))
+        .chain(apposition_columns(
+            models.iter().flatten().next(),
+            &unit(Unit::Length),
+        ))
         .collect();
     // The table.
     let mut csv = String::from("variant");

@@ -14,7 +14,10 @@
 //!   when it never does);
 //! - **final residual shape**: `ρ` (mean and largest) and `u` at the last saved step;
 //! - **warnings**: how many `summary.json` lists (a run can complete with one: stabilisation above its limit,
-//!   a device heated but not recovered), so a table of completed variants does not hide them.
+//!   a device heated but not recovered), so a table of completed variants does not hide them;
+//! - **apposition**, per obstacle of a model with contact, at the end (`summary.json`'s `contact[].apposition`):
+//!   the share of the wires' length in contact, the largest gap of a wire from the surface (malapposition) and
+//!   the mean line pressure over the length in contact.
 //!
 //! The peak strain is not reported: runs do not compute strains yet. A design without a programme gets only
 //! the final displacement. A run that stopped early gives the metrics its history reaches.
@@ -51,6 +54,20 @@ pub(crate) struct Metrics {
     pub final_ratio_max: Option<Real>,
     /// `u` at the last saved step \[length\].
     pub final_displacement: Option<Real>,
+    /// Per obstacle of a model with contact, in the model's order, how the wires lie on it at the last
+    /// converged step (`summary.json`'s `contact[].apposition`).
+    pub apposition: Vec<AppositionMetrics>,
+}
+
+/// How the wires lie on one obstacle at the end of a run (`summary.json`'s `contact[].apposition`).
+#[derive(Debug, Clone, PartialEq, Default)]
+pub(crate) struct AppositionMetrics {
+    /// The share of the wires' length in contact.
+    pub contact_fraction: Option<Real>,
+    /// The largest gap of a wire from the surface \[length\].
+    pub largest_gap: Option<Real>,
+    /// The mean line pressure over the length in contact \[force/length\].
+    pub mean_pressure: Option<Real>,
 }
 
 /// `history.csv` as columns.
@@ -192,6 +209,22 @@ pub(crate) fn metrics(
         final_ratio_mean: rho.last().map(|p| p.1),
         final_ratio_max: rho_max.last().map(|p| p.1),
         final_displacement: u.last().map(|p| p.1),
+        apposition: summary
+            .and_then(|s| s["contact"].as_array())
+            .map(|obstacles| {
+                obstacles
+                    .iter()
+                    .map(|o| {
+                        let a = &o["apposition"];
+                        AppositionMetrics {
+                            contact_fraction: a["contact_fraction"].as_f64(),
+                            largest_gap: a["largest_gap"]["value"].as_f64(),
+                            mean_pressure: a["mean_pressure"].as_f64(),
+                        }
+                    })
+                    .collect()
+            })
+            .unwrap_or_default(),
     }
 }
 
@@ -241,5 +274,32 @@ mod tests {
         assert!(close(m.time_to_90, 1.5));
         assert!(close(m.final_ratio_mean, 0.0));
         assert!(close(m.final_displacement, 0.0));
+        assert!(m.apposition.is_empty(), "no summary, no apposition");
+    }
+
+    /// Source: `summary.json`'s contact entries as the run writes them: each obstacle's apposition read back in
+    /// the model's order, an obstacle without one (a summary written before it existed) left empty.
+    #[test]
+    fn the_apposition_is_read_per_obstacle_from_the_summary() {
+        let summary = serde_json::json!({
+            "contact": [
+                {"obstacle": "vessel", "apposition": {"time": 4.0, "contact_fraction": 0.25,
+                    "largest_gap": {"value": 1.5, "patch": "c1_w9", "u": 0.5},
+                    "peak_pressure": 0.04, "mean_pressure": 0.01}},
+                {"obstacle": "crimper"}
+            ]
+        });
+        let m = metrics(None, &History::default(), Some(&summary), &[]);
+        assert_eq!(
+            m.apposition,
+            vec![
+                AppositionMetrics {
+                    contact_fraction: Some(0.25),
+                    largest_gap: Some(1.5),
+                    mean_pressure: Some(0.01),
+                },
+                AppositionMetrics::default(),
+            ]
+        );
     }
 }
