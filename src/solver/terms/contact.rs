@@ -795,10 +795,7 @@ impl PointTerm for SurfaceContact {
         if worst <= tolerance {
             // A crest between the points deeper than the tolerance comes out with the points around it, as far
             // as it is not deeper than they are by more than the tolerance (beyond that only a finer patch helps).
-            let anywhere = match self.checked.take() {
-                Some(anywhere) => anywhere,
-                None => self.penetration_between(state, at_points),
-            };
+            let anywhere = self.penetration_between(state, at_points);
             let between = worst > 0.0
                 && anywhere.is_some_and(|d| d.depth > tolerance && d.depth - worst <= tolerance);
             if !between || self.updates == self.settings.max_updates {
