@@ -337,38 +337,23 @@ impl RadialBench {
         let Some(radius) = crimper_radius(model) else {
             return Vec::new();
         };
-        let mut lines = history.lines();
-        let names: Vec<&str> = lines
-            .next()
-            .map(|h| h.split(',').collect())
-            .unwrap_or_default();
-        let column = |name: &str| names.iter().position(|n| *n == name);
+        let history = crate::io::history::History::parse(history);
         let (Some(force), Some(points)) = (
-            column("contact_radial_force@crimper"),
-            column("contact_points@crimper"),
+            history.column("contact_radial_force@crimper"),
+            history.column("contact_points@crimper"),
         ) else {
             return Vec::new();
         };
         let mut out = Vec::new();
-        for line in lines {
-            let cells: Vec<&str> = line.split(',').collect();
-            let parsed = (
-                cells.first().and_then(|c| c.parse::<Real>().ok()),
-                cells.get(force).and_then(|c| c.parse::<Real>().ok()),
-                cells.get(points).and_then(|c| c.parse::<usize>().ok()),
-            );
-            let (Some(time), Some(f), Some(n)) = parsed else {
-                break;
-            };
-            let closing_end = self.closing * (1.0 + 1e-9);
+        for (&(time, f), &(_, n)) in force.iter().zip(&points) {
             let point = |branch| RadialPoint {
                 time,
                 branch,
                 diameter: 2.0 * radius(time),
                 force: self.copies * f,
-                points: n,
+                points: n as usize,
             };
-            if time <= closing_end {
+            if time <= self.closing * (1.0 + 1e-9) {
                 out.push(point(Branch::Loading));
             }
             if time >= self.closing * (1.0 - 1e-9) {
@@ -378,14 +363,15 @@ impl RadialBench {
         out
     }
 
-    /// The radial force per unit length \[force/length\] and the equivalent pressure in kPa of `p`.
-    pub fn per_length_and_pressure(&self, p: &RadialPoint) -> (Real, Real) {
+    /// The radial force `force` at diameter `diameter` per unit length \[force/length\] and as the equivalent
+    /// pressure in kPa.
+    pub fn per_length_and_pressure(&self, force: Real, diameter: Real) -> (Real, Real) {
         let kpa_per_stress = match self.units {
             Units::Si => 1e-3,
             Units::MmNMpa => 1e3,
         };
-        let per_length = p.force / self.length;
-        let pressure = p.force / (std::f64::consts::PI * p.diameter * self.length);
+        let per_length = force / self.length;
+        let pressure = force / (std::f64::consts::PI * diameter * self.length);
         (per_length, pressure * kpa_per_stress)
     }
 
@@ -396,7 +382,7 @@ impl RadialBench {
             "time,branch,diameter_{length},radial_force_N,force_per_length_N_per_{length},pressure_kPa,pressure_mmHg,points_in_contact\n"
         );
         for p in points {
-            let (per_length, kpa) = self.per_length_and_pressure(p);
+            let (per_length, kpa) = self.per_length_and_pressure(p.force, p.diameter);
             out.push_str(&format!(
                 "{:.10e},{},{:.9e},{:.9e},{:.9e},{:.9e},{:.9e},{}\n",
                 p.time,
@@ -487,14 +473,7 @@ impl RadialBench {
                 ] {
                     let line = match Self::force_at(points, branch, d) {
                         Some(f) => {
-                            let p = RadialPoint {
-                                time: 0.0,
-                                branch,
-                                diameter: d,
-                                force: f,
-                                points: 0,
-                            };
-                            let (per_length, kpa) = self.per_length_and_pressure(&p);
+                            let (per_length, kpa) = self.per_length_and_pressure(f, d);
                             format!(
                                 "{what} at the vessel diameter {d:.4} {length}: {f:.4e} N, {per_length:.4e} N/{length}, {kpa:.4} kPa ({:.4} mmHg)",
                                 kpa / KPA_PER_MMHG

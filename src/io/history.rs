@@ -30,6 +30,7 @@
 //! Rows are flushed as they are written, so an interrupted run leaves a valid file up to its last step; a row
 //! that cannot be written whole (a full disk) is cut off again, so the file always ends with a complete row.
 
+use crate::math::Real;
 use crate::solver::{Observer, Simulation, StepReport};
 use std::fs::File;
 use std::io::{BufWriter, Write};
@@ -38,6 +39,53 @@ use std::path::{Path, PathBuf};
 
 /// The columns of `history.csv` that hold text (a patch's name) rather than numbers.
 pub const TEXT_COLUMNS: &[&str] = &["surface_strain_patch"];
+
+/// `history.csv` read back as columns (`sweep collect`'s metrics, the bench's table).
+#[derive(Debug, Clone, PartialEq, Default)]
+pub(crate) struct History {
+    names: Vec<String>,
+    rows: Vec<Vec<Real>>,
+}
+
+impl History {
+    /// Parses the text of a `history.csv` (a row that does not parse whole ends the table: a killed run's
+    /// last line may be cut).
+    pub(crate) fn parse(text: &str) -> Self {
+        let mut lines = text.lines();
+        let names: Vec<String> = lines
+            .next()
+            .map(|h| h.split(',').map(str::to_string).collect())
+            .unwrap_or_default();
+        // Text columns (a patch's name) are read as NaN: only numbers are looked up.
+        let text: Vec<bool> = names
+            .iter()
+            .map(|n| TEXT_COLUMNS.contains(&n.as_str()))
+            .collect();
+        let rows = lines
+            .map(|l| {
+                l.split(',')
+                    .zip(text.iter().chain(std::iter::repeat(&false)))
+                    .map(|(x, &is_text)| {
+                        if is_text {
+                            Ok(Real::NAN)
+                        } else {
+                            x.parse::<Real>()
+                        }
+                    })
+                    .collect::<Result<Vec<_>, _>>()
+            })
+            .take_while(|r| r.as_ref().is_ok_and(|r| r.len() == names.len()))
+            .filter_map(Result::ok)
+            .collect();
+        Self { names, rows }
+    }
+
+    /// The column `name` as (time, value) pairs.
+    pub(crate) fn column(&self, name: &str) -> Option<Vec<(Real, Real)>> {
+        let c = self.names.iter().position(|n| n == name)?;
+        Some(self.rows.iter().map(|r| (r[0], r[c])).collect())
+    }
+}
 
 /// The materials with a strain limit, as `(material index, limit)`.
 fn limited_materials(strain_limits: &[Option<f64>]) -> Vec<(usize, f64)> {

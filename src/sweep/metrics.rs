@@ -22,6 +22,7 @@
 //! The peak strain is not reported: runs do not compute strains yet. A design without a programme gets only
 //! the final displacement. A run that stopped early gives the metrics its history reaches.
 
+use crate::io::history::History;
 use crate::math::Real;
 use crate::model::Model;
 use std::path::Path;
@@ -68,53 +69,6 @@ pub(crate) struct AppositionMetrics {
     pub largest_gap: Option<Real>,
     /// The mean line pressure over the length in contact \[force/length\].
     pub mean_pressure: Option<Real>,
-}
-
-/// `history.csv` as columns.
-#[derive(Debug, Clone, PartialEq, Default)]
-pub(crate) struct History {
-    names: Vec<String>,
-    rows: Vec<Vec<Real>>,
-}
-
-impl History {
-    /// Parses the text of a `history.csv` (a row that does not parse whole ends the table: a killed run's
-    /// last line may be cut).
-    pub(crate) fn parse(text: &str) -> Self {
-        let mut lines = text.lines();
-        let names: Vec<String> = lines
-            .next()
-            .map(|h| h.split(',').map(str::to_string).collect())
-            .unwrap_or_default();
-        // Text columns (a patch's name) are read as NaN: only numbers are looked up.
-        let text: Vec<bool> = names
-            .iter()
-            .map(|n| crate::io::history::TEXT_COLUMNS.contains(&n.as_str()))
-            .collect();
-        let rows = lines
-            .map(|l| {
-                l.split(',')
-                    .zip(text.iter().chain(std::iter::repeat(&false)))
-                    .map(|(x, &is_text)| {
-                        if is_text {
-                            Ok(Real::NAN)
-                        } else {
-                            x.parse::<Real>()
-                        }
-                    })
-                    .collect::<Result<Vec<_>, _>>()
-            })
-            .take_while(|r| r.as_ref().is_ok_and(|r| r.len() == names.len()))
-            .filter_map(Result::ok)
-            .collect();
-        Self { names, rows }
-    }
-
-    /// The column `name` as (time, value) pairs.
-    fn column(&self, name: &str) -> Option<Vec<(Real, Real)>> {
-        let c = self.names.iter().position(|n| n == name)?;
-        Some(self.rows.iter().map(|r| (r[0], r[c])).collect())
-    }
 }
 
 /// The value of `series` at `t`, linear between its points; `None` outside them.
