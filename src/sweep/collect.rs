@@ -102,7 +102,7 @@ fn apposition_columns(model: Option<&crate::model::Model>, length: &str) -> Vec<
             .map(crate::io::contact::column_name)
             .collect()
     });
-    let line_pressure = format!(" (N/{})", model.units.length());
+    let line_pressure = format!(" ({}/{})", model.units.force(), model.units.length());
     let mut columns = Vec::new();
     for (k, name) in names.into_iter().enumerate() {
         type Pick = fn(&super::metrics::AppositionMetrics) -> Option<Real>;
