@@ -12,7 +12,7 @@
 
 use std::path::Path;
 use std::time::Instant;
-use stentkit::bench::{radial_design, write_radial_outputs};
+use stentkit::bench::{radial_design, write_outputs};
 use stentkit::design::DesignOverrides;
 use stentkit::run::{Folder, Interrupt, Lines, RunSettings};
 
@@ -31,7 +31,7 @@ fn main() {
             ..RunSettings::new("cargo bench --bench radial")
         };
         run_bench(&design, &dir, &settings);
-        let lines = write_radial_outputs(&dir, &bench, &design.model).expect("the bench's outputs");
+        let lines = write_outputs(&dir, &bench, &design.model).expect("the bench's outputs");
         let wall = start.elapsed().as_secs_f64();
         let table = std::fs::read_to_string(dir.join("radial.csv")).expect("radial.csv");
         let rows = table.lines().count() - 1;

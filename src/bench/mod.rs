@@ -17,6 +17,7 @@
 //!   min_diameter: 10      # [length] (default: the programme's crimped outer diameter 2 (R − Δr) + d)
 //!   vessel_diameter: 12   # [length] where the chronic outward force is read (default: a vessel file's mean lumen)
 //!   diameters: 30         # recorded per branch (default 30)
+//!   min_gap: 6            # [length] the crush's smallest plate gap (default half the device's outer diameter)
 //! ```
 //!
 //! **What it measures.** At each recorded step the crimper's diameter `D` (its inner diameter, the device's outer
@@ -29,8 +30,19 @@
 //! the crimper reached and the RRF and COF at the vessel's diameter (interpolated linearly between recorded
 //! diameters on each branch).
 //!
+//! **Flat-plate crush** (`stentkit bench crush`). The same run with two rigid plates instead of the crimper:
+//! planes parallel to the device's straight axis, either side of it, closing along the normal of the model's
+//! first symmetry plane through the axis (for a full model, of the plane through the axis and its first node) from
+//! 2 % clear of the device to the smallest gap `bench.min_gap` (default half the device's outer diameter, a
+//! 50 % crush) and opening again, their gap changing at `rate` (`programme: {kind: crush}`; a symmetry plane
+//! parallel to the plates leaves one plate in the model). What it measures: the gap `D` between the plates and
+//! the force `F` on one plate (the model's plates' normal forces times `2^k / 2`), per unit length `F / L` and
+//! as the mean pressure on the device's projected area `F / (D L)`; `crush.csv`, `charts/crush_force.svg`, and
+//! printed the smallest gap reached and the force on each branch at 10 %, 25 % and 50 % of the device's outer
+//! diameter crushed (`bench.vessel_diameter` adds its gap).
+//!
 //! A run the solver could not finish leaves what it reached: the table up to there, and the smallest diameter
-//! reached says how far it got.
+//! (gap) reached says how far it got.
 
 use crate::design::{Design, DesignError, DesignOverrides, SetOverride, load_design_with};
 use crate::io::chart::{LineChart, Series};
@@ -40,12 +52,49 @@ use std::path::{Path, PathBuf};
 
 /// The default temperature of a bench test \[°C\]: body temperature.
 pub const DEFAULT_TEMPERATURE: Real = 37.0;
-/// The default rate of the crimper's diameter, in mm/s (converted to the design's units).
+/// The default rate of the crimper's diameter (the plates' gap), in mm/s (converted to the design's units).
 pub const DEFAULT_RATE_MM_PER_S: Real = 0.1;
 /// The default number of diameters recorded per branch.
 pub const DEFAULT_DIAMETERS: usize = 30;
+/// The crush's readings: the force at these fractions of the device's outer diameter crushed (module docs).
+pub const CRUSH_READINGS: [Real; 3] = [0.1, 0.25, 0.5];
 /// 1 mmHg in kPa (133.322 Pa).
 const KPA_PER_MMHG: Real = 0.133_322_387;
+
+/// Which test of the bench (module docs).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Test {
+    /// The radial force in a closing and opening cylindrical crimper.
+    Radial,
+    /// The flat-plate crush.
+    Crush,
+}
+
+impl Test {
+    /// The command's and the run folder's name, and the stem of its table and chart.
+    pub fn name(self) -> &'static str {
+        match self {
+            Test::Radial => "radial",
+            Test::Crush => "crush",
+        }
+    }
+
+    /// The programme kind the bench gives the design.
+    fn programme(self) -> &'static str {
+        match self {
+            Test::Radial => "crimp",
+            Test::Crush => "crush",
+        }
+    }
+
+    /// What the tool's size is: the crimper's diameter or the plates' gap.
+    pub fn size(self) -> &'static str {
+        match self {
+            Test::Radial => "diameter",
+            Test::Crush => "gap",
+        }
+    }
+}
 
 /// Why a bench could not be set up.
 #[derive(Debug, thiserror::Error)]
@@ -66,22 +115,27 @@ pub enum BenchError {
     Output(String),
 }
 
-/// The radial bench of a design, its defaults resolved (module docs).
+/// A bench test of a design, its defaults resolved (module docs).
 #[derive(Debug, Clone, PartialEq)]
-pub struct RadialBench {
+pub struct Bench {
+    /// Radial force or crush.
+    pub test: Test,
     /// Temperature \[°C\].
     pub temperature: Real,
-    /// Rate of the crimper's diameter \[length/time\].
+    /// Rate of the crimper's diameter or the plates' gap \[length/time\].
     pub rate: Real,
-    /// The crimper's diameter at the start, 2 % clear of the device \[length\].
+    /// The tool's size at the start (the crimper's diameter, the plates' gap), 2 % clear of the device
+    /// \[length\].
     pub start_diameter: Real,
-    /// The smallest diameter \[length\].
+    /// The device's outer diameter across the tool (twice the wires' reach from the axis) \[length\].
+    pub outer_diameter: Real,
+    /// The smallest size the tool closes to \[length\].
     pub min_diameter: Real,
     /// Where the chronic outward force is read \[length\].
     pub vessel_diameter: Option<Real>,
-    /// Diameters recorded per branch.
+    /// Sizes recorded per branch.
     pub diameters: usize,
-    /// The time the crimper takes to close (and to open) \[time\].
+    /// The time the tool takes to close (and to open) \[time\].
     pub closing: Real,
     /// The device's length along its axis \[length\].
     pub length: Real,
@@ -91,16 +145,40 @@ pub struct RadialBench {
     pub units: Units,
 }
 
-/// The design of the radial bench of the design at `path` with the command's `overrides` (module docs), and the
-/// bench with its defaults resolved.
+/// The radial bench's design of the design at `path` (module docs): [`bench_design`] with [`Test::Radial`].
 ///
 /// # Errors
-/// [`BenchError::Design`] for a design or an override refused (located in the file), [`BenchError::Unfit`] for
-/// a design without a generated stent or a smallest diameter at or above the device's.
+/// As [`bench_design`].
 pub fn radial_design(
     path: &Path,
     overrides: &DesignOverrides,
-) -> Result<(Design, RadialBench), BenchError> {
+) -> Result<(Design, Bench), BenchError> {
+    bench_design(Test::Radial, path, overrides)
+}
+
+/// The design of `test` on the design at `path` with the command's `overrides` (module docs), and the bench
+/// with its defaults resolved.
+///
+/// # Errors
+/// [`BenchError::Design`] for a design or an override refused (located in the file), [`BenchError::Unfit`] for
+/// a design without a generated stent, a temperature field, a crush of a curved device, or a smallest size at
+/// or above the device's.
+pub fn bench_design(
+    test: Test,
+    path: &Path,
+    overrides: &DesignOverrides,
+) -> Result<(Design, Bench), BenchError> {
+    // `--set contact…` tunes the tool's contact: a design without obstacles has no contact to tune until the
+    // bench's programme brings its tool, so those come after the bench's own overrides.
+    let (contact, others): (Vec<SetOverride>, Vec<SetOverride>) = overrides
+        .sets
+        .iter()
+        .cloned()
+        .partition(|s| s.path.first() == Some(&crate::design::PathStep::Key("contact".into())));
+    let overrides = &DesignOverrides {
+        sets: others,
+        ..overrides.clone()
+    };
     let design = load_design_with(path, overrides)?;
     let unfit = |message: String| BenchError::Unfit {
         file: path.to_path_buf(),
@@ -110,17 +188,17 @@ pub fn radial_design(
         .ok()
         .is_some_and(|v| v.get("stent").is_some());
     if !has_stent {
-        return Err(unfit(
-            "the radial bench crimps a generated stent (a `stent:` block); this design has none"
-                .into(),
-        ));
+        return Err(unfit(format!(
+            "the {} bench closes on a generated stent (a `stent:` block); this design has none",
+            test.name()
+        )));
     }
     if design.model.temperature_field.is_some() {
-        return Err(unfit(
-            "the radial bench holds the device at one temperature (`bench.temperature`): a design with a \
-             `temperature_field` cannot be put on it as it is; remove the field"
-                .into(),
-        ));
+        return Err(unfit(format!(
+            "the {} bench holds the device at one temperature (`bench.temperature`): a design with a \
+             `temperature_field` cannot be put on it as it is; remove the field",
+            test.name()
+        )));
     }
     let spec = design.bench;
     let units = design.model.units;
@@ -128,20 +206,23 @@ pub fn radial_design(
         Units::Si => 1e-3,
         Units::MmNMpa => 1.0,
     };
-    // A first crimper closing by a negligible Δr tells the crimper's geometry: its start radius (2 % clear of
-    // the device) and `R + d/2` (its closed radius plus that Δr), from which any smallest diameter follows.
+    // A first tool closing by a negligible Δr tells the tool's geometry: its start distance from the axis (2 %
+    // clear of the device) and `R + d/2` (its closed distance plus that Δr), from which any smallest size
+    // follows.
     let probe = 1e-9 * per_mm;
     let first = with_sets(
         path,
         overrides,
-        &bench_sets(probe, 1.0, 1.0, DEFAULT_TEMPERATURE),
+        &bench_sets(test, probe, 1.0, 1.0, DEFAULT_TEMPERATURE),
+        &contact,
     )?;
-    let crimper = crimper_radius(&first.model)
-        .ok_or_else(|| unfit("the crimp programme built no crimper".into()))?;
-    let (start, reach) = (crimper(0.0), crimper(1.0) + probe);
-    let min_diameter = match spec.min_diameter {
-        Some(d) => d,
-        None => match design.model.programme.as_ref().map(|p| p.kind) {
+    let distance = tool_distance(&first.model)
+        .ok_or_else(|| unfit(format!("the {} programme built no tool", test.programme())))?;
+    let (start, reach) = (distance(0.0), distance(1.0) + probe);
+    let min_diameter = match (test, spec.min_diameter, spec.min_gap) {
+        (Test::Radial, Some(d), _) | (Test::Crush, _, Some(d)) => d,
+        (Test::Crush, _, None) => reach,
+        (Test::Radial, None, _) => match design.model.programme.as_ref().map(|p| p.kind) {
             Some(
                 crate::model::ProgrammeKind::RadialContraction { delta_r }
                 | crate::model::ProgrammeKind::Crimp { delta_r, .. },
@@ -156,9 +237,13 @@ pub fn radial_design(
         .map(|s| s.diameter())
         .fold(0.0, Real::max);
     if !(min_diameter > wire && min_diameter < 2.0 * start) {
+        let field = match test {
+            Test::Radial => "bench.min_diameter: the crimper would close to",
+            Test::Crush => "bench.min_gap: the plates would close to",
+        };
         return Err(unfit(format!(
-            "bench.min_diameter: the crimper would close to {min_diameter} {}, which must lie between the wire's \
-             diameter {wire} and the crimper's start {:.4} (2 % clear of the device)",
+            "{field} {min_diameter} {}, which must lie between the wire's diameter {wire} and the tool's start \
+             {:.4} (2 % clear of the device)",
             units.length(),
             2.0 * start
         )));
@@ -168,17 +253,20 @@ pub fn radial_design(
     let closing = (2.0 * start - min_diameter) / rate;
     let diameters = spec.diameters.unwrap_or(DEFAULT_DIAMETERS);
     let sets = bench_sets(
+        test,
         reach - 0.5 * min_diameter,
         closing,
         closing / (diameters - 1) as Real,
         temperature,
     );
-    let bench_design = with_sets(path, overrides, &sets)?;
+    let bench_design = with_sets(path, overrides, &sets, &contact)?;
     let model = &bench_design.model;
-    let bench = RadialBench {
+    let bench = Bench {
+        test,
         temperature,
         rate,
         start_diameter: 2.0 * start,
+        outer_diameter: 2.0 * start / 1.02,
         min_diameter,
         vessel_diameter: spec.vessel_diameter.or_else(|| vessel_diameter(model)),
         diameters,
@@ -190,11 +278,12 @@ pub fn radial_design(
     Ok((bench_design, bench))
 }
 
-/// The design at `path` with the command's `overrides`, then the bench's `sets`.
+/// The design at `path` with the command's `overrides`, then the bench's `sets`, then the command's `after`.
 fn with_sets(
     path: &Path,
     overrides: &DesignOverrides,
     sets: &[String],
+    after: &[SetOverride],
 ) -> Result<Design, BenchError> {
     let mut all = overrides.clone();
     for s in sets {
@@ -204,15 +293,23 @@ fn with_sets(
                 message: format!("the bench's own override was refused: {e}"),
             })?);
     }
+    all.sets.extend_from_slice(after);
     Ok(load_design_with(path, &all)?)
 }
 
-/// The bench's overrides of a design (module docs): a crimper closing by `delta_r` over `closing` and opening
-/// over as long, fixed steps of `step`, the temperature held, no other obstacle.
-fn bench_sets(delta_r: Real, closing: Real, step: Real, temperature: Real) -> Vec<String> {
+/// The bench's overrides of a design (module docs): the test's tool closing by `delta_r` over `closing` and
+/// opening over as long, fixed steps of `step`, the temperature held, no other obstacle.
+fn bench_sets(
+    test: Test,
+    delta_r: Real,
+    closing: Real,
+    step: Real,
+    temperature: Real,
+) -> Vec<String> {
     vec![
         format!(
-            "programme={{kind: crimp, nodes: all_joints, delta_r: {delta_r:e}, ramp: [0, {closing:e}], release: {closing:e}, open: {closing:e}}}"
+            "programme={{kind: {}, nodes: all_joints, delta_r: {delta_r:e}, ramp: [0, {closing:e}], release: {closing:e}, open: {closing:e}}}",
+            test.programme()
         ),
         format!("temperature={temperature:e}"),
         "obstacles=[]".into(),
@@ -220,16 +317,30 @@ fn bench_sets(delta_r: Real, closing: Real, step: Real, temperature: Real) -> Ve
     ]
 }
 
-/// The crimper's radius as a function of time: the last obstacle of a crimp programme's model (a cylinder's
-/// radius, or the scale of a tube of radius 1 around a curved axis).
-fn crimper_radius(model: &Model) -> Option<impl Fn(Real) -> Real + '_> {
-    let crimper = model.contact.as_ref()?.obstacles.last()?;
-    let schedule = match &crimper.surface {
-        Surface::Cylinder { radius, .. } => radius,
-        Surface::Lumen(tube) => tube.scale(),
-        Surface::Plane { .. } => return None,
+/// The tool of a crimp or crush programme's model: its obstacles (the last ones, from the programme's first).
+fn tool(model: &Model) -> Option<&[crate::model::Obstacle]> {
+    let (first, _) = model.programme.as_ref()?.kind.tool()?;
+    model.contact.as_ref()?.obstacles.get(first..)
+}
+
+/// The tool's distance from the axis as a function of time: a crimper's radius (a cylinder's, or the scale
+/// of a tube of radius 1 around a curved axis), a plate's distance from the axis plane between the plates.
+fn tool_distance(model: &Model) -> Option<impl Fn(Real) -> Real + '_> {
+    let first = tool(model)?.first()?;
+    let axis_point = model.programme.as_ref()?.nodes.first()?.axis_point;
+    let distance: Box<dyn Fn(Real) -> Real + '_> = match &first.surface {
+        Surface::Cylinder { radius, .. } => Box::new(move |t| radius.value(t)),
+        Surface::Lumen(tube) => Box::new(move |t| tube.scale().value(t)),
+        Surface::Plane {
+            point,
+            normal,
+            offset,
+        } => {
+            let start = (point - axis_point).dot(normal).abs();
+            Box::new(move |t| start - offset.value(t))
+        }
     };
-    Some(move |t: Real| schedule.value(t))
+    Some(distance)
 }
 
 /// A vessel file's mean lumen diameter (its radius samples weighted by the chords between them), if the
@@ -246,10 +357,11 @@ fn vessel_diameter(model: &Model) -> Option<Real> {
     (length > 0.0).then(|| 2.0 * weighted / length)
 }
 
-/// The device's length along its axis: the extent of its wires' sample points along a straight crimper's
-/// axis, or along the centreline of a curved crimper's tube (between the points' closest parameters).
+/// The device's length along its axis: the extent of its wires' sample points along the axis of a straight
+/// crimper (or of the driven nodes' axis, for plates), or along the centreline of a curved crimper's tube
+/// (between the points' closest parameters).
 fn device_length(model: &Model) -> Real {
-    let Some(crimper) = model.contact.as_ref().and_then(|c| c.obstacles.last()) else {
+    let Some(first) = tool(model).and_then(|t| t.first()) else {
         return 0.0;
     };
     let points: Vec<Vec3> = model
@@ -257,24 +369,23 @@ fn device_length(model: &Model) -> Real {
         .iter()
         .flat_map(|p| p.dense_points())
         .collect();
-    match &crimper.surface {
-        Surface::Cylinder { point, axis, .. } => {
-            let along = points.iter().map(|x| (x - point).dot(axis));
-            let (lo, hi) = along.fold((Real::INFINITY, Real::NEG_INFINITY), |(lo, hi), s| {
-                (lo.min(s), hi.max(s))
-            });
-            (hi - lo).max(0.0)
-        }
+    let extent = |values: &mut dyn Iterator<Item = Real>| {
+        values.fold((Real::INFINITY, Real::NEG_INFINITY), |(lo, hi), s| {
+            (lo.min(s), hi.max(s))
+        })
+    };
+    let along = |point: Vec3, axis: Vec3| {
+        let (lo, hi) = extent(&mut points.iter().map(|x| (x - point).dot(&axis)));
+        (hi - lo).max(0.0)
+    };
+    match &first.surface {
+        Surface::Cylinder { point, axis, .. } => along(*point, *axis),
+        Surface::Plane { .. } => match model.programme.as_ref().and_then(|p| p.nodes.first()) {
+            Some(node) => along(node.axis_point, node.axis_direction.normalize()),
+            None => 0.0,
+        },
         Surface::Lumen(tube) => {
-            let u: Vec<Real> = points
-                .iter()
-                .filter_map(|x| tube.closest(x, None))
-                .collect();
-            let (lo, hi) = u
-                .iter()
-                .fold((Real::INFINITY, Real::NEG_INFINITY), |(lo, hi), &s| {
-                    (lo.min(s), hi.max(s))
-                });
+            let (lo, hi) = extent(&mut points.iter().filter_map(|x| tube.closest(x, None)));
             if !(hi > lo) {
                 return 0.0;
             }
@@ -290,21 +401,19 @@ fn device_length(model: &Model) -> Real {
                 })
                 .sum()
         }
-        Surface::Plane { .. } => 0.0,
     }
 }
-
 /// Closing or opening.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Branch {
-    /// The crimper closes: the radial resistive force.
+    /// The tool closes: the radial resistive force, the crush force.
     Loading,
-    /// The crimper opens: the chronic outward force.
+    /// The tool opens: the chronic outward force, the force of the device's spring-back.
     Unloading,
 }
 
 impl Branch {
-    /// The name in `radial.csv`.
+    /// The name in the bench's table.
     pub fn name(self) -> &'static str {
         match self {
             Branch::Loading => "loading",
@@ -313,45 +422,83 @@ impl Branch {
     }
 }
 
-/// One recorded diameter of the radial bench (module docs).
+/// One recorded size of a bench run (module docs).
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub struct RadialPoint {
+pub struct BenchPoint {
     /// Time \[time\].
     pub time: Real,
-    /// Closing or opening (the smallest diameter is the last of the loading branch and the first of the
-    /// unloading one).
+    /// Closing or opening (the smallest size is the last of the loading branch and the first of the unloading
+    /// one).
     pub branch: Branch,
-    /// The crimper's diameter \[length\].
+    /// The crimper's diameter or the plates' gap \[length\].
     pub diameter: Real,
-    /// The radial force on the whole device \[force\].
+    /// The radial force on the whole device, or the force on one plate \[force\].
     pub force: Real,
-    /// Points of the model in contact with the crimper.
+    /// Points of the model in contact with the tool.
     pub points: usize,
 }
 
-impl RadialBench {
-    /// The recorded diameters of a bench run from its `history.csv` text (module docs): each row's time, the
-    /// crimper's diameter from `model`'s (the bench design's) schedule, the radial force and points from the
-    /// crimper's columns. Rows after a cut one end the table (as a killed run's last line may be cut).
-    pub fn points(&self, model: &Model, history: &str) -> Vec<RadialPoint> {
-        let Some(radius) = crimper_radius(model) else {
+impl Bench {
+    /// The recorded sizes of a bench run from its `history.csv` text (module docs): each row's time, the tool's
+    /// size from `model`'s (the bench design's) schedule, the force and points from the tool's columns. Rows
+    /// after a cut one end the table (as a killed run's last line may be cut).
+    pub fn points(&self, model: &Model, history: &str) -> Vec<BenchPoint> {
+        let (Some(distance), Some(tool)) = (tool_distance(model), tool(model)) else {
             return Vec::new();
         };
         let history = crate::io::history::History::parse(history);
-        let (Some(force), Some(points)) = (
-            history.column("contact_radial_force@crimper"),
-            history.column("contact_points@crimper"),
-        ) else {
-            return Vec::new();
+        // Per tool obstacle: its force on the rods per row (inward for a crimper, along the plate's normal),
+        // and its points in contact.
+        let mut columns = Vec::new();
+        for obstacle in tool {
+            let name = &obstacle.name;
+            let force = match (&obstacle.surface, self.test) {
+                (Surface::Plane { normal, .. }, Test::Crush) => {
+                    let axes = ["x", "y", "z"]
+                        .map(|c| history.column(&format!("contact_force_{c}@{name}")));
+                    let [Some(x), Some(y), Some(z)] = axes else {
+                        return Vec::new();
+                    };
+                    x.iter()
+                        .zip(&y)
+                        .zip(&z)
+                        .map(|((&(t, fx), &(_, fy)), &(_, fz))| {
+                            (t, Vec3::new(fx, fy, fz).dot(normal))
+                        })
+                        .collect()
+                }
+                _ => match history.column(&format!("contact_radial_force@{name}")) {
+                    Some(f) => f,
+                    None => return Vec::new(),
+                },
+            };
+            let Some(points) = history.column(&format!("contact_points@{name}")) else {
+                return Vec::new();
+            };
+            columns.push((force, points));
+        }
+        // The whole device's radial force; one plate's force (the plates of the whole device carry twice it).
+        let share = match self.test {
+            Test::Radial => self.copies,
+            Test::Crush => 0.5 * self.copies,
         };
+        let rows = columns
+            .iter()
+            .map(|(f, p)| f.len().min(p.len()))
+            .min()
+            .unwrap_or(0);
         let mut out = Vec::new();
-        for (&(time, f), &(_, n)) in force.iter().zip(&points) {
-            let point = |branch| RadialPoint {
+        for row in 0..rows {
+            let time = columns[0].0[row].0;
+            let force: Real = columns.iter().map(|(f, _)| f[row].1).sum();
+            let points: Real = columns.iter().map(|(_, p)| p[row].1).sum();
+            let point = |branch| BenchPoint {
                 time,
                 branch,
-                diameter: 2.0 * radius(time),
-                force: self.copies * f,
-                points: n as usize,
+                diameter: 2.0 * distance(time),
+                // `+ 0.0`: no force is 0, not the −0 of a plate's `−0 · n`.
+                force: share * force + 0.0,
+                points: points as usize,
             };
             if time <= self.closing * (1.0 + 1e-9) {
                 out.push(point(Branch::Loading));
@@ -363,23 +510,31 @@ impl RadialBench {
         out
     }
 
-    /// The radial force `force` at diameter `diameter` per unit length \[force/length\] and as the equivalent
-    /// pressure in kPa.
+    /// The force `force` at size `diameter` per unit length \[force/length\] and as the equivalent pressure in
+    /// kPa: on a cylinder of that diameter, `F / (π D L)`, or on the device's area projected on a plate,
+    /// `F / (D L)`.
     pub fn per_length_and_pressure(&self, force: Real, diameter: Real) -> (Real, Real) {
         let kpa_per_stress = match self.units {
             Units::Si => 1e-3,
             Units::MmNMpa => 1e3,
         };
         let per_length = force / self.length;
-        let pressure = force / (std::f64::consts::PI * diameter * self.length);
-        (per_length, pressure * kpa_per_stress)
+        let area = match self.test {
+            Test::Radial => std::f64::consts::PI * diameter * self.length,
+            Test::Crush => diameter * self.length,
+        };
+        (per_length, force / area * kpa_per_stress)
     }
 
-    /// `radial.csv`: one row per recorded diameter and branch (module docs).
-    pub fn table(&self, points: &[RadialPoint]) -> String {
+    /// The bench's table (`radial.csv`, `crush.csv`): one row per recorded size and branch (module docs).
+    pub fn table(&self, points: &[BenchPoint]) -> String {
         let length = self.units.length();
+        let (size, force) = match self.test {
+            Test::Radial => ("diameter", "radial_force"),
+            Test::Crush => ("gap", "crush_force"),
+        };
         let mut out = format!(
-            "time,branch,diameter_{length},radial_force_N,force_per_length_N_per_{length},pressure_kPa,pressure_mmHg,points_in_contact\n"
+            "time,branch,{size}_{length},{force}_N,force_per_length_N_per_{length},pressure_kPa,pressure_mmHg,points_in_contact\n"
         );
         for p in points {
             let (per_length, kpa) = self.per_length_and_pressure(p.force, p.diameter);
@@ -398,13 +553,15 @@ impl RadialBench {
         out
     }
 
-    /// The radial force on `branch` at diameter `d`, linear between the recorded diameters; `None` outside them.
-    pub fn force_at(points: &[RadialPoint], branch: Branch, d: Real) -> Option<Real> {
-        let branch: Vec<&RadialPoint> = points.iter().filter(|p| p.branch == branch).collect();
+    /// The force on `branch` at size `d`, linear between the recorded sizes; `None` outside them (by more than
+    /// 1e-9 of the size: a reading at the smallest size, computed another way, lands on it to round-off).
+    pub fn force_at(points: &[BenchPoint], branch: Branch, d: Real) -> Option<Real> {
+        let branch: Vec<&BenchPoint> = points.iter().filter(|p| p.branch == branch).collect();
         branch.windows(2).find_map(|w| {
             let (a, b) = (w[0], w[1]);
             let (lo, hi) = (a.diameter.min(b.diameter), a.diameter.max(b.diameter));
-            if !(lo <= d && d <= hi) {
+            let slack = 1e-9 * hi.abs();
+            if !(lo - slack <= d && d <= hi + slack) {
                 return None;
             }
             if hi == lo {
@@ -414,22 +571,27 @@ impl RadialBench {
         })
     }
 
-    /// The chart of both branches, force against diameter, the vessel's diameter dashed.
-    pub fn chart(&self, points: &[RadialPoint]) -> LineChart {
+    /// The chart of both branches, force against size, the vessel's diameter dashed.
+    pub fn chart(&self, points: &[BenchPoint]) -> LineChart {
         let length = self.units.length();
+        let (what, size, labels) = match self.test {
+            Test::Radial => (
+                "radial force",
+                "diameter",
+                ["closing (RRF)", "opening (COF)"],
+            ),
+            Test::Crush => ("crush force", "plate gap", ["closing", "opening"]),
+        };
         let mut chart = LineChart::new(
             format!(
-                "radial force at {} °C, {} {length}/s",
+                "{what} at {} °C, {} {length}/s",
                 crate::math::Short(self.temperature),
                 crate::math::Short(self.rate)
             ),
-            format!("diameter ({length})"),
-            "radial force (N)",
+            format!("{size} ({length})"),
+            format!("{what} (N)"),
         );
-        for (branch, label) in [
-            (Branch::Loading, "closing (RRF)"),
-            (Branch::Unloading, "opening (COF)"),
-        ] {
+        for (branch, label) in [Branch::Loading, Branch::Unloading].into_iter().zip(labels) {
             let xy: Vec<(Real, Real)> = points
                 .iter()
                 .filter(|p| p.branch == branch)
@@ -448,9 +610,11 @@ impl RadialBench {
         chart
     }
 
-    /// What the bench prints at the end: the smallest diameter reached and the forces at the vessel's diameter.
-    pub fn summary(&self, points: &[RadialPoint]) -> Vec<String> {
+    /// What the bench prints at the end: the smallest size reached and the forces at the vessel's diameter
+    /// (and, for a crush, at 10 %, 25 % and 50 % of the outer diameter crushed).
+    pub fn summary(&self, points: &[BenchPoint]) -> Vec<String> {
         let length = self.units.length();
+        let size = self.test.size();
         let mut lines = Vec::new();
         let reached = points
             .iter()
@@ -458,32 +622,49 @@ impl RadialBench {
             .fold(Real::INFINITY, Real::min);
         if reached.is_finite() {
             lines.push(format!(
-                "smallest diameter reached: {reached:.4} {length} (asked {:.4} {length})",
+                "smallest {size} reached: {reached:.4} {length} (asked {:.4} {length})",
                 self.min_diameter
             ));
         }
-        match self.vessel_diameter {
-            None => lines.push(
+        let reading = |what: &str, at: &str, branch: Branch, d: Real| match Self::force_at(
+            points, branch, d,
+        ) {
+            Some(f) => {
+                let (per_length, kpa) = self.per_length_and_pressure(f, d);
+                format!(
+                    "{what} at {at} {d:.4} {length}: {f:.4e} N, {per_length:.4e} N/{length}, {kpa:.4} kPa ({:.4} mmHg)",
+                    kpa / KPA_PER_MMHG
+                )
+            }
+            None => format!("{what}: {at} {d:.4} {length} was not reached on this branch"),
+        };
+        if self.test == Test::Crush {
+            for f in CRUSH_READINGS {
+                let gap = self.outer_diameter * (1.0 - f);
+                for (branch, what) in [
+                    (Branch::Loading, "crush force (closing)"),
+                    (Branch::Unloading, "crush force (opening)"),
+                ] {
+                    let at = format!("{} % crushed, the gap", crate::math::Short(100.0 * f));
+                    lines.push(reading(what, &at, branch, gap));
+                }
+            }
+        }
+        match (self.vessel_diameter, self.test) {
+            (None, Test::Radial) => lines.push(
                 "no vessel diameter (a vessel file's lumen, or `bench.vessel_diameter`): no COF read".into(),
             ),
-            Some(d) => {
-                for (branch, what) in [
-                    (Branch::Loading, "radial resistive force (closing)"),
-                    (Branch::Unloading, "chronic outward force (opening)"),
-                ] {
-                    let line = match Self::force_at(points, branch, d) {
-                        Some(f) => {
-                            let (per_length, kpa) = self.per_length_and_pressure(f, d);
-                            format!(
-                                "{what} at the vessel diameter {d:.4} {length}: {f:.4e} N, {per_length:.4e} N/{length}, {kpa:.4} kPa ({:.4} mmHg)",
-                                kpa / KPA_PER_MMHG
-                            )
-                        }
-                        None => format!(
-                            "{what}: the vessel diameter {d:.4} {length} was not reached on this branch"
-                        ),
-                    };
-                    lines.push(line);
+            (None, Test::Crush) => {}
+            (Some(d), test) => {
+                let whats = match test {
+                    Test::Radial => [
+                        "radial resistive force (closing)",
+                        "chronic outward force (opening)",
+                    ],
+                    Test::Crush => ["crush force (closing)", "crush force (opening)"],
+                };
+                for (branch, what) in [Branch::Loading, Branch::Unloading].into_iter().zip(whats) {
+                    lines.push(reading(what, "the vessel diameter", branch, d));
                 }
             }
         }
@@ -491,17 +672,14 @@ impl RadialBench {
     }
 }
 
-/// Adds the radial bench's table (`radial.csv`) and chart (`charts/radial_force.svg`) to the run folder `dir` of
-/// its run (listed in the folder's manifest, so `--force` removes them with the run's files) and returns what the
-/// bench prints at the end ([`RadialBench::summary`]). `model` is the bench design's.
+/// Adds the bench's table (`radial.csv`, `crush.csv`) and chart (`charts/radial_force.svg`,
+/// `charts/crush_force.svg`) to the run folder `dir` of its run (listed in the folder's manifest, so `--force`
+/// removes them with the run's files) and returns what the bench prints at the end ([`Bench::summary`]).
+/// `model` is the bench design's.
 ///
 /// # Errors
 /// [`BenchError::Output`] when the folder cannot be taken again (another run holds it) or a file cannot be written.
-pub fn write_radial_outputs(
-    dir: &Path,
-    bench: &RadialBench,
-    model: &Model,
-) -> Result<Vec<String>, BenchError> {
+pub fn write_outputs(dir: &Path, bench: &Bench, model: &Model) -> Result<Vec<String>, BenchError> {
     use crate::io::run_folder;
     let fail = |e: &dyn std::fmt::Display| BenchError::Output(e.to_string());
     let history = std::fs::read_to_string(dir.join("history.csv"))
@@ -517,11 +695,12 @@ pub fn write_radial_outputs(
         crate::io::atomic::write_bytes_atomically(&path, bytes)
             .map_err(|e| fail(&format!("{}: {e}", path.display())))
     };
-    write("radial.csv", bench.table(&points).as_bytes())?;
+    let name = bench.test.name();
+    write(&format!("{name}.csv"), bench.table(&points).as_bytes())?;
     if !points.is_empty() {
         let svg = crate::io::chart::render_svg(&bench.chart(&points)).map_err(|e| fail(&e))?;
         std::fs::create_dir_all(dir.join(run_folder::CHARTS_FOLDER)).map_err(|e| fail(&e))?;
-        write("charts/radial_force.svg", svg.as_bytes())?;
+        write(&format!("charts/{name}_force.svg"), svg.as_bytes())?;
     }
     Ok(bench.summary(&points))
 }

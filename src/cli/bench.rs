@@ -7,13 +7,14 @@ use crate::run::{Folder, RunSettings};
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
-/// `stentkit bench radial`: sets the bench's run up from the design, runs it into its folder (default
-/// `runs/<design name>-radial`), adds the table and chart, and prints the results.
+/// `stentkit bench radial` and `bench crush`: sets the bench's run up from the design, runs it into its folder
+/// (default `runs/<design name>-<test>`), adds the table and chart, and prints the results.
 ///
 /// # Errors
 /// The design or the bench refused (exit status 2), the run failed or was interrupted (as `run`'s), a file of
 /// the bench not written.
-pub(crate) fn radial(
+pub(crate) fn bench(
+    test: crate::bench::Test,
     design_path: &Path,
     output: Option<PathBuf>,
     force: bool,
@@ -27,14 +28,20 @@ pub(crate) fn radial(
         ..DesignOverrides::default()
     };
     let (design, bench) =
-        crate::bench::radial_design(design_path, &overrides).map_err(|e| match e {
+        crate::bench::bench_design(test, design_path, &overrides).map_err(|e| match e {
             crate::bench::BenchError::Design(d) => anyhow::Error::from(d),
             e => super::BadInput(e.to_string()).into(),
         })?;
     let mut console = Terminal::new(quiet, false, Out::default());
     let length = design.model.units.length();
+    let size = test.size();
+    let tool = match test {
+        crate::bench::Test::Radial => "the crimper's diameter",
+        crate::bench::Test::Crush => "the plates' gap",
+    };
     eprintln!(
-        "radial bench: {} °C, the crimper's diameter from {:.4} to {:.4} {length} and back at {} {length}/s ({} diameters each way); device length {:.4} {length}, {} of it modelled",
+        "{} bench: {} °C, {tool} from {:.4} to {:.4} {length} and back at {} {length}/s ({} {size}s each way); device length {:.4} {length}, {} of it modelled",
+        test.name(),
         crate::math::Short(bench.temperature),
         bench.start_diameter,
         bench.min_diameter,
@@ -47,8 +54,9 @@ pub(crate) fn radial(
             "all".to_string()
         }
     );
-    let dir =
-        output.unwrap_or_else(|| Path::new("runs").join(format!("{}-radial", design.model.name())));
+    let dir = output.unwrap_or_else(|| {
+        Path::new("runs").join(format!("{}-{}", design.model.name(), test.name()))
+    });
     let settings = RunSettings {
         quiet,
         started,
@@ -69,7 +77,7 @@ pub(crate) fn radial(
     if let Err(e @ crate::run::RunError::Refused(_)) = completed {
         return Err(command_error(e));
     }
-    let lines = crate::bench::write_radial_outputs(&dir, &bench, &design.model);
+    let lines = crate::bench::write_outputs(&dir, &bench, &design.model);
     match (completed, lines) {
         (Ok(c), Ok(lines)) => {
             println!("{}", c.report);

@@ -17,6 +17,7 @@ pub(crate) mod study;
 pub(crate) mod sweep;
 pub(crate) mod tune;
 
+use crate::bench::Test;
 use crate::design::SetOverride;
 use clap::{Parser, Subcommand};
 use std::path::PathBuf;
@@ -60,6 +61,28 @@ pub(crate) enum BenchTest {
         #[arg(short, long)]
         quiet: bool,
         /// Override a field of the design, `bench:` included: `PATH=VALUE` (`--set bench.rate=0.5`).
+        #[arg(long = "set", value_name = "PATH=VALUE", value_parser = arguments::set_override())]
+        set: Vec<SetOverride>,
+    },
+    /// The flat-plate crush: the device at the bench's temperature between two rigid plates parallel to its
+    /// straight axis closing from just outside it to `bench.min_gap` (default a 50 % crush) and opening again
+    /// at `bench.rate`; writes `crush.csv` (gap, branch, force on one plate in N, N per length, kPa, mmHg) and
+    /// `charts/crush_force.svg` and prints the smallest gap reached and the forces at 10, 25 and 50 % crushed.
+    ///
+    /// Example: stentkit bench crush designs/straight_stent.yaml --set bench.min_gap=30
+    Crush {
+        /// The design file (YAML).
+        design: PathBuf,
+        /// Run folder (default: `runs/<design name>-crush`).
+        #[arg(short, long)]
+        output: Option<PathBuf>,
+        /// Replace an earlier run in the run folder (only the files it wrote are removed).
+        #[arg(long)]
+        force: bool,
+        /// No progress bar; the results are printed.
+        #[arg(short, long)]
+        quiet: bool,
+        /// Override a field of the design, `bench:` included: `PATH=VALUE` (`--set bench.min_gap=20`).
         #[arg(long = "set", value_name = "PATH=VALUE", value_parser = arguments::set_override())]
         set: Vec<SetOverride>,
     },
@@ -132,7 +155,7 @@ pub(crate) enum Command {
         set: Vec<SetOverride>,
     },
     /// The virtual bench: a test a stent engineer runs on the device, as a run of the design (`bench radial`:
-    /// the radial force in a closing and opening crimper). The design's `bench:` block sets it (`--set
+    /// the radial force in a closing and opening crimper; `bench crush`: the flat-plate crush). The design's `bench:` block sets it (`--set
     /// bench.temperature=90`); the run folder gets the bench's table and chart besides a run's files.
     ///
     /// Example: stentkit bench radial designs/straight_stent.yaml -o runs/straight_stent-radial
@@ -661,7 +684,17 @@ pub fn main() -> ExitCode {
                     quiet,
                     set,
                 },
-        } => bench::radial(&design, output, force, quiet, set),
+        } => bench::bench(Test::Radial, &design, output, force, quiet, set),
+        Command::Bench {
+            test:
+                BenchTest::Crush {
+                    design,
+                    output,
+                    force,
+                    quiet,
+                    set,
+                },
+        } => bench::bench(Test::Crush, &design, output, force, quiet, set),
         Command::Export {
             run_dir,
             time,

@@ -258,16 +258,21 @@ fn bench(dto: Option<&super::dto::BenchDto>, wire: Real) -> Result<super::BenchS
             format!("{n} diameters per branch: at least 2 make a curve"),
         ));
     }
-    if let Some(d) = b.min_diameter
-        && d.0 <= wire
-    {
-        return Err(issue(
-            "bench.min_diameter",
-            format!(
-                "{} is not above the wire's diameter {}: the crimper cannot close onto the axis",
-                d.0, wire
-            ),
-        ));
+    for (field, value, tool) in [
+        ("bench.min_diameter", b.min_diameter, "the crimper"),
+        ("bench.min_gap", b.min_gap, "the plates"),
+    ] {
+        if let Some(d) = value
+            && d.0 <= wire
+        {
+            return Err(issue(
+                field,
+                format!(
+                    "{} is not above the wire's diameter {}: {tool} cannot close onto the axis",
+                    d.0, wire
+                ),
+            ));
+        }
     }
     Ok(super::BenchSpec {
         temperature: b.temperature,
@@ -275,6 +280,7 @@ fn bench(dto: Option<&super::dto::BenchDto>, wire: Real) -> Result<super::BenchS
         min_diameter: b.min_diameter.map(|d| d.0),
         vessel_diameter: b.vessel_diameter.map(|d| d.0),
         diameters: b.diameters,
+        min_gap: b.min_gap.map(|d| d.0),
     })
 }
 
@@ -323,7 +329,7 @@ pub(crate) fn field_path(field: &Field, dto: &DesignDto) -> String {
         Field::RecordTime { .. } => "output.snapshots.times".into(),
         Field::Obstacle { index, field } => {
             let base = format!("obstacles[{index}]");
-            // The obstacles after the design's are a crimp programme's crimper.
+            // The obstacles after the design's are a crimp programme's crimper or a crush programme's plates.
             let Some(o) = dto.obstacles.get(index) else {
                 return "programme".into();
             };

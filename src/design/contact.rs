@@ -37,7 +37,7 @@
 //! without the step limit it took 1632 cuts and 2545 steps. A design may give its own. The tolerance on
 //! penetration is 1 % of the wire diameter (what a drawing of the wire cannot show); the law's transition band
 //! is a tenth of the tolerance; at most 10 augmented-Lagrange updates per step besides the one between steps.
-//! A `programme` of `kind: crimp` adds its crimper after the design's obstacles.
+//! A `programme` of `kind: crimp` adds its crimper after the design's obstacles, one of `kind: crush` its plates.
 //!
 //! **Friction** is a property of an obstacle (`friction: μ`, the pair of surfaces that touch), so friction
 //! without contact cannot be written; the crimper of a crimp programme is frictionless.
@@ -59,15 +59,15 @@ pub(crate) fn contact(
     vessel: Option<&Vessel>,
 ) -> Result<Option<Contact>> {
     let diameter = section.diameter();
-    let crimp = dto
+    let tool = dto
         .programme
         .as_ref()
-        .is_some_and(|p| p.kind == ProgrammeKindDto::Crimp);
-    if dto.obstacles.is_empty() && !crimp {
+        .is_some_and(|p| matches!(p.kind, ProgrammeKindDto::Crimp | ProgrammeKindDto::Crush));
+    if dto.obstacles.is_empty() && !tool {
         return match dto.contact {
             Some(_) => Err(issue(
                 "contact",
-                "contact settings without anything to touch: add `obstacles` (or a `programme` of `kind: crimp`), or remove `contact`",
+                "contact settings without anything to touch: add `obstacles` (or a `programme` of `kind: crimp` or `crush`), or remove `contact`",
             )),
             None => Ok(None),
         };

@@ -345,6 +345,10 @@ pub struct BenchDto {
     /// Diameters recorded on each branch, closing and opening (default 30, at least 2).
     #[serde(default)]
     pub diameters: Option<usize>,
+    /// The smallest gap the crush plates close to \[length\] (default half the device's outer diameter, a
+    /// 50 % crush).
+    #[serde(default)]
+    pub min_gap: Option<Positive>,
 }
 
 /// An obstacle: a named surface (give exactly one of `cylinder`, `plane` or `lumen`) with its wall and the times
@@ -352,7 +356,8 @@ pub struct BenchDto {
 #[derive(Debug, Clone, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct ObstacleDto {
-    /// Unique name (history columns, messages); `crimper` is taken by a crimp programme's.
+    /// Unique name (history columns, messages); `crimper` is taken by a crimp programme's, `upper_plate` and
+    /// `lower_plate` by a crush programme's.
     pub name: String,
     /// A circular cylinder that keeps the rods inside it (a crimper, a sheath, a tube).
     #[serde(default)]
@@ -1324,19 +1329,22 @@ pub enum ProgrammeKindDto {
     TargetShape,
     /// A crimper closes on the device to a radial contraction `Δr`, holds, and opens at the release.
     Crimp,
+    /// Flat plates either side of a straight device close to `R − Δr` from its axis, hold, and open at the
+    /// release.
+    Crush,
 }
 
 /// The `programme:` block.
 #[derive(Debug, Clone, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct ProgrammeDto {
-    /// `radial_contraction`, `target_shape` or `crimp`.
+    /// `radial_contraction`, `target_shape`, `crimp` or `crush`.
     pub kind: ProgrammeKindDto,
     /// The driven node set (default `all_joints`): `all_joints`, `crests`, `troughs`, `crown_<k>` (k = 1, 2, …
     /// along the centreline), `bridge_ends` or `symmetry`.
     #[serde(default)]
     pub nodes: Option<String>,
-    /// Radial contraction `Δr` \[length\] (radial_contraction, crimp).
+    /// Radial contraction `Δr` \[length\] (radial_contraction, crimp, crush).
     #[serde(default)]
     pub delta_r: Option<Positive>,
     /// The temporary placement (target_shape).
@@ -1347,7 +1355,8 @@ pub struct ProgrammeDto {
     /// Release time \[time\]: the driven components become free, or the crimper opens (default: never).
     #[serde(default)]
     pub release: Option<NonNegative>,
-    /// Time a crimper takes to open from the release \[time\] (crimp; default a tenth of the ramp).
+    /// Time a crimper or crush plates take to open from the release \[time\] (crimp, crush; default a tenth of
+    /// the ramp).
     #[serde(default)]
     pub open: Option<Positive>,
 }

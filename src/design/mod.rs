@@ -30,7 +30,7 @@ pub mod variants;
 pub mod vessel;
 
 pub use crate::io::output::{OutputSettings, RecordingSettings, SnapshotSettings};
-pub use set::SetOverride;
+pub use set::{PathStep, SetOverride};
 pub use tuned::{TunedChoice, TunedTextError, tuned_text};
 
 use crate::io::output::RunDesign;
@@ -80,6 +80,8 @@ pub struct BenchSpec {
     pub vessel_diameter: Option<f64>,
     /// Diameters recorded per branch.
     pub diameters: Option<usize>,
+    /// The smallest gap the crush plates close to \[length\].
+    pub min_gap: Option<f64>,
 }
 
 impl RunDesign for Design {

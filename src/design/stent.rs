@@ -461,41 +461,41 @@ pub(crate) fn mesh(dto: &StentDto, mesh: Option<&MeshDto>) -> Result<StentMesh> 
 /// The programme of a `programme:` block, with the checks of its form (which fields go with which kind).
 pub(crate) fn programme(dto: &ProgrammeDto, metres_per_unit: Real) -> Result<ProgrammeSpec> {
     let base = "programme";
-    if dto.open.is_some() && dto.kind != ProgrammeKindDto::Crimp {
+    let tool = matches!(dto.kind, ProgrammeKindDto::Crimp | ProgrammeKindDto::Crush);
+    if dto.open.is_some() && !tool {
         return Err(issue(
             format!("{base}.open"),
-            "`open` (the crimper's opening time) belongs to `kind: crimp`",
+            "`open` (the tool's opening time) belongs to `kind: crimp` or `crush`",
         ));
     }
     let target = match dto.kind {
-        ProgrammeKindDto::RadialContraction | ProgrammeKindDto::Crimp => {
+        ProgrammeKindDto::RadialContraction | ProgrammeKindDto::Crimp | ProgrammeKindDto::Crush => {
             if dto.temporary.is_some() {
                 return Err(issue(
                     format!("{base}.temporary"),
-                    "`temporary` belongs to `kind: target_shape`; a radial contraction or a crimp needs only `delta_r`",
+                    "`temporary` belongs to `kind: target_shape`; a radial contraction, a crimp or a crush needs only `delta_r`",
                 ));
             }
             let Some(Positive(delta_r)) = dto.delta_r else {
                 return Err(issue(
                     base,
-                    "a radial contraction or a crimp needs `delta_r` (the radius change, in the design's length unit)",
+                    "a radial contraction, a crimp or a crush needs `delta_r` (the radius change, in the design's length unit)",
                 ));
             };
-            if dto.kind == ProgrammeKindDto::Crimp {
-                let ramp = dto.ramp[1].0 - dto.ramp[0].0;
-                ProgrammeTarget::Crimp {
-                    delta_r,
-                    open: dto.open.map_or(0.1 * ramp, |o| o.0),
-                }
-            } else {
-                ProgrammeTarget::RadialContraction { delta_r }
+            let open = dto
+                .open
+                .map_or(0.1 * (dto.ramp[1].0 - dto.ramp[0].0), |o| o.0);
+            match dto.kind {
+                ProgrammeKindDto::Crimp => ProgrammeTarget::Crimp { delta_r, open },
+                ProgrammeKindDto::Crush => ProgrammeTarget::Crush { delta_r, open },
+                _ => ProgrammeTarget::RadialContraction { delta_r },
             }
         }
         ProgrammeKindDto::TargetShape => {
             if dto.delta_r.is_some() {
                 return Err(issue(
                     format!("{base}.delta_r"),
-                    "`delta_r` belongs to `kind: radial_contraction` or `crimp`; a target shape needs `temporary`",
+                    "`delta_r` belongs to `kind: radial_contraction`, `crimp` or `crush`; a target shape needs `temporary`",
                 ));
             }
             let Some(t) = &dto.temporary else {

@@ -128,21 +128,18 @@ fn load_let_go(f: &TimeFunction) -> Option<(Real, Real)> {
 }
 
 impl Model {
-    /// A crimper programme's let-go: the crimper opening from the release, with its radius schedule (whose
-    /// breakpoints before the release are the programming; around a curved axis the factor on its tube's
-    /// radius).
-    fn crimper_let_go(&self) -> Option<((Real, Real), &TimeFunction)> {
+    /// A tool's let-go (a crimper's or crush plates'): the tool opening from the release, with its schedule
+    /// (whose breakpoints before the release are the programming): a cylinder's radius, the factor on a curved
+    /// crimper tube's radius, a plate's offset.
+    fn tool_let_go(&self) -> Option<((Real, Real), &TimeFunction)> {
         let programme = self.programme.as_ref()?;
-        let super::ProgrammeKind::Crimp { obstacle, open, .. } = programme.kind else {
-            return None;
-        };
+        let (obstacle, open) = programme.kind.tool()?;
         let release = programme.release?;
-        let crimper = self.contact.as_ref()?.obstacles.get(obstacle)?;
-        // A cylinder's radius, or the scale on a curved crimper tube's radius (the same schedule's shape).
-        let schedule = match &crimper.surface {
+        let tool = self.contact.as_ref()?.obstacles.get(obstacle)?;
+        let schedule = match &tool.surface {
             super::Surface::Cylinder { radius, .. } => radius,
             super::Surface::Lumen(tube) => tube.scale(),
-            super::Surface::Plane { .. } => return None,
+            super::Surface::Plane { offset, .. } => offset,
         };
         Some(((release, release + open), schedule))
     }
@@ -164,7 +161,7 @@ impl Model {
                     .flat_map(|l| l.force.iter().chain(&l.couple))
                     .filter_map(|f| load_let_go(f).map(|times| (times, f))),
             )
-            .chain(self.crimper_let_go())
+            .chain(self.tool_let_go())
             .collect::<Vec<_>>();
         let fixed = drives.iter().map(|((f, _), _)| *f).reduce(Real::min)?;
         let released = drives.iter().map(|((_, r), _)| *r).reduce(Real::max)?;

@@ -39,6 +39,33 @@ pub enum ProgrammeKind {
         /// Time the crimper takes to open from the release \[time\].
         open: Real,
     },
+    /// A flat-plate crush: plates either side of a straight stent axis, parallel to it (the model's contact
+    /// obstacles from `obstacle` on: two, or the one on the modelled side of a symmetry plane parallel to them),
+    /// close until the wires' reach across them is `R − Δr`, hold, and open over `open` from the release. Free
+    /// from the start like a crimper; the targets are the nominal flattening (each driven node moved along the
+    /// plates' normal to within `R − Δr` of the axis plane between them).
+    Crush {
+        /// Nominal plate travel past the crown radius: the plates close to `R − Δr` from the axis (plus the
+        /// wire's radius) \[length\], `0 < Δr < R`.
+        delta_r: Real,
+        /// Index of the first plate in the model's contact obstacles.
+        obstacle: usize,
+        /// Time the plates take to open from the release \[time\].
+        open: Real,
+    },
+}
+
+impl ProgrammeKind {
+    /// The tool of a programme driven through contact (a crimper or crush plates): the index of its first
+    /// obstacle among the model's and the time it takes to open; `None` for a programme that prescribes its
+    /// nodes.
+    pub fn tool(&self) -> Option<(usize, Real)> {
+        match *self {
+            ProgrammeKind::Crimp { obstacle, open, .. }
+            | ProgrammeKind::Crush { obstacle, open, .. } => Some((obstacle, open)),
+            ProgrammeKind::RadialContraction { .. } | ProgrammeKind::TargetShape => None,
+        }
+    }
 }
 
 /// One driven node.
@@ -103,9 +130,9 @@ pub enum ProgrammeError {
 pub(crate) const SYMMETRY_TOLERANCE: Real = 1e-9;
 
 impl Programme {
-    /// Whether it prescribes its driven nodes (a crimper drives them through contact instead).
+    /// Whether it prescribes its driven nodes (a crimper or crush plates drive them through contact instead).
     pub fn prescribes(&self) -> bool {
-        !matches!(self.kind, ProgrammeKind::Crimp { .. })
+        self.kind.tool().is_none()
     }
 
     /// Whether its target is a radial contraction of the driven nodes (by prescription or by a crimper), whose
@@ -118,7 +145,8 @@ impl Programme {
     }
 
     /// The time from which the device is free and its rigid-body motion is fixed by gauge constraints: the
-    /// release for a programme that prescribes its nodes, the start for a crimper (`None`: never released).
+    /// release for a programme that prescribes its nodes, the start for a crimper or crush plates (`None`: never
+    /// released).
     pub fn free_from(&self) -> Option<Real> {
         if self.prescribes() {
             self.release

@@ -73,6 +73,14 @@ pub enum ProgrammeTarget {
         /// Time the crimper takes to open \[time\], > 0.
         open: Real,
     },
+    /// Flat plates either side of the straight axis close until the wires' reach across them is `R − Δr` over
+    /// the ramp, hold, and open over `open` from the release ([`crate::model::ProgrammeKind::Crush`]).
+    Crush {
+        /// Nominal plate travel Δr \[length\], `0 < Δr < R`.
+        delta_r: Real,
+        /// Time the plates take to open \[time\], > 0.
+        open: Real,
+    },
     /// Every driven node moves to its place in a temporary shape of the same crowns (paper §4.3, curved
     /// stent).
     TargetShape {
@@ -130,7 +138,8 @@ impl ProgrammeSpec {
     pub fn placement(&self) -> Placement {
         match &self.target {
             ProgrammeTarget::RadialContraction { delta_r }
-            | ProgrammeTarget::Crimp { delta_r, .. } => (
+            | ProgrammeTarget::Crimp { delta_r, .. }
+            | ProgrammeTarget::Crush { delta_r, .. } => (
                 TemporarySpec {
                     centreline: crate::geometry::stent::TemporaryCentreline::Same,
                     radius: None,
@@ -502,7 +511,8 @@ pub fn programme(
     let radius = stent.family.radius_range().0;
     let (kind, targets): (ProgrammeKind, Vec<Vec3>) = match &spec.target {
         &ProgrammeTarget::RadialContraction { delta_r }
-        | &ProgrammeTarget::Crimp { delta_r, .. } => {
+        | &ProgrammeTarget::Crimp { delta_r, .. }
+        | &ProgrammeTarget::Crush { delta_r, .. } => {
             if !(delta_r > 0.0 && delta_r.is_finite()) {
                 return Err(BuildError::new(
                     at(ProgrammeField::DeltaR),
@@ -517,27 +527,52 @@ pub fn programme(
                     ),
                 ));
             }
-            let kind = match spec.target {
-                ProgrammeTarget::Crimp { open, .. } => {
-                    if !(open > 0.0 && open.is_finite()) {
-                        return Err(BuildError::new(
-                            at(ProgrammeField::Whole),
-                            format!("the crimper's opening time {open} must be > 0 and finite"),
-                        ));
-                    }
-                    // The crimper is the model's last obstacle: the builder appends it (`crimper`).
+            if let ProgrammeTarget::Crimp { open, .. } | ProgrammeTarget::Crush { open, .. } =
+                spec.target
+                && !(open > 0.0 && open.is_finite())
+            {
+                return Err(BuildError::new(
+                    at(ProgrammeField::Whole),
+                    format!("the tool's opening time {open} must be > 0 and finite"),
+                ));
+            }
+            // A crimper or crush plates are the model's last obstacles: the builder appends them (`crimper`,
+            // `plates`).
+            match spec.target {
+                ProgrammeTarget::Crimp { open, .. } => (
                     ProgrammeKind::Crimp {
                         delta_r,
                         obstacle: usize::MAX,
                         open,
-                    }
+                    },
+                    geometry.nodes.iter().map(|n| -n.radial * delta_r).collect(),
+                ),
+                ProgrammeTarget::Crush { open, .. } => {
+                    let frame = CrushFrame::of(stent)
+                        .map_err(|e| BuildError::new(at(ProgrammeField::Whole), e))?;
+                    let limit = stent.family.radius_range().1 - delta_r;
+                    let targets = geometry
+                        .nodes
+                        .iter()
+                        .map(|n| {
+                            let h = frame.normal.dot(&(n.position - frame.point));
+                            frame.normal * (-h.signum() * (h.abs() - limit).max(0.0))
+                        })
+                        .collect();
+                    (
+                        ProgrammeKind::Crush {
+                            delta_r,
+                            obstacle: usize::MAX,
+                            open,
+                        },
+                        targets,
+                    )
                 }
-                _ => ProgrammeKind::RadialContraction { delta_r },
-            };
-            (
-                kind,
-                geometry.nodes.iter().map(|n| -n.radial * delta_r).collect(),
-            )
+                _ => (
+                    ProgrammeKind::RadialContraction { delta_r },
+                    geometry.nodes.iter().map(|n| -n.radial * delta_r).collect(),
+                ),
+            }
         }
         ProgrammeTarget::TargetShape { temporary, align } => {
             let positions = stent
@@ -597,8 +632,8 @@ pub fn programme(
 /// axis whose radius starts 2 % clear of the device's outermost wire ([`Patch::dense_points`]), holds there
 /// until the ramp starts, closes linearly over the ramp until the wires' reach is `R − Δr` (`R` the largest
 /// crown radius; its radius `R − Δr + d/2`, `d` the thickest wire), holds until the release and opens back
-/// over `open`. Around a straight axis it is a cylinder; around a curved one, the tube of that radius around
-/// the permanent centreline between the first and the last crown, continued straight
+/// over `open` ([`tool_schedule`]). Around a straight axis it is a cylinder; around a curved one, the tube of
+/// that radius around the permanent centreline between the first and the last crown, continued straight
 /// beyond (a curved crimping tube, or a mandrel-guided crimp: the device is compacted onto its own axis).
 pub fn crimper(
     programme: &Programme,
@@ -610,41 +645,205 @@ pub fn crimper(
     let ProgrammeKind::Crimp { delta_r, open, .. } = programme.kind else {
         return Err(BuildError::new(at(), "not a crimp programme"));
     };
-    let nodes = &stent.geometry.nodes;
-    let Some(first) = nodes.first() else {
-        return Err(BuildError::new(at(), "the stent has no nodes"));
+    // The curved crimper is a tube of radius 1 scaled by the radius schedule.
+    let axis = straight_axis(stent);
+    let tube = match axis {
+        Some(_) => None,
+        None => Some(crimper_tube(stent).map_err(|e| BuildError::new(at(), e))?),
     };
+    let (start, closed) = reach(stent, patches, sections, delta_r, |x| match (&tube, axis) {
+        (Some(t), _) => t.distance(x, None, 0.0).map_or(0.0, |d| 1.0 - d.value),
+        (None, Some((point, axis))) => {
+            let d = x - point;
+            (d - axis * axis.dot(&d)).norm()
+        }
+        (None, None) => 0.0,
+    });
+    let radius = tool_schedule(programme, open, |t| t, start, closed)?;
+    let surface = match (tube, axis) {
+        (Some(tube), _) => crate::model::Surface::Lumen(tube.with_scale(radius)),
+        (None, Some((point, axis))) => crate::model::Surface::Cylinder {
+            point,
+            axis,
+            radius,
+        },
+        (None, None) => return Err(BuildError::new(at(), "the stent has no nodes")),
+    };
+    Ok(Obstacle::new("crimper", surface, crate::model::Wall::Rigid))
+}
+
+/// The plates of a crush programme ([`crate::model::ProgrammeKind::Crush`]): rigid planes parallel to the
+/// straight stent axis, either side of it along the crush direction ([`CrushFrame`]), `upper_plate` on the
+/// side the direction points to and `lower_plate` opposite (only the one on the modelled side when a symmetry
+/// plane parallel to them halves the device). Their distance from the axis starts 2 % clear of the wires'
+/// reach across them, closes over the ramp to `R − Δr + d/2` (`R` the largest crown radius, `d` the thickest
+/// wire), holds until the release and opens back over `open` ([`tool_schedule`]); as a plane's schedule it is
+/// the offset `start − distance` along its inward normal.
+pub fn plates(
+    programme: &Programme,
+    stent: &GeneratedStent,
+    patches: &[Patch],
+    sections: &[Section],
+) -> Result<Vec<Obstacle>> {
+    let at = || Field::Programme(ProgrammeField::Whole);
+    let ProgrammeKind::Crush { delta_r, open, .. } = programme.kind else {
+        return Err(BuildError::new(at(), "not a crush programme"));
+    };
+    let frame = CrushFrame::of(stent).map_err(|e| BuildError::new(at(), e))?;
+    let (start, closed) = reach(stent, patches, sections, delta_r, |x| {
+        frame.normal.dot(&(x - frame.point)).abs()
+    });
+    let offset = tool_schedule(programme, open, |d| start - d, start, closed)?;
+    Ok(frame
+        .sides
+        .iter()
+        .map(|&side| {
+            let name = if side > 0.0 {
+                "upper_plate"
+            } else {
+                "lower_plate"
+            };
+            let surface = crate::model::Surface::Plane {
+                point: frame.point + frame.normal * (side * start),
+                normal: -frame.normal * side,
+                offset: offset.clone(),
+            };
+            Obstacle::new(name, surface, crate::model::Wall::Rigid)
+        })
+        .collect())
+}
+
+/// How a crush sits on a straight stent: a point of its axis, the unit direction the plates close along, and
+/// the signs of that direction on which plates are modelled.
+#[derive(Debug, Clone, PartialEq)]
+pub struct CrushFrame {
+    /// A point of the axis \[length\].
+    pub point: Vec3,
+    /// The plates' unit normal (the crush direction), perpendicular to the axis.
+    pub normal: Vec3,
+    /// `+1` for the plate the normal points to, `−1` for the opposite one: both, or the modelled side's alone.
+    pub sides: Vec<Real>,
+}
+
+impl CrushFrame {
+    /// The crush of `stent` (module docs of [`plates`]): along the normal of its first symmetry plane through
+    /// the axis (the plates parallel to it, so the mirror image across it is the other plate), or, without one,
+    /// along the normal of the plane through the axis and the first node (the plane a half model is cut by: the
+    /// same crush, whole). Every symmetry plane must be one of the crush's: across the axis, along the crush
+    /// direction, or through the axis perpendicular to it.
+    ///
+    /// # Errors
+    /// A sentence: a curved axis, or a symmetry plane the crush does not share.
+    pub fn of(stent: &GeneratedStent) -> std::result::Result<Self, String> {
+        let (point, axis) = straight_axis(stent).ok_or(
+            "crush plates close on a device with a straight axis; this stent's axis is curved (crimp it instead)",
+        )?;
+        let scale = stent.family.radius_range().1;
+        let parallel = |a: &Vec3, b: &Vec3| a.cross(b).norm() <= 1e-9;
+        let through_axis = |p: &Vec3| {
+            let d = p - point;
+            (d - axis * axis.dot(&d)).norm() <= 1e-9 * scale
+        };
+        let planes = &stent.geometry.symmetry_planes;
+        let normal = match planes.iter().find(|p| !parallel(&p.normal, &axis)) {
+            Some(p) => p.normal.normalize(),
+            None => {
+                let first = stent
+                    .geometry
+                    .nodes
+                    .first()
+                    .ok_or("the stent has no nodes")?;
+                axis.cross(&first.radial).normalize()
+            }
+        };
+        let mut sides = vec![1.0, -1.0];
+        for (k, p) in planes.iter().enumerate() {
+            let m = p.normal.normalize();
+            if parallel(&m, &axis) {
+                continue;
+            }
+            let along = parallel(&m, &normal);
+            if !(through_axis(&p.point) && (along || m.dot(&normal).abs() <= 1e-9)) {
+                return Err(format!(
+                    "the crush along ({:.3}, {:.3}, {:.3}) is not symmetric about the model's symmetry plane {} \
+                     (normal ({:.3}, {:.3}, {:.3})): crush a model with `symmetry: half`, `quarter` about \
+                     perpendicular planes, or `none`",
+                    normal.x,
+                    normal.y,
+                    normal.z,
+                    k + 1,
+                    m.x,
+                    m.y,
+                    m.z
+                ));
+            }
+            if along {
+                let side: Real = (stent.geometry.nodes.iter())
+                    .map(|n| normal.dot(&(n.position - point)))
+                    .sum();
+                sides = vec![if side >= 0.0 { 1.0 } else { -1.0 }];
+            }
+        }
+        Ok(Self {
+            point,
+            normal,
+            sides,
+        })
+    }
+}
+
+/// The stent's axis when it is straight, as a point and a unit direction (its first node's crown station and
+/// tangent, every other node's on the same line).
+fn straight_axis(stent: &GeneratedStent) -> Option<(Vec3, Vec3)> {
+    let nodes = &stent.geometry.nodes;
+    let first = nodes.first()?;
     let (point, axis) = (first.axis_point, first.axis_tangent.normalize());
     let scale = stent.family.radius_range().1;
     let off_axis = |x: &Vec3| {
         let d = x - point;
         (d - axis * axis.dot(&d)).norm()
     };
-    let straight = nodes.iter().all(|n| {
-        n.axis_tangent.normalize().cross(&axis).norm() <= 1e-9
-            && off_axis(&n.axis_point) <= 1e-9 * scale
-    });
-    // The curved crimper is a tube of radius 1 scaled by the radius schedule.
-    let tube = if straight {
-        None
-    } else {
-        Some(crimper_tube(stent).map_err(|e| BuildError::new(at(), e))?)
-    };
-    let distance_from_axis = |x: &Vec3| match &tube {
-        None => off_axis(x),
-        Some(t) => t.distance(x, None, 0.0).map_or(0.0, |d| 1.0 - d.value),
-    };
+    nodes
+        .iter()
+        .all(|n| {
+            n.axis_tangent.normalize().cross(&axis).norm() <= 1e-9
+                && off_axis(&n.axis_point) <= 1e-9 * scale
+        })
+        .then_some((point, axis))
+}
+
+/// A tool's start and closed distance from the axis: 2 % clear of the wires' reach (the largest `distance` of
+/// a dense point plus its wire's radius), and `R − Δr + d/2` with `R` the largest crown radius and `d` the
+/// thickest wire.
+fn reach(
+    stent: &GeneratedStent,
+    patches: &[Patch],
+    sections: &[Section],
+    delta_r: Real,
+    distance: impl Fn(&Vec3) -> Real,
+) -> (Real, Real) {
     let mut reach: Real = 0.0;
     let mut wire: Real = 0.0;
     for patch in patches {
         let r = 0.5 * sections[patch.section].diameter();
         wire = wire.max(r);
         for x in patch.dense_points() {
-            reach = reach.max(distance_from_axis(&x) + r);
+            reach = reach.max(distance(&x) + r);
         }
     }
-    let start = 1.02 * reach;
-    let closed = stent.family.radius_range().1 - delta_r + wire;
+    (1.02 * reach, stent.family.radius_range().1 - delta_r + wire)
+}
+
+/// A tool's schedule: its distance from the axis `start` until the ramp, closing linearly to `closed` over the
+/// ramp, held until the release and back to `start` over `open`, mapped through `value` (a crimper's radius is
+/// the distance itself, a plate's offset is `start − distance`).
+fn tool_schedule(
+    programme: &Programme,
+    open: Real,
+    value: impl Fn(Real) -> Real,
+    start: Real,
+    closed: Real,
+) -> Result<TimeFunction> {
     let (t0, t1) = programme.ramp;
     let mut table = Vec::new();
     if t0 > 0.0 {
@@ -655,17 +854,9 @@ pub fn crimper(
         table.extend([(r, closed), (r + open, start)]);
     }
     table.dedup_by(|b, a| a.0 == b.0 && a.1 == b.1);
-    let radius = TimeFunction::try_table(table)
-        .map_err(|e| BuildError::new(Field::Programme(ProgrammeField::Release), e.to_string()))?;
-    let surface = match tube {
-        None => crate::model::Surface::Cylinder {
-            point,
-            axis,
-            radius,
-        },
-        Some(tube) => crate::model::Surface::Lumen(tube.with_scale(radius)),
-    };
-    Ok(Obstacle::new("crimper", surface, crate::model::Wall::Rigid))
+    let table = table.into_iter().map(|(t, d)| (t, value(d))).collect();
+    TimeFunction::try_table(table)
+        .map_err(|e| BuildError::new(Field::Programme(ProgrammeField::Release), e.to_string()))
 }
 
 /// Samples of the axis per largest crown radius of its length, for the curved crimper's centreline.

@@ -1,10 +1,11 @@
-//! `stentkit bench radial` (issue 34): the radial-force bench as a run of a design, its table and what it
-//! measures, checked against the contact report it is made of and against the symmetry it multiplies by.
+//! `stentkit bench radial` and `bench crush` (issue 34): the bench's tests as runs of a design, their tables
+//! and what they measure, checked against the contact report they are made of, against the symmetry they
+//! multiply by and, for the crush, against the thin ring's diametral-load closed form.
 
 use crate::mesh::TempDir;
 use std::path::{Path, PathBuf};
 use std::process::Command;
-use stentkit::bench::{RadialBench, radial_design};
+use stentkit::bench::{Bench, Test, bench_design, radial_design};
 use stentkit::design::{DesignOverrides, SetOverride};
 use stentkit::math::Real;
 
@@ -38,7 +39,7 @@ fn overrides(sets: &[String]) -> DesignOverrides {
 /// The radial force on the whole device at the end of the bench's closing branch, as the contact's line
 /// pressures at the collocation points integrated here: the trapezoidal rule in the reference arc length along
 /// each patch (the points' `arc_length`), times the copies of the model in the device.
-fn closed_force_from_pressures(design: &stentkit::Design, bench: &RadialBench) -> Real {
+fn closed_force_from_pressures(design: &stentkit::Design, bench: &Bench) -> Real {
     let mut sim = stentkit::Simulation::new(&design.model).expect("valid");
     while sim.time() < bench.closing * (1.0 - 1e-12) {
         sim.step().expect("the bench's closing converges");
@@ -197,4 +198,165 @@ fn a_smallest_diameter_above_the_device_is_refused_and_nothing_is_written() {
         "{stderr}"
     );
     assert!(!out_dir.exists());
+}
+
+/// Runs `stentkit bench <test>` on `design` with `sets` into `dir`, and returns what it printed and the
+/// closing branch of its table as `(size, force)`.
+fn run_bench(
+    test: &str,
+    design: &Path,
+    sets: &[String],
+    dir: &Path,
+) -> (String, Vec<(Real, Real)>) {
+    let mut command = Command::new(env!("CARGO_BIN_EXE_stentkit"));
+    command
+        .args(["bench", test])
+        .arg(design)
+        .arg("-o")
+        .arg(dir)
+        .arg("--quiet");
+    for s in sets {
+        command.args(["--set", s]);
+    }
+    let out = command.output().expect("stentkit runs");
+    let stdout = String::from_utf8_lossy(&out.stdout).into_owned();
+    assert!(
+        out.status.success(),
+        "{stdout}\n{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let table = std::fs::read_to_string(dir.join(format!("{test}.csv"))).expect("the table");
+    assert!(dir.join(format!("charts/{test}_force.svg")).is_file());
+    let closing = table
+        .lines()
+        .skip(1)
+        .map(|l| l.split(',').collect::<Vec<_>>())
+        .filter(|r| r[1] == "loading")
+        .map(|r| (r[2].parse().expect("size"), r[3].parse().expect("force")))
+        .collect();
+    (stdout, closing)
+}
+
+/// The force on one plate of the whole device at the end of the crush's closing branch, from an in-process
+/// simulation of the bench design: the contact report's forces on the rods from the model's plates, each
+/// along its normal, times the model's copies in the device, halved (the device's two plates carry the same).
+fn closed_plate_force(design: &stentkit::Design, bench: &Bench) -> Real {
+    let mut sim = stentkit::Simulation::new(&design.model).expect("valid");
+    while sim.time() < bench.closing * (1.0 - 1e-12) {
+        sim.step().expect("the crush's closing converges");
+    }
+    let report = sim.contact().expect("contact");
+    let obstacles = &design.model.contact.as_ref().expect("contact").obstacles;
+    let mut total = 0.0;
+    for (o, r) in obstacles.iter().zip(&report.obstacles) {
+        if let stentkit::model::Surface::Plane { normal, .. } = &o.surface {
+            total += r.force.dot(normal);
+        }
+    }
+    0.5 * bench.copies * total
+}
+
+/// Source: symmetry and the contact report. The two-crown straight stent crushed to a gap of 30 (of its outer
+/// diameter 40.6) as a quarter model — one plate, parallel to the symmetry plane it is cut by — and whole —
+/// both plates, nothing prescribed on the planes — must put the same force on a plate: the quarter's plate
+/// force times 4 / 2 against the full device's two plates' over 2. Tolerance 1e-3, as for the radial bench
+/// (the plates prescribe where the wires are up to the penetration tolerance, 6e-3 against a travel of ~10
+/// since the wires touched; measured 4.2e-4). And the table's closing force is that of the in-process simulation of the same
+/// bench design to its 10 printed digits (1e-8); the plates close from 2 % clear of the device (41.412).
+#[test]
+fn the_crush_bench_puts_the_same_force_on_a_plate_from_a_quarter_and_a_full_model() {
+    let dir = TempDir::new("bench-crush");
+    let (design, mut sets) = small_bench(&[]);
+    sets.push("bench.min_gap=30".into());
+    let (stdout, closing) = run_bench("crush", &design, &sets, &dir.join("run"));
+    assert!(stdout.contains("smallest gap reached: 30"), "{stdout}");
+    // 5 gaps at the fixed steps, and the steps cut on the way if any.
+    assert!(closing.len() >= 5, "{closing:?}");
+    assert!(
+        (closing[0].0 - 1.02 * 2.0 * 20.3).abs() < 1e-3,
+        "{closing:?}"
+    );
+    let (quarter, quarter_bench) =
+        bench_design(Test::Crush, &design, &overrides(&sets)).expect("the bench");
+    let a = closed_plate_force(&quarter, &quarter_bench);
+    let table = closing.last().expect("closed").1;
+    assert!(
+        ((table - a) / a).abs() < 1e-8,
+        "table {table}, simulation {a}"
+    );
+    sets.push("stent.symmetry=none".into());
+    let (full, full_bench) =
+        bench_design(Test::Crush, &design, &overrides(&sets)).expect("the bench");
+    assert_eq!((quarter_bench.copies, full_bench.copies), (4.0, 1.0));
+    let plates = |d: &stentkit::Design| d.model.contact.as_ref().map(|c| c.obstacles.len());
+    assert_eq!((plates(&quarter), plates(&full)), (Some(1), Some(2)));
+    let b = closed_plate_force(&full, &full_bench);
+    println!(
+        "quarter: {a:.12e} N, full: {b:.12e} N, relative {:.3e}",
+        (a - b) / b
+    );
+    assert!(
+        a > 0.0 && ((a - b) / b).abs() < 1e-3,
+        "quarter {a}, full {b}"
+    );
+}
+
+/// Source: the thin circular ring under two opposite point loads `P` along a diameter (Roark's Formulas for
+/// Stress and Strain, 7th ed., Table 9.2 case 1; Timoshenko, Strength of Materials I, §81): the diameter
+/// along the load shortens by `δ = (π/4 − 2/π) P R³ / (E I)`, for a ring of centreline radius `R` and bending
+/// stiffness `E I`, at small deflection, shear and stretching neglected. The ring: one crown of the straight
+/// stent (R = 20, wire diameter 0.6, so `R/d` = 33), its undulation 0.2 (1 % of R) — the closest a generated
+/// crown comes to a plane ring —, of an elastic material (E = 100 MPa), as a half model about the plane
+/// through its axis and a crest, crushed between two plates parallel to that plane to 0.15 past first contact
+/// (δ/R < 0.75 %). Five peaks, so that the plates touch it midway between two nodes, where the contact law acts
+/// at collocation points, not at a joint. The table's stiffness `ΔF / Δgap` between consecutive gaps is
+/// extrapolated linearly to zero force (the small-deflection limit the closed form is) and compared with
+/// `1 / ((π/4 − 2/π) R³ / EI)` = 5.345e-4 N/mm. Tolerance 1 %: the crown's undulation (slope 5 × 0.2 / 20 =
+/// 0.05) adds ~(0.05)²/4 of length and a torsion share, shear and stretching ~(d/R)² ≈ 1e-3, the
+/// discretisation (n = 20 and 40 agree to 1.5e-3); measured −0.10 %.
+#[test]
+fn a_ring_crushed_between_plates_matches_the_diametral_load_closed_form() {
+    let dir = TempDir::new("bench-ring");
+    let design = Path::new(env!("CARGO_MANIFEST_DIR")).join("designs/straight_stent.yaml");
+    let sets: Vec<String> = [
+        "stent.crowns=1",
+        "stent.peaks=5",
+        "stent.rotation_deg=0",
+        "stent.symmetry=half",
+        "stent.amplitude=0.2",
+        "material={E_inf: 100, nu: 0.3}",
+        "bench.min_gap=40.45",
+        "bench.diameters=40",
+        "contact={tolerance: 1e-7}",
+    ]
+    .iter()
+    .map(|s| s.to_string())
+    .collect();
+    let (_, closing) = run_bench("crush", &design, &sets, &dir.join("run"));
+    let touching: Vec<(Real, Real)> = closing.into_iter().filter(|&(_, f)| f > 0.0).collect();
+    assert!(touching.len() >= 5, "{touching:?}");
+    // Stiffness between consecutive gaps against the mean force there, fitted by a line (least squares).
+    let pairs: Vec<(Real, Real)> = touching
+        .windows(2)
+        .map(|w| {
+            (
+                0.5 * (w[0].1 + w[1].1),
+                (w[1].1 - w[0].1) / (w[0].0 - w[1].0),
+            )
+        })
+        .collect();
+    let n = pairs.len() as Real;
+    let (mf, mk) = (
+        pairs.iter().map(|p| p.0).sum::<Real>() / n,
+        pairs.iter().map(|p| p.1).sum::<Real>() / n,
+    );
+    let slope = pairs.iter().map(|p| (p.0 - mf) * (p.1 - mk)).sum::<Real>()
+        / pairs.iter().map(|p| (p.0 - mf).powi(2)).sum::<Real>();
+    let stiffness = mk - slope * mf;
+    let ei = 100.0 * std::f64::consts::PI * 0.6_f64.powi(4) / 64.0;
+    let closed_form =
+        1.0 / ((std::f64::consts::FRAC_PI_4 - 2.0 / std::f64::consts::PI) * 20.0_f64.powi(3) / ei);
+    let relative = (stiffness - closed_form) / closed_form;
+    println!("ring: {stiffness:.6e} N/mm at zero force against {closed_form:.6e}: {relative:+.3e}");
+    assert!(relative.abs() < 1e-2, "{stiffness} against {closed_form}");
 }

@@ -909,21 +909,32 @@ impl ModelBuilder {
         )?;
         let probes = self.probes(&patches, &nodes)?;
         let record_times = checks::record_times(&self.record_times, time.end)?;
-        // A crimper programme's crimper is the last obstacle.
+        // A crimper programme's crimper, or a crush programme's plates, are the last obstacles.
         let mut contact = self.contact.clone();
         let mut programme = programme;
         if let (Some(p), Some(s)) = (programme.as_mut(), &stent)
-            && let ProgrammeKind::Crimp { obstacle, .. } = &mut p.kind
+            && p.kind.tool().is_some()
         {
             let Some(c) = contact.as_mut() else {
                 return Err(BuildError::new(
                     Field::Programme(ProgrammeField::Whole),
-                    "a crimper programme needs the contact settings (`ModelBuilder::contact`, a design's `contact:`)",
+                    "a crimper or crush programme needs the contact settings (`ModelBuilder::contact`, a design's `contact:`)",
                 ));
             };
-            *obstacle = c.obstacles.len();
-            c.obstacles
-                .push(stent_model::crimper(p, s, &patches, &sections)?);
+            let first = c.obstacles.len();
+            match &mut p.kind {
+                ProgrammeKind::Crimp { obstacle, .. } => {
+                    *obstacle = first;
+                    c.obstacles
+                        .push(stent_model::crimper(p, s, &patches, &sections)?);
+                }
+                ProgrammeKind::Crush { obstacle, .. } => {
+                    *obstacle = first;
+                    c.obstacles
+                        .extend(stent_model::plates(p, s, &patches, &sections)?);
+                }
+                ProgrammeKind::RadialContraction { .. } | ProgrammeKind::TargetShape => {}
+            }
         }
         let model = Model {
             name: self.name.clone(),
