@@ -8,8 +8,12 @@
 //! `contact_force_z@<name>` (the total force the obstacle exerts on the rods [force]), for a cylinder and a lumen
 //! `contact_radial_force@<name>` (its radial part, the sum of the pressures' magnitudes: positive when the wires press
 //! on the wall [force]), `contact_points@<name>` (collocation points with a positive pressure),
-//! `contact_penetration@<name>` (the largest penetration [length]) and `contact_friction_work@<name>` ([force·length];
-//! 0 for a frictionless obstacle). Of the model as simulated: a symmetry-reduced model's share.
+//! `contact_penetration@<name>` (the largest penetration [length]), `contact_friction_work@<name>` ([force·length];
+//! 0 for a frictionless obstacle), and how the wires lie on it (the contact report's *Apposition*):
+//! `contact_length_fraction@<name>` (the share of the wires' length in contact), `contact_largest_gap@<name>` (the
+//! widest gap of a wire from the surface [length], empty when no point has one) and `contact_mean_pressure@<name>`
+//! (the mean line pressure over the length in contact [force/length]). Of the model as simulated: a
+//! symmetry-reduced model's share (the fractions and pressures are the device's).
 
 use crate::math::Real;
 use crate::model::{Model, Obstacle, Surface};
@@ -48,7 +52,14 @@ pub(crate) fn header(model: &Model) -> String {
         if matches!(o.surface, Surface::Cylinder { .. } | Surface::Lumen(_)) {
             header.push_str(&format!(",contact_radial_force@{name}"));
         }
-        for quantity in ["points", "penetration", "friction_work"] {
+        for quantity in [
+            "points",
+            "penetration",
+            "friction_work",
+            "length_fraction",
+            "largest_gap",
+            "mean_pressure",
+        ] {
             header.push_str(&format!(",contact_{quantity}@{name}"));
         }
     }
@@ -69,6 +80,12 @@ pub(crate) fn push_row(line: &mut String, report: Option<&ContactReport>) {
             ",{},{:.6e},{:.6e}",
             o.points, o.penetration, o.friction_work
         ));
+        let a = &o.apposition;
+        line.push_str(&format!(",{:.6e},", a.contact_fraction));
+        if let Some((gap, _, _)) = a.largest_gap {
+            line.push_str(&format!("{gap:.6e}"));
+        }
+        line.push_str(&format!(",{:.6e}", a.mean_pressure));
     }
 }
 

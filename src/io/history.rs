@@ -16,7 +16,9 @@
 //! the permanent one — and, for a radial contraction, `delta_r`: the mean radial contraction of the driven
 //! nodes (positive towards the axis; the paper's Δr), and for a device of several materials
 //! `recovery_ratio_mean@<material>`, the mean ratio over the driven nodes touching a rod of that material (a node
-//! joining two materials counts in both; [`crate::model::Model::material_regions`]). With a temperature field,
+//! joining two materials counts in both; [`crate::model::Model::material_regions`]), then `device_diameter` and
+//! `device_length`, the driven nodes' mean outer diameter and their extent along the axis (length unit;
+//! [`crate::post::deployment`], whose recoil and foreshortening `summary.json` reads off them). With a temperature field,
 //! `temperature` is the field's reference schedule and `temperature_min`, `temperature_max` (after `cuts`) the
 //! extremes over the collocation points. Then `max_displacement`, the largest
 //! displacement of any node from the reference shape (length unit): the size of the programmed shape, of the
@@ -26,7 +28,8 @@
 //! `surface_strain_patch` (the patch's name) and `surface_strain_s` (the reference arc length from the patch's
 //! start, length unit).
 //! With contact (`model.contact`), the contact columns of each obstacle follow (`crate::io::contact`: the total
-//! force, its radial part for a cylinder, the points in contact, the largest penetration, the friction work).
+//! force, its radial part for a cylinder, the points in contact, the largest penetration, the friction work, and
+//! how the wires lie on it: the share of their length in contact, the largest gap, the mean line pressure).
 //! Rows are flushed as they are written, so an interrupted run leaves a valid file up to its last step; a row
 //! that cannot be written whole (a full disk) is cut off again, so the file always ends with a complete row.
 
@@ -107,6 +110,31 @@ pub struct SurfaceStrainPeak {
     pub patch: String,
     /// Reference arc length from the patch's start \[length\].
     pub arc_length: f64,
+}
+
+/// The column of the programmed device's mean outer diameter (`crate::post::deployment`).
+pub const DEVICE_DIAMETER: &str = "device_diameter";
+/// The column of the programmed device's length along its axis (`crate::post::deployment`).
+pub const DEVICE_LENGTH: &str = "device_length";
+
+/// The deployment samples of a history's rows `text` (a resumed run's rows before its checkpoint), as a run
+/// of `model` gathered them.
+fn run_deployment(
+    model: &crate::model::Model,
+    text: &str,
+) -> crate::post::deployment::DeploymentTrack {
+    let mut track = crate::post::deployment::DeploymentTrack::default();
+    let history = History::parse(text);
+    if let (Some(d), Some(l)) = (
+        history.column(DEVICE_DIAMETER),
+        history.column(DEVICE_LENGTH),
+    ) {
+        let (cycle, tolerance) = (model.cycle(), model.time().landing_tolerance());
+        for (&(t, d), &(_, l)) in d.iter().zip(&l) {
+            track.observe(cycle.as_ref(), tolerance, (t, d, l));
+        }
+    }
+    track
 }
 
 /// The row of `history.csv` (its text) where the device's surface strain peaks over the run; `None` without
@@ -208,6 +236,8 @@ pub struct HistoryWriter {
     peak: Option<SurfaceStrainPeak>,
     /// The peaks of the contact columns so far (empty without contact).
     contact: Vec<super::contact::ObstaclePeaks>,
+    /// The programmed device's diameter and length at the cycle's events so far.
+    deployment: crate::post::deployment::DeploymentTrack,
     path: PathBuf,
     /// `None` once a write failed.
     out: Option<BufWriter<File>>,
@@ -260,6 +290,7 @@ impl HistoryWriter {
             for m in model.material_regions() {
                 header.push_str(&format!(",recovery_ratio_mean@{}", model.material_names[m]));
             }
+            header.push_str(&format!(",{DEVICE_DIAMETER},{DEVICE_LENGTH}"));
         }
         header.push_str(
             ",max_displacement,surface_strain_peak,surface_strain_patch,surface_strain_s",
@@ -279,6 +310,7 @@ impl HistoryWriter {
             warnings: Vec::new(),
             peak: None,
             contact: super::contact::no_peaks(sim.model()),
+            deployment: Default::default(),
             path: path.to_path_buf(),
             complete: header.len() as u64 + 1,
             out: Some(out),
@@ -311,6 +343,7 @@ impl HistoryWriter {
         std::io::Read::read_to_string(&mut file, &mut text)?;
         let peak = run_peak_surface_strain(&text);
         let contact = super::contact::run_peaks(model, &text);
+        let deployment = run_deployment(model, &text);
         std::io::Seek::seek(&mut file, std::io::SeekFrom::End(0))?;
         Ok(Self {
             exceeded: vec![false; limits.len()],
@@ -318,6 +351,7 @@ impl HistoryWriter {
             warnings: Vec::new(),
             peak,
             contact,
+            deployment,
             path: path.to_path_buf(),
             complete: position.bytes,
             out: Some(BufWriter::new(file)),
@@ -349,6 +383,21 @@ impl HistoryWriter {
     /// The file written.
     pub fn path(&self) -> &Path {
         &self.path
+    }
+
+    /// The programmed device's recoil and foreshortening over the rows written ([`crate::post::deployment`]).
+    pub fn deployment(
+        &self,
+        model: &crate::model::Model,
+    ) -> (
+        Option<crate::post::deployment::Recoil>,
+        Option<crate::post::deployment::Foreshortening>,
+    ) {
+        let (cycle, tolerance) = (model.cycle(), model.time().landing_tolerance());
+        (
+            self.deployment.recoil(cycle.as_ref(), tolerance),
+            self.deployment.foreshortening(cycle.as_ref(), tolerance),
+        )
     }
 
     /// Where the surface strain peaked over the rows written.
@@ -421,6 +470,20 @@ impl HistoryWriter {
             }
             for ratio in &r.by_material {
                 line.push_str(&format!(",{ratio:.9e}"));
+            }
+        }
+        if sim.model().programme.is_some() {
+            match crate::post::deployment::device_shape(sim) {
+                Some(shape) => {
+                    line.push_str(&format!(",{:.9e},{:.9e}", shape.diameter, shape.length));
+                    let model = sim.model();
+                    self.deployment.observe(
+                        model.cycle().as_ref(),
+                        model.time().landing_tolerance(),
+                        (t, shape.diameter, shape.length),
+                    );
+                }
+                None => line.push_str(",,"),
             }
         }
         line.push_str(&format!(

@@ -376,6 +376,23 @@ pub struct RunSummaryFile {
     /// the run, with when (`history.csv`'s contact columns; [`super::contact`]).
     #[serde(skip_serializing_if = "Vec::is_empty")]
     pub contact: Vec<super::contact::ObstaclePeaks>,
+    /// For a programmed device, how it deployed: recoil, foreshortening and each crown against the lumen
+    /// ([`crate::post::deployment`]).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub deployment: Option<Deployment>,
+}
+
+/// How a programmed device deployed (`summary.json` `deployment`; [`crate::post::deployment`]).
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Deployment {
+    /// Recoil as the tool let go, once the run reached the end of the let-go.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub recoil: Option<crate::post::deployment::Recoil>,
+    /// Foreshortening from the crimped state to the end, once the run went past the let-go.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub foreshortening: Option<crate::post::deployment::Foreshortening>,
+    /// Each crown's diameter at the end against the lumen around it.
+    pub crowns: Vec<crate::post::deployment::CrownFit>,
 }
 
 /// What error-controlled stepping did (`summary.json` `time_error_control`).
@@ -510,6 +527,7 @@ impl RunSummaryFile {
             peak_surface_strain: None,
             strain_limit_warnings: Vec::new(),
             contact: Vec::new(),
+            deployment: None,
         }
     }
 

@@ -85,6 +85,10 @@ pub struct DrivenNode {
     /// Unit direction of the stent axis there.
     #[serde(serialize_with = "crate::math::serial::components")]
     pub axis_direction: Vec3,
+    /// The crown the node belongs to (0-based; a junction's: the crown whose crest it is).
+    pub crown: usize,
+    /// The arc length of the stent axis at the node's crown station \[length\].
+    pub station: Real,
     /// Reference distance from the axis (the crown radius `R`) \[length\].
     pub radius: Real,
     /// Number of nodes of the full device this node stands for (1, 2 or 4 in a reduced model): the weight of
@@ -280,6 +284,8 @@ mod tests {
                 target: Vec3::new(0.0, -15.0, 0.0),
                 axis_point: Vec3::zeros(),
                 axis_direction: Vec3::x(),
+                crown: 0,
+                station: 0.0,
                 radius: 20.0,
                 weight: 2.0,
             }],

@@ -612,6 +612,8 @@ pub fn programme(
                     target: targets[k],
                     axis_point: g.axis_point,
                     axis_direction: g.axis_tangent,
+                    crown: g.crown,
+                    station: g.station,
                     radius,
                     weight: g.multiplicity as Real,
                 }

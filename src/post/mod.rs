@@ -12,6 +12,7 @@
 //! returns). Pure: no files, no printing, no serde.
 
 pub mod chart;
+pub mod deployment;
 pub mod device;
 pub mod path;
 pub mod print;

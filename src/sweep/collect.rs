@@ -90,6 +90,24 @@ const AFTER_RATIOS: [Column; 5] = [
     ("final_displacement", Unit::Length, |m| m.final_displacement),
 ];
 
+/// The deployment columns of a programmed device's `model` (none without a programme): its recoil and
+/// foreshortening.
+fn deployment_columns(model: Option<&crate::model::Model>) -> Vec<MetricColumn> {
+    if model.is_none_or(|m| m.programme.is_none()) {
+        return Vec::new();
+    }
+    let recoil: fn(&Metrics) -> Option<Real> = |m| m.recoil;
+    let foreshortening: fn(&Metrics) -> Option<Real> = |m| m.foreshortening;
+    [("recoil", recoil), ("foreshortening", foreshortening)]
+        .into_iter()
+        .map(|(name, get)| MetricColumn {
+            name: name.into(),
+            unit: String::new(),
+            get: Box::new(get),
+        })
+        .collect()
+}
+
 /// The apposition columns of `model`'s obstacles (none without contact): per obstacle `<name>` the share of the
 /// wires' length in contact, the largest gap (`length`: the length unit's suffix) and the mean line pressure.
 fn apposition_columns(model: Option<&crate::model::Model>, length: &str) -> Vec<MetricColumn> {
@@ -192,6 +210,7 @@ pub fn collect(dir: &SweepDir, times: Option<&[Real]>) -> Result<Collected, Swee
             get: Box::new(move |m: &Metrics| m.recovery_at.get(k).copied().flatten()),
         }))
         .chain(AFTER_RATIOS.iter().map(fixed))
+        .chain(deployment_columns(models.iter().flatten().next()))
         .chain(apposition_columns(
             models.iter().flatten().next(),
             &unit(Unit::Length),

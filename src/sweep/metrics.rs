@@ -17,7 +17,10 @@
 //!   a device heated but not recovered), so a table of completed variants does not hide them;
 //! - **apposition**, per obstacle of a model with contact, at the end (`summary.json`'s `contact[].apposition`):
 //!   the share of the wires' length in contact, the largest gap of a wire from the surface (malapposition) and
-//!   the mean line pressure over the length in contact.
+//!   the mean line pressure over the length in contact;
+//! - **recoil** and **foreshortening** of a programmed device (`summary.json`'s `deployment`;
+//!   `crate::post::deployment`): the diameter it gave back as its tool let go, and its length lost from the
+//!   crimped state to the end, each as a fraction.
 //!
 //! The peak strain is not reported: runs do not compute strains yet. A design without a programme gets only
 //! the final displacement. A run that stopped early gives the metrics its history reaches.
@@ -58,6 +61,10 @@ pub(crate) struct Metrics {
     /// Per obstacle of a model with contact, in the model's order, how the wires lie on it at the last
     /// converged step (`summary.json`'s `contact[].apposition`).
     pub apposition: Vec<AppositionMetrics>,
+    /// `(D_open − D_closed) / D_closed` as the tool let go (`summary.json`'s `deployment.recoil`).
+    pub recoil: Option<Real>,
+    /// `(L_crimped − L_end) / L_crimped` (`summary.json`'s `deployment.foreshortening`).
+    pub foreshortening: Option<Real>,
 }
 
 /// How the wires lie on one obstacle at the end of a run (`summary.json`'s `contact[].apposition`).
@@ -179,6 +186,9 @@ pub(crate) fn metrics(
                     .collect()
             })
             .unwrap_or_default(),
+        recoil: summary.and_then(|s| s["deployment"]["recoil"]["recoil"].as_f64()),
+        foreshortening: summary
+            .and_then(|s| s["deployment"]["foreshortening"]["foreshortening"].as_f64()),
     }
 }
 

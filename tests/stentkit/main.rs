@@ -11,6 +11,7 @@ mod checkpoint;
 mod cli;
 mod contact;
 mod crimp;
+mod deployment;
 mod design_errors;
 mod designs;
 mod diamond;

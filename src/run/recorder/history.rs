@@ -63,11 +63,11 @@ pub(super) const HISTORY: RecorderKind = RecorderKind {
 const HISTORY_FILE: &str = "history.csv";
 
 /// Bytes of a `history.csv` row (io::history's formats at their longest): time (17), three displacements per
-/// probe (20 each), temperature (11), iterations (3), residual (10), cuts (3), the recovery ratios (18 each)
-/// and Δr (17) of a programme, the largest node displacement (16), the peak surface strain (16), its patch
+/// probe (20 each), temperature (11), iterations (3), residual (10), cuts (3), the recovery ratios (18 each),
+/// Δr (17), the device's diameter and length (17 each) of a programme, the largest node displacement (16), the peak surface strain (16), its patch
 /// (the longest name) and arc length (16), one peak per material with a strain limit (16), per obstacle of a
-/// model with contact its force components and radial force (17 each), points (6), penetration and friction
-/// work (14 each), the line end.
+/// model with contact its force components and radial force (17 each), points (6), penetration, friction
+/// work and the three apposition columns (14 each), the line end.
 fn row_bytes(model: &Model, strain_limits: &[Option<Real>]) -> Real {
     let name = model
         .patches
@@ -78,10 +78,10 @@ fn row_bytes(model: &Model, strain_limits: &[Option<Real>]) -> Real {
     let limits = strain_limits.iter().flatten().count() as Real;
     let peaks = 16.0 + 17.0 + name + 1.0 + 17.0 + 17.0 * limits;
     let recovery = match &model.programme {
-        Some(p) => 36.0 + if p.is_radial() { 18.0 } else { 0.0 },
+        Some(p) => 36.0 + if p.is_radial() { 18.0 } else { 0.0 } + 34.0,
         None => 0.0,
     };
-    let contact = 102.0 * model.contact.as_ref().map_or(0, |c| c.obstacles.len()) as Real;
+    let contact = 144.0 * model.contact.as_ref().map_or(0, |c| c.obstacles.len()) as Real;
     17.0 + 60.0 * model.probes.len() as Real
         + 11.0
         + 3.0
@@ -130,6 +130,14 @@ impl Recorder for HistoryWriter {
             for (peaks, a) in summary.contact.iter_mut().zip(now) {
                 peaks.apposition = Some(a);
             }
+        }
+        if sim.model().programme.is_some() {
+            let (recoil, foreshortening) = self.deployment(sim.model());
+            summary.deployment = Some(crate::io::summary::Deployment {
+                recoil,
+                foreshortening,
+                crowns: crate::post::deployment::crown_fits(sim),
+            });
         }
     }
 
