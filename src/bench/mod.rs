@@ -54,15 +54,23 @@ use std::path::{Path, PathBuf};
 pub const DEFAULT_TEMPERATURE: Real = 37.0;
 /// The default rate of the crimper's diameter (the plates' gap), in mm/s (converted to the design's units).
 pub const DEFAULT_RATE_MM_PER_S: Real = 0.1;
+/// The file of a bench's results in its run folder ([`BenchResults`]).
+pub const RESULTS_FILE: &str = "bench.json";
 /// The default number of diameters recorded per branch.
 pub const DEFAULT_DIAMETERS: usize = 30;
 /// The crush's readings: the force at these fractions of the device's outer diameter crushed (module docs).
 pub const CRUSH_READINGS: [Real; 3] = [0.1, 0.25, 0.5];
+/// The name of the crush's reading at the fraction `f` of the outer diameter crushed (`10%` for 0.1).
+pub fn crush_reading_name(f: Real) -> String {
+    format!("{}%", crate::math::Short(100.0 * f))
+}
+
 /// 1 mmHg in kPa (133.322 Pa).
 const KPA_PER_MMHG: Real = 0.133_322_387;
 
 /// Which test of the bench (module docs).
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "snake_case")]
 pub enum Test {
     /// The radial force in a closing and opening cylindrical crimper.
     Radial,
@@ -77,6 +85,13 @@ impl Test {
             Test::Radial => "radial",
             Test::Crush => "crush",
         }
+    }
+
+    /// The test of a name ([`Test::name`]).
+    pub fn from_name(name: &str) -> Option<Self> {
+        [Test::Radial, Test::Crush]
+            .into_iter()
+            .find(|t| t.name() == name)
     }
 
     /// The programme kind the bench gives the design.
@@ -610,70 +625,128 @@ impl Bench {
         chart
     }
 
+    /// Where the bench reads its forces: the vessel's diameter (named `vessel`) and, for a crush, 10 %, 25 % and
+    /// 50 % of the device's outer diameter crushed (named `10%`, …), as `(name, size)`.
+    fn reading_sizes(&self) -> Vec<(String, Real)> {
+        let mut sizes = Vec::new();
+        if self.test == Test::Crush {
+            for f in CRUSH_READINGS {
+                sizes.push((crush_reading_name(f), self.outer_diameter * (1.0 - f)));
+            }
+        }
+        sizes.extend(self.vessel_diameter.map(|d| ("vessel".to_string(), d)));
+        sizes
+    }
+
+    /// The bench's results from its recorded `points` (module docs): what it prints and writes to `bench.json`.
+    pub fn results(&self, points: &[BenchPoint]) -> BenchResults {
+        let reached = points
+            .iter()
+            .map(|p| p.diameter)
+            .fold(Real::INFINITY, Real::min);
+        BenchResults {
+            test: self.test,
+            temperature: self.temperature,
+            rate: self.rate,
+            length: self.length,
+            asked: self.min_diameter,
+            reached: reached.is_finite().then_some(reached),
+            readings: self
+                .reading_sizes()
+                .into_iter()
+                .map(|(name, size)| Reading {
+                    name,
+                    size,
+                    loading: Self::force_at(points, Branch::Loading, size),
+                    unloading: Self::force_at(points, Branch::Unloading, size),
+                })
+                .collect(),
+        }
+    }
+
     /// What the bench prints at the end: the smallest size reached and the forces at the vessel's diameter
     /// (and, for a crush, at 10 %, 25 % and 50 % of the outer diameter crushed).
     pub fn summary(&self, points: &[BenchPoint]) -> Vec<String> {
         let length = self.units.length();
         let size = self.test.size();
+        let results = self.results(points);
         let mut lines = Vec::new();
-        let reached = points
-            .iter()
-            .map(|p| p.diameter)
-            .fold(Real::INFINITY, Real::min);
-        if reached.is_finite() {
+        if let Some(reached) = results.reached {
             lines.push(format!(
                 "smallest {size} reached: {reached:.4} {length} (asked {:.4} {length})",
                 self.min_diameter
             ));
         }
-        let reading = |what: &str, at: &str, branch: Branch, d: Real| match Self::force_at(
-            points, branch, d,
-        ) {
-            Some(f) => {
-                let (per_length, kpa) = self.per_length_and_pressure(f, d);
-                format!(
-                    "{what} at {at} {d:.4} {length}: {f:.4e} N, {per_length:.4e} N/{length}, {kpa:.4} kPa ({:.4} mmHg)",
-                    kpa / KPA_PER_MMHG
-                )
-            }
-            None => format!("{what}: {at} {d:.4} {length} was not reached on this branch"),
-        };
-        if self.test == Test::Crush {
-            for f in CRUSH_READINGS {
-                let gap = self.outer_diameter * (1.0 - f);
-                for (branch, what) in [
-                    (Branch::Loading, "crush force (closing)"),
-                    (Branch::Unloading, "crush force (opening)"),
-                ] {
-                    let at = format!("{} % crushed, the gap", crate::math::Short(100.0 * f));
-                    lines.push(reading(what, &at, branch, gap));
-                }
-            }
-        }
-        match (self.vessel_diameter, self.test) {
-            (None, Test::Radial) => lines.push(
+        if self.test == Test::Radial && self.vessel_diameter.is_none() {
+            lines.push(
                 "no vessel diameter (a vessel file's lumen, or `bench.vessel_diameter`): no COF read".into(),
-            ),
-            (None, Test::Crush) => {}
-            (Some(d), test) => {
-                let whats = match test {
-                    Test::Radial => [
-                        "radial resistive force (closing)",
-                        "chronic outward force (opening)",
-                    ],
-                    Test::Crush => ["crush force (closing)", "crush force (opening)"],
-                };
-                for (branch, what) in [Branch::Loading, Branch::Unloading].into_iter().zip(whats) {
-                    lines.push(reading(what, "the vessel diameter", branch, d));
-                }
+            );
+        }
+        let whats = match self.test {
+            Test::Radial => [
+                "radial resistive force (closing)",
+                "chronic outward force (opening)",
+            ],
+            Test::Crush => ["crush force (closing)", "crush force (opening)"],
+        };
+        for r in &results.readings {
+            let at = match r.name.as_str() {
+                "vessel" => "the vessel diameter".to_string(),
+                fraction => format!("{} crushed, the gap", fraction.replace('%', " %")),
+            };
+            let d = r.size;
+            for (force, what) in [r.loading, r.unloading].into_iter().zip(whats) {
+                lines.push(match force {
+                    Some(f) => {
+                        let (per_length, kpa) = self.per_length_and_pressure(f, d);
+                        format!(
+                            "{what} at {at} {d:.4} {length}: {f:.4e} N, {per_length:.4e} N/{length}, {kpa:.4} kPa ({:.4} mmHg)",
+                            kpa / KPA_PER_MMHG
+                        )
+                    }
+                    None => format!("{what}: {at} {d:.4} {length} was not reached on this branch"),
+                });
             }
         }
         lines
     }
 }
 
-/// Adds the bench's table (`radial.csv`, `crush.csv`) and chart (`charts/radial_force.svg`,
-/// `charts/crush_force.svg`) to the run folder `dir` of its run (listed in the folder's manifest, so `--force`
+/// What a bench found (`bench.json` in its run folder; `stentkit sweep --bench` reads it): the smallest size
+/// the tool reached and the forces at the bench's readings.
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct BenchResults {
+    /// The test.
+    pub test: Test,
+    /// Temperature \[°C\].
+    pub temperature: Real,
+    /// Rate of the tool's size \[length/time\].
+    pub rate: Real,
+    /// The device's length along its axis \[length\].
+    pub length: Real,
+    /// The smallest size asked \[length\].
+    pub asked: Real,
+    /// The smallest size reached \[length\] (`None`: nothing recorded).
+    pub reached: Option<Real>,
+    /// The forces at the readings.
+    pub readings: Vec<Reading>,
+}
+
+/// The force on both branches at one size.
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct Reading {
+    /// `vessel` (at the vessel's diameter) or a crush's `10%`, `25%`, `50%`.
+    pub name: String,
+    /// The size \[length\].
+    pub size: Real,
+    /// The force closing (RRF, crush force) \[force\]; `None` where the branch did not reach the size.
+    pub loading: Option<Real>,
+    /// The force opening (COF) \[force\].
+    pub unloading: Option<Real>,
+}
+
+/// Adds the bench's table (`radial.csv`, `crush.csv`), chart (`charts/radial_force.svg`,
+/// `charts/crush_force.svg`) and results ([`RESULTS_FILE`]) to the run folder `dir` of its run (listed in the folder's manifest, so `--force`
 /// removes them with the run's files) and returns what the bench prints at the end ([`Bench::summary`]).
 /// `model` is the bench design's.
 ///
@@ -702,5 +775,7 @@ pub fn write_outputs(dir: &Path, bench: &Bench, model: &Model) -> Result<Vec<Str
         std::fs::create_dir_all(dir.join(run_folder::CHARTS_FOLDER)).map_err(|e| fail(&e))?;
         write(&format!("charts/{name}_force.svg"), svg.as_bytes())?;
     }
+    let results = serde_json::to_string_pretty(&bench.results(&points)).map_err(|e| fail(&e))?;
+    write(RESULTS_FILE, results.as_bytes())?;
     Ok(bench.summary(&points))
 }

@@ -367,6 +367,10 @@ pub(crate) struct SweepCli {
     /// Pair the k-th values of every --set instead of taking their cartesian product.
     #[arg(long)]
     pub zip: bool,
+    /// Run a bench test on every variant instead of its design's run (`radial` or `crush`, as `stentkit
+    /// bench`): sweep.csv gets the smallest size reached and the bench's forces.
+    #[arg(long, value_parser = ["radial", "crush"])]
+    pub bench: Option<String>,
     /// The sweep folder (new, or one this sweep wrote: it continues).
     #[arg(short, long, required = true)]
     pub output: Option<PathBuf>,
@@ -875,6 +879,7 @@ fn sweep(cli: SweepCli) -> anyhow::Result<()> {
                 sweep::SweepOptions {
                     sets: cli.set,
                     zip: cli.zip,
+                    bench: cli.bench.as_deref().and_then(Test::from_name),
                     output,
                     jobs: cli.jobs,
                     threads_per_run: cli.threads_per_run,

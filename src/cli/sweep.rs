@@ -29,6 +29,8 @@ pub(crate) struct SweepOptions {
     pub sets: Vec<String>,
     /// Pair the k-th values instead of the cartesian product.
     pub zip: bool,
+    /// The bench test every variant runs instead of its design's run.
+    pub bench: Option<crate::bench::Test>,
     /// The sweep folder.
     pub output: PathBuf,
     /// Local workers (default: cores / threads per run).
@@ -61,7 +63,9 @@ pub(crate) fn run(design: &Path, options: SweepOptions) -> anyhow::Result<()> {
         .map(|s| Parameter::parse(s))
         .collect::<Result<Vec<_>, _>>()
         .map_err(|e| BadInput(e.to_string()))?;
-    let plan = Plan::new(design, parameters, options.zip).map_err(|e| BadInput(e.to_string()))?;
+    let mut plan =
+        Plan::new(design, parameters, options.zip).map_err(|e| BadInput(e.to_string()))?;
+    plan.bench = options.bench;
     let dir = SweepDir {
         dir: options.output.clone(),
     };
@@ -461,10 +465,36 @@ fn task_with(
             ))
             .into());
         }
-        VariantState::Unfinished(_) if checkpoint => (true, false),
+        VariantState::Unfinished(_) if checkpoint && plan.bench.is_none() => (true, false),
         _ => (false, run_dir.exists()),
     };
     let _ = std::fs::remove_file(sweep.task_error(&id));
+    if let Some(test) = plan.bench {
+        let result = super::bench::bench_into(
+            test,
+            &sweep.design(&id),
+            &run_dir,
+            force,
+            started,
+            console,
+            interrupt,
+        )
+        .map(|(report, lines)| {
+            console.say(&report);
+            for l in lines {
+                console.say(&l);
+            }
+        });
+        if let Err(e) = &result
+            && !run_dir.join("summary.json").exists()
+        {
+            let _ = crate::io::no_follow::write(
+                &sweep.task_error(&id),
+                super::error_text(e).as_bytes(),
+            );
+        }
+        return result;
+    }
     let options = super::run::RunOptions {
         output: (!resume).then(|| run_dir.clone()),
         force,

@@ -90,6 +90,47 @@ const AFTER_RATIOS: [Column; 5] = [
     ("final_displacement", Unit::Length, |m| m.final_displacement),
 ];
 
+/// The bench's columns of a sweep of `test` (none for a plain sweep; a bench sweep has only these): the smallest size the tool reached and
+/// its forces at the readings ([`crate::bench::BenchResults`]), the units' suffixes `length` and `force`.
+fn bench_columns(test: Option<crate::bench::Test>, length: &str, force: &str) -> Vec<MetricColumn> {
+    use crate::bench::Test;
+    let Some(test) = test else {
+        return Vec::new();
+    };
+    let reading = |name: String, loading: bool| -> Getter {
+        Box::new(move |m: &Metrics| {
+            let r = m.bench.as_ref()?.readings.iter().find(|r| r.name == name)?;
+            if loading { r.loading } else { r.unloading }
+        })
+    };
+    let mut columns = vec![MetricColumn {
+        name: format!("smallest_{}", test.size()),
+        unit: length.to_string(),
+        get: Box::new(|m: &Metrics| m.bench.as_ref()?.reached),
+    }];
+    let readings: Vec<(String, String, bool)> = match test {
+        Test::Radial => vec![
+            ("rrf@vessel".into(), "vessel".into(), true),
+            ("cof@vessel".into(), "vessel".into(), false),
+        ],
+        Test::Crush => crate::bench::CRUSH_READINGS
+            .into_iter()
+            .map(|f| {
+                let r = crate::bench::crush_reading_name(f);
+                (format!("crush_force@{r}"), r, true)
+            })
+            .collect(),
+    };
+    for (name, at, loading) in readings {
+        columns.push(MetricColumn {
+            name,
+            unit: force.to_string(),
+            get: reading(at, loading),
+        });
+    }
+    columns
+}
+
 /// The deployment columns of a programmed device's `model` (none without a programme): its recoil and
 /// foreshortening.
 fn deployment_columns(model: Option<&crate::model::Model>) -> Vec<MetricColumn> {
@@ -201,21 +242,26 @@ pub fn collect(dir: &SweepDir, times: Option<&[Real]>) -> Result<Collected, Swee
         unit: unit(*u),
         get: Box::new(*get),
     };
-    let columns: Vec<MetricColumn> = BEFORE_RATIOS
-        .iter()
-        .map(fixed)
-        .chain(times.iter().enumerate().map(|(k, t)| MetricColumn {
-            name: format!("recovery_ratio@{}", crate::math::Short(*t)),
-            unit: String::new(),
-            get: Box::new(move |m: &Metrics| m.recovery_at.get(k).copied().flatten()),
-        }))
-        .chain(AFTER_RATIOS.iter().map(fixed))
-        .chain(deployment_columns(models.iter().flatten().next()))
-        .chain(apposition_columns(
-            models.iter().flatten().next(),
-            &unit(Unit::Length),
-        ))
-        .collect();
+    // A bench's run is not the design's cycle: its columns are the bench's alone.
+    let columns: Vec<MetricColumn> = if plan.bench.is_some() {
+        bench_columns(plan.bench, &unit(Unit::Length), " (N)")
+    } else {
+        BEFORE_RATIOS
+            .iter()
+            .map(fixed)
+            .chain(times.iter().enumerate().map(|(k, t)| MetricColumn {
+                name: format!("recovery_ratio@{}", crate::math::Short(*t)),
+                unit: String::new(),
+                get: Box::new(move |m: &Metrics| m.recovery_at.get(k).copied().flatten()),
+            }))
+            .chain(AFTER_RATIOS.iter().map(fixed))
+            .chain(deployment_columns(models.iter().flatten().next()))
+            .chain(apposition_columns(
+                models.iter().flatten().next(),
+                &unit(Unit::Length),
+            ))
+            .collect()
+    };
     // The table.
     let mut csv = String::from("variant");
     for p in &plan.parameters {

@@ -18,6 +18,9 @@
 //! - **apposition**, per obstacle of a model with contact, at the end (`summary.json`'s `contact[].apposition`):
 //!   the share of the wires' length in contact, the largest gap of a wire from the surface (malapposition) and
 //!   the mean line pressure over the length in contact;
+//! - **the bench's numbers**, for a sweep of a bench test (`bench.json`, `crate::bench::BenchResults`): the
+//!   smallest size the tool reached and its forces at the readings (the radial force closing and opening at
+//!   the vessel's diameter; the crush force closing at 10 %, 25 % and 50 % crushed);
 //! - **recoil** and **foreshortening** of a programmed device (`summary.json`'s `deployment`;
 //!   `crate::post::deployment`): the diameter it gave back as its tool let go, and its length lost from the
 //!   crimped state to the end, each as a fraction.
@@ -65,6 +68,8 @@ pub(crate) struct Metrics {
     pub recoil: Option<Real>,
     /// `(L_crimped − L_end) / L_crimped` (`summary.json`'s `deployment.foreshortening`).
     pub foreshortening: Option<Real>,
+    /// A bench run's results (`bench.json`).
+    pub bench: Option<crate::bench::BenchResults>,
 }
 
 /// How the wires lie on one obstacle at the end of a run (`summary.json`'s `contact[].apposition`).
@@ -189,6 +194,7 @@ pub(crate) fn metrics(
         recoil: summary.and_then(|s| s["deployment"]["recoil"]["recoil"].as_f64()),
         foreshortening: summary
             .and_then(|s| s["deployment"]["foreshortening"]["foreshortening"].as_f64()),
+        bench: None,
     }
 }
 
@@ -198,7 +204,12 @@ pub(crate) fn run_metrics(model: &Model, run: &Path, times: &[Real]) -> Metrics 
         .map(|t| History::parse(&t))
         .unwrap_or_default();
     let summary = crate::io::input::read_json(&run.join("summary.json")).ok();
-    metrics(Release::of(model), &history, summary.as_ref(), times)
+    Metrics {
+        bench: std::fs::read_to_string(run.join(crate::bench::RESULTS_FILE))
+            .ok()
+            .and_then(|text| serde_json::from_str(&text).ok()),
+        ..metrics(Release::of(model), &history, summary.as_ref(), times)
+    }
 }
 
 #[cfg(test)]

@@ -37,6 +37,11 @@
 //! lock: one command at a time prepares or collects it (two at once could remove each other's temporary in
 //! progress, and the later rename fails with an error naming the file).
 //!
+//! **Bench.** With `--bench radial` or `--bench crush` (`sweep.json`'s `bench`) every variant runs that bench
+//! test of its design (`crate::bench`) instead of the design's own run: its `run/` is the bench's run folder,
+//! with `bench.json`, whose smallest size reached and forces `sweep collect` adds as columns. A bench run
+//! cannot be continued from a checkpoint: an interrupted variant runs again from the start.
+//!
 //! **State** of a variant ([`VariantState`]) is read from its files: `summary.json`'s status, or `error.txt`
 //! (its design was refused), or `task_error.txt` (its run was refused before it wrote a summary), or nothing
 //! yet.
@@ -225,6 +230,9 @@ pub struct Plan {
     pub zip: bool,
     /// The variants.
     pub variants: Vec<Variant>,
+    /// The bench test each variant runs instead of its design's run (`stentkit sweep --bench`; module docs).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub bench: Option<crate::bench::Test>,
 }
 
 impl Plan {
@@ -285,6 +293,7 @@ impl Plan {
                     values,
                 })
                 .collect(),
+            bench: None,
         })
     }
 
@@ -490,14 +499,17 @@ impl SweepDir {
             let existing = self.read_plan()?;
             if existing != *plan {
                 return Err(folder(format!(
-                    "holds another sweep ({} with {}); give the same design and --set arguments to continue it, or another -o",
+                    "holds another sweep ({} with {}{}); give the same design, --set and --bench arguments to continue it, or another -o",
                     existing.design.display(),
                     existing
                         .parameters
                         .iter()
                         .map(Parameter::argument)
                         .collect::<Vec<_>>()
-                        .join(" ")
+                        .join(" "),
+                    existing
+                        .bench
+                        .map_or_else(String::new, |t| format!(" --bench {}", t.name()))
                 )));
             }
             return Ok(());

@@ -360,3 +360,82 @@ fn a_ring_crushed_between_plates_matches_the_diametral_load_closed_form() {
     println!("ring: {stiffness:.6e} N/mm at zero force against {closed_form:.6e}: {relative:+.3e}");
     assert!(relative.abs() < 1e-2, "{stiffness} against {closed_form}");
 }
+
+/// Source: the variants' own bench results. A sweep with `--bench radial` over the wire diameter runs the
+/// radial bench on every variant and `sweep collect` tabulates each one's smallest diameter reached and its
+/// forces at the vessel's diameter: the table's values are those of the variant's `bench.json` (to the table's
+/// 10 significant digits), and nothing of the design's own cycle is tabulated (a bench's run has none). The
+/// thicker wire (0.6 against 0.5; bending stiffness `∝ d⁴`, twice as stiff) puts the larger chronic outward
+/// force on the vessel.
+#[test]
+fn a_sweep_of_the_radial_bench_tabulates_each_variants_forces() {
+    let dir = TempDir::new("bench-sweep");
+    let sweep = dir.join("sweep");
+    let design = Path::new(env!("CARGO_MANIFEST_DIR")).join("designs/straight_stent.yaml");
+    let out = Command::new(env!("CARGO_BIN_EXE_stentkit"))
+        .arg("sweep")
+        .arg(&design)
+        .args([
+            "--set",
+            "stent.crowns=2",
+            "--set",
+            "section.diameter=0.5,0.6",
+            "--set",
+            "bench.min_diameter=30",
+            "--set",
+            "bench.diameters=5",
+            "--set",
+            "bench.vessel_diameter=34",
+            "--bench",
+            "radial",
+            "-o",
+        ])
+        .arg(&sweep)
+        .output()
+        .expect("stentkit runs");
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let table = std::fs::read_to_string(sweep.join("sweep.csv")).expect("sweep.csv");
+    let mut lines = table.lines();
+    let header: Vec<&str> = lines.next().expect("a header").split(',').collect();
+    let column = |name: &str| {
+        header
+            .iter()
+            .position(|h| *h == name)
+            .unwrap_or_else(|| panic!("no {name} in {header:?}"))
+    };
+    let (smallest, rrf, cof) = (
+        column("smallest_diameter (mm)"),
+        column("rrf@vessel (N)"),
+        column("cof@vessel (N)"),
+    );
+    assert!(
+        !header.iter().any(|h| h.starts_with("recovery_ratio")),
+        "{header:?}"
+    );
+    let mut cofs = Vec::new();
+    for (k, line) in lines.enumerate() {
+        let row: Vec<&str> = line.split(',').collect();
+        let value = |i: usize| row[i].parse::<Real>().expect("a number");
+        let results: serde_json::Value = serde_json::from_str(
+            &std::fs::read_to_string(sweep.join(format!("variants/v{k:03}/run/bench.json")))
+                .expect("bench.json"),
+        )
+        .expect("JSON");
+        let reading = &results["readings"][0];
+        assert_eq!(reading["name"], "vessel");
+        let close = |a: Real, b: &serde_json::Value| {
+            let b = b.as_f64().expect("a number");
+            (a - b).abs() <= 1e-9 * b.abs()
+        };
+        assert!(close(value(smallest), &results["reached"]), "{line}");
+        assert!(close(value(rrf), &reading["loading"]), "{line}");
+        assert!(close(value(cof), &reading["unloading"]), "{line}");
+        cofs.push(value(cof));
+    }
+    assert_eq!(cofs.len(), 2);
+    assert!(cofs[1] > cofs[0] && cofs[0] > 0.0, "{cofs:?}");
+}
