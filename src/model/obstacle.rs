@@ -1,7 +1,7 @@
 //! Obstacles: surfaces the rods of a device touch (issue 33) — a cylinder that keeps the rods inside it (a
 //! crimper, a catheter sheath, a vessel idealised as a tube), a plane that keeps them on one side (a crush plate,
 //! a table), a vessel's lumen around its centreline spline ([`Lumen`]) — with a rigid or a compliant wall (a
-//! lumen's: rigid), and the contact settings of a model.
+//! plane's: rigid), and the contact settings of a model.
 //!
 //! What an obstacle is, not how the solver enforces it: the geometry gives the signed distance of a point from
 //! the surface (positive on the side the rods belong to), its gradient and its Hessian
@@ -13,7 +13,10 @@
 //! `δ / R`): a radial foundation of stiffness `k = E_w h / R²` \[force/length³\]. A wire presses on the strip of
 //! wall it carries, of width `b` (the wall area per unit length of wire), so its line force per unit wire length is
 //! `k b` times the wall's displacement: the contact law's penalty becomes the physical `k b`, and the
-//! penetration is the wall's displacement, not an error (no augmented-Lagrange updates).
+//! penetration is the wall's displacement, not an error (no augmented-Lagrange updates). On a lumen `R` is the
+//! local radius `R(u)` where the wire touches ([`Surface::wall_radius`]): a vessel is stiffer where it is
+//! narrower. Each point of wall carries its own wire (a Winkler foundation: the hoop coupling between points
+//! along the circumference, which spreads a strut's load over the tube, is left out).
 //!
 //! **Friction.** Each obstacle has its Coulomb coefficient ([`Obstacle::friction`]): a point in contact carries
 //! a tangential line force of at most `μ p` opposing its slip over the surface (the solver's regularised law).
@@ -449,12 +452,29 @@ impl Surface {
         }
     }
 
-    /// The radius of a cylinder at time `t` (`None` for a plane and a lumen, whose radius varies along it): the
-    /// `R` of a compliant wall's stiffness.
+    /// The radius of a cylinder at time `t` (`None` for a plane and a lumen, whose radius varies along it).
     pub fn radius(&self, t: Real) -> Option<Real> {
         match self {
             Surface::Cylinder { radius, .. } => Some(radius.value(t)),
             Surface::Plane { .. } | Surface::Lumen(_) => None,
+        }
+    }
+
+    /// The `R` of a compliant wall's stiffness at time `t` where a point touches it: a cylinder's radius, a
+    /// lumen's radius at the centreline parameter `parameter` of the point's closest point (scaled), or — for a
+    /// point whose parameter is not known yet — the lumen's mean tabulated radius; `None` for a plane.
+    pub fn wall_radius(&self, t: Real, parameter: Option<Real>) -> Option<Real> {
+        match self {
+            Surface::Cylinder { radius, .. } => Some(radius.value(t)),
+            Surface::Plane { .. } => None,
+            Surface::Lumen(lumen) => {
+                let table = lumen.radius_table();
+                let radius = match parameter {
+                    Some(u) => lumen.radius(u).0,
+                    None => table.iter().map(|r| r.1).sum::<Real>() / table.len() as Real,
+                };
+                Some(radius * lumen.scale().value(t))
+            }
         }
     }
 

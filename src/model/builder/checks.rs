@@ -169,12 +169,6 @@ pub(crate) fn contact(contact: &crate::model::Contact, model: &crate::model::Mod
                         ),
                     ));
                 }
-                if obstacle.wall != Wall::Rigid {
-                    return Err(BuildError::new(
-                        at(ObstacleField::Wall),
-                        "a lumen's wall must be rigid: its radius varies along it, and a compliant wall's stiffness E_w h / R² is not yet taken at the local radius".to_string(),
-                    ));
-                }
                 None
             }
         };

@@ -526,7 +526,8 @@ impl SurfaceContact {
     }
 
     /// The penalty and multiplier of obstacle `k` at point `g` (a compliant wall: its line stiffness, no
-    /// multiplier).
+    /// multiplier; on a lumen, of the radius where the point's closest point was at the last converged step —
+    /// the foundation's stiffness lags the point's slide along the vessel by a step).
     pub(crate) fn law(&self, k: usize, g: usize) -> (Real, Real) {
         let obstacle = &self.obstacles[k];
         if obstacle.wall == Wall::Rigid {
@@ -534,7 +535,7 @@ impl SurfaceContact {
         }
         match obstacle
             .surface
-            .radius(self.time)
+            .wall_radius(self.time, self.hint(k, g))
             .and_then(|r| obstacle.wall.line_stiffness(r))
         {
             Some(stiffness) => (stiffness, 0.0),
@@ -1251,6 +1252,34 @@ mod tests {
     /// tolerance is the solver's (1e-8 relative).
     #[test]
     fn a_ring_in_a_compliant_tube_balances_as_two_springs_in_series() {
+        springs_in_series(cylinder);
+    }
+
+    /// Source: as [`a_ring_in_a_compliant_tube_balances_as_two_springs_in_series`], the tube given as a
+    /// vessel's lumen: a straight centreline along the axis (a cubic with uneven control points) with a
+    /// constant radius, closing through its scale. The wall's stiffness takes the lumen's local radius where
+    /// each point touches, here the same everywhere: the same balance, to the same 1e-8.
+    #[test]
+    fn a_ring_in_a_compliant_lumen_balances_as_two_springs_in_series() {
+        springs_in_series(|from, to, wall| {
+            let knots = crate::math::KnotVector::clamped_uniform(3, 6).expect("a knot vector");
+            let points = [0.0, 0.1, 0.3, 0.6, 0.8, 1.0]
+                .iter()
+                .map(|&t| Vec3::new(0.0, 0.0, -20.0 + 40.0 * t))
+                .collect();
+            let centreline = crate::math::NurbsCurve::try_bspline(knots, points).expect("a curve");
+            let scale = TimeFunction::try_table(vec![(0.0, from / to), (1.0, 1.0)])
+                .expect("increasing times");
+            let lumen = crate::model::Lumen::try_new(centreline, vec![(0.0, to), (1.0, to)])
+                .expect("a lumen")
+                .with_scale(scale);
+            Obstacle::new("vessel", Surface::Lumen(lumen), wall)
+        });
+    }
+
+    /// The ring crimped into the compliant tube that `tube(from, to, wall)` makes (its radius closing from
+    /// `from` to `to` over the run) balances as the two springs in series (the tests above).
+    fn springs_in_series(tube_of: impl Fn(Real, Real, Wall) -> Obstacle) {
         let r = D / 2.0;
         let (modulus, thickness, width) = (100.0, 1.0, 2.0);
         let settings = RING;
@@ -1260,7 +1289,7 @@ mod tests {
             width,
         };
         let tube = R0 + r - 0.5;
-        let (radii, _, _) = crimp(cylinder(R0 + r + 0.2, tube, wall), settings);
+        let (radii, _, _) = crimp(tube_of(R0 + r + 0.2, tube, wall), settings);
         let area = std::f64::consts::PI * D * D / 4.0;
         let ring = E * area / (R0 * R0);
         let k = modulus * thickness * width / (tube * tube);
