@@ -12,6 +12,11 @@
 //!   - name: vessel
 //!     lumen: {}                   # the lumen of the stent's vessel file (`stent.centreline.file`)
 //!     from: 2.25
+//!     wall: {E: 0.5, thickness: 0.9}   # compliant at its local radius where each wire touches
+//!   - name: sheath
+//!     lumen: {radius: 3.5}        # a tube of its own radius along the vessel's centreline
+//!     from: 2.25
+//!     until: 2.6
 //!   - name: tube
 //!     cylinder: {point: [0, 0, 0], axis: [1, 0, 0], radius: 21}
 //!     wall: {E: 1.0, thickness: 0.5}   # compliant (width: default the wire's diameter); rigid without it
@@ -149,10 +154,25 @@ fn obstacle(
     let surface = match (&o.cylinder, &o.plane, &o.lumen) {
         (None, None, Some(l)) => {
             let lumen = lumen(vessel, &format!("{base}.lumen"))?;
-            Surface::Lumen(match &l.scale {
-                Some(f) => lumen.with_scale(time_function(f, "lumen.scale")?),
-                None => lumen,
-            })
+            // A radius of its own: the centreline's tube of radius 1 scaled by it.
+            match (&l.radius, &l.scale) {
+                (Some(_), Some(_)) => {
+                    return Err(issue(
+                        format!("{base}.lumen.scale"),
+                        "give the lumen a `radius` of its own or a `scale` on the file's radius, not both",
+                    ));
+                }
+                (Some(r), None) => {
+                    let lo = lumen.centreline().knots().domain().0;
+                    let unit = Lumen::try_new(lumen.centreline().clone(), vec![(lo, 1.0)])
+                        .map_err(|e| issue(format!("{base}.lumen"), e))?;
+                    Surface::Lumen(unit.with_scale(time_function(r, "lumen.radius")?))
+                }
+                (None, Some(f)) => {
+                    Surface::Lumen(lumen.with_scale(time_function(f, "lumen.scale")?))
+                }
+                (None, None) => Surface::Lumen(lumen),
+            }
         }
         (Some(c), None, None) => Surface::Cylinder {
             point: vec3(&c.point),

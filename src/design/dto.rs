@@ -403,6 +403,10 @@ pub struct LumenDto {
     /// A factor on the lumen radius: a number or a table `[[t, f], …]` (default 1).
     #[serde(default)]
     pub scale: Option<TimeFn>,
+    /// A radius of its own along the vessel's centreline instead of the file's lumen radius \[length\]: a
+    /// number or a table `[[t, r], …]` (a sheath or a catheter that follows the vessel); not with `scale`.
+    #[serde(default)]
+    pub radius: Option<TimeFn>,
 }
 
 /// A plane obstacle.

@@ -100,3 +100,78 @@ fn column(history: &str, name: &str) -> Vec<(Real, Real)> {
         })
         .collect()
 }
+
+/// Runs the design `name` of `designs/` into `dir` and returns its `summary.json`.
+fn run_design(name: &str, dir: &Path) -> serde_json::Value {
+    let design = Path::new(env!("CARGO_MANIFEST_DIR")).join(format!("designs/{name}.yaml"));
+    let out = Command::new(env!("CARGO_BIN_EXE_stentkit"))
+        .arg("run")
+        .arg(&design)
+        .arg("-o")
+        .arg(dir)
+        .arg("--quiet")
+        .output()
+        .expect("stentkit runs");
+    assert!(
+        out.status.success(),
+        "{name}: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    serde_json::from_str(&std::fs::read_to_string(dir.join("summary.json")).expect("summary.json"))
+        .expect("JSON")
+}
+
+/// What a deployment's `summary.json` must say, by geometry: the device given back by the crimper (closed at
+/// the wires' reach `reach`) into the sheath of radius `sheath` has a mean outer diameter between the two
+/// (recoil positive, and the sheath's diameter not exceeded by more than the contact tolerance, 1 % of the
+/// wire: the crests press on it); the device shortened or kept its length within 10 %; every crown, at the
+/// end, has its vessel's lumen around it and stands inside it but for the wall's own give (`give`: the vessel's
+/// largest penetration, which on a compliant wall is its displacement, on both sides of the diameter); part of
+/// the wires lie on the wall.
+fn check_deployment(summary: &serde_json::Value, reach: Real, sheath: Real, wire: Real) {
+    let number = |v: &serde_json::Value| v.as_f64().unwrap_or_else(|| panic!("a number: {v}"));
+    let d = &summary["deployment"];
+    let recoil = &d["recoil"];
+    let (closed, open) = (
+        number(&recoil["diameter_closed"]),
+        number(&recoil["diameter_open"]),
+    );
+    assert!(closed <= 2.0 * reach + 0.02 * wire, "{recoil}");
+    assert!(
+        open > closed && open <= 2.0 * sheath + 0.02 * wire,
+        "{recoil}"
+    );
+    let fore = number(&d["foreshortening"]["foreshortening"]);
+    assert!(fore.abs() < 0.1, "{fore}");
+    let vessel = summary["contact"]
+        .as_array()
+        .expect("contact")
+        .iter()
+        .find(|c| c["obstacle"] == "vessel")
+        .expect("the vessel's contact");
+    let give = number(&vessel["largest_penetration"]["value"]);
+    for c in d["crowns"].as_array().expect("crowns") {
+        let (diameter, lumen) = (number(&c["diameter"]), number(&c["lumen_diameter"]));
+        assert!(
+            diameter <= lumen + 2.0 * give + 0.02 * wire,
+            "{c}, the wall's give {give}"
+        );
+    }
+    let fraction = number(&vessel["apposition"]["contact_fraction"]);
+    assert!(fraction > 0.0 && fraction < 1.0, "{vessel}");
+}
+
+/// Source: the geometry of each design's tools (module docs of `check_deployment`). The aorta stent
+/// (`designs/aorta_stent_deployed.yaml`: crimped to a reach of 3.2075 = R − Δr + d/2 with R = 6.3075, Δr =
+/// 3.3, d = 0.4; a sheath of radius 3.5; a compliant wall) and the coronary stent
+/// (`designs/coronary_stent_deployed.yaml`, on a vessel file in centimetres: R = 1.7119, Δr = 0.9, d = 0.15; a
+/// sheath of radius 1.0; a rigid wall) run their whole deployment and report it within what their tools allow.
+#[test]
+#[ignore = "full size (two patient deployments, ~45 s): run by .ci/run with cargo test --release -- --ignored"]
+fn the_patient_deployments_report_recoil_foreshortening_and_crowns_within_their_tools() {
+    let dir = TempDir::new("deployments");
+    let aorta = run_design("aorta_stent_deployed", &dir.join("aorta"));
+    check_deployment(&aorta, 6.3075 - 3.3 + 0.2, 3.5, 0.4);
+    let coronary = run_design("coronary_stent_deployed", &dir.join("coronary"));
+    check_deployment(&coronary, 1.7119 - 0.9 + 0.075, 1.0, 0.15);
+}
