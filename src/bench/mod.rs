@@ -281,7 +281,7 @@ pub fn bench_design(
         temperature,
         rate,
         start_diameter: 2.0 * start,
-        outer_diameter: 2.0 * start / 1.02,
+        outer_diameter: 2.0 * start / crate::model::stent::TOOL_CLEARANCE,
         min_diameter,
         vessel_diameter: spec.vessel_diameter.or_else(|| vessel_diameter(model)),
         diameters,

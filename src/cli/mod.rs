@@ -48,44 +48,33 @@ pub(crate) enum BenchTest {
     /// the smallest diameter reached and the forces at the vessel's diameter.
     ///
     /// Example: stentkit bench radial designs/straight_stent.yaml --set bench.temperature=90
-    Radial {
-        /// The design file (YAML).
-        design: PathBuf,
-        /// Run folder (default: `runs/<design name>-radial`).
-        #[arg(short, long)]
-        output: Option<PathBuf>,
-        /// Replace an earlier run in the run folder (only the files it wrote are removed).
-        #[arg(long)]
-        force: bool,
-        /// No progress bar; the results are printed.
-        #[arg(short, long)]
-        quiet: bool,
-        /// Override a field of the design, `bench:` included: `PATH=VALUE` (`--set bench.rate=0.5`).
-        #[arg(long = "set", value_name = "PATH=VALUE", value_parser = arguments::set_override())]
-        set: Vec<SetOverride>,
-    },
+    Radial(BenchArgs),
     /// The flat-plate crush: the device at the bench's temperature between two rigid plates parallel to its
     /// straight axis closing from just outside it to `bench.min_gap` (default a 50 % crush) and opening again
     /// at `bench.rate`; writes `crush.csv` (gap, branch, force on one plate in N, N per length, kPa, mmHg) and
     /// `charts/crush_force.svg` and prints the smallest gap reached and the forces at 10, 25 and 50 % crushed.
     ///
     /// Example: stentkit bench crush designs/straight_stent.yaml --set bench.min_gap=30
-    Crush {
-        /// The design file (YAML).
-        design: PathBuf,
-        /// Run folder (default: `runs/<design name>-crush`).
-        #[arg(short, long)]
-        output: Option<PathBuf>,
-        /// Replace an earlier run in the run folder (only the files it wrote are removed).
-        #[arg(long)]
-        force: bool,
-        /// No progress bar; the results are printed.
-        #[arg(short, long)]
-        quiet: bool,
-        /// Override a field of the design, `bench:` included: `PATH=VALUE` (`--set bench.min_gap=20`).
-        #[arg(long = "set", value_name = "PATH=VALUE", value_parser = arguments::set_override())]
-        set: Vec<SetOverride>,
-    },
+    Crush(BenchArgs),
+}
+
+/// The arguments of every bench test.
+#[derive(Debug, clap::Args)]
+pub(crate) struct BenchArgs {
+    /// The design file (YAML).
+    design: PathBuf,
+    /// Run folder (default: `runs/<design name>-<test>`).
+    #[arg(short, long)]
+    output: Option<PathBuf>,
+    /// Replace an earlier run in the run folder (only the files it wrote are removed).
+    #[arg(long)]
+    force: bool,
+    /// No progress bar; the results are printed.
+    #[arg(short, long)]
+    quiet: bool,
+    /// Override a field of the design, `bench:` included: `PATH=VALUE` (`--set bench.rate=0.5`).
+    #[arg(long = "set", value_name = "PATH=VALUE", value_parser = arguments::set_override())]
+    set: Vec<SetOverride>,
 }
 
 /// The subcommands.
@@ -679,26 +668,13 @@ pub fn main() -> ExitCode {
                 sets: set,
             },
         ),
-        Command::Bench {
-            test:
-                BenchTest::Radial {
-                    design,
-                    output,
-                    force,
-                    quiet,
-                    set,
-                },
-        } => bench::bench(Test::Radial, &design, output, force, quiet, set),
-        Command::Bench {
-            test:
-                BenchTest::Crush {
-                    design,
-                    output,
-                    force,
-                    quiet,
-                    set,
-                },
-        } => bench::bench(Test::Crush, &design, output, force, quiet, set),
+        Command::Bench { test } => {
+            let (test, a) = match test {
+                BenchTest::Radial(a) => (Test::Radial, a),
+                BenchTest::Crush(a) => (Test::Crush, a),
+            };
+            bench::bench(test, &a.design, a.output, a.force, a.quiet, a.set)
+        }
         Command::Export {
             run_dir,
             time,

@@ -634,7 +634,7 @@ pub fn programme(
 /// axis whose radius starts 2 % clear of the device's outermost wire ([`Patch::dense_points`]), holds there
 /// until the ramp starts, closes linearly over the ramp until the wires' reach is `R − Δr` (`R` the largest
 /// crown radius; its radius `R − Δr + d/2`, `d` the thickest wire), holds until the release and opens back
-/// over `open` ([`tool_schedule`]). Around a straight axis it is a cylinder; around a curved one, the tube of
+/// over `open` (`tool_schedule`). Around a straight axis it is a cylinder; around a curved one, the tube of
 /// that radius around the permanent centreline between the first and the last crown, continued straight
 /// beyond (a curved crimping tube, or a mandrel-guided crimp: the device is compacted onto its own axis).
 pub fn crimper(
@@ -679,7 +679,7 @@ pub fn crimper(
 /// side the direction points to and `lower_plate` opposite (only the one on the modelled side when a symmetry
 /// plane parallel to them halves the device). Their distance from the axis starts 2 % clear of the wires'
 /// reach across them, closes over the ramp to `R − Δr + d/2` (`R` the largest crown radius, `d` the thickest
-/// wire), holds until the release and opens back over `open` ([`tool_schedule`]); as a plane's schedule it is
+/// wire), holds until the release and opens back over `open` (`tool_schedule`); as a plane's schedule it is
 /// the offset `start − distance` along its inward normal.
 pub fn plates(
     programme: &Programme,
@@ -814,6 +814,10 @@ fn straight_axis(stent: &GeneratedStent) -> Option<(Vec3, Vec3)> {
         .then_some((point, axis))
 }
 
+/// A crimper's or crush plate's distance from the axis at the start over the wires' reach: 2 % clear of the
+/// device.
+pub const TOOL_CLEARANCE: Real = 1.02;
+
 /// A tool's start and closed distance from the axis: 2 % clear of the wires' reach (the largest `distance` of
 /// a dense point plus its wire's radius), and `R − Δr + d/2` with `R` the largest crown radius and `d` the
 /// thickest wire.
@@ -833,7 +837,10 @@ fn reach(
             reach = reach.max(distance(&x) + r);
         }
     }
-    (1.02 * reach, stent.family.radius_range().1 - delta_r + wire)
+    (
+        TOOL_CLEARANCE * reach,
+        stent.family.radius_range().1 - delta_r + wire,
+    )
 }
 
 /// A tool's schedule: its distance from the axis `start` until the ramp, closing linearly to `closed` over the
