@@ -4,6 +4,9 @@
 //! symmetry-reduced) is held at the bench's temperature in a rigid cylindrical crimper — for a device on a
 //! curved axis, the tube around that axis — that closes at a constant rate of its diameter from just outside the
 //! device (2 % clear of its outermost wire) to the bench's smallest diameter and opens again at the same rate.
+//! With `segments`, a segmented head of that many flat faces around a straight axis instead
+//! (`crate::model::stent::segmented_crimper`): its diameter is the polygon's inscribed one, its force the faces'
+//! normal forces summed.
 //! The bench is a run of the design with its programme replaced by that crimp (`programme: {kind: crimp}`,
 //! nothing prescribed, the device's free rigid motion held by the gauge), its temperature by the bench's, its
 //! obstacles removed and fixed time steps that record `diameters` diameters on each branch; the run folder is a
@@ -18,6 +21,7 @@
 //!   vessel_diameter: 12   # [length] where the chronic outward force is read (default: a vessel file's mean lumen)
 //!   diameters: 30         # recorded per branch (default 30)
 //!   min_gap: 6            # [length] the crush's smallest plate gap (default half the device's outer diameter)
+//!   segments: 12          # the radial bench's crimper as a segmented head of 12 flat faces (default: a cylinder)
 //! ```
 //!
 //! **What it measures.** At each recorded step the crimper's diameter `D` (its inner diameter, the device's outer
@@ -228,7 +232,7 @@ pub fn bench_design(
     let first = with_sets(
         path,
         overrides,
-        &bench_sets(test, probe, 1.0, 1.0, DEFAULT_TEMPERATURE),
+        &bench_sets(test, spec.segments, probe, 1.0, 1.0, DEFAULT_TEMPERATURE),
         &contact,
     )?;
     let distance = tool_distance(&first.model)
@@ -269,6 +273,7 @@ pub fn bench_design(
     let diameters = spec.diameters.unwrap_or(DEFAULT_DIAMETERS);
     let sets = bench_sets(
         test,
+        spec.segments,
         reach - 0.5 * min_diameter,
         closing,
         closing / (diameters - 1) as Real,
@@ -312,18 +317,24 @@ fn with_sets(
     Ok(load_design_with(path, &all)?)
 }
 
-/// The bench's overrides of a design (module docs): the test's tool closing by `delta_r` over `closing` and
-/// opening over as long, fixed steps of `step`, the temperature held, no other obstacle.
+/// The bench's overrides of a design (module docs): the test's tool (a radial bench's crimper of `segments`
+/// segments if given) closing by `delta_r` over `closing` and opening over as long, fixed steps of `step`, the
+/// temperature held, no other obstacle.
 fn bench_sets(
     test: Test,
+    segments: Option<usize>,
     delta_r: Real,
     closing: Real,
     step: Real,
     temperature: Real,
 ) -> Vec<String> {
+    let segments = match (test, segments) {
+        (Test::Radial, Some(n)) => format!(", segments: {n}"),
+        _ => String::new(),
+    };
     vec![
         format!(
-            "programme={{kind: {}, nodes: all_joints, delta_r: {delta_r:e}, ramp: [0, {closing:e}], release: {closing:e}, open: {closing:e}}}",
+            "programme={{kind: {}, nodes: all_joints, delta_r: {delta_r:e}, ramp: [0, {closing:e}], release: {closing:e}, open: {closing:e}{segments}}}",
             test.programme()
         ),
         format!("temperature={temperature:e}"),
@@ -467,8 +478,8 @@ impl Bench {
         let mut columns = Vec::new();
         for obstacle in tool {
             let name = &obstacle.name;
-            let force = match (&obstacle.surface, self.test) {
-                (Surface::Plane { normal, .. }, Test::Crush) => {
+            let force = match &obstacle.surface {
+                Surface::Plane { normal, .. } => {
                     let axes = ["x", "y", "z"]
                         .map(|c| history.column(&format!("contact_force_{c}@{name}")));
                     let [Some(x), Some(y), Some(z)] = axes else {
@@ -482,10 +493,12 @@ impl Bench {
                         })
                         .collect()
                 }
-                _ => match history.column(&format!("contact_radial_force@{name}")) {
-                    Some(f) => f,
-                    None => return Vec::new(),
-                },
+                Surface::Cylinder { .. } | Surface::Lumen(_) => {
+                    match history.column(&format!("contact_radial_force@{name}")) {
+                        Some(f) => f,
+                        None => return Vec::new(),
+                    }
+                }
             };
             let Some(points) = history.column(&format!("contact_points@{name}")) else {
                 return Vec::new();

@@ -250,6 +250,14 @@ fn bench(dto: Option<&super::dto::BenchDto>, wire: Real) -> Result<super::BenchS
             format!("{t} °C is not a temperature"),
         ));
     }
+    if let Some(n) = b.segments
+        && n < 3
+    {
+        return Err(issue(
+            "bench.segments",
+            format!("a segmented crimper needs at least 3 segments, not {n}"),
+        ));
+    }
     if let Some(n) = b.diameters
         && n < 2
     {
@@ -281,6 +289,7 @@ fn bench(dto: Option<&super::dto::BenchDto>, wire: Real) -> Result<super::BenchS
         vessel_diameter: b.vessel_diameter.map(|d| d.0),
         diameters: b.diameters,
         min_gap: b.min_gap.map(|d| d.0),
+        segments: b.segments,
     })
 }
 

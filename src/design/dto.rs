@@ -349,6 +349,9 @@ pub struct BenchDto {
     /// 50 % crush).
     #[serde(default)]
     pub min_gap: Option<Positive>,
+    /// The radial bench's crimper as a segmented head of this many flat segments (default: a cylinder).
+    #[serde(default)]
+    pub segments: Option<usize>,
 }
 
 /// An obstacle: a named surface (give exactly one of `cylinder`, `plane` or `lumen`) with its wall and the times
@@ -1363,6 +1366,10 @@ pub struct ProgrammeDto {
     /// the ramp).
     #[serde(default)]
     pub open: Option<Positive>,
+    /// A segmented-head crimper of this many flat segments instead of a cylinder (crimp; at least 3, a straight
+    /// device).
+    #[serde(default)]
+    pub segments: Option<usize>,
 }
 
 /// The temporary placement of a target-shape programme.

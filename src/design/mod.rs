@@ -82,6 +82,8 @@ pub struct BenchSpec {
     pub diameters: Option<usize>,
     /// The smallest gap the crush plates close to \[length\].
     pub min_gap: Option<f64>,
+    /// Segments of the radial bench's segmented-head crimper (`None`: a cylinder).
+    pub segments: Option<usize>,
 }
 
 impl RunDesign for Design {

@@ -462,6 +462,20 @@ pub(crate) fn mesh(dto: &StentDto, mesh: Option<&MeshDto>) -> Result<StentMesh> 
 pub(crate) fn programme(dto: &ProgrammeDto, metres_per_unit: Real) -> Result<ProgrammeSpec> {
     let base = "programme";
     let tool = matches!(dto.kind, ProgrammeKindDto::Crimp | ProgrammeKindDto::Crush);
+    if let Some(n) = dto.segments {
+        if dto.kind != ProgrammeKindDto::Crimp {
+            return Err(issue(
+                format!("{base}.segments"),
+                "`segments` (a segmented-head crimper) belongs to `kind: crimp`",
+            ));
+        }
+        if n < 3 {
+            return Err(issue(
+                format!("{base}.segments"),
+                format!("a segmented crimper needs at least 3 segments, not {n}"),
+            ));
+        }
+    }
     if dto.open.is_some() && !tool {
         return Err(issue(
             format!("{base}.open"),
@@ -486,7 +500,11 @@ pub(crate) fn programme(dto: &ProgrammeDto, metres_per_unit: Real) -> Result<Pro
                 .open
                 .map_or(0.1 * (dto.ramp[1].0 - dto.ramp[0].0), |o| o.0);
             match dto.kind {
-                ProgrammeKindDto::Crimp => ProgrammeTarget::Crimp { delta_r, open },
+                ProgrammeKindDto::Crimp => ProgrammeTarget::Crimp {
+                    delta_r,
+                    open,
+                    segments: dto.segments,
+                },
                 ProgrammeKindDto::Crush => ProgrammeTarget::Crush { delta_r, open },
                 _ => ProgrammeTarget::RadialContraction { delta_r },
             }

@@ -38,6 +38,9 @@ pub enum ProgrammeKind {
         obstacle: usize,
         /// Time the crimper takes to open from the release \[time\].
         open: Real,
+        /// A segmented-head crimper of this many flat segments (the model's obstacles from `obstacle` on)
+        /// instead of a cylinder; `None`: a cylinder, or a tube around a curved axis.
+        segments: Option<usize>,
     },
     /// A flat-plate crush: plates either side of a straight stent axis, parallel to it (the model's contact
     /// obstacles from `obstacle` on: two, or the one on the modelled side of a symmetry plane parallel to them),

@@ -72,6 +72,8 @@ pub enum ProgrammeTarget {
         delta_r: Real,
         /// Time the crimper takes to open \[time\], > 0.
         open: Real,
+        /// Flat segments of a segmented-head crimper (≥ 3; `None`: a cylinder or a tube).
+        segments: Option<usize>,
     },
     /// Flat plates either side of the straight axis close until the wires' reach across them is `R − Δr` over
     /// the ramp, hold, and open over `open` from the release ([`crate::model::ProgrammeKind::Crush`]).
@@ -539,11 +541,12 @@ pub fn programme(
             // A crimper or crush plates are the model's last obstacles: the builder appends them (`crimper`,
             // `plates`).
             match spec.target {
-                ProgrammeTarget::Crimp { open, .. } => (
+                ProgrammeTarget::Crimp { open, segments, .. } => (
                     ProgrammeKind::Crimp {
                         delta_r,
                         obstacle: usize::MAX,
                         open,
+                        segments,
                     },
                     geometry.nodes.iter().map(|n| -n.radial * delta_r).collect(),
                 ),
@@ -636,17 +639,27 @@ pub fn programme(
 /// crown radius; its radius `R − Δr + d/2`, `d` the thickest wire), holds until the release and opens back
 /// over `open` (`tool_schedule`). Around a straight axis it is a cylinder; around a curved one, the tube of
 /// that radius around the permanent centreline between the first and the last crown, continued straight
-/// beyond (a curved crimping tube, or a mandrel-guided crimp: the device is compacted onto its own axis).
+/// beyond (a curved crimping tube, or a mandrel-guided crimp: the device is compacted onto its own axis). With
+/// `segments`, a segmented-head crimper instead ([`segmented_crimper`]).
 pub fn crimper(
     programme: &Programme,
     stent: &GeneratedStent,
     patches: &[Patch],
     sections: &[Section],
-) -> Result<Obstacle> {
+) -> Result<Vec<Obstacle>> {
     let at = || Field::Programme(ProgrammeField::Whole);
-    let ProgrammeKind::Crimp { delta_r, open, .. } = programme.kind else {
+    let ProgrammeKind::Crimp {
+        delta_r,
+        open,
+        segments,
+        ..
+    } = programme.kind
+    else {
         return Err(BuildError::new(at(), "not a crimp programme"));
     };
+    if let Some(n) = segments {
+        return segmented_crimper(programme, stent, patches, sections, n);
+    }
     // The curved crimper is a tube of radius 1 scaled by the radius schedule.
     let axis = straight_axis(stent);
     let tube = match axis {
@@ -671,7 +684,100 @@ pub fn crimper(
         },
         (None, None) => return Err(BuildError::new(at(), "the stent has no nodes")),
     };
-    Ok(Obstacle::new("crimper", surface, crate::model::Wall::Rigid))
+    Ok(vec![Obstacle::new(
+        "crimper",
+        surface,
+        crate::model::Wall::Rigid,
+    )])
+}
+
+/// A segmented-head crimper of `n` segments (ASTM F3067's radial-force tester): `n` rigid flat faces parallel to
+/// the straight stent axis, the inner faces of a regular `n`-gon around it, the first centred on the first
+/// node's radial direction (`crimper_1` … `crimper_n`). Their distance from the axis (the polygon's inscribed
+/// radius) follows a crimper's schedule (2 % clear of the wires' reach across the faces, closing to
+/// `R − Δr + d/2`, `tool_schedule`); as a plane's schedule it is the offset `start − distance` along its inward
+/// normal. Every face is in the model, whatever its symmetry (a face across the axis from the modelled part
+/// never touches it), and the polygon must be symmetric about every symmetry plane of the model.
+///
+/// # Errors
+/// Fewer than 3 segments, a curved axis, or a polygon a symmetry plane does not map onto itself.
+pub fn segmented_crimper(
+    programme: &Programme,
+    stent: &GeneratedStent,
+    patches: &[Patch],
+    sections: &[Section],
+    n: usize,
+) -> Result<Vec<Obstacle>> {
+    let at = || Field::Programme(ProgrammeField::Whole);
+    let (ProgrammeKind::Crimp { delta_r, open, .. }, Some(first)) =
+        (programme.kind, stent.geometry.nodes.first())
+    else {
+        return Err(BuildError::new(
+            at(),
+            "not a crimp programme of a stent with nodes",
+        ));
+    };
+    if n < 3 {
+        return Err(BuildError::new(
+            at(),
+            format!("a segmented crimper needs at least 3 segments, not {n}"),
+        ));
+    }
+    let (point, axis) = straight_axis(stent).ok_or_else(|| {
+        BuildError::new(
+            at(),
+            "a segmented crimper closes on a device with a straight axis; this stent's axis is curved",
+        )
+    })?;
+    let e0 = (first.radial - axis * axis.dot(&first.radial)).normalize();
+    let e1 = axis.cross(&e0);
+    let directions: Vec<Vec3> = (0..n)
+        .map(|k| {
+            let angle = 2.0 * std::f64::consts::PI * k as Real / n as Real;
+            e0 * angle.cos() + e1 * angle.sin()
+        })
+        .collect();
+    for (k, plane) in stent.geometry.symmetry_planes.iter().enumerate() {
+        let m = plane.normal.normalize();
+        let mirrored = directions.iter().all(|e| {
+            let image = e - m * (2.0 * m.dot(e));
+            directions.iter().any(|f| (image - f).norm() <= 1e-9)
+        });
+        if !mirrored {
+            return Err(BuildError::new(
+                at(),
+                format!(
+                    "a crimper of {n} segments is not symmetric about the model's symmetry plane {}: give an even \
+                     number of segments for a quarter model (its first face is centred at ϑ = 0), or model the \
+                     device whole",
+                    k + 1
+                ),
+            ));
+        }
+    }
+    let (start, closed) = reach(stent, patches, sections, delta_r, |x| {
+        directions
+            .iter()
+            .map(|e| e.dot(&(x - point)))
+            .fold(Real::NEG_INFINITY, Real::max)
+    });
+    let offset = tool_schedule(programme, open, |d| start - d, start, closed)?;
+    Ok(directions
+        .iter()
+        .enumerate()
+        .map(|(k, e)| {
+            let surface = crate::model::Surface::Plane {
+                point: point + e * start,
+                normal: -e,
+                offset: offset.clone(),
+            };
+            Obstacle::new(
+                format!("crimper_{}", k + 1),
+                surface,
+                crate::model::Wall::Rigid,
+            )
+        })
+        .collect())
 }
 
 /// The plates of a crush programme ([`crate::model::ProgrammeKind::Crush`]): rigid planes parallel to the

@@ -25,6 +25,7 @@ fn a_crimp_programme_builds_its_crimper_and_prescribes_nothing() {
         delta_r,
         obstacle,
         open,
+        ..
     } = programme.kind
     else {
         panic!("a crimp programme: {:?}", programme.kind);

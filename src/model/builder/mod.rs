@@ -926,7 +926,7 @@ impl ModelBuilder {
                 ProgrammeKind::Crimp { obstacle, .. } => {
                     *obstacle = first;
                     c.obstacles
-                        .push(stent_model::crimper(p, s, &patches, &sections)?);
+                        .extend(stent_model::crimper(p, s, &patches, &sections)?);
                 }
                 ProgrammeKind::Crush { obstacle, .. } => {
                     *obstacle = first;
