@@ -469,8 +469,8 @@ fn task_with(
         _ => (false, run_dir.exists()),
     };
     let _ = std::fs::remove_file(sweep.task_error(&id));
-    if let Some(test) = plan.bench {
-        let result = super::bench::bench_into(
+    let result = match plan.bench {
+        Some(test) => super::bench::bench_into(
             test,
             &sweep.design(&id),
             &run_dir,
@@ -484,29 +484,22 @@ fn task_with(
             for l in lines {
                 console.say(&l);
             }
-        });
-        if let Err(e) = &result
-            && !run_dir.join("summary.json").exists()
-        {
-            let _ = crate::io::no_follow::write(
-                &sweep.task_error(&id),
-                super::error_text(e).as_bytes(),
-            );
+        }),
+        None => {
+            let options = super::run::RunOptions {
+                output: (!resume).then(|| run_dir.clone()),
+                force,
+                quiet: true,
+                verbose: false,
+                resume: resume.then(|| run_dir.clone()),
+                checkpoint_every: 60.0,
+                time_tolerance: None,
+                sets: Vec::new(),
+            };
+            super::run::run_with(&sweep.design(&id), options, started, console, interrupt)
+                .map(|completed| console.say(&completed.report))
         }
-        return result;
-    }
-    let options = super::run::RunOptions {
-        output: (!resume).then(|| run_dir.clone()),
-        force,
-        quiet: true,
-        verbose: false,
-        resume: resume.then(|| run_dir.clone()),
-        checkpoint_every: 60.0,
-        time_tolerance: None,
-        sets: Vec::new(),
     };
-    let result = super::run::run_with(&sweep.design(&id), options, started, console, interrupt)
-        .map(|completed| console.say(&completed.report));
     if let Err(e) = &result
         && !run_dir.join("summary.json").exists()
     {

@@ -90,8 +90,9 @@ const AFTER_RATIOS: [Column; 5] = [
     ("final_displacement", Unit::Length, |m| m.final_displacement),
 ];
 
-/// The bench's columns of a sweep of `test` (none for a plain sweep; a bench sweep has only these): the smallest size the tool reached and
-/// its forces at the readings ([`crate::bench::BenchResults`]), the units' suffixes `length` and `force`.
+/// The bench's columns of a sweep of `test` (none for a plain sweep; a bench sweep has only these): the
+/// smallest size the tool reached and its forces at the readings ([`crate::bench::BenchResults`]), the units'
+/// suffixes `length` and `force`.
 fn bench_columns(test: Option<crate::bench::Test>, length: &str, force: &str) -> Vec<MetricColumn> {
     use crate::bench::Test;
     let Some(test) = test else {
