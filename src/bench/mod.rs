@@ -314,7 +314,20 @@ fn with_sets(
             })?);
     }
     all.sets.extend_from_slice(after);
-    Ok(load_design_with(path, &all)?)
+    // The design refused what the bench set (its tool, its temperature, its time): say so in the bench's words,
+    // not as an override the user did not give.
+    load_design_with(path, &all).map_err(|e| match e {
+        DesignError::Override {
+            argument,
+            field,
+            message,
+            ..
+        } if sets.contains(&argument) => BenchError::Unfit {
+            file: path.to_path_buf(),
+            message: format!("the bench cannot be set up on this design: {field}: {message}"),
+        },
+        e => e.into(),
+    })
 }
 
 /// The bench's overrides of a design (module docs): the test's tool (a radial bench's crimper of `segments`

@@ -482,3 +482,29 @@ fn a_segmented_crimper_tends_to_the_cylindrical_one_as_its_faces_multiply() {
     let message = refused.err().map(|e| e.to_string()).unwrap_or_default();
     assert!(message.contains("not symmetric"), "{message}");
 }
+
+/// A bench that cannot put its tool on the design is refused in the bench's words, not as an override the user
+/// did not give: crush plates on the curved stent (exit status 2, the design file and the reason named, nothing
+/// written).
+#[test]
+fn a_crush_of_a_curved_stent_is_refused_in_the_benchs_words() {
+    let dir = TempDir::new("bench-crush-curved");
+    let out_dir = dir.join("run");
+    let design = Path::new(env!("CARGO_MANIFEST_DIR")).join("designs/curved_stent.yaml");
+    let out = Command::new(env!("CARGO_BIN_EXE_stentkit"))
+        .args(["bench", "crush"])
+        .arg(&design)
+        .arg("-o")
+        .arg(&out_dir)
+        .output()
+        .expect("stentkit runs");
+    let stderr = String::from_utf8_lossy(&out.stderr).into_owned();
+    assert_eq!(out.status.code(), Some(2), "{stderr}");
+    assert!(
+        stderr.contains("curved_stent.yaml: the bench cannot be set up on this design: programme:")
+            && stderr.contains("straight axis")
+            && !stderr.contains("--set"),
+        "{stderr}"
+    );
+    assert!(!out_dir.exists());
+}
