@@ -475,12 +475,25 @@ impl HistoryWriter {
         if sim.model().programme.is_some() {
             match crate::post::deployment::device_shape(sim) {
                 Some(shape) => {
-                    line.push_str(&format!(",{:.9e},{:.9e}", shape.diameter, shape.length));
+                    // The track keeps the values as the row prints them, so that a run resumed from its
+                    // checkpoint (whose track is read back from these rows) reports the same recoil and
+                    // foreshortening as one never interrupted, to the last digit.
+                    let (diameter, length) = (
+                        format!("{:.9e}", shape.diameter),
+                        format!("{:.9e}", shape.length),
+                    );
+                    line.push_str(&format!(",{diameter},{length}"));
+                    let printed = |text: &str, exact: Real| text.parse().unwrap_or(exact);
+                    let time = printed(&format!("{t:.10e}"), t);
                     let model = sim.model();
                     self.deployment.observe(
                         model.cycle().as_ref(),
                         model.time().landing_tolerance(),
-                        (t, shape.diameter, shape.length),
+                        (
+                            time,
+                            printed(&diameter, shape.diameter),
+                            printed(&length, shape.length),
+                        ),
                     );
                 }
                 None => line.push_str(",,"),
