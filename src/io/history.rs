@@ -52,7 +52,8 @@ pub(crate) struct History {
 
 impl History {
     /// Parses the text of a `history.csv` (a row that does not parse whole ends the table: a killed run's
-    /// last line may be cut).
+    /// last line may be cut). An empty cell — a quantity the row does not have, such as the largest gap from an
+    /// obstacle not yet in place — reads as NaN and keeps its row.
     pub(crate) fn parse(text: &str) -> Self {
         let mut lines = text.lines();
         let names: Vec<String> = lines
@@ -69,7 +70,7 @@ impl History {
                 l.split(',')
                     .zip(text.iter().chain(std::iter::repeat(&false)))
                     .map(|(x, &is_text)| {
-                        if is_text {
+                        if is_text || x.is_empty() {
                             Ok(Real::NAN)
                         } else {
                             x.parse::<Real>()
@@ -581,5 +582,21 @@ impl Observer for HistoryWriter {
 
     fn step(&mut self, sim: &Simulation<'_>, report: &StepReport) -> ControlFlow<()> {
         self.row(sim, Some(report))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::History;
+
+    // Hand-written: a row with an empty cell (an obstacle's largest gap before it is in place) is kept, its cell
+    // NaN; a row cut short (a killed run's last line) ends the table.
+    #[test]
+    fn an_empty_cell_keeps_its_row_and_a_cut_row_ends_the_table() {
+        let h = History::parse("time,a,contact_largest_gap@sheath\n0,1,\n1,2,0.5\n2,3");
+        let gap = h.column("contact_largest_gap@sheath").expect("the column");
+        assert_eq!(gap.len(), 2);
+        assert!(gap[0].1.is_nan() && gap[1] == (1.0, 0.5));
+        assert_eq!(h.column("a"), Some(vec![(0.0, 1.0), (1.0, 2.0)]));
     }
 }
