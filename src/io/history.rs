@@ -124,18 +124,22 @@ fn run_deployment(
     model: &crate::model::Model,
     text: &str,
 ) -> crate::post::deployment::DeploymentTrack {
-    let mut track = crate::post::deployment::DeploymentTrack::default();
+    let mut track = deployment_track(model);
     let history = History::parse(text);
     if let (Some(d), Some(l)) = (
         history.column(DEVICE_DIAMETER),
         history.column(DEVICE_LENGTH),
     ) {
-        let (cycle, tolerance) = (model.cycle(), model.time().landing_tolerance());
         for (&(t, d), &(_, l)) in d.iter().zip(&l) {
-            track.observe(cycle.as_ref(), tolerance, (t, d, l));
+            track.observe((t, d, l));
         }
     }
     track
+}
+
+/// An empty deployment track for `model`'s cycle.
+fn deployment_track(model: &crate::model::Model) -> crate::post::deployment::DeploymentTrack {
+    crate::post::deployment::DeploymentTrack::new(model.cycle(), model.time().landing_tolerance())
 }
 
 /// The row of `history.csv` (its text) where the device's surface strain peaks over the run; `None` without
@@ -311,7 +315,7 @@ impl HistoryWriter {
             warnings: Vec::new(),
             peak: None,
             contact: super::contact::no_peaks(sim.model()),
-            deployment: Default::default(),
+            deployment: deployment_track(sim.model()),
             path: path.to_path_buf(),
             complete: header.len() as u64 + 1,
             out: Some(out),
@@ -386,19 +390,10 @@ impl HistoryWriter {
         &self.path
     }
 
-    /// The programmed device's recoil and foreshortening over the rows written ([`crate::post::deployment`]).
-    pub fn deployment(
-        &self,
-        model: &crate::model::Model,
-    ) -> (
-        Option<crate::post::deployment::Recoil>,
-        Option<crate::post::deployment::Foreshortening>,
-    ) {
-        let (cycle, tolerance) = (model.cycle(), model.time().landing_tolerance());
-        (
-            self.deployment.recoil(cycle.as_ref(), tolerance),
-            self.deployment.foreshortening(cycle.as_ref(), tolerance),
-        )
+    /// The programmed device's diameter and length at the cycle's events over the rows written, whose recoil and
+    /// foreshortening `summary.json` reports ([`crate::post::deployment`]).
+    pub fn deployment(&self) -> &crate::post::deployment::DeploymentTrack {
+        &self.deployment
     }
 
     /// Where the surface strain peaked over the rows written.
@@ -486,16 +481,11 @@ impl HistoryWriter {
                     line.push_str(&format!(",{diameter},{length}"));
                     let printed = |text: &str, exact: Real| text.parse().unwrap_or(exact);
                     let time = printed(&format!("{t:.10e}"), t);
-                    let model = sim.model();
-                    self.deployment.observe(
-                        model.cycle().as_ref(),
-                        model.time().landing_tolerance(),
-                        (
-                            time,
-                            printed(&diameter, shape.diameter),
-                            printed(&length, shape.length),
-                        ),
-                    );
+                    self.deployment.observe((
+                        time,
+                        printed(&diameter, shape.diameter),
+                        printed(&length, shape.length),
+                    ));
                 }
                 None => line.push_str(",,"),
             }

@@ -104,8 +104,12 @@ pub type Sample = (Real, Real, Real);
 
 /// The device's shape at the cycle's events, gathered state by state (or row by row of a history): the last
 /// sample at or before `fixed`, at or before `released`, and the last of all.
-#[derive(Debug, Clone, PartialEq, Default)]
+#[derive(Debug, Clone, PartialEq)]
 pub struct DeploymentTrack {
+    /// The model's cycle, if it has one.
+    cycle: Option<Cycle>,
+    /// Time stepping's landing tolerance \[s\].
+    tolerance: Real,
     closed: Option<Sample>,
     open: Option<Sample>,
     last: Option<Sample>,
@@ -138,24 +142,36 @@ pub struct Foreshortening {
 }
 
 impl DeploymentTrack {
-    /// Takes the sample `(t, D, L)` of a state (or a history row), for the model's `cycle` with time stepping's
-    /// landing `tolerance`.
-    pub fn observe(&mut self, cycle: Option<&Cycle>, tolerance: Real, sample: Sample) {
+    /// An empty track for the events of `cycle` (a model's, if it has one) with time stepping's landing
+    /// `tolerance`.
+    pub fn new(cycle: Option<Cycle>, tolerance: Real) -> Self {
+        Self {
+            cycle,
+            tolerance,
+            closed: None,
+            open: None,
+            last: None,
+        }
+    }
+
+    /// Takes the sample `(t, D, L)` of a state (or a history row).
+    pub fn observe(&mut self, sample: Sample) {
         let t = sample.0;
-        if let Some(c) = cycle {
-            if t <= c.fixed + tolerance {
+        if let Some(c) = &self.cycle {
+            if t <= c.fixed + self.tolerance {
                 self.closed = Some(sample);
             }
-            if t <= c.released + tolerance {
+            if t <= c.released + self.tolerance {
                 self.open = Some(sample);
             }
         }
         self.last = Some(sample);
     }
 
-    /// The recoil, once the run has reached the `released` event of `cycle` (and the tool's release before it).
-    pub fn recoil(&self, cycle: Option<&Cycle>, tolerance: Real) -> Option<Recoil> {
-        let (c, closed, open) = (cycle?, self.closed?, self.open?);
+    /// The recoil, once the run has reached the cycle's `released` event (and the tool's release before it).
+    pub fn recoil(&self) -> Option<Recoil> {
+        let tolerance = self.tolerance;
+        let (c, closed, open) = (self.cycle.as_ref()?, self.closed?, self.open?);
         (closed.0 >= c.fixed - tolerance && open.0 >= c.released - tolerance && closed.1 > 0.0)
             .then(|| Recoil {
                 diameter_closed: closed.1,
@@ -166,9 +182,10 @@ impl DeploymentTrack {
             })
     }
 
-    /// The foreshortening, once the run has gone past the `released` event of `cycle`.
-    pub fn foreshortening(&self, cycle: Option<&Cycle>, tolerance: Real) -> Option<Foreshortening> {
-        let (c, closed, last) = (cycle?, self.closed?, self.last?);
+    /// The foreshortening, once the run has gone past the cycle's `released` event.
+    pub fn foreshortening(&self) -> Option<Foreshortening> {
+        let tolerance = self.tolerance;
+        let (c, closed, last) = (self.cycle.as_ref()?, self.closed?, self.last?);
         (closed.0 >= c.fixed - tolerance && last.0 >= c.released - tolerance && closed.2 > 0.0)
             .then(|| Foreshortening {
                 crimped_length: closed.2,
@@ -298,21 +315,21 @@ mod tests {
             fixed: 1.0,
             released: 1.1,
         };
-        let mut track = DeploymentTrack::default();
+        let mut track = DeploymentTrack::new(Some(cycle), 1e-9);
         for i in 0..=40 {
             let t = 0.05 * i as Real;
-            assert!(track.recoil(Some(&cycle), 1e-9).is_none() || t > 1.1 - 1e-9);
+            assert!(track.recoil().is_none() || t > 1.1 - 1e-9);
             let d = if t <= 1.0 + 1e-9 { 10.0 } else { 11.0 };
             let l = if t >= 2.0 - 1e-9 { 28.0 } else { 30.0 };
-            track.observe(Some(&cycle), 1e-9, (t, d, l));
+            track.observe((t, d, l));
         }
-        let r = track.recoil(Some(&cycle), 1e-9).expect("recoil");
+        let r = track.recoil().expect("recoil");
         assert!((r.recoil - 0.1).abs() < 1e-12, "{r:?}");
         assert!((r.closed_at - 1.0).abs() < 1e-9 && (r.open_at - 1.1).abs() < 1e-9);
-        let f = track
-            .foreshortening(Some(&cycle), 1e-9)
-            .expect("foreshortening");
+        let f = track.foreshortening().expect("foreshortening");
         assert!((f.foreshortening - 2.0 / 30.0).abs() < 1e-12, "{f:?}");
-        assert!(DeploymentTrack::default().recoil(None, 1e-9).is_none());
+        let mut no_cycle = DeploymentTrack::new(None, 1e-9);
+        no_cycle.observe((1.5, 10.0, 30.0));
+        assert!(no_cycle.recoil().is_none() && no_cycle.foreshortening().is_none());
     }
 }

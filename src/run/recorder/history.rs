@@ -132,10 +132,10 @@ impl Recorder for HistoryWriter {
             }
         }
         if sim.model().programme.is_some() {
-            let (recoil, foreshortening) = self.deployment(sim.model());
+            let track = self.deployment();
             summary.deployment = Some(crate::io::summary::Deployment {
-                recoil,
-                foreshortening,
+                recoil: track.recoil(),
+                foreshortening: track.foreshortening(),
                 crowns: crate::post::deployment::crown_fits(sim),
             });
         }
