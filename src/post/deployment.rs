@@ -231,12 +231,14 @@ pub fn crown_fits(sim: &Simulation<'_>) -> Vec<CrownFit> {
                 .iter()
                 .find(|d| d.crown == crown)
                 .map(|d| d.axis_point);
-            let lumen_diameter = vessel.zip(axis_point).and_then(|(o, a)| match &o.surface {
-                Surface::Cylinder { radius, .. } => Some(2.0 * radius.value(t)),
-                Surface::Lumen(lumen) => lumen
-                    .closest(&a, None)
-                    .map(|u| 2.0 * lumen.radius(u).0 * lumen.scale().value(t)),
-                Surface::Plane { .. } => None,
+            // The wall's radius where the crown's axis point projects on the lumen's centreline (none beyond
+            // its ends), or the cylinder's.
+            let lumen_diameter = vessel.zip(axis_point).and_then(|(o, a)| {
+                let parameter = match &o.surface {
+                    Surface::Lumen(lumen) => Some(lumen.closest(&a, None)?),
+                    _ => None,
+                };
+                o.surface.wall_radius(t, parameter).map(|r| 2.0 * r)
             });
             CrownFit {
                 crown: crown + 1,
