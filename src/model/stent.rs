@@ -668,10 +668,7 @@ pub fn crimper(
     };
     let (start, closed) = reach(stent, patches, sections, delta_r, |x| match (&tube, axis) {
         (Some(t), _) => t.distance(x, None, 0.0).map_or(0.0, |d| 1.0 - d.value),
-        (None, Some((point, axis))) => {
-            let d = x - point;
-            (d - axis * axis.dot(&d)).norm()
-        }
+        (None, Some((point, axis))) => off_axis(x, point, axis),
         (None, None) => 0.0,
     });
     let radius = tool_schedule(programme, open, |t| t, start, closed)?;
@@ -709,8 +706,7 @@ pub fn segmented_crimper(
     n: usize,
 ) -> Result<Vec<Obstacle>> {
     let at = || Field::Programme(ProgrammeField::Whole);
-    let (ProgrammeKind::Crimp { delta_r, open, .. }, Some(first)) =
-        (programme.kind, stent.geometry.nodes.first())
+    let (ProgrammeKind::Crimp { .. }, Some(first)) = (programme.kind, stent.geometry.nodes.first())
     else {
         return Err(BuildError::new(
             at(),
@@ -755,6 +751,43 @@ pub fn segmented_crimper(
             ));
         }
     }
+    let faces = directions
+        .iter()
+        .enumerate()
+        .map(|(k, &e)| (format!("crimper_{}", k + 1), e));
+    flat_tool(
+        programme,
+        stent,
+        patches,
+        sections,
+        point,
+        &directions,
+        faces,
+    )
+}
+
+/// The rigid flat faces of a tool closing on a straight stent along the outward unit `directions` from its axis
+/// point `point` (a segmented crimper's `n`, a crush's two): the faces `(name, direction)` of the model, each at
+/// a distance from the axis that starts 2 % clear of the wires' reach across the faces, the largest
+/// `e · (x − point)` over the directions and the dense points (plus the wire's radius), and follows the
+/// programme's tool schedule (`tool_schedule`) as the plane's offset `start − distance` along its inward normal.
+fn flat_tool(
+    programme: &Programme,
+    stent: &GeneratedStent,
+    patches: &[Patch],
+    sections: &[Section],
+    point: Vec3,
+    directions: &[Vec3],
+    faces: impl Iterator<Item = (String, Vec3)>,
+) -> Result<Vec<Obstacle>> {
+    let (ProgrammeKind::Crimp { delta_r, open, .. } | ProgrammeKind::Crush { delta_r, open, .. }) =
+        programme.kind
+    else {
+        return Err(BuildError::new(
+            Field::Programme(ProgrammeField::Whole),
+            "not a programme with a tool",
+        ));
+    };
     let (start, closed) = reach(stent, patches, sections, delta_r, |x| {
         directions
             .iter()
@@ -762,20 +795,14 @@ pub fn segmented_crimper(
             .fold(Real::NEG_INFINITY, Real::max)
     });
     let offset = tool_schedule(programme, open, |d| start - d, start, closed)?;
-    Ok(directions
-        .iter()
-        .enumerate()
-        .map(|(k, e)| {
+    Ok(faces
+        .map(|(name, e)| {
             let surface = crate::model::Surface::Plane {
                 point: point + e * start,
                 normal: -e,
                 offset: offset.clone(),
             };
-            Obstacle::new(
-                format!("crimper_{}", k + 1),
-                surface,
-                crate::model::Wall::Rigid,
-            )
+            Obstacle::new(name, surface, crate::model::Wall::Rigid)
         })
         .collect())
 }
@@ -794,31 +821,28 @@ pub fn plates(
     sections: &[Section],
 ) -> Result<Vec<Obstacle>> {
     let at = || Field::Programme(ProgrammeField::Whole);
-    let ProgrammeKind::Crush { delta_r, open, .. } = programme.kind else {
+    if !matches!(programme.kind, ProgrammeKind::Crush { .. }) {
         return Err(BuildError::new(at(), "not a crush programme"));
-    };
+    }
     let frame = CrushFrame::of(stent).map_err(|e| BuildError::new(at(), e))?;
-    let (start, closed) = reach(stent, patches, sections, delta_r, |x| {
-        frame.normal.dot(&(x - frame.point)).abs()
+    let faces = frame.sides.iter().map(|&side| {
+        let name = if side > 0.0 {
+            "upper_plate"
+        } else {
+            "lower_plate"
+        };
+        (name.to_string(), frame.normal * side)
     });
-    let offset = tool_schedule(programme, open, |d| start - d, start, closed)?;
-    Ok(frame
-        .sides
-        .iter()
-        .map(|&side| {
-            let name = if side > 0.0 {
-                "upper_plate"
-            } else {
-                "lower_plate"
-            };
-            let surface = crate::model::Surface::Plane {
-                point: frame.point + frame.normal * (side * start),
-                normal: -frame.normal * side,
-                offset: offset.clone(),
-            };
-            Obstacle::new(name, surface, crate::model::Wall::Rigid)
-        })
-        .collect())
+    let both = [frame.normal, -frame.normal];
+    flat_tool(
+        programme,
+        stent,
+        patches,
+        sections,
+        frame.point,
+        &both,
+        faces,
+    )
 }
 
 /// How a crush sits on a straight stent: a point of its axis, the unit direction the plates close along, and
@@ -848,10 +872,7 @@ impl CrushFrame {
         )?;
         let scale = stent.family.radius_range().1;
         let parallel = |a: &Vec3, b: &Vec3| a.cross(b).norm() <= 1e-9;
-        let through_axis = |p: &Vec3| {
-            let d = p - point;
-            (d - axis * axis.dot(&d)).norm() <= 1e-9 * scale
-        };
+        let through_axis = |p: &Vec3| off_axis(p, point, axis) <= 1e-9 * scale;
         let planes = &stent.geometry.symmetry_planes;
         let normal = match planes.iter().find(|p| !parallel(&p.normal, &axis)) {
             Some(p) => p.normal.normalize(),
@@ -907,17 +928,19 @@ fn straight_axis(stent: &GeneratedStent) -> Option<(Vec3, Vec3)> {
     let first = nodes.first()?;
     let (point, axis) = (first.axis_point, first.axis_tangent.normalize());
     let scale = stent.family.radius_range().1;
-    let off_axis = |x: &Vec3| {
-        let d = x - point;
-        (d - axis * axis.dot(&d)).norm()
-    };
     nodes
         .iter()
         .all(|n| {
             n.axis_tangent.normalize().cross(&axis).norm() <= 1e-9
-                && off_axis(&n.axis_point) <= 1e-9 * scale
+                && off_axis(&n.axis_point, point, axis) <= 1e-9 * scale
         })
         .then_some((point, axis))
+}
+
+/// The distance of `x` from the line through `point` along the unit `axis`.
+fn off_axis(x: &Vec3, point: Vec3, axis: Vec3) -> Real {
+    let d = x - point;
+    (d - axis * axis.dot(&d)).norm()
 }
 
 /// A crimper's or crush plate's distance from the axis at the start over the wires' reach: 2 % clear of the
