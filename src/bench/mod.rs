@@ -690,12 +690,12 @@ impl Bench {
         }
     }
 
-    /// What the bench prints at the end: the smallest size reached and the forces at the vessel's diameter
-    /// (and, for a crush, at 10 %, 25 % and 50 % of the outer diameter crushed).
-    pub fn summary(&self, points: &[BenchPoint]) -> Vec<String> {
+    /// What the bench prints at the end of its `results` ([`Bench::results`]): the smallest size reached and
+    /// the forces at the vessel's diameter (and, for a crush, at 10 %, 25 % and 50 % of the outer diameter
+    /// crushed).
+    pub fn summary(&self, results: &BenchResults) -> Vec<String> {
         let length = self.units.length();
         let size = self.test.size();
-        let results = self.results(points);
         let mut lines = Vec::new();
         if let Some(reached) = results.reached {
             lines.push(format!(
@@ -801,7 +801,8 @@ pub fn write_outputs(dir: &Path, bench: &Bench, model: &Model) -> Result<Vec<Str
         std::fs::create_dir_all(dir.join(run_folder::CHARTS_FOLDER)).map_err(|e| fail(&e))?;
         write(&format!("charts/{name}_force.svg"), svg.as_bytes())?;
     }
-    let results = serde_json::to_string_pretty(&bench.results(&points)).map_err(|e| fail(&e))?;
-    write(RESULTS_FILE, results.as_bytes())?;
-    Ok(bench.summary(&points))
+    let results = bench.results(&points);
+    let json = serde_json::to_string_pretty(&results).map_err(|e| fail(&e))?;
+    write(RESULTS_FILE, json.as_bytes())?;
+    Ok(bench.summary(&results))
 }
