@@ -45,6 +45,13 @@
 //! printed the smallest gap reached and the force on each branch at 10 %, 25 % and 50 % of the device's outer
 //! diameter crushed (`bench.vessel_diameter` adds its gap).
 //!
+//! **Where the wires touch** (issue 35, both tests). The run records the first step at which the device's wires
+//! touch each other (module docs of `crate::solver::terms::crossing`); the bench reads its time from
+//! summary.json and prints the tool's sizes at that step's start and end — between them struts lock — with
+//! where they touched (refine the bench's steps to narrow it), and `bench.json` keeps it (`touch`; `sweep collect`'s `touch_diameter`, `touch_gap`). Rod-on-rod
+//! contact is not modelled yet: past that size the wires pass through each other (the run warns once they do by
+//! more than its tolerance), so the forces past it are not the device's.
+//!
 //! A run the solver could not finish leaves what it reached: the table up to there, and the smallest diameter
 //! (gap) reached says how far it got.
 
@@ -443,7 +450,8 @@ fn device_length(model: &Model) -> Real {
     }
 }
 /// Closing or opening.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "lowercase")]
 pub enum Branch {
     /// The tool closes: the radial resistive force, the crush force.
     Loading,
@@ -664,13 +672,32 @@ impl Bench {
         sizes
     }
 
-    /// The bench's results from its recorded `points` (module docs): what it prints and writes to `bench.json`.
-    pub fn results(&self, points: &[BenchPoint]) -> BenchResults {
+    /// The bench's results from its recorded `points` (module docs) and the run's first touch of its wires
+    /// (summary.json's `wire_touch`: time and where): what it prints and writes to `bench.json`.
+    pub fn results(&self, points: &[BenchPoint], touch: Option<(Real, String)>) -> BenchResults {
         let reached = points
             .iter()
             .map(|p| p.diameter)
             .fold(Real::INFINITY, Real::min);
+        // The tool's size at the step the wires first touched (a recorded row: each step has one) and at the
+        // step before, when they did not yet.
+        let touch = touch.and_then(|(time, place)| {
+            let k = (0..points.len()).min_by(|&a, &b| {
+                (points[a].time - time)
+                    .abs()
+                    .total_cmp(&(points[b].time - time).abs())
+            })?;
+            let p = points[k];
+            Some(Touch {
+                size: p.diameter,
+                before: points[k.saturating_sub(1)].diameter,
+                time,
+                branch: p.branch,
+                place,
+            })
+        });
         BenchResults {
+            touch,
             test: self.test,
             temperature: self.temperature,
             rate: self.rate,
@@ -702,6 +729,23 @@ impl Bench {
                 "smallest {size} reached: {reached:.4} {length} (asked {:.4} {length})",
                 self.min_diameter
             ));
+        }
+        match &results.touch {
+            Some(t) => lines.push(format!(
+                "wires first touched in the step from {size} {:.4} to {:.4} {length} ({}, t = {}): {}; rod-on-rod contact is not modelled, so past it they pass through each other",
+                t.before,
+                t.size,
+                match t.branch {
+                    Branch::Loading => "closing",
+                    Branch::Unloading => "opening",
+                },
+                t.time,
+                t.place
+            )),
+            None if results.reached.is_some() => {
+                lines.push("wires never touched each other".into());
+            }
+            None => {}
         }
         if self.test == Test::Radial && self.vessel_diameter.is_none() {
             lines.push(
@@ -756,6 +800,24 @@ pub struct BenchResults {
     pub reached: Option<Real>,
     /// The forces at the readings.
     pub readings: Vec<Reading>,
+    /// Where the device's wires first touched each other, if they did: the size at which struts lock.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub touch: Option<Touch>,
+}
+
+/// The tool's size when the device's wires first touched each other (module docs).
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct Touch {
+    /// The tool's size at the end of the step in which the wires first touched \[length\].
+    pub size: Real,
+    /// The tool's size at the step's start, when they did not yet \[length\].
+    pub before: Real,
+    /// The time \[time\].
+    pub time: Real,
+    /// Closing or opening.
+    pub branch: Branch,
+    /// Where, in words (the two patches, the depth, the point).
+    pub place: String,
 }
 
 /// The force on both branches at one size.
@@ -801,7 +863,15 @@ pub fn write_outputs(dir: &Path, bench: &Bench, model: &Model) -> Result<Vec<Str
         std::fs::create_dir_all(dir.join(run_folder::CHARTS_FOLDER)).map_err(|e| fail(&e))?;
         write(&format!("charts/{name}_force.svg"), svg.as_bytes())?;
     }
-    let results = bench.results(&points);
+    // The run's first touch of its wires, from its summary.json (written by the run before the bench's files).
+    let touch = std::fs::read_to_string(dir.join("summary.json"))
+        .ok()
+        .and_then(|text| serde_json::from_str::<serde_json::Value>(&text).ok())
+        .and_then(|v| {
+            let t = &v["wire_touch"];
+            Some((t["time"].as_f64()?, t["place"].as_str()?.to_string()))
+        });
+    let results = bench.results(&points, touch);
     let json = serde_json::to_string_pretty(&results).map_err(|e| fail(&e))?;
     write(RESULTS_FILE, json.as_bytes())?;
     Ok(bench.summary(&results))

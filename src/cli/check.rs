@@ -237,6 +237,7 @@ pub fn describe(design: &Design, file: &str) -> String {
             let _ = writeln!(s, "geometry fit error  0 (all patches exact)");
         }
     }
+    let _ = write!(s, "{}", describe_overlaps(model));
     if !model.probes.is_empty() {
         let names: Vec<_> = model.probes.iter().map(|p| p.name.as_str()).collect();
         let _ = writeln!(s, "probes              {}", names.join(", "));
@@ -254,6 +255,44 @@ pub fn describe(design: &Design, file: &str) -> String {
     }
     s
 }
+
+/// Overlaps of `model`'s wires in the shape it is generated in (module docs of [`crate::model::wires`]) deeper than
+/// [`OVERLAP_ROUND_OFF`] of the largest wire radius, the deepest first, the first five in words: the `wires` lines
+/// of `check` and `mesh`.
+pub(crate) fn describe_overlaps(model: &crate::model::Model) -> String {
+    let wires = crate::model::wires::DeviceWires::new(model);
+    let control: Vec<_> = (model.patches.iter())
+        .flat_map(|p| p.curve.points().iter().copied())
+        .collect();
+    let found = wires.overlaps(&control, OVERLAP_ROUND_OFF * wires.largest_radius());
+    let unit = model.units.length();
+    let mut s = String::new();
+    if found.is_empty() {
+        let _ = writeln!(
+            s,
+            "wires               no two closer than their radii allow"
+        );
+        return s;
+    }
+    let _ = writeln!(
+        s,
+        "wires               {} pair{} of wires overlap; the deepest by {:.4e} {unit}",
+        found.len(),
+        if found.len() == 1 { "" } else { "s" },
+        found[0].depth
+    );
+    for o in found.iter().take(5) {
+        let _ = writeln!(s, "  - {}", wires.describe(o, unit));
+    }
+    if found.len() > 5 {
+        let _ = writeln!(s, "  - and {} more", found.len() - 5);
+    }
+    s
+}
+
+/// Overlaps shallower than this fraction of the largest wire radius are round-off of wires that touch, not
+/// overlaps (`check`, `mesh`).
+const OVERLAP_ROUND_OFF: crate::math::Real = 1e-9;
 
 /// The most steps an error-controlled run of `design` can take, `None` for fixed steps (and arc length): every
 /// step at `time.min_step` (error control and step cutting take no shorter one, except to land on a

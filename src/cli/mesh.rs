@@ -149,6 +149,8 @@ pub(crate) fn run(
             model.units.length()
         );
     }
+    // Wires that overlap in the shape written (a rigid motion changes no distance).
+    print!("{}", super::check::describe_overlaps(&model));
     Ok(())
 }
 

@@ -1,8 +1,8 @@
 //! Geometry: exact NURBS primitives (lines, circular arcs), analytic curves and their spline fits,
 //! rotation-minimising section frames (along spline curves in `frame`, along bare polylines in `polyline`), the
-//! stent generator, and closed surfaces: the triangle mesh type (`mesh`), tubes swept along centrelines
-//! (`tube`), spheres (`sphere`) and whole devices (`device_tubes`) — vertices and triangles only; writing files
-//! is the `io` layer's job.
+//! stent generator, wire-on-wire proximity (`proximity`), and closed surfaces: the triangle mesh type (`mesh`),
+//! tubes swept along centrelines (`tube`), spheres (`sphere`) and whole devices (`device_tubes`) — vertices and
+//! triangles only; writing files is the `io` layer's job.
 
 pub mod analytic;
 pub(crate) mod device_tubes;
@@ -12,6 +12,7 @@ pub mod mesh;
 #[cfg(test)]
 pub(crate) mod polyline;
 pub mod primitives;
+pub mod proximity;
 pub(crate) mod simplify;
 pub mod solid;
 #[cfg(test)]

@@ -380,6 +380,10 @@ pub struct RunSummaryFile {
     /// ([`crate::post::deployment`]).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub deployment: Option<Deployment>,
+    /// When and where the device's wires first touched each other, if they did (rod-on-rod contact is not
+    /// modelled: from then on they may pass through each other; [`crate::solver::terms::crossing`]).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub wire_touch: Option<crate::solver::terms::crossing::WireTouch>,
 }
 
 /// How a programmed device deployed (`summary.json` `deployment`; [`crate::post::deployment`]).
@@ -528,6 +532,7 @@ impl RunSummaryFile {
             strain_limit_warnings: Vec::new(),
             contact: Vec::new(),
             deployment: None,
+            wire_touch: None,
         }
     }
 

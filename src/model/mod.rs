@@ -15,6 +15,7 @@ pub(crate) mod programme;
 pub(crate) mod schedule;
 pub mod stent;
 pub(crate) mod temperature;
+pub mod wires;
 
 pub use obstacle::{Contact, ContactSettings, Distance, Lumen, Obstacle, Surface, Wall};
 pub use programme::{DrivenNode, Programme, ProgrammeError, ProgrammeKind};

@@ -91,7 +91,8 @@ const AFTER_RATIOS: [Column; 5] = [
 ];
 
 /// The bench's columns of a sweep of `test` (none for a plain sweep; a bench sweep has only these): the
-/// smallest size the tool reached and its forces at the readings ([`crate::bench::BenchResults`]), the units'
+/// smallest size the tool reached, its size where the wires first touched (empty if they did not) and its forces
+/// at the readings ([`crate::bench::BenchResults`]), the units'
 /// suffixes `length` and `force`.
 fn bench_columns(test: Option<crate::bench::Test>, length: &str, force: &str) -> Vec<MetricColumn> {
     use crate::bench::Test;
@@ -109,6 +110,11 @@ fn bench_columns(test: Option<crate::bench::Test>, length: &str, force: &str) ->
         unit: length.to_string(),
         get: Box::new(|m: &Metrics| m.bench.as_ref()?.reached),
     }];
+    columns.push(MetricColumn {
+        name: format!("touch_{}", test.size()),
+        unit: length.to_string(),
+        get: Box::new(|m: &Metrics| Some(m.bench.as_ref()?.touch.as_ref()?.size)),
+    });
     let readings: Vec<(String, String, bool)> = match test {
         Test::Radial => vec![
             ("rrf@vessel".into(), "vessel".into(), true),

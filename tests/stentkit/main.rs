@@ -36,3 +36,4 @@ mod sweep_hostile;
 mod tune;
 mod viscoelastic;
 mod warnings;
+mod wires;

@@ -125,6 +125,7 @@ impl Recorder for HistoryWriter {
     fn summarise(&self, summary: &mut RunSummaryFile, sim: &Simulation<'_>) {
         summary.peak_surface_strain = self.peak_surface_strain().cloned();
         summary.contact = self.contact_peaks().to_vec();
+        summary.wire_touch = sim.wire_touch();
         if let Some(report) = sim.contact() {
             let now = crate::io::contact::appositions(sim.model(), &report);
             for (peaks, a) in summary.contact.iter_mut().zip(now) {

@@ -1,4 +1,5 @@
-//! The contact of the current state, for the run's outputs: [`Simulation::contact`].
+//! The contact of the current state, for the run's outputs: [`Simulation::contact`]; and when the wires first
+//! touched each other, [`Simulation::wire_touch`].
 //!
 //! Why an accessor of the simulation: the recorders (history, snapshots, recording, charts) see a run only
 //! through the [`Simulation`] their observer calls are given, and what contact did is not a function of the
@@ -8,6 +9,7 @@
 
 use super::Simulation;
 use crate::solver::terms::contact::{ContactReport, SurfaceContact};
+use crate::solver::terms::crossing::{WireCrossing, WireTouch};
 
 impl Simulation<'_> {
     /// The contact of the current (last converged) state with every obstacle of the model
@@ -22,5 +24,14 @@ impl Simulation<'_> {
             &self.solution.state,
             self.measures.point_weights(self.model, &self.disc),
         ))
+    }
+
+    /// When and where the device's wires first touched each other in the steps so far
+    /// ([`crate::solver::terms::crossing::WireCrossing::first_touch`]); `None` if they have not.
+    pub fn wire_touch(&self) -> Option<WireTouch> {
+        self.terms
+            .iter()
+            .find_map(|t| t.as_any()?.downcast_ref::<WireCrossing>())?
+            .first_touch()
     }
 }

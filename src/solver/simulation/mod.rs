@@ -115,6 +115,7 @@ use super::gauge::Gauge;
 use super::linear::LinearSystem;
 use super::state::State;
 use super::terms::contact::SurfaceContact;
+use super::terms::crossing::WireCrossing;
 use super::terms::damping::Damping;
 use super::terms::distributed::DistributedLoad;
 use super::terms::{Constraint, PointTerm, Terms};
@@ -362,7 +363,11 @@ impl Simulation<'_> {
 /// The point terms of `model` that every assembly includes, in the order they add up: the registry of
 /// [`crate::solver::terms`] (a new term is one line here).
 fn registered_terms(model: &Model, disc: &Discretisation) -> Vec<Box<dyn PointTerm + Send>> {
-    let mut terms: Vec<Box<dyn PointTerm + Send>> = vec![Box::new(DistributedLoad)];
+    // The wire crossing adds no load: it looks for wires passing through each other after each step (issue 35).
+    let mut terms: Vec<Box<dyn PointTerm + Send>> = vec![
+        Box::new(DistributedLoad),
+        Box::new(WireCrossing::new(model, disc)),
+    ];
     if let Some(contact) = &model.contact {
         terms.push(Box::new(SurfaceContact::new(
             model,

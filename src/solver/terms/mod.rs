@@ -46,9 +46,10 @@
 //! tangent's blocks are `a_jl` and `−a_jl` exactly. Several constraints number their multipliers one after
 //! another in the order of the list.
 //!
-//! The terms of today: [`distributed::DistributedLoad`] (the model's distributed loads), the viscous
-//! regularisation [`damping::Damping`] of automatic stabilisation, and the gauge constraints
-//! (`super::gauge::Gauge`) of a released device.
+//! The terms of today: [`distributed::DistributedLoad`] (the model's distributed loads), the contact with
+//! surfaces [`contact::SurfaceContact`], the check for wires passing through each other
+//! [`crossing::WireCrossing`] (no load; it reports), the viscous regularisation [`damping::Damping`] of
+//! automatic stabilisation, and the gauge constraints (`super::gauge::Gauge`) of a released device.
 //!
 //! **A new term** is one module here (a type implementing [`PointTerm`]; its `pub mod` line above) plus one
 //! registration line: in `registered_terms` of `simulation/mod.rs` for a term every simulation of a model has,
@@ -58,6 +59,7 @@
 //! foundation against its closed form.
 
 pub mod contact;
+pub mod crossing;
 pub mod damping;
 pub mod distributed;
 #[cfg(test)]

@@ -485,11 +485,13 @@ fn a_terms_state_is_committed_and_carried_by_checkpoints() {
     let checkpoint = first.checkpoint();
     assert_eq!(
         checkpoint.snapshot.terms.len(),
-        2,
-        "distributed load and the spring"
+        3,
+        "distributed load, wire crossing and the spring"
     );
     assert!(checkpoint.snapshot.terms[0].is_empty());
-    let anchors = &checkpoint.snapshot.terms[1];
+    // The wire crossing's: no step with an overlap (a count of 0 and its first time).
+    assert_eq!(checkpoint.snapshot.terms[1], [0.0, 0.0]);
+    let anchors = &checkpoint.snapshot.terms[2];
     let reference: Vec<Real> = RelaxingSpring::new(&disc, stiffness)
         .anchors
         .iter()
@@ -502,13 +504,13 @@ fn a_terms_state_is_committed_and_carried_by_checkpoints() {
     while second.step().expect("converges").is_some() {}
     assert_eq!(first.state(), second.state(), "continued bit for bit");
     let mut forgotten = checkpoint.clone();
-    forgotten.snapshot.terms[1] = reference;
+    forgotten.snapshot.terms[2] = reference;
     let mut third = simulation();
     third.restore(&forgotten).expect("restores");
     while third.step().expect("converges").is_some() {}
     assert_ne!(first.state().control, third.state().control);
     let mut damaged = checkpoint;
-    damaged.snapshot.terms[1].pop();
+    damaged.snapshot.terms[2].pop();
     assert!(matches!(
         simulation().restore(&damaged),
         Err(crate::solver::CheckpointError::Term { expected, .. }) if expected == 3 * disc.points.len()

@@ -1,0 +1,169 @@
+//! A model's rods as the wire-on-wire proximity search sees them ([`crate::geometry::proximity`], issue 35):
+//! each patch sampled into a polyline, its radius, the nodes its ends belong to and the symmetry planes it lies
+//! in; and the overlaps of the device's wires at any placement of its control points, located by patch and
+//! curve parameter for the user.
+//!
+//! **Sampling.** Each patch's knot spans cut into `SAMPLES_PER_SPAN` = 8 equal parts of the parameter: a curve between two samples lies off its chord by `h²/(8ρ)` at most (`h` the chord, `ρ`
+//! the curve's radius of curvature there), which is how much an overlap can be under-reported. The positions of
+//! the samples are linear in the control points (`x(u) = Σ R_a(u) c_a`, the patch's rational basis), so a
+//! state's are found with the basis values kept from the start.
+
+use super::{End, Model};
+use crate::geometry::proximity::{Mirror, Overlap, Search, Wire, Wires};
+use crate::math::basis::nurbs_basis;
+use crate::math::{Real, Vec3};
+
+/// Parts of each knot span between samples (module docs).
+const SAMPLES_PER_SPAN: usize = 8;
+
+/// One sample of a patch: the index of its first control point in the model's flat list of control points
+/// (the patches' points one after another) and the basis values there.
+#[derive(Debug, Clone)]
+struct Sample {
+    first: usize,
+    basis: Vec<Real>,
+}
+
+/// The device's wires with their samples (module docs).
+pub struct DeviceWires {
+    wires: Wires,
+    /// Per patch, its samples in order along it.
+    samples: Vec<Vec<Sample>>,
+    /// Patch names, for the reports.
+    names: Vec<String>,
+}
+
+impl DeviceWires {
+    /// The wires of `model`, their reference arc lengths taken from its patches' curves.
+    pub fn new(model: &Model) -> Self {
+        let mut samples = Vec::with_capacity(model.patches.len());
+        let mut wires = Vec::with_capacity(model.patches.len());
+        let mut offset = 0;
+        let mut ends = vec![[0usize; 2]; model.patches.len()];
+        for (k, node) in model.nodes.iter().enumerate() {
+            for e in &node.ends {
+                ends[e.patch][usize::from(e.end == End::End)] = k;
+            }
+        }
+        for (k, patch) in model.patches.iter().enumerate() {
+            let curve = &patch.curve;
+            let knots = curve.knots();
+            let (lo, hi) = knots.domain();
+            let mut parameters = vec![lo];
+            for w in knots.knots().windows(2) {
+                let (a, b) = (w[0], w[1]);
+                if !(b > a && a >= lo && b <= hi) {
+                    continue;
+                }
+                for j in 1..=SAMPLES_PER_SPAN {
+                    parameters.push(a + (b - a) * j as Real / SAMPLES_PER_SPAN as Real);
+                }
+            }
+            let here: Vec<Sample> = parameters
+                .iter()
+                .map(|&u| {
+                    let table = nurbs_basis(knots, curve.weights(), u, 0);
+                    Sample {
+                        first: offset + table.first,
+                        basis: table.ders[0].clone(),
+                    }
+                })
+                .collect();
+            let reference: Vec<Vec3> = parameters.iter().map(|&u| curve.point(u)).collect();
+            let mut arc = vec![0.0];
+            for pair in reference.windows(2) {
+                arc.push(arc[arc.len() - 1] + (pair[1] - pair[0]).norm());
+            }
+            wires.push(Wire {
+                parameters,
+                arc,
+                radius: model.wire_radius(k),
+                ends: ends[k],
+                lies_in: model.patch_symmetry_plane(k).into_iter().collect(),
+            });
+            samples.push(here);
+            offset += curve.num_points();
+        }
+        let scale = (model.nodes.iter())
+            .map(|n| n.position.norm())
+            .fold(0.0, Real::max)
+            .max(Real::MIN_POSITIVE);
+        let mirrors = (model.symmetry_planes.iter())
+            .map(|(point, normal)| Mirror {
+                point: *point,
+                normal: *normal,
+                nodes: (model.nodes.iter().enumerate())
+                    .filter(|(_, n)| (n.position - point).dot(normal).abs() <= 1e-9 * scale)
+                    .map(|(k, _)| k)
+                    .collect(),
+            })
+            .collect();
+        Self {
+            wires: Wires::new(wires, mirrors, model.nodes.len()),
+            samples,
+            names: model.patches.iter().map(|p| p.name.clone()).collect(),
+        }
+    }
+
+    /// The samples' positions for the control points `control` (the patches' points one after another).
+    pub fn points(&self, control: &[Vec3]) -> Vec<Vec<Vec3>> {
+        (self.samples.iter())
+            .map(|patch| {
+                (patch.iter())
+                    .map(|s| {
+                        (s.basis.iter().enumerate())
+                            .map(|(a, n)| control[s.first + a] * *n)
+                            .sum()
+                    })
+                    .collect()
+            })
+            .collect()
+    }
+
+    /// The overlaps deeper than `depth` of the wires with control points `control` (deepest first; module docs of
+    /// [`crate::geometry::proximity`]).
+    pub fn overlaps(&self, control: &[Vec3], depth: Real) -> Vec<Overlap> {
+        self.wires.overlaps(&self.points(control), depth)
+    }
+
+    /// [`DeviceWires::overlaps`] with the slack of the search (module docs of [`crate::geometry::proximity`]),
+    /// up to `margin`.
+    pub fn search(&self, control: &[Vec3], depth: Real, margin: Real) -> Search {
+        self.wires.search(&self.points(control), depth, margin)
+    }
+
+    /// The largest radius of the wires \[length\].
+    pub fn largest_radius(&self) -> Real {
+        (self.wires.wires().iter())
+            .map(|w| w.radius)
+            .fold(0.0, Real::max)
+    }
+
+    /// Where an overlap is, in words: the two patches and curve parameters, the image, the depth and the point.
+    pub fn describe(&self, o: &Overlap, unit: &str) -> String {
+        let planes: Vec<String> = (0..usize::BITS as usize)
+            .filter(|k| o.image & (1 << k) != 0)
+            .map(|k| (k + 1).to_string())
+            .collect();
+        let image = match planes.len() {
+            0 => String::new(),
+            1 => format!(" (its mirror image across symmetry plane {})", planes[0]),
+            _ => format!(
+                " (its mirror image across symmetry planes {})",
+                planes.join(" and ")
+            ),
+        };
+        let x = o.a.position;
+        format!(
+            "patch `{}` at u = {:.4} and patch `{}` at u = {:.4}{image} overlap by {:.4e} {unit} at ({:.4}, {:.4}, {:.4})",
+            self.names[o.a.wire],
+            o.a.parameter,
+            self.names[o.b.wire],
+            o.b.parameter,
+            o.depth,
+            x.x,
+            x.y,
+            x.z
+        )
+    }
+}
