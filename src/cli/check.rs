@@ -257,14 +257,14 @@ pub fn describe(design: &Design, file: &str) -> String {
 }
 
 /// Overlaps of `model`'s wires in the shape it is generated in (module docs of [`crate::model::wires`]) deeper than
-/// [`OVERLAP_ROUND_OFF`] of the largest wire radius, the deepest first, the first five in words: the `wires` lines
-/// of `check` and `mesh`.
+/// its round-off, the deepest first, the first five in words: the `wires` lines of `check` and `mesh`.
 pub(crate) fn describe_overlaps(model: &crate::model::Model) -> String {
-    let wires = crate::model::wires::DeviceWires::new(model);
-    let control: Vec<_> = (model.patches.iter())
-        .flat_map(|p| p.curve.points().iter().copied())
-        .collect();
-    let found = wires.overlaps(&control, OVERLAP_ROUND_OFF * wires.largest_radius());
+    use crate::model::wires::{DeviceWires, ROUND_OFF, reference_control};
+    let wires = DeviceWires::new(model);
+    let found = wires.overlaps(
+        &reference_control(model),
+        ROUND_OFF * wires.largest_radius(),
+    );
     let unit = model.units.length();
     let mut s = String::new();
     if found.is_empty() {
@@ -289,10 +289,6 @@ pub(crate) fn describe_overlaps(model: &crate::model::Model) -> String {
     }
     s
 }
-
-/// Overlaps shallower than this fraction of the largest wire radius are round-off of wires that touch, not
-/// overlaps (`check`, `mesh`).
-const OVERLAP_ROUND_OFF: crate::math::Real = 1e-9;
 
 /// The most steps an error-controlled run of `design` can take, `None` for fixed steps (and arc length): every
 /// step at `time.min_step` (error control and step cutting take no shorter one, except to land on a

@@ -10,8 +10,8 @@
 //! **Broad phase.** The axis-aligned box of every run of `CHUNK` = 8 consecutive segments of a wire, grown by the
 //! wire's radius, goes into an R*-tree (the `rstar` crate: bulk loading is O(n log n), and the tree's join with
 //! itself or with the tree of a mirror image lists the pairs of boxes that intersect without testing all pairs).
-//! A pair of runs no further apart along the wires than a joint's reach (below) is dropped whole: most boxes meet
-//! their neighbours'. For an image only the segments within two radii of its planes enter.
+//! A pair of runs whose points are all neighbours along the wires (below) is dropped whole: most boxes meet their
+//! neighbours'. For an image only the segments within two radii (and the margin, below) of its planes enter.
 //!
 //! **Narrow phase.** The closest points of two segments (Ericson, *Real-Time Collision Detection*, 2005,
 //! §5.1.9) and their distance `d`; the pair overlaps by `r_a + r_b − d` where that is positive. Between

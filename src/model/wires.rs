@@ -3,10 +3,11 @@
 //! in; and the overlaps of the device's wires at any placement of its control points, located by patch and
 //! curve parameter for the user.
 //!
-//! **Sampling.** Each patch's knot spans cut into `SAMPLES_PER_SPAN` = 8 equal parts of the parameter: a curve between two samples lies off its chord by `h²/(8ρ)` at most (`h` the chord, `ρ`
-//! the curve's radius of curvature there), which is how much an overlap can be under-reported. The positions of
-//! the samples are linear in the control points (`x(u) = Σ R_a(u) c_a`, the patch's rational basis), so a
-//! state's are found with the basis values kept from the start.
+//! **Sampling.** Each patch's knot spans cut into `SAMPLES_PER_SPAN` = 8 equal parts of the parameter: a curve
+//! between two samples lies off its chord by `h²/(8ρ)` at most (`h` the chord, `ρ` the curve's radius of
+//! curvature there), which is how much an overlap can be under-reported. The positions of the samples are linear
+//! in the control points (`x(u) = Σ R_a(u) c_a`, the patch's rational basis), so a state's are found with the
+//! basis values kept from the start.
 
 use super::{End, Model};
 use crate::geometry::proximity::{Mirror, Overlap, Search, Wire, Wires};
@@ -15,6 +16,17 @@ use crate::math::{Real, Vec3};
 
 /// Parts of each knot span between samples (module docs).
 const SAMPLES_PER_SPAN: usize = 8;
+
+/// Overlaps no deeper than this fraction of the largest wire radius are round-off of wires that touch, not
+/// overlaps (`check`, `mesh` and the run's first touch).
+pub const ROUND_OFF: Real = 1e-9;
+
+/// The control points of `model`'s patches as generated, one patch after another: the reference placement.
+pub fn reference_control(model: &Model) -> Vec<Vec3> {
+    (model.patches.iter())
+        .flat_map(|p| p.curve.points().iter().copied())
+        .collect()
+}
 
 /// One sample of a patch: the index of its first control point in the model's flat list of control points
 /// (the patches' points one after another) and the basis values there.

@@ -25,6 +25,19 @@ fn small_bench(extra: &[&str]) -> (PathBuf, Vec<String>) {
     (design, sets)
 }
 
+/// `stentkit bench radial designs/straight_stent.yaml -o OUT_DIR` with the arguments `extra`.
+fn straight_stent_bench(out_dir: &Path, extra: &[&str]) -> std::process::Output {
+    let (design, _) = small_bench(&[]);
+    Command::new(env!("CARGO_BIN_EXE_stentkit"))
+        .args(["bench", "radial"])
+        .arg(&design)
+        .arg("-o")
+        .arg(out_dir)
+        .args(extra)
+        .output()
+        .expect("stentkit runs")
+}
+
 /// The overrides of `sets`.
 fn overrides(sets: &[String]) -> DesignOverrides {
     DesignOverrides {
@@ -180,15 +193,7 @@ fn a_quarter_model_on_the_radial_bench_gives_the_full_devices_force() {
 fn a_smallest_diameter_above_the_device_is_refused_and_nothing_is_written() {
     let dir = TempDir::new("bench-refused");
     let out_dir = dir.join("run");
-    let (design, _) = small_bench(&[]);
-    let out = Command::new(env!("CARGO_BIN_EXE_stentkit"))
-        .args(["bench", "radial"])
-        .arg(&design)
-        .arg("-o")
-        .arg(&out_dir)
-        .args(["--set", "bench.min_diameter=50"])
-        .output()
-        .expect("stentkit runs");
+    let out = straight_stent_bench(&out_dir, &["--set", "bench.min_diameter=50"]);
     let stderr = String::from_utf8_lossy(&out.stderr).into_owned();
     assert_eq!(out.status.code(), Some(2), "{stderr}");
     assert!(
@@ -521,21 +526,18 @@ fn a_crush_of_a_curved_stent_is_refused_in_the_benchs_words() {
 fn the_radial_bench_says_where_the_wires_first_touch() {
     let dir = TempDir::new("bench-touch");
     let out_dir = dir.join("run");
-    let (design, _) = small_bench(&[]);
-    let out = Command::new(env!("CARGO_BIN_EXE_stentkit"))
-        .args(["bench", "radial"])
-        .arg(&design)
-        .arg("-o")
-        .arg(&out_dir)
-        .args(["--quiet", "--set", "stent.crowns=2"])
-        .args([
+    let out = straight_stent_bench(
+        &out_dir,
+        &[
+            "--quiet",
+            "--set",
+            "stent.crowns=2",
             "--set",
             "bench.min_diameter=8",
             "--set",
             "bench.diameters=10",
-        ])
-        .output()
-        .expect("stentkit runs");
+        ],
+    );
     let stdout = String::from_utf8_lossy(&out.stdout).into_owned();
     assert!(out.status.success(), "{stdout}");
     assert!(

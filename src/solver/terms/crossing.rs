@@ -26,7 +26,7 @@ use super::{InteriorLoad, PointTerm, PointView};
 use crate::geometry::proximity::Overlap;
 use crate::math::{Real, Vec3};
 use crate::model::Model;
-use crate::model::wires::DeviceWires;
+use crate::model::wires::{DeviceWires, ROUND_OFF};
 use crate::solver::discretisation::Discretisation;
 use crate::solver::state::State;
 
@@ -34,10 +34,6 @@ use crate::solver::state::State;
 /// 5 %, a slip of a wire into another that a contact would also allow at a soft penalty, far below wires that
 /// have passed through each other.
 pub const TOLERANCE_OF_DIAMETER: Real = 0.05;
-
-/// Overlaps no deeper than this fraction of the largest wire radius beyond the reference's own are round-off of
-/// wires that touch, not wires touching.
-const ROUND_OFF: Real = 1e-9;
 
 /// The deepest overlap found in the committed steps and where (module docs).
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -107,9 +103,7 @@ impl WireCrossing {
             wires,
         }
     }
-}
 
-impl WireCrossing {
     /// The first step whose wires touched (module docs): its time, the deepest overlap then (beyond the design's
     /// own) and where, in words.
     pub fn first_touch(&self) -> Option<WireTouch> {
@@ -127,7 +121,7 @@ impl WireCrossing {
 pub struct WireTouch {
     /// The time of the step \[time\].
     pub time: Real,
-    /// The deepest overlap at that step \[length\].
+    /// The deepest overlap at that step, the design's own included \[length\].
     pub depth: Real,
     /// The point of the first wire there \[length\].
     pub position: [Real; 3],
@@ -251,5 +245,70 @@ impl PointTerm for WireCrossing {
         self.steps = head[0] as usize;
         self.first = head[1];
         Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use crate::material::{CircularSection, ElasticLaw};
+    use crate::math::Vec3;
+    use crate::model::TimeFunction;
+    use crate::model::builder::{ConditionSpec, ModelBuilder, PatchShape, TimeSpec};
+    use crate::solver::Simulation;
+
+    /// A checkpoint keeps what the check found (the steps, the deepest overlap, the first touch), so a run
+    /// restored from it reports what the run that went on reports. Two rods of diameter 0.2 crossing 0.5 apart,
+    /// the upper one's ends moved down by 0.8 in eight steps (they touch from t = 0.5 on and overlap by more than
+    /// the tolerance at t = 0.5, 0.625, 0.75); the checkpoint after six steps, with both records held.
+    #[test]
+    fn a_restored_run_reports_the_crossing_the_first_run_found() {
+        let material = ElasticLaw::try_new(2.0e5, 0.3).expect("E > 0, ν = 0.3");
+        let section = CircularSection::try_new(0.2).expect("d > 0").into();
+        let mut b = ModelBuilder::new("crossing", material, section);
+        for (name, from, to) in [
+            ("low", Vec3::new(-1.0, 0.0, 0.0), Vec3::new(1.0, 0.0, 0.0)),
+            ("high", Vec3::new(0.0, -1.0, 0.5), Vec3::new(0.0, 1.0, 0.5)),
+        ] {
+            b.patch(name, PatchShape::Line { from, to }, 4, 10);
+        }
+        b.condition(ConditionSpec::clamp("low.start"));
+        b.condition(ConditionSpec::clamp("low.end"));
+        let ramp = TimeFunction::try_table(vec![(0.0, 0.0), (1.0, -0.8)]).expect("a ramp");
+        for end in ["high.start", "high.end"] {
+            let mut c = ConditionSpec::at(end).with_displacement(2, ramp.clone());
+            for i in 0..3 {
+                c = c.with_rotation(i, TimeFunction::constant(0.0));
+            }
+            for i in 0..2 {
+                c = c.with_displacement(i, TimeFunction::constant(0.0));
+            }
+            b.condition(c);
+        }
+        b.time(TimeSpec::new(1.0, 0.125));
+        let model = b.build().expect("valid model").model;
+        let mut first = Simulation::new(&model).expect("simulation");
+        for _ in 0..6 {
+            first.step().expect("converges");
+        }
+        let checkpoint = first.checkpoint();
+        assert_eq!(
+            checkpoint.snapshot.terms[1].len(),
+            4 + 2 * 15,
+            "both records"
+        );
+        while first.step().expect("converges").is_some() {}
+        let mut second = Simulation::new(&model).expect("simulation");
+        second.restore(&checkpoint).expect("restores");
+        while second.step().expect("converges").is_some() {}
+        assert_eq!(first.warnings(), second.warnings());
+        assert_eq!(first.wire_touch(), second.wire_touch());
+        let touch = first.wire_touch().expect("the rods touched");
+        assert_eq!(touch.time, 0.5, "{touch:?}");
+        assert_eq!(first.warnings().len(), 1, "{:?}", first.warnings());
+        assert!(
+            first.warnings()[0].contains("in 3 step(s)"),
+            "{:?}",
+            first.warnings()
+        );
     }
 }

@@ -489,8 +489,9 @@ fn a_terms_state_is_committed_and_carried_by_checkpoints() {
         "distributed load, wire crossing and the spring"
     );
     assert!(checkpoint.snapshot.terms[0].is_empty());
-    // The wire crossing's: no step with an overlap (a count of 0 and its first time).
-    assert_eq!(checkpoint.snapshot.terms[1], [0.0, 0.0]);
+    // The wire crossing's: no step with an overlap (a count of 0, its first time, no deepest overlap and no
+    // touch recorded).
+    assert_eq!(checkpoint.snapshot.terms[1], [0.0; 4]);
     let anchors = &checkpoint.snapshot.terms[2];
     let reference: Vec<Real> = RelaxingSpring::new(&disc, stiffness)
         .anchors
