@@ -190,14 +190,28 @@ pub(crate) fn no_peaks(model: &Model) -> Vec<ObstaclePeaks> {
         .collect()
 }
 
-/// Takes the row of `report` at `time` into `peaks` (made by [`no_peaks`] for the same model).
+/// `x` as history.csv prints it with `digits` digits after the point (`{:.digits e}`), read back.
+fn as_printed(x: Real, digits: usize) -> Real {
+    format!("{x:.digits$e}").parse().unwrap_or(x)
+}
+
+/// Takes the row of `report` at `time` into `peaks` (made by [`no_peaks`] for the same model). The values are
+/// taken as the row prints them ([`push_row`]; the time as history.csv prints it), so that a run resumed from
+/// its checkpoint, whose peaks before it are read back from the rows ([`run_peaks`]), reports the same peaks
+/// as one never interrupted, to the last digit.
 pub(crate) fn keep_peaks(peaks: &mut [ObstaclePeaks], report: &ContactReport, time: Real) {
+    let time = as_printed(time, 10);
     for (p, o) in peaks.iter_mut().zip(&report.obstacles) {
-        Peak::keep(&mut p.peak_force, o.force.norm(), time);
+        let force = o.force.map(|c| as_printed(c, 9));
+        Peak::keep(&mut p.peak_force, force.norm(), time);
         if let Some(radial) = o.radial_force {
-            Peak::keep(&mut p.peak_radial_force, radial, time);
+            Peak::keep(&mut p.peak_radial_force, as_printed(radial, 9), time);
         }
-        Peak::keep(&mut p.largest_penetration, o.penetration, time);
+        Peak::keep(
+            &mut p.largest_penetration,
+            as_printed(o.penetration, 6),
+            time,
+        );
     }
 }
 
