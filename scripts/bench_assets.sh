@@ -2,7 +2,8 @@
 # The virtual bench's assets (issue 34): the paper's straight stent on the radial and crush benches with their
 # defaults (37 °C, 0.1 mm/s; the radial force read at a vessel of 34 mm, the device's 40.6 oversized by 19 %),
 # and the radial-force study: the same bench over wire diameter × number of crowns (rings) as a sweep. Writes
-#   assets/bench/straight_stent_radial.{csv,svg}, assets/bench/straight_stent_crush.{csv,svg},
+#   assets/bench/straight_stent_radial.{csv,svg,json}, assets/bench/straight_stent_crush.{csv,svg,json} (the
+#   tables, charts and bench.json: the sizes the bench reads its forces at),
 #   assets/bench/radial_study.csv and assets/bench/radial_study_cof.svg
 # from a release build; `scripts/docs_tables.py` makes the README's tables from the CSVs. A new measurement needs
 # new entries in assets/provenance.json (date, machine, command, sha256), or that script refuses it.
@@ -15,9 +16,11 @@ trap 'rm -rf "$work"' EXIT
 mkdir -p assets/bench
 "$bin" bench radial designs/straight_stent.yaml --set bench.vessel_diameter=34 -o "$work/radial" --quiet
 cp "$work/radial/radial.csv" assets/bench/straight_stent_radial.csv
+cp "$work/radial/bench.json" assets/bench/straight_stent_radial.json
 cp "$work/radial/charts/radial_force.svg" assets/bench/straight_stent_radial.svg
 "$bin" bench crush designs/straight_stent.yaml -o "$work/crush" --quiet
 cp "$work/crush/crush.csv" assets/bench/straight_stent_crush.csv
+cp "$work/crush/bench.json" assets/bench/straight_stent_crush.json
 cp "$work/crush/charts/crush_force.svg" assets/bench/straight_stent_crush.svg
 "$bin" sweep designs/straight_stent.yaml --set section.diameter=0.4:0.7:0.1 --set stent.crowns=2,4,6 \
     --set bench.vessel_diameter=34 --bench radial -o "$work/study"

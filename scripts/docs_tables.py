@@ -640,9 +640,13 @@ def interpolated(points, x):
 def bench_curves():
     """README: the straight stent on the radial and crush benches, read off their tables (linear between rows)."""
     radial, crush = "assets/bench/straight_stent_radial.csv", "assets/bench/straight_stent_crush.csv"
-    head = stamp(radial, crush)
+    radial_results, crush_results = (a.replace(".csv", ".json") for a in (radial, crush))
+    head = stamp(radial, crush, radial_results, crush_results)
     r, _ = rows(radial)
     c, _ = rows(crush)
+    # The sizes the benches read their forces at (bench.json's readings): the vessel's diameter, the crush's gaps.
+    sizes = lambda asset: {x["name"]: x["size"] for x in json.loads((ROOT / asset).read_text())["readings"]}
+    radial_sizes, crush_sizes = sizes(radial_results), sizes(crush_results)
 
     def read(data, size_key, size, branch, keys):
         rows_on = [x for x in data if x["branch"] == branch]
@@ -650,13 +654,12 @@ def bench_curves():
 
     keys = lambda force: [force, "force_per_length_N_per_mm", "pressure_kPa", "pressure_mmHg"]
     cells = lambda f, per, kpa, mmhg: [f"{f:.3f} N", f"{per:.4f} N/mm", f"{kpa:.3f} kPa ({mmhg:.2f} mmHg)"]
-    vessel = 34.0
+    vessel = radial_sizes["vessel"]
     body = []
     for label, branch in (("radial, closing (RRF)", "loading"), ("radial, opening (COF)", "unloading")):
         body.append([label, f"diameter {vessel:g} mm"] + cells(*read(r, "diameter_mm", vessel, branch, keys("radial_force_N"))))
-    outer = float(c[0]["gap_mm"]) / 1.02  # the plates start 2 % clear of the device
-    for fraction in (0.1, 0.25, 0.5):
-        gap = outer * (1 - fraction)
+    for name, gap in crush_sizes.items():
+        fraction = float(name.rstrip("%")) / 100
         values = read(c, "gap_mm", gap, "loading", keys("crush_force_N"))
         at = f"{100 * fraction:g} % crushed (gap {gap:.2f} mm)"
         body.append(["crush, closing", at] + (["—"] * 3 if None in values else cells(*values)))
