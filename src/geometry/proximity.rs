@@ -523,6 +523,14 @@ fn search(
                 slack = slack.min(depth - overlap);
                 continue;
             }
+            // A pair no deeper than the one already kept for its wires and image changes nothing: the tests of
+            // neighbours and joints below are only made for a pair that would be kept.
+            if found
+                .iter()
+                .any(|o| (o.a.wire, o.b.wire, o.image) == (wa, wb, image) && o.depth >= overlap)
+            {
+                continue;
+            }
             let point = |w: usize, i: usize, f: Real, position: Vec3| {
                 let wire = &wires[w];
                 let lerp = |v: &[Real]| v[i] + (v[i + 1] - v[i]) * f;
