@@ -3,9 +3,12 @@
 //! in; and the overlaps of the device's wires at any placement of its control points, located by patch and
 //! curve parameter for the user.
 //!
-//! **Sampling.** Each patch's knot spans cut into `SAMPLES_PER_SPAN` = 8 equal parts of the parameter: a curve
-//! between two samples lies off its chord by `h²/(8ρ)` at most (`h` the chord, `ρ` the curve's radius of
-//! curvature there), which is how much an overlap can be under-reported. The positions of the samples are linear
+//! **Sampling.** Each patch's knot spans cut into equal parts of the parameter, as few as keep every part under
+//! half the wire's radius long and at most `SAMPLES_PER_SPAN` = 8 (a fine mesh's short spans take one or two, a
+//! coarse one's eight). A curve between two samples lies off its chord by `h²/(8ρ)` at most (`h` the chord, `ρ`
+//! the curve's radius of curvature there), which is how much an overlap can be under-reported: for `h ≤ r/2` and
+//! a wire bent no tighter than its own radius (`ρ ≥ r`; tighter, it overlaps itself anyway), `r/32`, a third of
+//! the tolerance a run warns past without contact (5 % of the diameter). The positions of the samples are linear
 //! in the control points (`x(u) = Σ R_a(u) c_a`, the patch's rational basis), so a state's are found with the
 //! basis values kept from the start.
 
@@ -14,8 +17,11 @@ use crate::geometry::proximity::{Mirror, Overlap, Search, Wire, Wires};
 use crate::math::basis::nurbs_basis;
 use crate::math::{Real, Vec3};
 
-/// Parts of each knot span between samples (module docs).
+/// The most parts of a knot span between samples (module docs).
 const SAMPLES_PER_SPAN: usize = 8;
+
+/// The longest part between samples, in wire radii (module docs).
+const SEGMENT_OF_RADIUS: Real = 0.5;
 
 /// Overlaps no deeper than this fraction of the largest wire radius are round-off of wires that touch, not
 /// overlaps (`check`, `mesh` and the run's first touch).
@@ -62,13 +68,20 @@ impl DeviceWires {
             let knots = curve.knots();
             let (lo, hi) = knots.domain();
             let mut parameters = vec![lo];
+            let longest = SEGMENT_OF_RADIUS * model.wire_radius(k);
             for w in knots.knots().windows(2) {
                 let (a, b) = (w[0], w[1]);
                 if !(b > a && a >= lo && b <= hi) {
                     continue;
                 }
-                for j in 1..=SAMPLES_PER_SPAN {
-                    parameters.push(a + (b - a) * j as Real / SAMPLES_PER_SPAN as Real);
+                // The span's length along its finest parts, then as many parts as keep each under the longest.
+                let finest: Vec<Vec3> = (0..=SAMPLES_PER_SPAN)
+                    .map(|j| curve.point(a + (b - a) * j as Real / SAMPLES_PER_SPAN as Real))
+                    .collect();
+                let length: Real = finest.windows(2).map(|q| (q[1] - q[0]).norm()).sum();
+                let parts = ((length / longest).ceil() as usize).clamp(1, SAMPLES_PER_SPAN);
+                for j in 1..=parts {
+                    parameters.push(a + (b - a) * j as Real / parts as Real);
                 }
             }
             let here: Vec<Sample> = parameters
