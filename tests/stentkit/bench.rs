@@ -25,17 +25,24 @@ fn small_bench(extra: &[&str]) -> (PathBuf, Vec<String>) {
     (design, sets)
 }
 
-/// `stentkit bench radial designs/straight_stent.yaml -o OUT_DIR` with the arguments `extra`.
-fn straight_stent_bench(out_dir: &Path, extra: &[&str]) -> std::process::Output {
-    let (design, _) = small_bench(&[]);
+/// `stentkit bench TEST designs/DESIGN -o OUT_DIR` with the arguments `extra`.
+fn bench_command(test: &str, design: &str, out_dir: &Path, extra: &[&str]) -> std::process::Output {
+    let design = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("designs")
+        .join(design);
     Command::new(env!("CARGO_BIN_EXE_stentkit"))
-        .args(["bench", "radial"])
+        .args(["bench", test])
         .arg(&design)
         .arg("-o")
         .arg(out_dir)
         .args(extra)
         .output()
         .expect("stentkit runs")
+}
+
+/// `stentkit bench radial designs/straight_stent.yaml -o OUT_DIR` with the arguments `extra`.
+fn straight_stent_bench(out_dir: &Path, extra: &[&str]) -> std::process::Output {
+    bench_command("radial", "straight_stent.yaml", out_dir, extra)
 }
 
 /// The overrides of `sets`.
@@ -495,14 +502,7 @@ fn a_segmented_crimper_tends_to_the_cylindrical_one_as_its_faces_multiply() {
 fn a_crush_of_a_curved_stent_is_refused_in_the_benchs_words() {
     let dir = TempDir::new("bench-crush-curved");
     let out_dir = dir.join("run");
-    let design = Path::new(env!("CARGO_MANIFEST_DIR")).join("designs/curved_stent.yaml");
-    let out = Command::new(env!("CARGO_BIN_EXE_stentkit"))
-        .args(["bench", "crush"])
-        .arg(&design)
-        .arg("-o")
-        .arg(&out_dir)
-        .output()
-        .expect("stentkit runs");
+    let out = bench_command("crush", "curved_stent.yaml", &out_dir, &[]);
     let stderr = String::from_utf8_lossy(&out.stderr).into_owned();
     assert_eq!(out.status.code(), Some(2), "{stderr}");
     assert!(

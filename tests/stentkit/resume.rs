@@ -286,6 +286,65 @@ impl stentkit::run::Console for StopAt<'_> {
     fn end(&mut self, _: &stentkit::solver::Simulation<'_>) {}
 }
 
+/// `design` run in process into the new folder `dir` to its end; its report.
+fn run_whole(design: &stentkit::Design, dir: &Path) -> String {
+    use stentkit::run::{Folder, Interrupt, Lines, RunSettings, run};
+    let folder = Folder::New {
+        dir: dir.to_path_buf(),
+        force: false,
+    };
+    let settings = RunSettings::new("in-process test");
+    run(
+        design,
+        folder,
+        &settings,
+        &Interrupt::new(),
+        &mut Lines::default(),
+    )
+    .expect("the uninterrupted run completes")
+    .report
+}
+
+/// `design` run in process into the new folder `dir`, its interrupt requested at step `at`: what it ended with.
+fn stop_at(
+    design: &stentkit::Design,
+    dir: &Path,
+    at: usize,
+) -> Result<stentkit::run::Completed, stentkit::run::RunError> {
+    use stentkit::run::{Folder, Interrupt, RunSettings, run};
+    let interrupt = Interrupt::new();
+    let mut console = StopAt {
+        at,
+        interrupt: &interrupt,
+    };
+    let folder = Folder::New {
+        dir: dir.to_path_buf(),
+        force: false,
+    };
+    run(
+        design,
+        folder,
+        &RunSettings::new("in-process test"),
+        &interrupt,
+        &mut console,
+    )
+}
+
+/// The run in folder `dir` of `design` resumed in process from its checkpoint to its end: the lines it said.
+fn resume_in_process(design: &stentkit::Design, dir: &Path) -> Vec<String> {
+    use stentkit::run::{Folder, Interrupt, Lines, RunSettings, run};
+    let mut lines = Lines::default();
+    run(
+        design,
+        Folder::Resume(dir.to_path_buf()),
+        &RunSettings::new("in-process test"),
+        &Interrupt::new(),
+        &mut lines,
+    )
+    .expect("the resumed run completes");
+    lines.lines().to_vec()
+}
+
 /// The run as a library call ([`stentkit::run::run`], no process, no signal): the two-crown stent stopped by an
 /// [`stentkit::run::Interrupt`] requested at step 400 of 1301 ends with [`stentkit::run::RunError::Interrupted`]
 /// and a checkpoint at that step, and [`stentkit::run::Folder::Resume`] continues it to the uninterrupted
@@ -293,33 +352,15 @@ impl stentkit::run::Console for StopAt<'_> {
 /// `stentkit::run`, as the test above for signals).
 #[test]
 fn an_in_process_run_stopped_by_its_interrupt_resumes_to_the_uninterrupted_result() {
-    use stentkit::run::{Folder, Interrupt, Lines, RunError, RunSettings, run};
+    use stentkit::run::RunError;
     let root = scratch("in_process");
     let design = stentkit::design::load_design(&two_crown_stent(&root)).expect("design");
     let full = root.join("full");
-    let settings = RunSettings::new("in-process test");
-    let new = |dir: &Path| Folder::New {
-        dir: dir.to_path_buf(),
-        force: false,
-    };
-    let done = run(
-        &design,
-        new(&full),
-        &settings,
-        &Interrupt::new(),
-        &mut Lines::default(),
-    )
-    .expect("the uninterrupted run completes");
-    assert!(done.report.contains("1301 steps"), "{}", done.report);
+    let report = run_whole(&design, &full);
+    assert!(report.contains("1301 steps"), "{report}");
 
     let dir = root.join("stopped");
-    let interrupt = Interrupt::new();
-    let mut console = StopAt {
-        at: 400,
-        interrupt: &interrupt,
-    };
-    let stopped = run(&design, new(&dir), &settings, &interrupt, &mut console);
-    match stopped {
+    match stop_at(&design, &dir, 400) {
         Err(RunError::Interrupted(message)) => assert!(
             message.contains("interrupted by a test after 400 steps"),
             "{message}"
@@ -328,22 +369,13 @@ fn an_in_process_run_stopped_by_its_interrupt_resumes_to_the_uninterrupted_resul
     }
     assert_eq!(summary(&dir)["status"], "interrupted");
     assert!(dir.join("checkpoint.bin").exists());
-    let mut lines = Lines::default();
-    run(
-        &design,
-        Folder::Resume(dir.clone()),
-        &settings,
-        &Interrupt::new(),
-        &mut lines,
-    )
-    .expect("the resumed run completes");
+    let lines = resume_in_process(&design, &dir);
     assert!(
-        lines.lines()[0].starts_with(&format!(
+        lines[0].starts_with(&format!(
             "stentkit run: resuming {} from its checkpoint at step 400",
             dir.display()
         )),
-        "{:?}",
-        lines.lines()
+        "{lines:?}"
     );
     assert_eq!(
         std::fs::read(dir.join("history.csv")).expect("history"),
@@ -365,40 +397,15 @@ fn an_in_process_run_stopped_by_its_interrupt_resumes_to_the_uninterrupted_resul
 /// t = 0.98499999999999 kept exactly (and its peak force in the 12th digit).
 #[test]
 fn a_resumed_crimped_run_reports_the_uninterrupted_runs_peaks() {
-    use stentkit::run::{Folder, Interrupt, Lines, RunSettings, run};
     let root = scratch("resumed_peaks");
     let design = fixtures::design("straight_stent_crimped.yaml")
         .crowns(2)
         .design();
-    let settings = RunSettings::new("in-process test");
-    let new = |dir: &Path| Folder::New {
-        dir: dir.to_path_buf(),
-        force: false,
-    };
     let full = root.join("full");
-    run(
-        &design,
-        new(&full),
-        &settings,
-        &Interrupt::new(),
-        &mut Lines::default(),
-    )
-    .expect("the uninterrupted run completes");
+    run_whole(&design, &full);
     let dir = root.join("stopped");
-    let interrupt = Interrupt::new();
-    let mut console = StopAt {
-        at: 800,
-        interrupt: &interrupt,
-    };
-    assert!(run(&design, new(&dir), &settings, &interrupt, &mut console).is_err());
-    run(
-        &design,
-        Folder::Resume(dir.clone()),
-        &settings,
-        &Interrupt::new(),
-        &mut Lines::default(),
-    )
-    .expect("the resumed run completes");
+    assert!(stop_at(&design, &dir, 800).is_err());
+    resume_in_process(&design, &dir);
     let (resumed, uninterrupted) = (summary(&dir), summary(&full));
     assert!(uninterrupted["contact"].is_array(), "{uninterrupted}");
     for key in ["contact", "deployment", "wire_touch"] {

@@ -45,11 +45,7 @@ impl ObstacleDrawing {
     /// The drawing of `model`'s obstacles; `None` without contact.
     pub(super) fn new(model: &Model) -> Option<Self> {
         let contact = model.contact.as_ref()?;
-        let points: Vec<Vec3> = model
-            .patches
-            .iter()
-            .flat_map(|p| p.curve.points().iter().copied())
-            .collect();
+        let points = crate::model::wires::reference_control(model);
         let (lo, hi) = points.iter().fold(
             (
                 Vec3::repeat(Real::INFINITY),
