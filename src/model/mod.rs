@@ -658,21 +658,37 @@ impl Model {
     /// The symmetry plane (index into [`Model::symmetry_planes`]) that patch `patch` lies in, if any: every
     /// control point within `1e-9` of the model size from the plane.
     pub fn patch_symmetry_plane(&self, patch: usize) -> Option<usize> {
-        // Relative distance below which a control point is on a plane: generated in-plane patches are there
-        // to round-off (~1e-15), other patches are a wire's length away.
-        const IN_PLANE: Real = 1e-9;
         let points = self.patches[patch].curve.points();
-        let scale = self
-            .nodes
-            .iter()
+        let tolerance = self.symmetry_tolerance();
+        (0..self.symmetry_planes.len()).find(|&k| {
+            points
+                .iter()
+                .all(|q| self.plane_distance(k, q) <= tolerance)
+        })
+    }
+
+    /// Whether `x` lies on symmetry plane `plane` (index into [`Model::symmetry_planes`]), as a patch does for
+    /// [`Model::patch_symmetry_plane`].
+    pub fn lies_on_symmetry_plane(&self, plane: usize, x: &Vec3) -> bool {
+        self.plane_distance(plane, x) <= self.symmetry_tolerance()
+    }
+
+    /// The distance of `x` from symmetry plane `plane`.
+    fn plane_distance(&self, plane: usize, x: &Vec3) -> Real {
+        let (point, normal) = &self.symmetry_planes[plane];
+        (x - point).dot(normal).abs()
+    }
+
+    /// How near a symmetry plane a point lies on it: `1e-9` of the model size, the distance of its farthest node
+    /// from the origin. Generated in-plane patches and nodes are there to round-off (~1e-15), the others a
+    /// wire's length away.
+    fn symmetry_tolerance(&self) -> Real {
+        const IN_PLANE: Real = 1e-9;
+        let scale = (self.nodes.iter())
             .map(|n| n.position.norm())
             .fold(0.0, Real::max)
             .max(Real::MIN_POSITIVE);
-        self.symmetry_planes.iter().position(|(point, normal)| {
-            points
-                .iter()
-                .all(|q| (q - point).dot(normal).abs() <= IN_PLANE * scale)
-        })
+        IN_PLANE * scale
     }
 
     /// The steps a run takes when no step is cut: time stepping goes by `time.step` and also lands on every

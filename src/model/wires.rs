@@ -109,16 +109,12 @@ impl DeviceWires {
             samples.push(here);
             offset += curve.num_points();
         }
-        let scale = (model.nodes.iter())
-            .map(|n| n.position.norm())
-            .fold(0.0, Real::max)
-            .max(Real::MIN_POSITIVE);
-        let mirrors = (model.symmetry_planes.iter())
-            .map(|(point, normal)| Mirror {
+        let mirrors = (model.symmetry_planes.iter().enumerate())
+            .map(|(plane, (point, normal))| Mirror {
                 point: *point,
                 normal: *normal,
                 nodes: (model.nodes.iter().enumerate())
-                    .filter(|(_, n)| (n.position - point).dot(normal).abs() <= 1e-9 * scale)
+                    .filter(|(_, n)| model.lies_on_symmetry_plane(plane, &n.position))
                     .map(|(k, _)| k)
                     .collect(),
             })
