@@ -46,7 +46,7 @@
 //! crosses the cut onto its image); a wire lying in a plane of the image is its own mirror there and has no pair
 //! with that image.
 
-use crate::math::{Real, Vec3};
+use crate::math::{Mat3, Real, Vec3};
 use rstar::{AABB, Envelope as _, RTree, RTreeObject};
 
 /// One wire: what stays of a polyline along a rod's centreline while the rod moves (module docs); its points are
@@ -392,6 +392,18 @@ impl Wires {
         &self.wires
     }
 
+    /// The image `image` (as [`Overlap::image`]) as an affine map `x ↦ M x + b`: `M` (symmetric, its own
+    /// inverse for the orthogonal planes of a reduced model) and `b`.
+    pub fn image_map(&self, image: usize) -> (Mat3, Vec3) {
+        (self.mirrors.iter().enumerate())
+            .filter(|(k, _)| image & (1 << k) != 0)
+            .fold((Mat3::identity(), Vec3::zeros()), |(m, b), (_, mirror)| {
+                let r = Mat3::identity() - mirror.normal * mirror.normal.transpose() * 2.0;
+                let shift = mirror.normal * (2.0 * mirror.point.dot(&mirror.normal));
+                (r * m, r * b + shift)
+            })
+    }
+
     /// Every pair of places on the wires at `points` (one polyline per wire, as many points as its
     /// parameters) closer than their radii allow by more than `depth`, the deepest per pair of wires and image,
     /// deepest first (module docs).
@@ -413,6 +425,55 @@ impl Wires {
     }
 }
 
+impl Wires {
+    /// Every point of the wires at `points` within `r_a + r_b + margin` of a segment of another wire, or of the
+    /// same wire further along it, or of an image (module docs), the two not neighbours along the wires nor a
+    /// joint's own overlap: each point with each such segment, both ways round (a point of `a` near a segment of
+    /// `b`, and the points of that segment near the segment of `a`), sorted.
+    pub fn near(&self, points: &[Vec<Vec3>], margin: Real) -> Vec<Near> {
+        let mut out = Vec::new();
+        let mut reaches = std::collections::HashMap::new();
+        let wires = &self.wires;
+        scan(
+            wires,
+            &self.mirrors,
+            &self.graph,
+            points,
+            margin,
+            &mut |context, pair| {
+                let (wa, wb) = (pair.a.wire, pair.b.wire);
+                if pair.distance >= wires[wa].radius + wires[wb].radius + margin
+                    || context.joined(&pair, &mut reaches)
+                {
+                    return;
+                }
+                let image = pair.image;
+                for point in [pair.i, pair.i + 1] {
+                    out.push(Near {
+                        wire: wa,
+                        point,
+                        other: wb,
+                        segment: pair.j,
+                        image,
+                    });
+                }
+                for point in [pair.j, pair.j + 1] {
+                    out.push(Near {
+                        wire: wb,
+                        point,
+                        other: wa,
+                        segment: pair.i,
+                        image,
+                    });
+                }
+            },
+        );
+        out.sort_unstable();
+        out.dedup();
+        out
+    }
+}
+
 /// What [`Wires::search`] found.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Search {
@@ -423,23 +484,82 @@ pub struct Search {
     pub slack: Real,
 }
 
-/// [`Wires::search`].
-fn search(
+/// Two segments within reach of each other (their radii and the scan's margin, by their boxes), not
+/// neighbours along the wires as wholes: the first's `i`-th segment of wire `wa`, the second's `j`-th of wire `wb`
+/// (of the image `image`), their closest points and where those lie on the wires.
+struct SegmentPair {
+    i: usize,
+    j: usize,
+    image: usize,
+    /// Distance of the closest points \[length\].
+    distance: Real,
+    a: WirePoint,
+    b: WirePoint,
+}
+
+/// What the scan of one image shares with its visitor: the wires, the distances along them and, for an image,
+/// the nodes a path across its planes goes through.
+struct ScanContext<'a> {
+    wires: &'a [Wire],
+    graph: &'a Graph,
+    own: &'a [Vec<Vec3>],
+    other: &'a [Vec<Vec3>],
+    through: Option<&'a [usize]>,
+}
+
+impl ScanContext<'_> {
+    /// Whether the closest points of `pair` are neighbours along the wires or a joint's own overlap (module
+    /// docs): no contact. `reaches` keeps each joint's reach across the calls of one scan.
+    fn joined(
+        &self,
+        pair: &SegmentPair,
+        reaches: &mut std::collections::HashMap<(usize, usize, usize, usize), Real>,
+    ) -> bool {
+        let (wires, (a, b)) = (self.wires, (&pair.a, &pair.b));
+        let (wa, wb, image) = (a.wire, b.wire, pair.image);
+        let threshold = 2.0 * (wires[wa].radius + wires[wb].radius);
+        if along(wires, self.graph, (wa, a.arc), (wb, b.arc), self.through) < threshold {
+            return true;
+        }
+        let joined = |m: &usize| self.through.is_none_or(|nodes| nodes.contains(m));
+        // The ends of wire a at a node wire b shares (a wire shares its own end with itself only where its two
+        // ends are one node, or across a cut with its image).
+        let shares = |ea: usize| {
+            let node = wires[wa].ends[ea];
+            joined(&node)
+                && if wa == wb && image == 0 {
+                    wires[wa].ends[1 - ea] == node
+                } else {
+                    wires[wb].ends.contains(&node)
+                }
+        };
+        (0..2).filter(|&ea| shares(ea)).any(|ea| {
+            let reach = *reaches.entry((wa, wb, image, ea)).or_insert_with(|| {
+                joint_reach(wires, (wa, &self.own[wa]), ea, (wb, &self.other[wb]))
+            });
+            let from_end = if ea == 0 {
+                a.arc - wires[wa].arc[0]
+            } else {
+                wires[wa].arc[wires[wa].arc.len() - 1] - a.arc
+            };
+            from_end < reach
+        })
+    }
+}
+
+/// Every pair of segments of the wires at `own` (and of the wires with each mirror image) whose boxes, grown by
+/// their radii and `margin`, meet and that are not neighbours along the wires segment by segment, each pair once,
+/// given to `visit` with the scan's context (module docs: broad and narrow phase).
+fn scan(
     wires: &[Wire],
     mirrors: &[Mirror],
     graph: &Graph,
     own: &[Vec<Vec3>],
-    depth: Real,
     margin: Real,
-) -> Search {
+    visit: &mut dyn FnMut(&ScanContext<'_>, SegmentPair),
+) {
     let largest = wires.iter().map(|w| w.radius).fold(0.0, Real::max);
-    let mut slack = margin;
     let tree = RTree::bulk_load(chunks(wires, own, margin, |_, _| true));
-    let mut found: Vec<Overlap> = Vec::new();
-    // How far from a shared node two wires overlap without a break (joint_reach), per wire, other wire, image
-    // and end.
-    let mut reaches: std::collections::HashMap<(usize, usize, usize, usize), Real> =
-        std::collections::HashMap::new();
     for image in 0..(1usize << mirrors.len()) {
         let planes: Vec<usize> = (0..mirrors.len())
             .filter(|k| image & (1 << k) != 0)
@@ -472,6 +592,13 @@ fn search(
                 .collect();
             &images
         };
+        let context = ScanContext {
+            wires,
+            graph,
+            own,
+            other,
+            through: through.as_deref(),
+        };
         let (near_tree, image_tree);
         let candidates = if image == 0 {
             tree.intersection_candidates_with_other_tree(&tree)
@@ -503,7 +630,6 @@ fn search(
                 continue;
             }
             let (ra, rb) = (wires[wa].radius, wires[wb].radius);
-            let threshold = 2.0 * (ra + rb);
             let (p0, p1) = (&own[wa][i], &own[wa][i + 1]);
             let (q0, q1) = (&other[wb][j], &other[wb][j + 1]);
             // The segments' own boxes, grown by the radii and the margin, first.
@@ -513,24 +639,13 @@ fn search(
             {
                 continue;
             }
-            if near_along(wires, (wa, i, i + 1), (wb, j, j + 1), through.as_deref()) < threshold {
+            if near_along(wires, (wa, i, i + 1), (wb, j, j + 1), through.as_deref())
+                < 2.0 * (ra + rb)
+            {
                 continue;
             }
             let (s, t) = closest_points(p0, p1, q0, q1);
             let (x, y) = (p0 + (p1 - p0) * s, q0 + (q1 - q0) * t);
-            let overlap = ra + rb - (x - y).norm();
-            if overlap <= depth {
-                slack = slack.min(depth - overlap);
-                continue;
-            }
-            // A pair no deeper than the one already kept for its wires and image changes nothing: the tests of
-            // neighbours and joints below are only made for a pair that would be kept.
-            if found
-                .iter()
-                .any(|o| (o.a.wire, o.b.wire, o.image) == (wa, wb, image) && o.depth >= overlap)
-            {
-                continue;
-            }
             let point = |w: usize, i: usize, f: Real, position: Vec3| {
                 let wire = &wires[w];
                 let lerp = |v: &[Real]| v[i] + (v[i + 1] - v[i]) * f;
@@ -541,60 +656,60 @@ fn search(
                     position,
                 }
             };
-            let (a, b) = (point(wa, i, s, x), point(wb, j, t, y));
-            let apart = along(wires, graph, (wa, a.arc), (wb, b.arc), through.as_deref());
-            if apart < threshold {
-                continue;
-            }
-            let joined = |m: &usize| through.as_ref().is_none_or(|nodes| nodes.contains(m));
-            // The ends of wire a at a node wire b shares (a wire shares its own end with itself only where its
-            // two ends are one node, or across a cut with its image).
-            let shares = |ea: usize| {
-                let node = wires[wa].ends[ea];
-                joined(&node)
-                    && if wa == wb && image == 0 {
-                        wires[wa].ends[1 - ea] == node
-                    } else {
-                        wires[wb].ends.contains(&node)
-                    }
+            let pair = SegmentPair {
+                i,
+                j,
+                image,
+                distance: (x - y).norm(),
+                a: point(wa, i, s, x),
+                b: point(wb, j, t, y),
             };
-            let from_joint = (0..2).filter(|&ea| shares(ea)).any(|ea| {
-                let reach = *reaches
-                    .entry((wa, wb, image, ea))
-                    .or_insert_with(|| joint_reach(wires, (wa, &own[wa]), ea, (wb, &other[wb])));
-                let from_end = if ea == 0 {
-                    a.arc - wires[wa].arc[0]
-                } else {
-                    wires[wa].arc[wires[wa].arc.len() - 1] - a.arc
-                };
-                from_end < reach
-            });
-            if from_joint {
-                continue;
-            }
-            let key = (wa, wb, image);
-            match found
-                .iter_mut()
-                .find(|o| (o.a.wire, o.b.wire, o.image) == key)
-            {
-                Some(o) if o.depth >= overlap => {}
-                Some(o) => {
-                    *o = Overlap {
-                        depth: overlap,
-                        a,
-                        b,
-                        image,
-                    }
-                }
-                None => found.push(Overlap {
-                    depth: overlap,
-                    a,
-                    b,
-                    image,
-                }),
-            }
+            visit(&context, pair);
         }
     }
+}
+
+/// [`Wires::search`].
+fn search(
+    wires: &[Wire],
+    mirrors: &[Mirror],
+    graph: &Graph,
+    own: &[Vec<Vec3>],
+    depth: Real,
+    margin: Real,
+) -> Search {
+    let mut slack = margin;
+    let mut found: Vec<Overlap> = Vec::new();
+    // How far from a shared node two wires overlap without a break (joint_reach), per wire, other wire, image
+    // and end.
+    let mut reaches = std::collections::HashMap::new();
+    scan(wires, mirrors, graph, own, margin, &mut |context, pair| {
+        let (wa, wb, image) = (pair.a.wire, pair.b.wire, pair.image);
+        let overlap = wires[wa].radius + wires[wb].radius - pair.distance;
+        if overlap <= depth {
+            slack = slack.min(depth - overlap);
+            return;
+        }
+        // A pair no deeper than the one already kept for its wires and image changes nothing: the tests of
+        // neighbours and joints are only made for a pair that would be kept.
+        let key = (wa, wb, image);
+        let kept = found
+            .iter()
+            .position(|o| (o.a.wire, o.b.wire, o.image) == key);
+        if kept.is_some_and(|k| found[k].depth >= overlap) || context.joined(&pair, &mut reaches) {
+            return;
+        }
+        let o = Overlap {
+            depth: overlap,
+            a: pair.a,
+            b: pair.b,
+            image,
+        };
+        match kept {
+            Some(k) => found[k] = o,
+            None => found.push(o),
+        }
+    });
     found.sort_by(|x, y| y.depth.total_cmp(&x.depth));
     if !found.is_empty() {
         slack = slack.min(depth - found[0].depth);
@@ -603,6 +718,22 @@ fn search(
         overlaps: found,
         slack,
     }
+}
+
+/// A point of one wire within reach of a segment of another wire (or of a mirror image), for contact between
+/// them ([`Wires::near`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash)]
+pub struct Near {
+    /// The wire of the point.
+    pub wire: usize,
+    /// The point's index in its wire's polyline.
+    pub point: usize,
+    /// The other wire.
+    pub other: usize,
+    /// The segment of the other wire (between its points `segment` and `segment + 1`).
+    pub segment: usize,
+    /// The image of the other wire the segment belongs to (as [`Overlap::image`]).
+    pub image: usize,
 }
 
 #[cfg(test)]

@@ -563,6 +563,11 @@ pub struct Model {
     /// description when `None`, so the checkpoint fingerprints of models without contact stay as they were.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub contact: Option<Contact>,
+    /// Contact between the device's own wires and the law it is enforced with (`None`: wires pass through
+    /// each other, which the run's wire-crossing check reports; `crate::solver::terms::wires`). Left out of the
+    /// serialised description when `None`, like `contact`.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub wire_contact: Option<ContactSettings>,
     /// The patches (indices into `patches`) that connect the crowns of a generated stent, as its family says
     /// (`StentFamily::is_connector`: the ring family's bridges), for advice that names them. A label, not
     /// mechanics: left out of the serialised description (the checkpoint fingerprint).

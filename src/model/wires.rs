@@ -153,6 +153,23 @@ impl DeviceWires {
         self.wires.search(&self.points(control), depth, margin)
     }
 
+    /// The patches' names, by wire.
+    pub fn names(&self) -> &[String] {
+        &self.names
+    }
+
+    /// The wires as the proximity search sees them.
+    pub fn wires(&self) -> &Wires {
+        &self.wires
+    }
+
+    /// Sample `i` of patch `patch`: the index of its first control point in the model's flat list and the basis
+    /// values of the control points from there (its position is `Σ_a basis[a] c[first + a]`).
+    pub fn sample(&self, patch: usize, i: usize) -> (usize, &[Real]) {
+        let s = &self.samples[patch][i];
+        (s.first, &s.basis)
+    }
+
     /// The largest radius of the wires \[length\].
     pub fn largest_radius(&self) -> Real {
         (self.wires.wires().iter())

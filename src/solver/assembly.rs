@@ -32,7 +32,7 @@ pub(crate) use super::actions::{Actions, ReleaseRamp};
 pub(crate) use super::discretisation::point_position;
 use super::discretisation::{CollocationPoint, Discretisation};
 use super::state::State;
-use super::terms::{EndLoad, InteriorLoad, PointView, Terms};
+use super::terms::{Coupled, EndLoad, InteriorLoad, PointView, Terms};
 use crate::material::{ConstitutiveLaw, SectionLaw, SectionStrains};
 use crate::math::so3::{hat, log};
 use crate::math::{Mat3, Real, Rot3, Vec3};
@@ -245,6 +245,23 @@ impl Assembler {
         let m = at.terms.multipliers();
         lin.residual.resize(n + m, 0.0);
         lin.row_scale.resize(n + m, 1.0);
+        // The coupled loads of the iterate (module docs of `super::terms`), their forces gathered per point.
+        let coupled: Vec<Option<Coupled>> = if matches!(sink, Sink::Pattern(_)) {
+            Vec::new()
+        } else {
+            let tangent = matches!(sink, Sink::Values { .. });
+            (at.terms.point.iter())
+                .map(|t| t.coupled(disc, at.state, tangent))
+                .collect()
+        };
+        let mut extra: Vec<Option<Vec3>> = Vec::new();
+        for c in coupled.iter().flatten() {
+            extra.resize(disc.points.len(), None);
+            for &(g, q) in &c.forces {
+                *extra[g].get_or_insert_with(Vec3::zeros) += q;
+            }
+        }
+        let extra = |g: usize| extra.get(g).copied().flatten();
         // Interior points: independent (each owns its six rows and a known slice of the tangent's entries), so
         // the tangent is assembled in parallel; the residual alone is too cheap per point to gain from it
         // (measured on the curved stent: tangent 0.81 → 0.60 s, residual 0.29 → 0.44 s over 0.5 s of the run).
@@ -268,7 +285,7 @@ impl Assembler {
                 .into_par_iter()
                 .for_each(|(g, residual, scale, values)| {
                     let mut sink = Sink::Values { values, next: 0 };
-                    self.interior(at, g, residual, scale, &mut sink);
+                    self.interior(at, g, extra(g), residual, scale, &mut sink);
                     if let Sink::Values { values, next } = sink {
                         debug_assert_eq!(
                             next,
@@ -283,7 +300,7 @@ impl Assembler {
                     let rows = 6 * g..6 * g + 6;
                     let (residual, scale) =
                         (&mut lin.residual[rows.clone()], &mut lin.row_scale[rows]);
-                    self.interior(at, g, residual, scale, sink);
+                    self.interior(at, g, extra(g), residual, scale, sink);
                 }
             }
         }
@@ -292,6 +309,26 @@ impl Assembler {
             self.node(at, k, node, lin, sink);
         }
         self.constraints(at, lin, sink);
+        self.coupled_blocks(at, &coupled, sink);
+    }
+
+    /// The coupled loads' tangent blocks `Rᵀ_g ∂q_g/∂c_k` in the force rows of `g` and the translation columns of
+    /// `k`, term after term in the order of their coupling (module docs of [`super::terms`]); every entry of the
+    /// coupling is pushed (zero where a term gave no block), so the pattern is the coupling's.
+    fn coupled_blocks(&self, at: &Assembly<'_>, coupled: &[Option<Coupled>], sink: &mut Sink<'_>) {
+        if matches!(sink, Sink::Discard) {
+            return;
+        }
+        for (k, term) in at.terms.point.iter().enumerate() {
+            let blocks = coupled.get(k).and_then(|c| c.as_ref()).map(|c| &c.blocks);
+            for (e, &(g, c)) in term.coupling().iter().enumerate() {
+                let block = match blocks.and_then(|b| b.get(e)) {
+                    Some(b) => at.state.rotation[g].transpose() * b,
+                    None => Mat3::zeros(),
+                };
+                sink.block(6 * g, 6 * c, &block);
+            }
+        }
     }
 
     /// The constraints' rows (`C_j`, rows `n + j`) and their multipliers' columns in the free translational rows
@@ -357,13 +394,15 @@ impl Assembler {
             .collect()
     }
 
-    /// The balance laws `F`, `T` at interior collocation point `g` (module docs) with the point terms' loads,
+    /// The balance laws `F`, `T` at interior collocation point `g` (module docs) with the point terms' loads (and
+    /// the coupled loads' force there),
     /// their row scales and, unless the sink discards them, their tangent blocks.
     #[allow(non_snake_case)]
     fn interior(
         &self,
         at: &Assembly<'_>,
         g: usize,
+        coupled: Option<Vec3>,
         residual: &mut [Real],
         row_scale: &mut [Real],
         sink: &mut Sink<'_>,
@@ -399,6 +438,9 @@ impl Assembler {
         let mut load = InteriorLoad::default();
         for term in at.terms.point {
             term.interior(&view, &mut load);
+        }
+        if let Some(q) = coupled {
+            load.add_force(q);
         }
         let nbar = Rt * load.force.unwrap_or_else(Vec3::zeros);
         let mbar = Rt * load.couple.unwrap_or_else(Vec3::zeros);

@@ -113,6 +113,25 @@ pub(crate) fn check_temperature(temperature: &TimeFunction) -> Result<()> {
     }
 }
 
+/// Checks a contact law's settings: a positive penalty, band and tolerance (of the surfaces' contact and of the
+/// wires').
+pub(crate) fn contact_settings(settings: &crate::model::ContactSettings) -> Result<()> {
+    let positive = |x: Real| x.is_finite() && x > 0.0;
+    if positive(settings.penalty)
+        && positive(settings.regularisation)
+        && positive(settings.tolerance)
+    {
+        return Ok(());
+    }
+    Err(BuildError::new(
+        Field::ContactSettings,
+        format!(
+            "the penalty ({}), the law's transition band ({}) and the penetration tolerance ({}) must be positive and finite",
+            settings.penalty, settings.regularisation, settings.tolerance
+        ),
+    ))
+}
+
 /// Checks a model's contact (the checks [`super::ModelBuilder::contact`] lists), at the obstacle and part at
 /// fault. A wire through a surface at the start is refused with where it is: the contact law would throw it out
 /// with a force of the penalty times the penetration in the first step.
@@ -120,19 +139,8 @@ pub(crate) fn contact(contact: &crate::model::Contact, model: &crate::model::Mod
     use super::field::ObstacleField;
     use crate::model::{Surface, Wall};
     let settings = &contact.settings;
+    contact_settings(settings)?;
     let positive = |x: Real| x.is_finite() && x > 0.0;
-    if !(positive(settings.penalty)
-        && positive(settings.regularisation)
-        && positive(settings.tolerance))
-    {
-        return Err(BuildError::new(
-            Field::ContactSettings,
-            format!(
-                "the penalty ({}), the law's transition band ({}) and the penetration tolerance ({}) must be positive and finite",
-                settings.penalty, settings.regularisation, settings.tolerance
-            ),
-        ));
-    }
     let wire = model
         .patches
         .iter()

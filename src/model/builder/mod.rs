@@ -550,6 +550,7 @@ pub struct ModelBuilder {
     vessel: Option<crate::model::Vessel>,
     /// Surfaces the rods touch.
     contact: Option<crate::model::Contact>,
+    wire_contact: Option<crate::model::ContactSettings>,
 }
 
 impl ModelBuilder {
@@ -586,6 +587,7 @@ impl ModelBuilder {
             record_times: Vec::new(),
             vessel: None,
             contact: None,
+            wire_contact: None,
         }
     }
 
@@ -652,6 +654,13 @@ impl ModelBuilder {
     /// wire through a surface at the start.
     pub fn contact(&mut self, contact: crate::model::Contact) -> &mut Self {
         self.contact = Some(contact);
+        self
+    }
+
+    /// Contact between the device's own wires under `settings` (its law, `crate::solver::terms::wires`),
+    /// checked when the model is built like the surfaces' settings (a positive penalty, band and tolerance).
+    pub fn wire_contact(&mut self, settings: crate::model::ContactSettings) -> &mut Self {
+        self.wire_contact = Some(settings);
         self
     }
 
@@ -904,7 +913,10 @@ impl ModelBuilder {
             &self.solver,
             &self.materials,
             &self.material_names,
-            programme.is_some() || time.tolerance.is_some() || self.contact.is_some(),
+            programme.is_some()
+                || time.tolerance.is_some()
+                || self.contact.is_some()
+                || self.wire_contact.is_some(),
             &nodes,
         )?;
         let probes = self.probes(&patches, &nodes)?;
@@ -956,10 +968,14 @@ impl ModelBuilder {
             record_times,
             vessel: self.vessel.clone(),
             contact,
+            wire_contact: self.wire_contact,
             connectors,
         };
         if let Some(contact) = &model.contact {
             checks::contact(contact, &model)?;
+        }
+        if let Some(settings) = &model.wire_contact {
+            checks::contact_settings(settings)?;
         }
         Ok(Built { model, warnings })
     }

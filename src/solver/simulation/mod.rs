@@ -118,6 +118,7 @@ use super::terms::contact::SurfaceContact;
 use super::terms::crossing::WireCrossing;
 use super::terms::damping::Damping;
 use super::terms::distributed::DistributedLoad;
+use super::terms::wires::WireContact;
 use super::terms::{Constraint, PointTerm, Terms};
 use crate::math::{Real, Vec3};
 use crate::model::{Model, ProbeLocation};
@@ -186,36 +187,25 @@ impl<'m> Simulation<'m> {
         let disc = Discretisation::new(model)?;
         let assembler = Assembler::new(model, &disc);
         let state = State::reference(&disc);
-        let mut pattern = Vec::new();
-        let mut lin = Linearisation::default();
-        let actions = Actions::at(model, 0.0, &[]);
         let materials = PointMaterials::new(model, &disc);
         let terms = registered_terms(model, &disc);
-        let (point, constraints) = assembly_terms(&terms, None, None);
-        assembler.assemble(
+        let (system, values) = analyse(
             &Assembly {
                 disc: &disc,
                 state: &state,
                 material: StepMaterial {
                     laws: &materials.laws,
                 },
-                actions: &actions,
-                terms: Terms {
-                    point: &point,
-                    constraints: &constraints,
-                },
+                actions: &Actions::at(model, 0.0, &[]),
+                terms: Terms::default(),
             },
-            &mut lin,
-            &mut Sink::Pattern(&mut pattern),
-        );
-        let system = LinearSystem::new(
-            disc.num_unknowns(),
-            &pattern,
-            &patch_ranges(&disc),
+            &assembler,
+            &terms,
+            None,
             model.solver().linear,
         )?;
-        let values = vec![0.0; pattern.len()];
         let n = disc.num_unknowns();
+        let coupling = coupling_versions(&terms);
         Ok(Self {
             model,
             measures: measures::Measures::new(model, &disc),
@@ -230,8 +220,9 @@ impl<'m> Simulation<'m> {
             stabiliser: stabilisation::Stabiliser::default(),
             work: workspace::Workspace {
                 system,
-                lin,
+                lin: Linearisation::default(),
                 values,
+                coupling,
                 delta: vec![0.0; n],
                 tangent: checkpoint::TangentRecord::default(),
             },
@@ -376,6 +367,9 @@ fn registered_terms(model: &Model, disc: &Discretisation) -> Vec<Box<dyn PointTe
             contact.settings,
         )));
     }
+    if let Some(settings) = model.wire_contact {
+        terms.push(Box::new(WireContact::new(model, disc, settings)));
+    }
     terms
 }
 
@@ -393,6 +387,38 @@ fn assembly_terms<'a>(
     }
     let constraints = gauge.map(|g| g as &dyn Constraint).into_iter().collect();
     (point, constraints)
+}
+
+/// The linear system of the assemblies with the point terms `registered` and the constraints of `gauge` (their
+/// pattern recorded at `at`'s iterate, whose own terms are ignored, and analysed for `method`), and room for its
+/// entries.
+fn analyse(
+    at: &Assembly<'_>,
+    assembler: &Assembler,
+    registered: &[Box<dyn PointTerm + Send>],
+    gauge: Option<&Gauge>,
+    method: crate::model::LinearMethod,
+) -> Result<(LinearSystem, Vec<Real>), SolverError> {
+    let mut pattern = Vec::new();
+    let (point, constraints) = assembly_terms(registered, None, gauge);
+    let terms = Terms {
+        point: &point,
+        constraints: &constraints,
+    };
+    assembler.assemble(
+        &Assembly { terms, ..*at },
+        &mut Linearisation::default(),
+        &mut Sink::Pattern(&mut pattern),
+    );
+    let n = at.disc.num_unknowns() + terms.multipliers();
+    let system = LinearSystem::new(n, &pattern, &patch_ranges(at.disc), method)?;
+    Ok((system, vec![0.0; pattern.len()]))
+}
+
+/// The coupling version of every registered term ([`PointTerm::coupling_version`]): the pattern's analysis was
+/// made for these.
+fn coupling_versions(terms: &[Box<dyn PointTerm + Send>]) -> Vec<usize> {
+    terms.iter().map(|t| t.coupling_version()).collect()
 }
 
 /// Each patch's first control point and count, for the block solver.

@@ -235,6 +235,9 @@ impl Simulation<'_> {
         actions: &Actions,
         with_tangent: bool,
     ) -> Result<Real, SolverError> {
+        if with_tangent {
+            self.refresh_pattern()?;
+        }
         let start = Instant::now();
         let material = StepMaterial {
             laws: &self.materials.laws,
@@ -282,6 +285,36 @@ impl Simulation<'_> {
             norm = norm.max(x);
         }
         Ok(norm)
+    }
+
+    /// Analyses the linear systems' patterns again (the rods' own and, once built, the gauge constraints') when a
+    /// point term's coupling changed since they were analysed (module docs of [`crate::solver::terms`]: contact
+    /// between wires found or lost); the factorisations are forgotten with the old patterns.
+    fn refresh_pattern(&mut self) -> Result<(), SolverError> {
+        let versions = super::coupling_versions(&self.terms);
+        if versions == self.work.coupling {
+            return Ok(());
+        }
+        let actions = Actions::at(self.model, self.clock.time, &self.releases.ramps);
+        let at = Assembly {
+            disc: &self.disc,
+            state: &self.solution.state,
+            material: StepMaterial {
+                laws: &self.materials.laws,
+            },
+            actions: &actions,
+            terms: Terms::default(),
+        };
+        let method = self.model.solver().linear;
+        (self.work.system, self.work.values) =
+            super::analyse(&at, &self.assembler, &self.terms, None, method)?;
+        if let Some((gauge, system, values)) = &mut self.releases.gauge {
+            (*system, *values) =
+                super::analyse(&at, &self.assembler, &self.terms, Some(gauge), method)?;
+        }
+        self.work.coupling = versions;
+        self.work.tangent.invalidate();
+        Ok(())
     }
 
     /// Normalised norm of the increment in `self.work.delta`: translations over the patch length, rotations in

@@ -1,12 +1,10 @@
 //! Release ramps (a released component's reaction, captured before the step that releases it) and the gauge
 //! constraints switched on by a programme's release.
 
-use super::{CheckpointError, Restorable, Simulation, patch_ranges};
+use super::{CheckpointError, Restorable, Simulation};
 use crate::math::{Real, Vec3};
 use crate::solver::SolverError;
-use crate::solver::assembly::{
-    Actions, Assembly, Linearisation, ReleaseRamp, Sink, point_position,
-};
+use crate::solver::assembly::{Actions, Assembly, ReleaseRamp, point_position};
 use crate::solver::gauge::Gauge;
 use crate::solver::linear::LinearSystem;
 use crate::solver::terms::{Constraint, Terms};
@@ -164,32 +162,19 @@ impl Simulation<'_> {
         else {
             return Ok(());
         };
-        let mut pattern = Vec::new();
-        let actions = Actions::at(self.model, t, &self.releases.ramps);
-        let material = self.step_material();
-        let mut lin = Linearisation::default();
-        let (point, constraints) = super::assembly_terms(&self.terms, None, Some(&gauge));
-        self.assembler.assemble(
+        let (system, values) = super::analyse(
             &Assembly {
                 disc: &self.disc,
                 state: &self.solution.state,
-                material,
-                actions: &actions,
-                terms: Terms {
-                    point: &point,
-                    constraints: &constraints,
-                },
+                material: self.step_material(),
+                actions: &Actions::at(self.model, t, &self.releases.ramps),
+                terms: Terms::default(),
             },
-            &mut lin,
-            &mut Sink::Pattern(&mut pattern),
-        );
-        let system = LinearSystem::new(
-            self.disc.num_unknowns() + gauge.len(),
-            &pattern,
-            &patch_ranges(&self.disc),
+            &self.assembler,
+            &self.terms,
+            Some(&gauge),
             self.model.solver().linear,
         )?;
-        let values = vec![0.0; pattern.len()];
         self.releases.gauge = Some((gauge, system, values));
         Ok(())
     }

@@ -381,7 +381,6 @@ impl Simulation<'_> {
         }
     }
 
-    /// Forgets every factorisation (the next Newton iteration assembles and factorises afresh).
     /// Lets every point term update its multipliers at the converged state ([`crate::solver::terms::PointTerm::augment`]); whether
     /// any did (then the step is solved again).
     fn augment_terms(&mut self) -> bool {
@@ -393,6 +392,7 @@ impl Simulation<'_> {
         any
     }
 
+    /// Forgets every factorisation (the next Newton iteration assembles and factorises afresh).
     pub(super) fn forget_factorisation(&mut self) {
         self.work.system.invalidate();
         if let Some((_, system, _)) = &mut self.releases.gauge {

@@ -16,6 +16,8 @@ pub(super) struct Workspace {
     pub(super) lin: Linearisation,
     /// The tangent's entries in the order of `system`'s pattern.
     pub(super) values: Vec<Real>,
+    /// The point terms' coupling versions the systems' patterns were analysed for (`super::analyse`).
+    pub(super) coupling: Vec<usize>,
     /// The last Newton increment.
     pub(super) delta: Vec<Real>,
     /// What the current factorisation was computed from, for checkpoints ([`super::checkpoint`]).

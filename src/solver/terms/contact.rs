@@ -144,7 +144,7 @@ use crate::solver::discretisation::{Discretisation, point_increment, point_posit
 use crate::solver::state::State;
 
 /// The C¹ ramp `Φ(x)` of the contact law and its derivative (module docs), with half-width `delta`.
-fn ramp(x: Real, delta: Real) -> (Real, Real) {
+pub(crate) fn ramp(x: Real, delta: Real) -> (Real, Real) {
     if x <= -delta {
         (0.0, 0.0)
     } else if x >= delta {

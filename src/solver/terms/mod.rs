@@ -34,6 +34,16 @@
 //!   damping of stabilisation is the one term built per attempt from the simulation's own memory (the last
 //!   converged state and `c/h`), which drops it when the attempt ends either way.
 //!
+//! **Coupled loads** — a point term whose line force at a point depends on control points other than those of
+//! the point's basis (the contact of two wires: the force on one depends on where the other is) gives them once per
+//! assembly ([`PointTerm::coupled`]: the forces per point and, with the tangent, a spatial block `∂q_g/∂c_k` per
+//! entry `(g, k)` of its [`PointTerm::coupling`]). The assembly adds each force to the point's load after the
+//! terms' own (so the balance law takes `Rᵀ q` and its rotation derivative as for any force) and pushes the blocks
+//! `Rᵀ_g ∂q_g/∂c_k` into the force rows of `g` and the translation columns of `k` after every other entry. The
+//! entries are part of the tangent's pattern: when a term's coupling changes (contact pairs found or lost between
+//! steps) the simulation analyses the pattern again before its next tangent, and a pattern with blocks across
+//! patches is solved by the general sparse LU (the block solver's patches must not couple).
+//!
 //! **[`Constraint`]** — equations held by Lagrange multipliers. A constraint of `m` rows adds `m` unknowns
 //! (its multipliers `λ_j`, stored after the rod's unknowns in `State::multipliers`) and `m` equations, linear
 //! in the positions of nodes (the position of a node's first end):
@@ -66,6 +76,7 @@ pub mod distributed;
 pub(crate) mod spring;
 #[cfg(test)]
 mod tests;
+pub mod wires;
 
 use super::actions::Actions;
 use super::discretisation::{CollocationPoint, Discretisation, point_position};
@@ -115,6 +126,28 @@ pub trait PointTerm: Sync {
         1.0
     }
 
+    /// The tangent entries this term's **coupled** loads occupy (module docs): `(g, k)` for a block of interior
+    /// collocation point `g`'s force rows against control point `k`'s translations, in the order of the blocks
+    /// of [`PointTerm::coupled`]. A term whose load at a point depends only on that point (every term but the
+    /// wires' contact) has none, the default. The list may change between steps (not during a Newton solve);
+    /// [`PointTerm::coupling_version`] says when.
+    fn coupling(&self) -> &[(usize, usize)] {
+        &[]
+    }
+
+    /// A number that changes whenever [`PointTerm::coupling`] does, so the simulation analyses the linear
+    /// system's pattern again (the default: never).
+    fn coupling_version(&self) -> usize {
+        0
+    }
+
+    /// The coupled loads at `state` (module docs): spatial line forces at interior collocation points that
+    /// depend on control points beyond the point's own basis (another wire's, in contact), and with `tangent`
+    /// their derivatives, one block per entry of [`PointTerm::coupling`]. The default: none.
+    fn coupled(&self, _disc: &Discretisation, _state: &State, _tangent: bool) -> Option<Coupled> {
+        None
+    }
+
     /// What the run's result must be read with, from this term (e.g. contact left above its tolerance); the
     /// default: nothing.
     fn warnings(&self) -> Vec<String> {
@@ -160,6 +193,16 @@ pub trait Constraint: Sync {
 
     /// The scale that makes the equations' residuals dimensionless \[length\].
     fn scale(&self) -> Real;
+}
+
+/// A term's coupled loads at one iterate ([`PointTerm::coupled`]).
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct Coupled {
+    /// Spatial line forces `q` \[force/length\] at interior collocation points `g`, `(g, q)`, a point possibly
+    /// more than once (they add up).
+    pub forces: Vec<(usize, Vec3)>,
+    /// `∂q_g/∂c_k` \[force/length²\] per entry `(g, k)` of [`PointTerm::coupling`] (empty without the tangent).
+    pub blocks: Vec<Mat3>,
 }
 
 /// The terms of one assembly, in the order they add up.

@@ -23,7 +23,7 @@ const EPS: Real = 1e-6;
 
 /// Tolerance of the comparison, relative to the largest entry of the term's own tangent row: well above the
 /// difference's error, far below a missing or wrong block (an O(1) relative error).
-const TOLERANCE: Real = 1e-6;
+pub(super) const TOLERANCE: Real = 1e-6;
 
 /// The largest error of `terms`' own tangent — the tangent with them minus the rod's alone — against central
 /// differences of their own residual (with them minus without), relative to the largest entry of the term's
@@ -32,7 +32,7 @@ const TOLERANCE: Real = 1e-6;
 /// theirs plus the rod's kinematic rows (node conditions and continuity, of order one), and the difference of
 /// the two residuals loses no digits to a large elastic residual (with the rod's stiffness, its 1e4-sized
 /// force rows leave round-off of ~1e-11/ε = 1e-5 in the differences, above a small term's entries).
-fn term_tangent_error(model: &Model, terms: Terms<'_>) -> (Real, Vec<String>) {
+pub(super) fn term_tangent_error(model: &Model, terms: Terms<'_>) -> (Real, Vec<String>) {
     let disc = Discretisation::new(model).expect("discretisation");
     let laws: Vec<SectionLaw> = disc
         .points
