@@ -99,9 +99,13 @@ pub(crate) fn build(dto: &DesignDto, default_name: &str, temporary_shape: bool) 
         builder.programme(stent::programme(p, metres_per_unit)?);
     }
     let contact = super::contact::contact(dto, &section, vessel.as_ref())?;
-    let has_contact = contact.is_some();
+    let wires = super::contact::wire_contact(dto, &section);
+    let has_contact = contact.is_some() || wires.is_some();
     if let Some(c) = contact {
         builder.contact(c);
+    }
+    if let Some(w) = wires {
+        builder.wire_contact(w);
     }
     if temporary_shape {
         builder.temporary_shape();

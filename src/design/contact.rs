@@ -21,8 +21,13 @@
 //!     cylinder: {point: [0, 0, 0], axis: [1, 0, 0], radius: 21}
 //!     wall: {E: 1.0, thickness: 0.5}   # compliant (width: default the wire's diameter); rigid without it
 //!     friction: 0.1               # Coulomb coefficient μ between the wires and this surface (default 0)
-//! contact: {penalty: 2500, tolerance: 0.006, regularisation: 0.0006, max_updates: 10}
+//! contact: {penalty: 2500, tolerance: 0.006, regularisation: 0.0006, max_updates: 10, wires: true}
 //! ```
+//!
+//! `wires: true` adds contact between the device's own wires (struts closing on each other when crimped, a wire
+//! on its mirror image across a symmetry cut; `crate::solver::terms::wires`) with the same law and settings; it
+//! needs no obstacle. Off by default: the wires' contact couples patches, so the Newton systems are solved by the
+//! general sparse LU while wires touch, and a run without it still reports wires that pass through each other.
 //!
 //! A name of our own for each surface, because the words a designer uses (crimper, sheath, vessel, plate) are
 //! roles, not shapes: the shape is the key (`cylinder`, `plane`, `lumen`), the role is the name, which the outputs use.
@@ -69,10 +74,11 @@ pub(crate) fn contact(
         .as_ref()
         .is_some_and(|p| matches!(p.kind, ProgrammeKindDto::Crimp | ProgrammeKindDto::Crush));
     if dto.obstacles.is_empty() && !tool {
-        return match dto.contact {
+        return match &dto.contact {
+            Some(c) if c.wires == Some(true) => Ok(None),
             Some(_) => Err(issue(
                 "contact",
-                "contact settings without anything to touch: add `obstacles` (or a `programme` of `kind: crimp` or `crush`), or remove `contact`",
+                "contact settings without anything to touch: add `obstacles` (or a `programme` of `kind: crimp` or `crush`), set `wires: true` for contact between the device's wires, or remove `contact`",
             )),
             None => Ok(None),
         };
@@ -87,6 +93,13 @@ pub(crate) fn contact(
         obstacles,
         settings: settings(dto.contact.as_ref(), dto, section),
     }))
+}
+
+/// The settings of the contact between the device's wires (`contact: {wires: true}`): the block's law, with the
+/// same defaults as the surfaces'.
+pub(crate) fn wire_contact(dto: &DesignDto, section: &Section) -> Option<ContactSettings> {
+    let c = dto.contact.as_ref().filter(|c| c.wires == Some(true))?;
+    Some(settings(Some(c), dto, section))
 }
 
 /// The settings of a `contact` block with the module's defaults.

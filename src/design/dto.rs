@@ -458,6 +458,10 @@ pub struct ContactDto {
     /// Most augmented-Lagrange updates per step (default 10).
     #[serde(default)]
     pub max_updates: Option<usize>,
+    /// Contact between the device's own wires, with the same law (default false: wires pass through each
+    /// other, which the run reports).
+    #[serde(default)]
+    pub wires: Option<bool>,
 }
 
 /// Material block.

@@ -9,9 +9,11 @@
 //! **What counts.** An overlap deeper than the tolerance — the contact settings' penetration tolerance when the
 //! design has contact, otherwise [`TOLERANCE_OF_DIAMETER`] of the thinnest wire's diameter — beyond what the
 //! device's own reference shape already has (the deepest overlap there, which `check` reports: a design whose
-//! wires are fused by construction is not warned at every step). Rod-on-rod contact is not modelled, so wires
-//! that overlap pass through each other unresisted and the run goes on: the warning says the result past that
-//! time is not the device's.
+//! wires are fused by construction is not warned at every step). Without the wires' contact (`contact: {wires:
+//! true}`, [`super::wires`]) wires that overlap pass through each other unresisted and the run goes on: the
+//! warning says the result past that time is not the device's. With it, the check stays as an independent
+//! witness on the segments between the samples (the contact's tolerance then): a warning says the contact let
+//! wires through.
 //!
 //! **Cost.** At most one search per converged step (not per iteration): the samples' positions (linear in the
 //! control points), an R*-tree of runs of segments and its join with itself and with each mirror image. A
@@ -51,6 +53,8 @@ pub struct WireCrossing {
     tolerance: Real,
     /// The unit of length, for the warning.
     unit: &'static str,
+    /// Whether the wires' contact is modelled (the warning's advice).
+    contact: bool,
     /// The time of the step being solved.
     time: Real,
     /// Committed steps with an overlap above the threshold.
@@ -78,10 +82,9 @@ impl WireCrossing {
         let thinnest = (0..model.patches.len())
             .map(|k| 2.0 * model.wire_radius(k))
             .fold(Real::INFINITY, Real::min);
-        let tolerance = model
-            .contact
-            .as_ref()
-            .map_or(TOLERANCE_OF_DIAMETER * thinnest, |c| c.settings.tolerance);
+        let tolerance = (model.wire_contact.as_ref())
+            .or(model.contact.as_ref().map(|c| &c.settings))
+            .map_or(TOLERANCE_OF_DIAMETER * thinnest, |c| c.tolerance);
         let reference = wires
             .overlaps(&disc.control0, 0.0)
             .first()
@@ -91,6 +94,7 @@ impl WireCrossing {
             threshold: reference + tolerance,
             tolerance,
             unit: model.units.length(),
+            contact: model.wire_contact.is_some(),
             time: 0.0,
             steps: 0,
             first: 0.0,
@@ -182,8 +186,13 @@ impl PointTerm for WireCrossing {
         let Some(d) = self.deepest else {
             return Vec::new();
         };
+        let why = if self.contact {
+            "the wires' contact let them through (a penalty too soft for the force, or a wire crossing another within one step: a stiffer penalty or shorter steps)"
+        } else {
+            "rod-on-rod contact is off (`contact: {wires: true}` turns it on)"
+        };
         vec![format!(
-            "wires passed through each other in {} step(s) (first at t = {}), deepest at t = {}: {}; rod-on-rod contact is not modelled, so the result from then on is not the device's (tolerance {:.3e} {} beyond the design's own overlap)",
+            "wires passed through each other in {} step(s) (first at t = {}), deepest at t = {}: {}; {why}, so the result from then on is not the device's (tolerance {:.3e} {} beyond the design's own overlap)",
             self.steps,
             self.first,
             d.time,

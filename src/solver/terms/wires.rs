@@ -576,6 +576,27 @@ impl PointTerm for WireContact {
         Some(out)
     }
 
+    fn step_limit(&self, _disc: &Discretisation, state: &State, delta: &[Real]) -> Real {
+        // As the surfaces' contact (module docs there): a sample the law does not act on yet stops at the middle
+        // of the law's band, the gap along the increment interpolated linearly.
+        let moved: Vec<Vec3> = (state.control.iter().enumerate())
+            .map(|(k, c)| c + Vec3::new(delta[6 * k], delta[6 * k + 1], delta[6 * k + 2]))
+            .collect();
+        let mut alpha: Real = 1.0;
+        for g in &self.groups {
+            let now = self.touch(&state.control, g);
+            if now.slope != 0.0 {
+                continue;
+            }
+            let stop = g.multiplier / self.settings.penalty;
+            let then = self.touch(&moved, g);
+            if then.gap < stop {
+                alpha = alpha.min((now.gap - stop) / (now.gap - then.gap));
+            }
+        }
+        alpha
+    }
+
     fn prepare(&mut self, _disc: &Discretisation, state: &State, t: Real) {
         self.time = t;
         self.updates = 0;
