@@ -735,7 +735,7 @@ impl PointTerm for WireContact {
 mod tests {
     use super::WireContact;
     use crate::material::{CircularSection, ElasticLaw};
-    use crate::math::{Real, Vec3};
+    use crate::math::{Mat3, Real, Vec3};
     use crate::model::builder::{ConditionSpec, ModelBuilder, PatchShape, TimeSpec};
     use crate::model::{ContactSettings, Model};
     use crate::solver::discretisation::Discretisation;
@@ -1033,5 +1033,103 @@ mod tests {
             .map(|j| at(0, j as Real / 10.0).norm())
             .fold(0.0, Real::max);
         assert!(lower < 1e-10, "the lower rod moved {lower}");
+    }
+
+    /// Source: a ring of `N` identical straight struts of diameter `d` parallel to the axis, pushed outward by a
+    /// line load and closed on by a crimper, locks when each strut touches its neighbours: their centres on a
+    /// regular `N`-gon of side `d` (`N` wire diameters around the circumference at the centres), of
+    /// circumradius `R_c = d / (2 sin(π/N))`. The struts follow the crimper (held against it by the load, their
+    /// ends free radially only) down to `R_c` and stop there while the crimper closes on 0.01 past it, pressing
+    /// the locked ring (a compliant wall: a rigid one would fight the wires' contact, two penalties, for the
+    /// same 0.01). Reference: that closed form. Tolerance: the wires' penetration is held within the contact
+    /// tolerance `τ` (augmented Lagrange), which lets neighbours' centres come `τ` closer than `d`, the struts
+    /// `τ / (2 sin(π/N))` further in.
+    #[test]
+    fn a_ring_of_struts_locks_at_n_wire_diameters_around() {
+        use crate::model::builder::{BasisSpec, DistributedLoadSpec, PatchTarget};
+        use crate::model::{Contact, Obstacle, ProbeLocation, Surface, TimeFunction, Wall};
+        use crate::solver::Simulation;
+        let n = 8;
+        let (d, r0, q, tolerance) = (0.2, 0.5, 0.1, 1e-4);
+        let locked = d / (2.0 * (std::f64::consts::PI / n as Real).sin());
+        let material = ElasticLaw::try_new(2.0e5, 0.3).expect("E > 0, ν = 0.3");
+        let section = CircularSection::try_new(d).expect("d > 0").into();
+        let mut b = ModelBuilder::new("ring of struts", material, section);
+        let constant = TimeFunction::constant;
+        for k in 0..n {
+            let phi = 2.0 * std::f64::consts::PI * k as Real / n as Real;
+            let radial = Vec3::new(0.0, phi.cos(), phi.sin());
+            let name = format!("s{k}");
+            let line = PatchShape::Line {
+                from: Vec3::new(-1.0, 0.0, 0.0) + radial * r0,
+                to: Vec3::new(1.0, 0.0, 0.0) + radial * r0,
+            };
+            b.patch(&name, line, 4, 6);
+            let axes = Mat3::from_columns(&[Vec3::x(), radial, Vec3::x().cross(&radial)]);
+            for end in ["start", "end"] {
+                let mut c = ConditionSpec::at(format!("{name}.{end}"));
+                c.basis = Some(BasisSpec::Axes(axes));
+                c = c
+                    .with_displacement(0, constant(0.0))
+                    .with_displacement(2, constant(0.0));
+                for i in 0..3 {
+                    c = c.with_rotation(i, constant(0.0));
+                }
+                b.condition(c);
+            }
+            b.distributed_load(DistributedLoadSpec {
+                patches: PatchTarget::Named(name),
+                force: [
+                    constant(0.0),
+                    constant(q * radial.y),
+                    constant(q * radial.z),
+                ],
+                couple: std::array::from_fn(|_| constant(0.0)),
+            });
+        }
+        let settings = ContactSettings {
+            penalty: 2.0e5 * std::f64::consts::PI / 64.0,
+            regularisation: 0.1 * tolerance,
+            tolerance,
+            max_updates: 10,
+        };
+        let closing =
+            TimeFunction::try_table(vec![(0.0, r0 + 0.5 * d), (1.0, locked + 0.5 * d - 0.01)])
+                .expect("a ramp");
+        let crimper = Surface::Cylinder {
+            point: Vec3::zeros(),
+            axis: Vec3::x(),
+            radius: closing,
+        };
+        // A compliant crimper: closing on past the locked ring it presses with a finite force (its wall's line
+        // stiffness `E h b / R²` ≈ 50–150 per unit length times its "penetration").
+        let wall = Wall::Compliant {
+            modulus: 1e3,
+            thickness: 0.1,
+            width: d,
+        };
+        b.contact(Contact {
+            obstacles: vec![Obstacle::new("crimper", crimper, wall)],
+            settings,
+        });
+        b.wire_contact(settings);
+        b.time(TimeSpec::new(1.0, 0.02));
+        let model = b.build().expect("valid model").model;
+        let mut sim = Simulation::new(&model).expect("simulation");
+        let mut smallest = Real::INFINITY;
+        while sim.step().expect("converges").is_some() {
+            let middle = sim.probe_displacement(&ProbeLocation::Patch { patch: 0, u: 0.5 });
+            smallest = smallest.min((Vec3::new(0.0, r0, 0.0) + middle).norm());
+        }
+        let within = tolerance / (2.0 * (std::f64::consts::PI / n as Real).sin());
+        println!(
+            "smallest radius of the struts' centres {smallest:.6}, locked ring {locked:.6} ({:.2e}); warnings {:?}",
+            smallest - locked,
+            sim.warnings()
+        );
+        assert!(
+            smallest >= locked - within && smallest <= locked + tolerance,
+            "{smallest} against {locked}"
+        );
     }
 }
