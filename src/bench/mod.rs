@@ -48,9 +48,18 @@
 //! **Where the wires touch** (issue 35, both tests). The run records the first step at which the device's wires
 //! touch each other (module docs of `crate::solver::terms::crossing`); the bench reads its time from
 //! summary.json and prints the tool's sizes at that step's start and end — between them struts lock — with
-//! where they touched (refine the bench's steps to narrow it), and `bench.json` keeps it (`touch`; `sweep collect`'s `touch_diameter`, `touch_gap`). Rod-on-rod
-//! contact is not modelled yet: past that size the wires pass through each other (the run warns once they do by
-//! more than its tolerance), so the forces past it are not the device's.
+//! where they touched (refine the bench's steps to narrow it), and `bench.json` keeps it (`touch`; `sweep
+//! collect`'s `touch_diameter`, `touch_gap`). Without the wires' contact past that size the wires pass through
+//! each other (the run warns once they do by more than its tolerance), so the forces past it are not the
+//! device's. With it (`contact: {wires: true}`, `crate::solver::terms::wires`) they press on each other, and
+//! the bench reads where the struts **lock**: the first recorded size after the wires touched at which the
+//! closing force's secant stiffness `ΔF/ΔD` is `LOCK_STIFFENING` = 10 times its mean between the tool's first
+//! touch of the device and the wires' first touch (the knee of the curve an engineer reads; on the straight
+//! stent the stiffness jumps from 8× to 36× across one step of 0.26 mm, so the choice of 10 moves the reading by
+//! at most a step). Printed, in `bench.json` (`lock`) and as `sweep collect`'s `lock_diameter` (`lock_gap`): the
+//! smallest crimp diameter the struts allow. The tool closes on to its smallest size past the lock (choose
+//! `bench.min_diameter` a little below it), pressing locked struts with the contact's penalty, which the run's
+//! warnings report when it leaves the penetration above the tolerance.
 //!
 //! A run the solver could not finish leaves what it reached: the table up to there, and the smallest diameter
 //! (gap) reached says how far it got.
@@ -169,6 +178,9 @@ pub struct Bench {
     pub copies: Real,
     /// The unit system (for the pressure's units).
     pub units: Units,
+    /// Whether the device's wires touch each other (`contact: {wires: true}`): the bench then reads where the
+    /// struts lock ([`Lock`]).
+    pub wire_contact: bool,
 }
 
 /// The radial bench's design of the design at `path` (module docs): [`bench_design`] with [`Test::Radial`].
@@ -301,6 +313,7 @@ pub fn bench_design(
         length: device_length(model),
         copies: (2.0 as Real).powi(model.symmetry_planes.len() as i32),
         units,
+        wire_contact: model.wire_contact.is_some(),
     };
     Ok((bench_design, bench))
 }
@@ -696,7 +709,13 @@ impl Bench {
                 place,
             })
         });
+        let lock = if self.wire_contact {
+            touch.as_ref().and_then(|t| lock(points, t.time))
+        } else {
+            None
+        };
         BenchResults {
+            lock,
             touch,
             test: self.test,
             temperature: self.temperature,
@@ -732,7 +751,7 @@ impl Bench {
         }
         match &results.touch {
             Some(t) => lines.push(format!(
-                "wires first touched in the step from {size} {:.4} to {:.4} {length} ({}, t = {}): {}; rod-on-rod contact is not modelled, so past it they pass through each other",
+                "wires first touched in the step from {size} {:.4} to {:.4} {length} ({}, t = {}): {}; {}",
                 t.before,
                 t.size,
                 match t.branch {
@@ -740,12 +759,29 @@ impl Bench {
                     Branch::Unloading => "opening",
                 },
                 t.time,
-                t.place
+                t.place,
+                if self.wire_contact {
+                    "from there on they press on each other"
+                } else {
+                    "rod-on-rod contact is off (`contact: {wires: true}`), so past it they pass through each other"
+                }
             )),
             None if results.reached.is_some() => {
                 lines.push("wires never touched each other".into());
             }
             None => {}
+        }
+        if self.wire_contact && results.touch.is_some() {
+            lines.push(match &results.lock {
+                Some(l) => format!(
+                    "struts lock at {size} {:.4} {length}: the force's stiffness there {:.4e} N/{length}, {:.1}× its mean {:.4e} N/{length} while closing before the wires touched",
+                    l.size, l.stiffness, l.stiffness / l.before, l.before
+                ),
+                None => format!(
+                    "the struts did not lock down to {size} {:.4} {length} (the force's stiffness never {LOCK_STIFFENING}× its mean before the wires touched)",
+                    results.reached.unwrap_or(Real::NAN)
+                ),
+            });
         }
         if self.test == Test::Radial && self.vessel_diameter.is_none() {
             lines.push(
@@ -800,9 +836,56 @@ pub struct BenchResults {
     pub reached: Option<Real>,
     /// The forces at the readings.
     pub readings: Vec<Reading>,
-    /// Where the device's wires first touched each other, if they did: the size at which struts lock.
+    /// Where the device's wires first touched each other, if they did.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub touch: Option<Touch>,
+    /// Where the struts locked, with the wires' contact on and the tool closing past it ([`Lock`]).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub lock: Option<Lock>,
+}
+
+/// The stiffening of the closing force that the bench calls struts locking: the secant stiffness `ΔF/ΔD`
+/// between two recorded sizes at least this many times its mean between the tool's first touch of the device and
+/// the wires' first touch of each other ([`lock`]).
+pub const LOCK_STIFFENING: Real = 10.0;
+
+/// Where the struts lock (module docs, *Where the wires touch*): the first recorded size on the closing branch,
+/// after the wires touched, at which the tool's force has stiffened [`LOCK_STIFFENING`] times.
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct Lock {
+    /// The tool's size \[length\].
+    pub size: Real,
+    /// The force's secant stiffness `ΔF/ΔD` over the step that ends there \[force/length\].
+    pub stiffness: Real,
+    /// Its mean while closing before the wires touched \[force/length\].
+    pub before: Real,
+}
+
+/// The lock on the closing branch of `points`, the wires having first touched at time `touch` (module docs).
+/// `None` when the tool had not touched the device before the wires touched each other, or the force did not
+/// stiffen [`LOCK_STIFFENING`] times.
+pub fn lock(points: &[BenchPoint], touch: Real) -> Option<Lock> {
+    let closing: Vec<&BenchPoint> = (points.iter())
+        .filter(|p| p.branch == Branch::Loading)
+        .collect();
+    let touched = closing
+        .iter()
+        .position(|p| p.time >= touch * (1.0 - 1e-12))?;
+    let first = closing.iter().position(|p| p.force > 0.0)?;
+    let last = touched.checked_sub(1).filter(|&k| k > first)?;
+    let secant = |a: &BenchPoint, b: &BenchPoint| (b.force - a.force) / (a.diameter - b.diameter);
+    let before = secant(closing[first], closing[last]);
+    if !(before > 0.0) {
+        return None;
+    }
+    closing[touched..].iter().enumerate().find_map(|(k, b)| {
+        let stiffness = secant(closing[touched + k - 1], b);
+        (stiffness >= LOCK_STIFFENING * before).then_some(Lock {
+            size: b.diameter,
+            stiffness,
+            before,
+        })
+    })
 }
 
 /// The tool's size when the device's wires first touched each other (module docs).

@@ -14,10 +14,16 @@
 //! widest gap of a wire from the surface [length], empty when no point has one) and `contact_mean_pressure@<name>`
 //! (the mean line pressure over the length in contact [force/length]). Of the model as simulated: a
 //! symmetry-reduced model's share (the fractions and pressures are the device's).
+//!
+//! With the contact between the wires (`contact: {wires: true}`, `crate::solver::terms::wires`), three columns
+//! after the obstacles': `wire_contacts` (the wires' samples pressing on another wire: the contact pairs of the
+//! step), `wire_contact_force` (the total force between the wires [force]) and `wire_penetration` (the deepest
+//! penetration of a sample [length]).
 
 use crate::math::Real;
 use crate::model::{Model, Obstacle, Surface};
 use crate::solver::terms::contact::ContactReport;
+use crate::solver::terms::wires::WireContactReport;
 use serde::Serialize;
 
 /// An obstacle's name as it appears in a column or array name: a comma, quote or line break (which would
@@ -64,6 +70,24 @@ pub(crate) fn header(model: &Model) -> String {
         }
     }
     header
+}
+
+/// The columns of the contact between the wires (module docs), each with its leading comma; empty without it.
+pub(crate) fn wire_header(model: &Model) -> String {
+    if model.wire_contact.is_none() {
+        return String::new();
+    }
+    ",wire_contacts,wire_contact_force,wire_penetration".into()
+}
+
+/// Appends the columns of the wires' contact `report` to a row of `history.csv` (nothing without one).
+pub(crate) fn push_wire_row(line: &mut String, report: Option<&WireContactReport>) {
+    if let Some(r) = report {
+        line.push_str(&format!(
+            ",{},{:.9e},{:.6e}",
+            r.samples, r.force, r.penetration
+        ));
+    }
 }
 
 /// Appends the contact columns of `report` to a row of `history.csv` (nothing without a report).

@@ -307,6 +307,7 @@ impl HistoryWriter {
             ));
         }
         header.push_str(&super::contact::header(sim.model()));
+        header.push_str(&super::contact::wire_header(sim.model()));
         writeln!(out, "{header}")?;
         out.flush()?;
         Ok(Self {
@@ -537,6 +538,7 @@ impl HistoryWriter {
         if let Some(report) = &contact {
             super::contact::keep_peaks(&mut self.contact, report, t);
         }
+        super::contact::push_wire_row(&mut line, sim.wire_contact().as_ref());
         let Some(out) = &mut self.out else {
             return ControlFlow::Break(());
         };

@@ -390,6 +390,7 @@ impl SnapshotWriter {
                 model,
                 &sim.point_fields(),
                 sim.contact().as_ref(),
+                sim.wire_contact().as_ref(),
                 &sim.probe_points(),
                 time,
             )

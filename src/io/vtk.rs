@@ -11,7 +11,9 @@
 //! and `arc_length`, and with contact per obstacle `<name>` `contact_gap@<name>` (the gap: distance from the
 //! surface minus the wire radius, negative in penetration; NaN on a cylinder's axis) and
 //! `contact_pressure@<name>` (the line pressure per unit reference length; at the patch ends as the contact
-//! report measures it, `crate::solver::terms::contact::ContactReport`); cell data `patch` and `material` (indices into the model's patches, in the order
+//! report measures it, `crate::solver::terms::contact::ContactReport`), and with the wires' contact
+//! `wire_contact_pressure` (the magnitude of the wires' line force on each other at the point, per unit
+//! reference length); cell data `patch` and `material` (indices into the model's patches, in the order
 //! `stentkit check` lists them, and into its materials: `material` first, then the named `materials`); field
 //! data `TimeValue` (the simulated time, which ParaView reads) and `probe_point` (per probe of the design, in
 //! `history.csv`'s order, the point it sits on; −1 for a probe between collocation points). Every point array
@@ -33,6 +35,7 @@ use crate::math::{Real, Vec3};
 use crate::model::Model;
 use crate::solver::PointFields;
 use crate::solver::terms::contact::ContactReport;
+use crate::solver::terms::wires::WireContactReport;
 use base64::Engine;
 use std::fmt::Write as _;
 use std::path::Path;
@@ -50,6 +53,7 @@ fn point_arrays(
     model: &Model,
     fields: &[PointFields],
     contact: Option<&ContactReport>,
+    wires: Option<&WireContactReport>,
 ) -> Vec<Array> {
     let u = model.units;
     let (length, force, moment) = (u.length(), u.force(), u.moment());
@@ -110,6 +114,14 @@ fn point_arrays(
             });
         }
     }
+    if let Some(w) = wires {
+        arrays.push(Array {
+            name: "wire_contact_pressure".into(),
+            unit: format!("{force}/{length}"),
+            components: &[],
+            values: w.line_force.clone(),
+        });
+    }
     arrays
 }
 
@@ -145,6 +157,7 @@ pub fn polydata(
     model: &Model,
     fields: &[PointFields],
     contact: Option<&ContactReport>,
+    wires: Option<&WireContactReport>,
     probe_points: &[Option<usize>],
     time: Real,
 ) -> String {
@@ -207,7 +220,7 @@ pub fn polydata(
         x,
         "      <PointData Vectors=\"displacement\" Scalars=\"surface_strain\">"
     );
-    for array in point_arrays(model, fields, contact) {
+    for array in point_arrays(model, fields, contact, wires) {
         let count = array.components.len().max(1);
         let _ = write!(
             x,
@@ -263,12 +276,13 @@ pub fn write_polydata(
     model: &Model,
     fields: &[PointFields],
     contact: Option<&ContactReport>,
+    wires: Option<&WireContactReport>,
     probe_points: &[Option<usize>],
     time: Real,
 ) -> std::io::Result<()> {
     super::atomic::write_bytes_atomically(
         path,
-        polydata(model, fields, contact, probe_points, time).as_bytes(),
+        polydata(model, fields, contact, wires, probe_points, time).as_bytes(),
     )
 }
 

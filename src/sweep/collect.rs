@@ -91,7 +91,8 @@ const AFTER_RATIOS: [Column; 5] = [
 ];
 
 /// The bench's columns of a sweep of `test` (none for a plain sweep; a bench sweep has only these): the
-/// smallest size the tool reached, its size where the wires first touched (empty if they did not) and its forces
+/// smallest size the tool reached, its size where the wires first touched (empty if they did not) and where the
+/// struts locked (empty without the wires' contact or a lock), and its forces
 /// at the readings ([`crate::bench::BenchResults`]), the units'
 /// suffixes `length` and `force`.
 fn bench_columns(test: Option<crate::bench::Test>, length: &str, force: &str) -> Vec<MetricColumn> {
@@ -114,6 +115,11 @@ fn bench_columns(test: Option<crate::bench::Test>, length: &str, force: &str) ->
         name: format!("touch_{}", test.size()),
         unit: length.to_string(),
         get: Box::new(|m: &Metrics| Some(m.bench.as_ref()?.touch.as_ref()?.size)),
+    });
+    columns.push(MetricColumn {
+        name: format!("lock_{}", test.size()),
+        unit: length.to_string(),
+        get: Box::new(|m: &Metrics| Some(m.bench.as_ref()?.lock.as_ref()?.size)),
     });
     let readings: Vec<(String, String, bool)> = match test {
         Test::Radial => vec![

@@ -187,7 +187,7 @@ pub(crate) fn summary(dir: &Path) -> Value {
 /// What the recording holds, read back with the mcap crate.
 pub(crate) struct Recording {
     /// Messages per topic: (log time, JSON body).
-    messages: BTreeMap<String, Vec<(u64, Value)>>,
+    pub(crate) messages: BTreeMap<String, Vec<(u64, Value)>>,
     /// Schema name per topic.
     schemas: BTreeMap<String, String>,
     /// Attachments: (name, media type, data).

@@ -1,6 +1,7 @@
 //! Issue 35 item 2, wires that pass through each other are said everywhere: `check` and `mesh` name the wires of
 //! a design that already overlap (where, by how much), and a run whose wires are driven through each other
-//! completes with a warning (summary.json, stderr) saying where and when. Rod-on-rod contact is not modelled yet.
+//! completes with a warning (summary.json, stderr) saying where and when. Issue 35 items 1 and 4: with
+//! `contact: {wires: true}` the same rods press on each other, and the outputs say where and how hard.
 
 use crate::outputs::{path_str, run_in_process, scratch_folder, stentkit, test_outputs, text};
 use crate::stabilisation::warning_said;
@@ -9,6 +10,11 @@ use std::path::{Path, PathBuf};
 /// Two straight rods of diameter 0.2 crossing at right angles, the upper one `gap` above the lower one (between
 /// their centrelines) and its ends moved down by `drop` over the run: written as `name.yaml` into `dir`.
 fn crossing_rods(dir: &Path, name: &str, gap: f64, drop: f64) -> PathBuf {
+    crossing_rods_with(dir, name, gap, drop, "")
+}
+
+/// [`crossing_rods`] with `extra` lines appended to the design.
+fn crossing_rods_with(dir: &Path, name: &str, gap: f64, drop: f64, extra: &str) -> PathBuf {
     let text = format!(
         "version: 1
 name: {name}
@@ -32,7 +38,7 @@ conditions:
   - {{node: c, displacement: [0, 0, [[0, 0], [1, -{drop}]]], rotation: [0, 0, 0]}}
   - {{node: d, displacement: [0, 0, [[0, 0], [1, -{drop}]]], rotation: [0, 0, 0]}}
 time: {{end: 1.0, step: 0.125}}
-"
+{extra}"
     );
     std::fs::create_dir_all(dir).expect("folder");
     let path = dir.join(format!("{name}.yaml"));
@@ -96,4 +102,67 @@ fn a_run_that_drives_wires_through_each_other_completes_with_a_warning() {
     let (code, stderr) = run_in_process(&short, &dir, &[]);
     assert_eq!(code, 0, "{stderr}");
     assert!(!stderr.contains("wires passed"), "{stderr}");
+}
+
+/// Source: the geometry and the outputs' definitions. The same crossing rods 0.5 apart with the wires' contact
+/// on, the upper one's ends moved down by 0.35: the rods touch from a drop of 0.3 (`0.5 − 0.2`), so at the end
+/// they press on each other (both bent, the penetration within the contact's tolerance, 1 % of the diameter by
+/// default): no warning; `history.csv`'s `wire_contacts` and `wire_contact_force` are zero while they are apart
+/// (t ≤ 0.75, a drop of 0.2625) and positive at the end, its `wire_penetration` at most the tolerance; the last
+/// field file's `wire_contact_pressure` is positive at the crossing; the recording draws the pairs.
+#[test]
+fn wires_with_contact_press_on_each_other_and_the_outputs_say_so() {
+    let root = test_outputs("wires_contact");
+    let design = crossing_rods_with(&root, "pressed", 0.5, 0.35, "contact: {wires: true}\n");
+    let dir = root.join("pressed_run");
+    let (code, stderr) = run_in_process(&design, &dir, &[]);
+    assert_eq!(code, 0, "{stderr}");
+    assert!(!stderr.contains("warning"), "{stderr}");
+    let history = std::fs::read_to_string(dir.join("history.csv")).expect("history");
+    let mut lines = history.lines();
+    let header: Vec<&str> = lines.next().expect("header").split(',').collect();
+    let column = |name: &str| header.iter().position(|h| *h == name).expect(name);
+    let (time, pairs, force, depth) = (
+        column("time"),
+        column("wire_contacts"),
+        column("wire_contact_force"),
+        column("wire_penetration"),
+    );
+    let rows: Vec<Vec<f64>> = lines
+        .map(|l| {
+            l.split(',')
+                .map(|v| v.parse().unwrap_or(f64::NAN))
+                .collect()
+        })
+        .collect();
+    for row in &rows {
+        if row[time] <= 0.75 {
+            assert_eq!((row[pairs], row[force]), (0.0, 0.0), "{row:?}");
+        }
+    }
+    let last = rows.last().expect("rows");
+    assert!(last[pairs] > 0.0 && last[force] > 0.0, "{last:?}");
+    assert!(last[depth] <= 0.01 * 0.2, "{last:?}");
+    let pvd = std::fs::read_to_string(dir.join("run.pvd")).expect("run.pvd");
+    let last_vtp = pvd
+        .lines()
+        .rev()
+        .find_map(|l| l.split("file=\"").nth(1)?.split('"').next())
+        .expect("a field file");
+    let vtp = std::fs::read_to_string(dir.join(last_vtp)).expect("field file");
+    assert!(
+        vtp.contains("Name=\"wire_contact_pressure\""),
+        "no wire_contact_pressure array"
+    );
+    let recording = crate::outputs::read_recording(&dir.join("run.mcap"));
+    let (_, update) = recording.messages["/centrelines"]
+        .last()
+        .expect("a message");
+    let lists = update["entities"][0]["lines"]
+        .as_array()
+        .expect("lines")
+        .iter()
+        .filter(|l| l["type"] == 2)
+        .count();
+    assert_eq!(lists, 1, "the pairs' LINE_LIST at the end");
 }

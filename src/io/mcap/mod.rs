@@ -4,7 +4,7 @@
 //! | topic | schema | when | content |
 //! |---|---|---|---|
 //! | `/state` | `stentkit.State` | every step and the initial state | time, step size, temperature, loads, Newton iterations and residuals, step cuts, probe displacements, recovery measures |
-//! | `/centrelines` | `foxglove.SceneUpdate` | every step | entity `centrelines`: one `LINE_STRIP` per rod of the full device (mirrored back), coloured by temperature; with contact, the samples touching an obstacle in green (`mcap/obstacles.rs`) |
+//! | `/centrelines` | `foxglove.SceneUpdate` | every step | entity `centrelines`: one `LINE_STRIP` per rod of the full device (mirrored back), coloured by temperature; with contact, the samples touching an obstacle in green (`mcap/obstacles.rs`); with the wires' contact, its pairs as a magenta `LINE_LIST` (each pressing sample to its closest point on the other wire, of the model as simulated) |
 //! | `/device` | `foxglove.SceneUpdate` | snapshot steps | entity `device`: the full device's closed tube mesh (`TriangleListPrimitive` with indices) |
 //! | `/vessel` | `foxglove.SceneUpdate` | once, at the start (a stent on a file centreline) | entity `vessel`: the vessel's centreline (`LINE_STRIP`) and its lumen (a translucent closed tube) |
 //! | `/obstacles` | `foxglove.SceneUpdate` | every step (a model with contact) | entity `obstacle.<name>` per obstacle: a cylinder (`CylinderPrimitive`, its diameter following its schedule) or a plane (a large thin square `CubePrimitive`), translucent (`mcap/obstacles.rs`) |
@@ -27,6 +27,9 @@
 mod format;
 mod obstacles;
 mod schema;
+
+/// Colour of the wires' contact pairs on `/centrelines` (`foxglove.Color`, opaque magenta).
+const WIRE_CONTACT_COLOR: &str = r#"{"r":0.900,"g":0.100,"b":0.800,"a":1}"#;
 
 pub(crate) use format::{coordinate_decimals, path_key};
 pub(crate) use schema::scene_update_schema;
@@ -533,6 +536,18 @@ impl McapRecorder {
                 lines,
                 r#"{{"type":0,"pose":{IDENTITY_POSE},"thickness":{thickness},"scale_invariant":false,"color":{color},"colors":[{}],"indices":[],"points":"#,
                 colors[k]
+            );
+            push_points(&mut lines, &points, self.decimals);
+            lines.push('}');
+        }
+        // The wires' contact pairs: a segment from each pressing sample to its closest point on the other wire.
+        if let Some(report) = sim.wire_contact().filter(|r| !r.pairs.is_empty()) {
+            let points: Vec<crate::math::Vec3> =
+                report.pairs.iter().flat_map(|&(a, b)| [a, b]).collect();
+            let thickness = self.thickness.first().copied().unwrap_or(0.1);
+            let _ = write!(
+                lines,
+                r#",{{"type":2,"pose":{IDENTITY_POSE},"thickness":{thickness},"scale_invariant":false,"color":{WIRE_CONTACT_COLOR},"colors":[],"indices":[],"points":"#
             );
             push_points(&mut lines, &points, self.decimals);
             lines.push('}');

@@ -101,11 +101,13 @@ fn estimated_files(s: &Sizing<'_>) -> [(&'static str, u64); 4] {
             + vertices * OBJ_VERTEX_LINE_BYTES
             + triangles * (3.0 * digits(vertices) + 5.0));
     // The field files: per collocation point three coordinates, 34 field values (and two per obstacle of a
-    // model with contact: gap and pressure) and a connectivity entry,
+    // model with contact: gap and pressure; with the wires' contact its pressure) and a connectivity entry,
     // 8 bytes each in base64 (4/3), plus the XML; run.pvd a line per snapshot.
     let vtp = if snapshot.vtk {
         let points: usize = model.patches.iter().map(|p| p.curve.num_points()).sum();
-        let values = 38.0 + 2.0 * model.contact.as_ref().map_or(0, |c| c.obstacles.len()) as Real;
+        let values = 38.0
+            + 2.0 * model.contact.as_ref().map_or(0, |c| c.obstacles.len()) as Real
+            + Real::from(u8::from(model.wire_contact.is_some()));
         count * (VTP_FIXED_BYTES + points as Real * values * 8.0 * 4.0 / 3.0 + PVD_LINE_BYTES)
     } else {
         0.0

@@ -1,5 +1,6 @@
-//! The contact of the current state, for the run's outputs: [`Simulation::contact`]; and when the wires first
-//! touched each other, [`Simulation::wire_touch`].
+//! The contact of the current state, for the run's outputs: [`Simulation::contact`] with the surfaces,
+//! [`Simulation::wire_contact`] between the wires; and when the wires first touched each other,
+//! [`Simulation::wire_touch`].
 //!
 //! Why an accessor of the simulation: the recorders (history, snapshots, recording, charts) see a run only
 //! through the [`Simulation`] their observer calls are given, and what contact did is not a function of the
@@ -10,6 +11,7 @@
 use super::Simulation;
 use crate::solver::terms::contact::{ContactReport, SurfaceContact};
 use crate::solver::terms::crossing::{WireCrossing, WireTouch};
+use crate::solver::terms::wires::{WireContact, WireContactReport};
 
 impl Simulation<'_> {
     /// The contact of the current (last converged) state with every obstacle of the model
@@ -33,5 +35,12 @@ impl Simulation<'_> {
             .iter()
             .find_map(|t| t.as_any()?.downcast_ref::<WireCrossing>())?
             .first_touch()
+    }
+
+    /// What the contact between the device's wires does in the current state
+    /// ([`crate::solver::terms::wires::WireContactReport`]); `None` without it (`contact: {wires: true}`).
+    pub fn wire_contact(&self) -> Option<WireContactReport> {
+        let term = (self.terms.iter()).find_map(|t| t.as_any()?.downcast_ref::<WireContact>())?;
+        Some(term.report(&self.disc, &self.solution.state))
     }
 }

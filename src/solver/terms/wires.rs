@@ -432,20 +432,55 @@ impl WireContact {
         }
     }
 
-    /// The samples in contact at `control` (a positive line force) and the total force between the wires (the
-    /// sum of the samples' forces on their own wires, reactions not counted again) \[force\].
-    pub fn active(&self, control: &[Vec3]) -> (usize, Real) {
-        let mut count = 0;
-        let mut total = 0.0;
+    /// What the contact does at `state` ([`WireContactReport`]).
+    pub fn report(&self, disc: &Discretisation, state: &State) -> WireContactReport {
+        let mut samples = 0;
+        let mut force = 0.0;
+        let mut penetration: Real = 0.0;
+        let mut pairs = Vec::new();
         for g in &self.groups {
-            let t = self.touch(control, g);
+            let t = self.touch(&state.control, g);
+            penetration = penetration.max(-t.gap);
             if t.pressure > 0.0 {
-                count += 1;
-                total += t.pressure * self.lengths[g.wire][g.point];
+                samples += 1;
+                force += 0.5 * t.pressure * self.lengths[g.wire][g.point];
+                let x = self.position(&state.control, g.wire, g.point);
+                pairs.push((x, x - t.normal * t.distance));
             }
         }
-        (count, 0.5 * total)
+        let mut sums = vec![Vec3::zeros(); disc.points.len()];
+        for (g, q) in self
+            .coupled(disc, state, false)
+            .map_or_else(Vec::new, |c| c.forces)
+        {
+            sums[g] += q;
+        }
+        WireContactReport {
+            samples,
+            force,
+            penetration,
+            line_force: sums.iter().map(Vec3::norm).collect(),
+            pairs,
+        }
     }
+}
+
+/// What the wires' contact does at a state, for the run's outputs (`history.csv`'s `wire_*` columns, the field
+/// files' `wire_contact_pressure`): of the model as simulated (a symmetry-reduced model's share).
+#[derive(Debug, Clone, PartialEq)]
+pub struct WireContactReport {
+    /// Samples pressing on another wire (a positive line force), each with each wire it presses on.
+    pub samples: usize,
+    /// The total force between the wires \[force\]: the samples' forces summed over both ways round, each
+    /// contact counted once.
+    pub force: Real,
+    /// The deepest penetration over the samples \[length\] (0 when none).
+    pub penetration: Real,
+    /// Per collocation point, the magnitude of the wires' line force there \[force/length\].
+    pub line_force: Vec<Real>,
+    /// Each pressing sample and its closest point on the wire it presses on (on a mirror image for a contact
+    /// across a symmetry cut) \[length\]: the contact pairs, drawn in the recording.
+    pub pairs: Vec<(Vec3, Vec3)>,
 }
 
 /// Where a force at parameter `u` of a patch with collocation points `points` (first global index and
