@@ -672,6 +672,27 @@ def bench_curves():
     return head + "\n" + text
 
 
+def bench_lock():
+    """README: where the straight stent's struts touch and lock on the radial bench with the wires' contact on."""
+    asset = "assets/bench/straight_stent_lock.json"
+    head = stamp(asset)
+    results = json.loads((ROOT / asset).read_text())
+    touch, lock = results["touch"], results["lock"]
+    body = [
+        ["wires first touch", f"between {touch['before']:.3f} and {touch['size']:.3f} mm", touch["place"]],
+        ["struts lock", f"{lock['size']:.3f} mm",
+         f"the force's stiffness {lock['stiffness']:.2f} N/mm, {lock['stiffness'] / lock['before']:.1f}× its mean "
+         f"{lock['before']:.3f} N/mm before the wires touched"],
+    ]
+    text = table(["", "crimper diameter", "where, how"], body)
+    text += (
+        f"\nAt {results['temperature']:g} °C and {results['rate']:g} mm/s, the crimper closing to "
+        f"{results['reached']:.2f} mm; the reading is as fine as the recorded diameters (here "
+        f"{touch['before'] - touch['size']:.3f} mm apart).\n"
+    )
+    return head + "\n" + text
+
+
 def bench_study():
     """README: the radial force of the straight stent over wire diameter × crowns, and what it shows."""
     asset = "assets/bench/radial_study.csv"
@@ -712,6 +733,7 @@ def bench_study():
 GENERATORS = {
     "bench-speed": bench_speed,
     "bench-curves": bench_curves,
+    "bench-lock": bench_lock,
     "bench-study": bench_study,
     "contact-map": contact_map,
     "contact-speed": contact_speed,

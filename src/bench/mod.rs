@@ -959,3 +959,42 @@ pub fn write_outputs(dir: &Path, bench: &Bench, model: &Model) -> Result<Vec<Str
     write(RESULTS_FILE, json.as_bytes())?;
     Ok(bench.summary(&results))
 }
+
+#[cfg(test)]
+mod tests {
+    use super::{BenchPoint, Branch, LOCK_STIFFENING, lock};
+
+    /// Closing points at diameters 20, 19, … with the forces `forces`, one time unit apart.
+    fn closing(forces: &[f64]) -> Vec<BenchPoint> {
+        (forces.iter().enumerate())
+            .map(|(k, &force)| BenchPoint {
+                time: k as f64,
+                branch: Branch::Loading,
+                diameter: 20.0 - k as f64,
+                force,
+                points: 0,
+            })
+            .collect()
+    }
+
+    /// Source: the definition (module docs). The tool touches the device at diameter 19 (force 0 at 20), the force
+    /// grows by 1 per unit of diameter to the wires' touch at 16 (t = 4), then by 5 (below the threshold of 10),
+    /// then by 12: the lock is the first size after the touch whose step's stiffness is 10× the mean 1 — 14 —
+    /// and a force that stiffens only 5× never locks.
+    #[test]
+    fn the_lock_is_where_the_closing_force_first_stiffens_tenfold() {
+        let points = closing(&[0.0, 1.0, 2.0, 3.0, 4.0, 9.0, 21.0, 33.0]);
+        let found = lock(&points, 4.0).expect("a lock");
+        assert_eq!(
+            (found.size, found.stiffness, found.before),
+            (14.0, 12.0, 1.0)
+        );
+        assert!(found.stiffness >= LOCK_STIFFENING * found.before);
+        assert_eq!(
+            lock(&closing(&[0.0, 1.0, 2.0, 3.0, 4.0, 9.0, 14.0]), 4.0),
+            None
+        );
+        // Wires touching before the tool has pressed over a step leave no mean to compare with.
+        assert_eq!(lock(&closing(&[0.0, 1.0, 20.0]), 1.0), None);
+    }
+}
