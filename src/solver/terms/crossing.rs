@@ -259,10 +259,6 @@ impl PointTerm for WireCrossing {
 
 #[cfg(test)]
 mod tests {
-    use crate::material::{CircularSection, ElasticLaw};
-    use crate::math::Vec3;
-    use crate::model::TimeFunction;
-    use crate::model::builder::{ConditionSpec, ModelBuilder, PatchShape, TimeSpec};
     use crate::solver::Simulation;
 
     /// A checkpoint keeps what the check found (the steps, the deepest overlap, the first touch), so a run
@@ -271,29 +267,7 @@ mod tests {
     /// the tolerance at t = 0.5, 0.625, 0.75); the checkpoint after six steps, with both records held.
     #[test]
     fn a_restored_run_reports_the_crossing_the_first_run_found() {
-        let material = ElasticLaw::try_new(2.0e5, 0.3).expect("E > 0, ν = 0.3");
-        let section = CircularSection::try_new(0.2).expect("d > 0").into();
-        let mut b = ModelBuilder::new("crossing", material, section);
-        for (name, from, to) in [
-            ("low", Vec3::new(-1.0, 0.0, 0.0), Vec3::new(1.0, 0.0, 0.0)),
-            ("high", Vec3::new(0.0, -1.0, 0.5), Vec3::new(0.0, 1.0, 0.5)),
-        ] {
-            b.patch(name, PatchShape::Line { from, to }, 4, 10);
-        }
-        b.condition(ConditionSpec::clamp("low.start"));
-        b.condition(ConditionSpec::clamp("low.end"));
-        let ramp = TimeFunction::try_table(vec![(0.0, 0.0), (1.0, -0.8)]).expect("a ramp");
-        for end in ["high.start", "high.end"] {
-            let mut c = ConditionSpec::at(end).with_displacement(2, ramp.clone());
-            for i in 0..3 {
-                c = c.with_rotation(i, TimeFunction::constant(0.0));
-            }
-            for i in 0..2 {
-                c = c.with_displacement(i, TimeFunction::constant(0.0));
-            }
-            b.condition(c);
-        }
-        b.time(TimeSpec::new(1.0, 0.125));
+        let b = crate::solver::terms::tests::crossing_rods(0.5, 0.8, 10, 0.125);
         let model = b.build().expect("valid model").model;
         let mut first = Simulation::new(&model).expect("simulation");
         for _ in 0..6 {

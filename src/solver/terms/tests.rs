@@ -93,6 +93,42 @@ pub(super) fn term_tangent_error(model: &Model, terms: Terms<'_>) -> (Real, Vec<
     (worst, report)
 }
 
+/// A node condition holding `end`'s rotations and its x and y translations, its z translation free (to be
+/// prescribed or loaded).
+pub(crate) fn held_but_z(end: &str) -> ConditionSpec {
+    let mut c = ConditionSpec::at(end);
+    for i in 0..3 {
+        c = c.with_rotation(i, TimeFunction::constant(0.0));
+    }
+    for i in 0..2 {
+        c = c.with_displacement(i, TimeFunction::constant(0.0));
+    }
+    c
+}
+
+/// Two straight rods of diameter 0.2 (E = 2e5, ν = 0.3) crossing at right angles, at degree 4 with `elements`
+/// elements: `low` from (−1, 0, 0) to (1, 0, 0), clamped at both ends; `high` from (0, −1, z) to (0, 1, z), its
+/// ends moved down by `drop` over t ∈ [0, 1] ([`held_but_z`] otherwise); steps of `step`.
+pub(crate) fn crossing_rods(z: Real, drop: Real, elements: usize, step: Real) -> ModelBuilder {
+    let material = ElasticLaw::try_new(2.0e5, 0.3).expect("E > 0, ν = 0.3");
+    let section = CircularSection::try_new(0.2).expect("d > 0").into();
+    let mut b = ModelBuilder::new("crossing rods", material, section);
+    for (name, from, to) in [
+        ("low", Vec3::new(-1.0, 0.0, 0.0), Vec3::new(1.0, 0.0, 0.0)),
+        ("high", Vec3::new(0.0, -1.0, z), Vec3::new(0.0, 1.0, z)),
+    ] {
+        b.patch(name, PatchShape::Line { from, to }, 4, elements);
+    }
+    b.condition(ConditionSpec::clamp("low.start"));
+    b.condition(ConditionSpec::clamp("low.end"));
+    let ramp = TimeFunction::try_table(vec![(0.0, 0.0), (1.0, -drop)]).expect("a ramp");
+    for end in ["high.start", "high.end"] {
+        b.condition(held_but_z(end).with_displacement(2, ramp.clone()));
+    }
+    b.time(TimeSpec::new(1.0, step));
+    b
+}
+
 /// The springs of the tests: forces and couples of the order of the test structure's own residual terms at
 /// its deformed state (displacements ~0.05, rotations ~0.3).
 fn spring() -> SpringToGround {

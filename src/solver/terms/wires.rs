@@ -831,7 +831,7 @@ mod tests {
     use crate::model::builder::{ConditionSpec, ModelBuilder, PatchShape, TimeSpec};
     use crate::model::{ContactSettings, Model};
     use crate::solver::discretisation::Discretisation;
-    use crate::solver::terms::tests::{TOLERANCE, term_tangent_error};
+    use crate::solver::terms::tests::{TOLERANCE, crossing_rods, held_but_z, term_tangent_error};
     use crate::solver::terms::{PointTerm, Terms};
     use crate::solver::tests::deformed_state;
 
@@ -934,43 +934,7 @@ mod tests {
     /// along y above it with its ends' centres `0.2 + gap` above `low`'s and pushed down by `push` over t ∈ [0, 1]
     /// (their rotations held), at degree 4 with `elements` elements; the wires' contact with `tolerance`.
     fn crossing_beams(gap: Real, push: Real, elements: usize, tolerance: Real) -> Model {
-        use crate::model::TimeFunction;
-        let material = ElasticLaw::try_new(2.0e5, 0.3).expect("E > 0, ν = 0.3");
-        let section = CircularSection::try_new(0.2).expect("d > 0").into();
-        let mut b = ModelBuilder::new("crossing beams", material, section);
-        let z = 0.2 + gap;
-        b.patch(
-            "low",
-            PatchShape::Line {
-                from: Vec3::new(-1.0, 0.0, 0.0),
-                to: Vec3::new(1.0, 0.0, 0.0),
-            },
-            4,
-            elements,
-        );
-        b.patch(
-            "high",
-            PatchShape::Line {
-                from: Vec3::new(0.0, -1.0, z),
-                to: Vec3::new(0.0, 1.0, z),
-            },
-            4,
-            elements,
-        );
-        b.condition(ConditionSpec::clamp("low.start"));
-        b.condition(ConditionSpec::clamp("low.end"));
-        let ramp = TimeFunction::try_table(vec![(0.0, 0.0), (1.0, -push)]).expect("a ramp");
-        for end in ["high.start", "high.end"] {
-            let mut c = ConditionSpec::at(end).with_displacement(2, ramp.clone());
-            for i in 0..3 {
-                c = c.with_rotation(i, TimeFunction::constant(0.0));
-            }
-            for i in 0..2 {
-                c = c.with_displacement(i, TimeFunction::constant(0.0));
-            }
-            b.condition(c);
-        }
-        b.time(TimeSpec::new(1.0, 0.05));
+        let mut b = crossing_rods(0.2 + gap, push, elements, 0.05);
         // The design's default penalty, `E I / d⁴`.
         let penalty = 2.0e5 * std::f64::consts::PI / 64.0;
         b.wire_contact(ContactSettings {
@@ -1068,14 +1032,7 @@ mod tests {
         b.condition(ConditionSpec::clamp("low.start"));
         b.condition(ConditionSpec::clamp("low.end"));
         for end in ["high.start", "high.end"] {
-            let mut c = ConditionSpec::at(end);
-            for i in 0..3 {
-                c = c.with_rotation(i, TimeFunction::constant(0.0));
-            }
-            for i in 0..2 {
-                c = c.with_displacement(i, TimeFunction::constant(0.0));
-            }
-            b.condition(c);
+            b.condition(held_but_z(end));
         }
         let ramp = |v: Real| TimeFunction::try_table(vec![(0.0, 0.0), (1.0, v)]).expect("a ramp");
         for (name, v) in [("low", q), ("high", -q)] {
