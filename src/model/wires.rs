@@ -54,6 +54,13 @@ pub struct DeviceWires {
 impl DeviceWires {
     /// The wires of `model`, their reference arc lengths taken from its patches' curves.
     pub fn new(model: &Model) -> Self {
+        Self::with_parameters(model, &[])
+    }
+
+    /// [`DeviceWires::new`] with the curve parameters `extra[k]` among patch `k`'s samples too (the wires'
+    /// contact samples every collocation point's parameter besides, `crate::solver::terms::wires`); a patch
+    /// past the end of `extra` gets none.
+    pub fn with_parameters(model: &Model, extra: &[Vec<Real>]) -> Self {
         let mut samples = Vec::with_capacity(model.patches.len());
         let mut wires = Vec::with_capacity(model.patches.len());
         let mut offset = 0;
@@ -83,6 +90,12 @@ impl DeviceWires {
                 for j in 1..=parts {
                     parameters.push(a + (b - a) * j as Real / parts as Real);
                 }
+            }
+            if let Some(more) = extra.get(k) {
+                parameters.extend(more.iter().filter(|&&u| u > lo && u < hi));
+                parameters.sort_by(Real::total_cmp);
+                let close = 1e-12 * (hi - lo);
+                parameters.dedup_by(|b, a| *b - *a <= close);
             }
             let here: Vec<Sample> = parameters
                 .iter()

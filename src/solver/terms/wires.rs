@@ -24,7 +24,10 @@
 //! collocation points of its patch around it, `w = 1 − ξ` and `ξ` by its place `ξ` between their parameters
 //! (a patch end's share goes to the interior point next to it: the node equations take no line force), as a
 //! line force `q_g = Σ w_g F / L_g` with `L_g = Σ w_g l` over the samples: a uniform line force `p` along a
-//! wire is then exactly `p` at every collocation point, and `Σ L_g q_g` is the total force.
+//! wire is then exactly `p` at every collocation point, and `Σ L_g q_g` is the total force. The samples include
+//! every collocation point's parameter (besides those half a radius apart), so each interior point has
+//! samples on both sides and a positive `L_g` (a fine mesh of high degree has Greville points closer than its
+//! knots, between which the plain samples could leave a point none).
 //!
 //! **Tangent.** With `e = y₁ − y₀` the other wire's segment and `t` the projection's place on it
 //! (`t = (x − y₀)·e/|e|²`, held at 0 or 1 beyond its ends), `dd = (I − e aᵀ) dx + (−(1−t) I − e b₀ᵀ) dy₀ +
@@ -166,7 +169,6 @@ impl Group {
 impl WireContact {
     /// The contact of `model`'s wires under `settings`, no candidates yet (they are searched at the first step).
     pub fn new(model: &Model, disc: &Discretisation, settings: ContactSettings) -> Self {
-        let wires = DeviceWires::new(model);
         let points: Vec<(usize, Vec<Real>)> = (disc.patches.iter())
             .map(|r| {
                 (
@@ -175,6 +177,10 @@ impl WireContact {
                 )
             })
             .collect();
+        // Every collocation point's parameter among the samples: each interior point's share of a force then
+        // has samples on both sides (its `L_g` is positive) and is linear between them.
+        let parameters: Vec<Vec<Real>> = points.iter().map(|(_, u)| u.clone()).collect();
+        let wires = DeviceWires::with_parameters(model, &parameters);
         let lengths: Vec<Vec<Real>> = (wires.wires().wires().iter())
             .map(|w| {
                 let n = w.arc.len();
