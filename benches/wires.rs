@@ -10,6 +10,11 @@
 //! everything the contact brings: its own search, law and tangent, the sparse LU its coupling needs instead of
 //! the block solver, the extra Newton iterations and updates.
 //!
+//! Where the time goes inside the run with the contact — the share of the contact term's own work (its search,
+//! projections, law and tangent, step limit, updates) against the linear algebra it brings — is measured by
+//! sampling (`scripts/wires_share.sh`, which runs this bench's contact run alone: `cargo bench --bench wires --
+//! with`).
+//!
 //! `cargo bench --bench wires`. With `STENTKIT_WRITE_ASSETS=1` in the environment it also writes the table,
 //! unrounded, to `assets/wires_speed.csv`. An asset measured again needs a new entry in
 //! `assets/provenance.json` (date, machine, command, sha256).
@@ -74,6 +79,13 @@ fn main() {
             })
     };
     let (with_window, with_whole) = best(&with);
+    if std::env::args().any(|a| a == "with") {
+        // `scripts/wires_share.sh` samples this run alone.
+        println!(
+            "with the wires' contact: touch to closed {with_window:.3} s, whole run {with_whole:.3} s"
+        );
+        return;
+    }
     let (without_window, without_whole) = best(&without);
     let share = |with: f64, without: f64| 1.0 - without / with;
     println!("the wires first touch at t = {touch:.3} s, the crimper closes at {closing:.3} s");
