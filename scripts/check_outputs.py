@@ -96,8 +96,12 @@ def check_scene_update(message, topic):
         missing = [f for f in ENTITY_FIELDS if f not in entity]
         require(not missing, f"{topic}: entity lacks {missing}")
         for line in entity["lines"]:
-            require(line["type"] == 0, f"{topic}: line type {line['type']} is not LINE_STRIP")
+            # foxglove.LinePrimitive: 0 LINE_STRIP (a rod's centreline), 2 LINE_LIST (the wires' contact pairs,
+            # segments of two points each).
+            require(line["type"] in (0, 2), f"{topic}: line type {line['type']} is neither LINE_STRIP nor LINE_LIST")
             require(len(line["points"]) >= 2, f"{topic}: line with {len(line['points'])} points")
+            require(line["type"] != 2 or len(line["points"]) % 2 == 0,
+                    f"{topic}: a LINE_LIST of {len(line['points'])} points (pairs expected)")
             require(line["thickness"] > 0, f"{topic}: line thickness {line['thickness']}")
             check_points(line["points"], topic)
         for tri in entity["triangles"]:
