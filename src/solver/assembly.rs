@@ -394,9 +394,9 @@ impl Assembler {
             .collect()
     }
 
-    /// The balance laws `F`, `T` at interior collocation point `g` (module docs) with the point terms' loads (and
-    /// the coupled loads' force there),
-    /// their row scales and, unless the sink discards them, their tangent blocks.
+    /// The balance laws `F`, `T` at interior collocation point `g` (module docs) with the point terms' loads and
+    /// the coupled loads' force there (`coupled`), their row scales and, unless the sink discards them, their
+    /// tangent blocks.
     #[allow(non_snake_case)]
     fn interior(
         &self,
