@@ -48,7 +48,10 @@
 //! block solver (measured on `designs/aorta_stent.yaml` compacted with the contact on: coupling every candidate
 //! kept the sparse LU for the whole run, 20.6 s of solver against 4.9 s without the contact). One that
 //! presses within a step without its blocks gets its force with no tangent in that step (the iteration still
-//! converges to the same equilibrium, more slowly) and its blocks from the next.
+//! converges to the same equilibrium, more slowly) and its blocks from the next. The coupling only grows while
+//! any group is coupled (entries of pairs that parted stay, as zeros), so the pattern is analysed again when a
+//! pair brings new entries, not whenever one parts; with none coupled it is emptied and the block solver
+//! returns.
 //!
 //! **Augmented Lagrange** as for the surfaces: every step starts with each multiplier set to its pressure at the
 //! converged state, and a converged step whose deepest penetration (over the samples) exceeds the tolerance is
@@ -415,8 +418,8 @@ impl WireContact {
     }
 
     /// Marks the groups whose tangent enters the coupling at `control` — those within half the margin of the
-    /// law's band, or pressing, and those marked before (until the next search: fewer analyses of the pattern)
-    /// — and, when that changes, the coupling and its version (module docs, *Which pairs*).
+    /// law's band, or pressing, and those marked before (until the next search) — and, when that brings entries
+    /// the coupling has not, adds them and changes its version (module docs, *Which pairs*).
     fn couple(&mut self, control: &[Vec3]) {
         let near = self.delta() + 0.5 * self.margin;
         let flags: Vec<bool> = (self.groups.iter())
@@ -429,8 +432,22 @@ impl WireContact {
         for (g, f) in self.groups.iter_mut().zip(flags) {
             g.coupled = f;
         }
-        if changed || self.version == 0 {
-            self.coupling = self.pattern();
+        if !(changed || self.version == 0) {
+            return;
+        }
+        // The pattern is analysed again only when an entry is new: entries of groups no longer coupled stay (as
+        // zeros) until no group is, when the block solver comes back.
+        let wanted = self.pattern();
+        let kept: std::collections::HashSet<(usize, usize)> =
+            self.coupling.iter().copied().collect();
+        if wanted.is_empty() {
+            if !self.coupling.is_empty() || self.version == 0 {
+                self.coupling.clear();
+                self.version += 1;
+            }
+        } else if wanted.iter().any(|e| !kept.contains(e)) {
+            self.coupling
+                .extend(wanted.into_iter().filter(|e| !kept.contains(e)));
             self.version += 1;
         }
     }
