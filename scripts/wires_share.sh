@@ -9,15 +9,13 @@
 #   scripts/wires_share.sh            # prints the shares
 #   STENTKIT_WRITE_ASSETS=1 scripts/wires_share.sh   # also writes assets/wires_share.csv
 #
-# Needs `perf` (Debian: linux-perf) and a release build with debug info (the crate's profile has it).
+# Needs `perf` (Debian: linux-perf) and a release build with debug info (the crate's profile has it); the
+# sampling itself is `scripts/perf_children.sh`.
 set -euo pipefail
 cd "$(dirname "$0")/.."
-cargo bench --bench wires --no-run >/dev/null 2>&1
-bin=$(ls -t target/release/deps/wires-* | grep -v '\.d$' | head -n 1)
 work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
-perf record -F 499 --call-graph dwarf,16384 -o "$work/perf.data" -- "$bin" with >/dev/null 2>"$work/record.log"
-perf report -i "$work/perf.data" --children --sort symbol --stdio -g none --percent-limit 0 2>/dev/null >"$work/report.txt"
+scripts/perf_children.sh wires with >"$work/report.txt"
 python3 - "$work/report.txt" <<'PY'
 import os, re, sys
 entry = re.compile(r"WireContact as stentkit::solver::terms::PointTerm>::(coupled|step_limit|prepare|augment|commit)\b")
