@@ -19,7 +19,7 @@
 //!   rate: 0.1             # diameter rate [length/time] (default 0.1 mm/s)
 //!   min_diameter: 10      # [length] (default: the programme's crimped outer diameter 2 (R − Δr) + d)
 //!   vessel_diameter: 12   # [length] where the chronic outward force is read (default: a vessel file's mean lumen)
-//!   diameters: 30         # recorded per branch (default 30)
+//!   diameters: 30         # recorded per branch (default 30; 120 with `contact: {wires: true}`)
 //!   min_gap: 6            # [length] the crush's smallest plate gap (default half the device's outer diameter)
 //!   segments: 12          # the radial bench's crimper as a segmented head of 12 flat faces (default: a cylinder)
 //! ```
@@ -78,6 +78,13 @@ pub const DEFAULT_RATE_MM_PER_S: Real = 0.1;
 pub const RESULTS_FILE: &str = "bench.json";
 /// The default number of diameters recorded per branch.
 pub const DEFAULT_DIAMETERS: usize = 30;
+
+/// The sizes recorded per branch by default when the device's wires touch each other (`contact: {wires: true}`):
+/// the lock is read to a recorded step, and struts that close on each other over a long step go deep before the
+/// contact's updates can hold them. On the straight stent crimped to 9 mm, 30 diameters (1.1 mm steps) read the
+/// lock at 9.279 mm with struts 7.7e-3 mm into each other (tolerance 6e-3); 120 (0.27 mm) read 9.545 mm, as
+/// `assets/bench/straight_stent_lock.json` has it.
+pub const DEFAULT_DIAMETERS_WITH_WIRES: usize = 120;
 /// The crush's readings: the force at these fractions of the device's outer diameter crushed (module docs).
 pub const CRUSH_READINGS: [Real; 3] = [0.1, 0.25, 0.5];
 /// The name of the crush's reading at the fraction `f` of the outer diameter crushed (`10%` for 0.1).
@@ -289,7 +296,13 @@ pub fn bench_design(
     let rate = spec.rate.unwrap_or(DEFAULT_RATE_MM_PER_S * per_mm);
     let temperature = spec.temperature.unwrap_or(DEFAULT_TEMPERATURE);
     let closing = (2.0 * start - min_diameter) / rate;
-    let diameters = spec.diameters.unwrap_or(DEFAULT_DIAMETERS);
+    let diameters = spec
+        .diameters
+        .unwrap_or(if first.model.wire_contact.is_some() {
+            DEFAULT_DIAMETERS_WITH_WIRES
+        } else {
+            DEFAULT_DIAMETERS
+        });
     let sets = bench_sets(
         test,
         spec.segments,
@@ -996,5 +1009,29 @@ mod tests {
         );
         // Wires touching before the tool has pressed over a step leave no mean to compare with.
         assert_eq!(lock(&closing(&[0.0, 1.0, 20.0]), 1.0), None);
+    }
+
+    /// Source: the defaults' definitions. The straight stent's radial bench records 30 diameters per branch,
+    /// and 120 when its wires touch each other (`contact.wires=true`, which the bench applies after its own
+    /// settings); a design's own `bench.diameters` wins over both.
+    #[test]
+    fn the_bench_records_finer_diameters_when_the_wires_touch() {
+        use super::{DEFAULT_DIAMETERS, DEFAULT_DIAMETERS_WITH_WIRES, radial_design};
+        use crate::design::DesignOverrides;
+        let design =
+            std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("designs/straight_stent.yaml");
+        let diameters = |sets: &[&str]| {
+            let sets = sets.iter().map(|s| s.parse().expect("a --set")).collect();
+            radial_design(&design, &DesignOverrides::sets(sets))
+                .expect("the bench's design")
+                .1
+                .diameters
+        };
+        assert_eq!(diameters(&[]), DEFAULT_DIAMETERS);
+        assert_eq!(
+            diameters(&["contact.wires=true"]),
+            DEFAULT_DIAMETERS_WITH_WIRES
+        );
+        assert_eq!(diameters(&["contact.wires=true", "bench.diameters=40"]), 40);
     }
 }
