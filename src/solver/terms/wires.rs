@@ -106,6 +106,16 @@ struct Share {
     slopes: [Real; 2],
 }
 
+/// What the tangent of one sample's forces needs from [`WireContact::loads`]: half its tributary length, the
+/// image's reflection, the reaction and where the forces went.
+struct Loads {
+    l: Real,
+    m: Mat3,
+    reaction: Vec3,
+    mine: Share,
+    theirs: Share,
+}
+
 /// A sample's contact with one other wire at an iterate (module docs).
 #[derive(Debug, Clone)]
 struct Touch {
@@ -139,6 +149,8 @@ pub struct WireContact {
     tributary: Vec<Real>,
     groups: Vec<Group>,
     coupling: Vec<(usize, usize)>,
+    /// The position of each entry in `coupling`, kept with it.
+    index: HashMap<(usize, usize), usize>,
     version: usize,
     /// The control points at the last search (empty before the first) and the search's margin.
     searched: Vec<Vec3>,
@@ -225,6 +237,7 @@ impl WireContact {
             tributary,
             groups: Vec::new(),
             coupling: Vec::new(),
+            index: HashMap::new(),
             version: 0,
             searched: Vec::new(),
             updates: 0,
@@ -438,16 +451,19 @@ impl WireContact {
         // The pattern is analysed again only when an entry is new: entries of groups no longer coupled stay (as
         // zeros) until no group is, when the block solver comes back.
         let wanted = self.pattern();
-        let kept: std::collections::HashSet<(usize, usize)> =
-            self.coupling.iter().copied().collect();
         if wanted.is_empty() {
             if !self.coupling.is_empty() || self.version == 0 {
                 self.coupling.clear();
+                self.index.clear();
                 self.version += 1;
             }
-        } else if wanted.iter().any(|e| !kept.contains(e)) {
-            self.coupling
-                .extend(wanted.into_iter().filter(|e| !kept.contains(e)));
+        } else if wanted.iter().any(|e| !self.index.contains_key(e)) {
+            for e in wanted {
+                if !self.index.contains_key(&e) {
+                    self.index.insert(e, self.coupling.len());
+                    self.coupling.push(e);
+                }
+            }
             self.version += 1;
         }
     }
@@ -515,12 +531,38 @@ impl WireContact {
         }
     }
 
+    /// Pushes the line forces of `group`'s contact `t` (module docs, *Into the collocated equations*) onto
+    /// `forces`: the sample's force on its wire's collocation points around it, the reaction on the other's
+    /// around the closest point. Returns what the tangent of those forces needs.
+    fn loads(&self, g: &Group, t: &Touch, forces: &mut Vec<(usize, Vec3)>) -> Loads {
+        let l = 0.5 * self.lengths[g.wire][g.point];
+        let force = t.normal * (t.pressure * l);
+        let (m, _) = self.wires.wires().image_map(g.image);
+        let reaction = -(m * force);
+        let mine = share(&self.points[g.wire], self.parameter(g.wire, g.point));
+        let theirs = share(&self.points[g.other], t.u);
+        for (p, w) in mine.points.into_iter().zip(mine.weights) {
+            forces.push((p, force * (w / self.tributary[p])));
+        }
+        for (p, w) in theirs.points.into_iter().zip(theirs.weights) {
+            forces.push((p, reaction * (w / self.tributary[p])));
+        }
+        Loads {
+            l,
+            m,
+            reaction,
+            mine,
+            theirs,
+        }
+    }
+
     /// What the contact does at `state` ([`WireContactReport`]).
     pub fn report(&self, disc: &Discretisation, state: &State) -> WireContactReport {
         let mut samples = 0;
         let mut force = 0.0;
         let mut penetration: Real = 0.0;
         let mut pairs = Vec::new();
+        let mut forces = Vec::new();
         for g in &self.groups {
             let t = self.touch(&state.control, g);
             penetration = penetration.max(-t.gap);
@@ -529,13 +571,11 @@ impl WireContact {
                 force += 0.5 * t.pressure * self.lengths[g.wire][g.point];
                 let x = self.position(&state.control, g.wire, g.point);
                 pairs.push((x, x - t.normal * t.distance));
+                self.loads(g, &t, &mut forces);
             }
         }
         let mut sums = vec![Vec3::zeros(); disc.points.len()];
-        for (g, q) in self
-            .coupled(disc, state, false)
-            .map_or_else(Vec::new, |c| c.forces)
-        {
+        for (g, q) in forces {
             sums[g] += q;
         }
         WireContactReport {
@@ -622,14 +662,7 @@ impl PointTerm for WireContact {
         if self.groups.is_empty() {
             return None;
         }
-        let control = &state.control;
-        let index: HashMap<(usize, usize), usize> = if tangent {
-            (self.coupling.iter().enumerate())
-                .map(|(e, &rc)| (rc, e))
-                .collect()
-        } else {
-            HashMap::new()
-        };
+        let (control, index) = (&state.control, &self.index);
         let mut out = Coupled {
             forces: Vec::new(),
             blocks: if tangent {
@@ -643,18 +676,13 @@ impl PointTerm for WireContact {
             if !(t.pressure > 0.0 || t.slope < 0.0) {
                 continue;
             }
-            let l = 0.5 * self.lengths[g.wire][g.point];
-            let force = t.normal * (t.pressure * l);
-            let (m, _) = self.wires.wires().image_map(g.image);
-            let reaction = -(m * force);
-            let mine = share(&self.points[g.wire], self.parameter(g.wire, g.point));
-            let theirs = share(&self.points[g.other], t.u);
-            for (p, w) in mine.points.into_iter().zip(mine.weights) {
-                out.forces.push((p, force * (w / self.tributary[p])));
-            }
-            for (p, w) in theirs.points.into_iter().zip(theirs.weights) {
-                out.forces.push((p, reaction * (w / self.tributary[p])));
-            }
+            let Loads {
+                l,
+                m,
+                reaction,
+                mine,
+                theirs,
+            } = self.loads(g, &t, &mut out.forces);
             if !tangent || !g.coupled {
                 continue;
             }
@@ -974,6 +1002,16 @@ mod tests {
         b.build().expect("valid model").model
     }
 
+    /// The force the ends of patch `patch` exert on their nodes, summed: at nodes held there, the reaction on
+    /// the patch (the solver's node resultants, not a contact term's report).
+    fn end_reaction(sim: &crate::solver::Simulation<'_>, patch: usize) -> Vec3 {
+        (sim.model().nodes.iter().enumerate())
+            .filter(|(_, n)| n.ends.iter().any(|e| e.patch == patch))
+            .flat_map(|(k, _)| sim.node_end_resultants(k))
+            .map(|(f, _)| f)
+            .sum()
+    }
+
     /// Source: two clamped–clamped beams crossing at right angles and pressed together at their middles are two
     /// springs in series with the contact: the approach of their ends beyond first touch, `push − gap`, is
     /// `w_low + w_high + δ` with each middle's deflection under the contact force `F`, `w = F (L³/(192 E I) +
@@ -1005,14 +1043,7 @@ mod tests {
             let mut sim = Simulation::new(&model).expect("simulation");
             while sim.step().expect("converges").is_some() {}
             assert!(sim.warnings().is_empty(), "{:?}", sim.warnings());
-            let high: Vec<usize> = (model.nodes.iter().enumerate())
-                .filter(|(_, n)| n.ends.iter().any(|e| e.patch == 1))
-                .map(|(k, _)| k)
-                .collect();
-            let reaction: Real = (high.iter())
-                .flat_map(|&k| sim.node_end_resultants(k))
-                .map(|(f, _)| f.z)
-                .sum();
+            let reaction = end_reaction(&sim, 1).z;
             let middle = |patch| sim.probe_displacement(&ProbeLocation::Patch { patch, u: 0.5 });
             let (w_low, w_high) = (-middle(0).z, middle(1).z + push);
             let force = reaction.abs();
@@ -1085,14 +1116,7 @@ mod tests {
         let mut sim = Simulation::new(&model).expect("simulation");
         while sim.step().expect("converges").is_some() {}
         assert!(sim.warnings().is_empty(), "{:?}", sim.warnings());
-        let low: Vec<usize> = (model.nodes.iter().enumerate())
-            .filter(|(_, n)| n.ends.iter().any(|e| e.patch == 0))
-            .map(|(k, _)| k)
-            .collect();
-        let reaction: Vec3 = (low.iter())
-            .flat_map(|&k| sim.node_end_resultants(k))
-            .map(|(f, _)| f)
-            .sum();
+        let reaction = end_reaction(&sim, 0);
         let at = |patch, u| sim.probe_displacement(&ProbeLocation::Patch { patch, u });
         let drop: Vec<Real> = [0.0, 0.1, 0.25, 0.5, 0.8, 1.0]
             .iter()
