@@ -380,8 +380,8 @@ pub struct RunSummaryFile {
     /// ([`crate::post::deployment`]).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub deployment: Option<Deployment>,
-    /// When and where the device's wires first touched each other, if they did (rod-on-rod contact is not
-    /// modelled: from then on they may pass through each other; [`crate::solver::terms::crossing`]).
+    /// When and where the device's wires first touched each other, if they did (without the wires' contact,
+    /// `contact: {wires: true}`, they may pass through each other from then on; [`crate::solver::terms::crossing`]).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub wire_touch: Option<crate::solver::terms::crossing::WireTouch>,
 }
