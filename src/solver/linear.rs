@@ -9,9 +9,14 @@ use crate::model::LinearMethod;
 
 /// The Newton systems' solver: the block-bordered solver ([`BlockSystem`]) when the design asks for it and the
 /// pattern allows, with the general sparse LU as its fallback (a patch interior singular on its own) and as
-/// the alternative the design can choose (`solver: {linear: sparse-lu}`).
+/// the alternative the design can choose (`solver: {linear: sparse-lu}`). Behind a block solver the sparse
+/// LU's analysis waits until a factorisation falls back to it: patterns are analysed again whenever a
+/// coupling changes (contact between wires), and most never need it.
 pub struct LinearSystem {
-    sparse: SparseSystem,
+    n: usize,
+    /// The pattern, kept until the sparse LU is analysed.
+    entries: Vec<(usize, usize)>,
+    sparse: Option<SparseSystem>,
     block: Option<BlockSystem>,
     /// The last factorisation is the sparse LU's although a block solver exists.
     fallback: bool,
@@ -39,8 +44,18 @@ impl LinearSystem {
             LinearMethod::Block => BlockSystem::new(n, entries, patches)?,
             LinearMethod::SparseLu => None,
         };
+        let sparse = match block {
+            Some(_) => None,
+            None => Some(SparseSystem::new(n, entries)?),
+        };
         Ok(Self {
-            sparse: SparseSystem::new(n, entries)?,
+            n,
+            entries: if sparse.is_none() {
+                entries.to_vec()
+            } else {
+                Vec::new()
+            },
+            sparse,
             block,
             fallback: false,
         })
@@ -57,12 +72,14 @@ impl LinearSystem {
 
     /// Number of unknowns.
     pub fn size(&self) -> usize {
-        self.sparse.size()
+        self.n
     }
 
     /// Forgets the factorisation (it belonged to a state that was abandoned).
     pub fn invalidate(&mut self) {
-        self.sparse.invalidate();
+        if let Some(s) = &mut self.sparse {
+            s.invalidate();
+        }
         if let Some(b) = &mut self.block {
             b.invalidate();
         }
@@ -72,7 +89,7 @@ impl LinearSystem {
     pub fn is_factored(&self) -> bool {
         match &self.block {
             Some(b) if !self.fallback => b.is_factored(),
-            _ => self.sparse.is_factored(),
+            _ => self.sparse.as_ref().is_some_and(SparseSystem::is_factored),
         }
     }
 
@@ -89,14 +106,22 @@ impl LinearSystem {
                 Err(e) => return Err(e),
             }
         }
-        self.sparse.factor(entry_values)
+        let sparse = match self.sparse.take() {
+            Some(s) => s,
+            None => SparseSystem::new(self.n, &self.entries)?,
+        };
+        self.entries = Vec::new();
+        self.sparse.insert(sparse).factor(entry_values)
     }
 
     /// Solves `A x = b` in place with the last factorisation.
     pub fn solve_in_place(&mut self, rhs: &mut [Real]) {
         match &mut self.block {
             Some(b) if !self.fallback => b.solve_in_place(rhs),
-            _ => self.sparse.solve_in_place(rhs),
+            _ => match &mut self.sparse {
+                Some(s) => s.solve_in_place(rhs),
+                None => panic!("solve before a successful factorisation"),
+            },
         }
     }
 }

@@ -97,11 +97,6 @@ impl SparseSystem {
         })
     }
 
-    /// Number of unknowns.
-    pub(crate) fn size(&self) -> usize {
-        self.n
-    }
-
     /// Forgets the factorisation (it belonged to a state that was abandoned).
     pub(crate) fn invalidate(&mut self) {
         self.factored = false;
