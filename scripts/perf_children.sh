@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Samples one run of a bench binary with perf and its DWARF call graph (499 Hz, every thread) and prints perf's
-# children report by symbol: what `scripts/contact_share.sh` and `scripts/wires_share.sh` add up.
+# children report by symbol: what `scripts/contact_share.sh` adds up.
 #
 #   scripts/perf_children.sh BENCH ARG > report.txt     # samples `cargo bench --bench BENCH -- ARG`
 #

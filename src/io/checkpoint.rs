@@ -50,7 +50,7 @@ pub(crate) const FILE_NAME: &str = crate::io::run_folder::CHECKPOINT_FILE;
 const MAGIC: &[u8; 8] = b"STKCKPT\0";
 
 /// The format version this build writes and reads.
-pub(crate) const VERSION: u32 = 9;
+pub(crate) const VERSION: u32 = 10;
 
 /// Bytes before the payload: magic, version, length.
 const HEADER: usize = 8 + 4 + 8;
@@ -533,21 +533,41 @@ fn decode_actions(d: &mut Decoder<'_>) -> Result<Actions, Problem> {
 }
 
 fn encode_timing(e: &mut Encoder, t: &SolverTiming) {
-    for (count, secs) in [t.residual, t.tangent, t.factorisation, t.solve, t.material] {
+    let parts = [
+        t.residual,
+        t.tangent,
+        t.factorisation,
+        t.solve,
+        t.material,
+        t.analysis,
+    ];
+    for (count, secs) in parts {
         e.usize(count);
         e.f64(secs);
+    }
+    e.usize(t.terms.len());
+    for (name, (count, secs)) in &t.terms {
+        e.str(name);
+        e.usize(*count);
+        e.f64(*secs);
     }
 }
 
 fn decode_timing(d: &mut Decoder<'_>) -> Result<SolverTiming, Problem> {
     let mut slot = || -> Result<(usize, Real), Problem> { Ok((d.usize()?, d.f64()?)) };
-    Ok(SolverTiming {
+    let mut timing = SolverTiming {
         residual: slot()?,
         tangent: slot()?,
         factorisation: slot()?,
         solve: slot()?,
         material: slot()?,
-    })
+        analysis: slot()?,
+        terms: Vec::new(),
+    };
+    for _ in 0..d.usize()? {
+        timing.terms.push((d.str()?, (d.usize()?, d.f64()?)));
+    }
+    Ok(timing)
 }
 
 fn encode_solver(e: &mut Encoder, c: &Checkpoint) {

@@ -165,6 +165,9 @@ pub(crate) struct Linearisation {
     pub residual: Vec<Real>,
     /// Dimensionless scale of each row (residual / scale is strain-like).
     pub row_scale: Vec<Real>,
+    /// Seconds the last assembly spent in each point term's coupled loads ([`PointTerm::coupled`]), by the
+    /// term's name, so the caller can count them apart (terms that have none are left out).
+    pub coupled_seconds: Vec<(&'static str, Real)>,
 }
 
 impl Assembler {
@@ -250,8 +253,17 @@ impl Assembler {
             Vec::new()
         } else {
             let tangent = matches!(sink, Sink::Values { .. });
+            lin.coupled_seconds.clear();
             (at.terms.point.iter())
-                .map(|t| t.coupled(disc, at.state, tangent))
+                .map(|t| {
+                    let start = std::time::Instant::now();
+                    let loads = t.coupled(disc, at.state, tangent);
+                    if loads.is_some() {
+                        let seconds = start.elapsed().as_secs_f64();
+                        lin.coupled_seconds.push((t.name(), seconds));
+                    }
+                    loads
+                })
                 .collect()
         };
         let mut extra: Vec<Option<Vec3>> = Vec::new();

@@ -192,10 +192,12 @@ impl Simulation<'_> {
             }
         }
         materials.refresh_laws(model.materials());
-        for term in &mut self.terms {
-            term.prepare(&self.disc, &self.solution.state, t_np1);
-        }
         SolverTiming::add(&mut self.record.timing.material, start);
+        for term in &mut self.terms {
+            let start = Instant::now();
+            term.prepare(&self.disc, &self.solution.state, t_np1);
+            (self.record.timing).add_term(term.name(), start.elapsed().as_secs_f64());
+        }
         Ok(())
     }
 
@@ -209,12 +211,14 @@ impl Simulation<'_> {
             let strains = |i: usize| point_strains(disc, state, points[i]);
             self.model.materials()[group.material].commit_step(&mut group.state, &strains);
         }
-        // The point terms' state after the materials' (module docs of `crate::solver::terms`).
-        for term in &mut self.terms {
-            term.commit(disc, state);
-        }
         // Counted with the step's preparation.
         self.record.timing.material.1 += start.elapsed().as_secs_f64();
+        // The point terms' state after the materials' (module docs of `crate::solver::terms`).
+        for term in &mut self.terms {
+            let start = Instant::now();
+            term.commit(disc, state);
+            (self.record.timing).add_term(term.name(), start.elapsed().as_secs_f64());
+        }
     }
 
     /// With a temperature field: the lowest and highest temperature over the collocation points at time `t`

@@ -187,11 +187,12 @@ impl Simulation<'_> {
     /// where it begins to act); whether it was limited. Called for the first increment of each solve. The increment's
     /// norm was recorded before: it is Newton's measure of the iterate's error, which the limit does not change.
     fn limit_step(&mut self) -> bool {
-        let alpha = self
-            .terms
-            .iter()
-            .map(|t| t.step_limit(&self.disc, &self.solution.state, &self.work.delta))
-            .fold(1.0, Real::min);
+        let mut alpha: Real = 1.0;
+        for term in &self.terms {
+            let start = Instant::now();
+            alpha = alpha.min(term.step_limit(&self.disc, &self.solution.state, &self.work.delta));
+            (self.record.timing).add_term(term.name(), start.elapsed().as_secs_f64());
+        }
         if alpha < 1.0 {
             for d in &mut self.work.delta {
                 *d *= alpha;
@@ -267,12 +268,19 @@ impl Simulation<'_> {
             &mut self.work.lin,
             &mut sink,
         );
+        let timing = &mut self.record.timing;
+        let coupled = std::mem::take(&mut self.work.lin.coupled_seconds);
         let slot = if with_tangent {
-            &mut self.record.timing.tangent
+            &mut timing.tangent
         } else {
-            &mut self.record.timing.residual
+            &mut timing.residual
         };
         SolverTiming::add(slot, start);
+        slot.1 -= coupled.iter().map(|(_, s)| s).sum::<Real>();
+        for &(name, seconds) in &coupled {
+            timing.add_term(name, seconds);
+        }
+        self.work.lin.coupled_seconds = coupled;
         if with_tangent {
             self.work.tangent.assembled(actions);
         }
@@ -305,6 +313,7 @@ impl Simulation<'_> {
             actions: &actions,
             terms: Terms::default(),
         };
+        let start = Instant::now();
         let method = self.model.solver().linear;
         (self.work.system, self.work.values) =
             super::analyse(&at, &self.assembler, &self.terms, None, method)?;
@@ -314,6 +323,7 @@ impl Simulation<'_> {
         }
         self.work.coupling = versions;
         self.work.tangent.invalidate();
+        SolverTiming::add(&mut self.record.timing.analysis, start);
         Ok(())
     }
 

@@ -9,6 +9,7 @@ use super::snapshot::StepSnapshot;
 use super::{NoObserver, Observer, RunSummary, Simulation, StepReport};
 use crate::math::Real;
 use crate::solver::SolverError;
+use std::time::Instant;
 
 /// Allowance, in units in the last place of the time reached, when a step size computed as `(t + h) − t` is
 /// compared with `time.min_step` or halved to it. `t + h` rounds to within half an ulp and the difference is
@@ -174,15 +175,32 @@ impl Simulation<'_> {
             }
             // Augmented Lagrange: a term that enforces a condition by multipliers (contact) may ask for the
             // converged step to be solved again with updated multipliers (each term bounds its own updates).
+            // The solve starts from the converged iterate with its last factorisation, as a step does, and is
+            // made again with Newton's method proper should that fail.
             while let Ok(newton) = &attempt
                 && self.augment_terms()
             {
-                let done = (newton.iterations, newton.factorisations);
+                let mut done = (newton.iterations, newton.factorisations);
+                let converged = reuse.then(|| {
+                    let s = &self.solution;
+                    (s.state.clone(), s.step_increment.clone())
+                });
                 attempt = if observer.interrupted() {
                     Err(NewtonFailure::Interrupted)
                 } else {
-                    self.newton(target, false, &*observer)
+                    self.newton(target, reuse, &*observer)
                 };
+                if let (Err(NewtonFailure::NotConverged(failed)), Some((state, increment))) =
+                    (&attempt, converged)
+                {
+                    done.1 += failed.factorisations;
+                    (self.solution.state, self.solution.step_increment) = (state, increment);
+                    attempt = if observer.interrupted() {
+                        Err(NewtonFailure::Interrupted)
+                    } else {
+                        self.newton(target, false, &*observer)
+                    };
+                }
                 if let Ok(newton) = &mut attempt {
                     newton.iterations += done.0;
                     newton.factorisations += done.1;
@@ -387,7 +405,9 @@ impl Simulation<'_> {
         let (disc, state) = (&self.disc, &self.solution.state);
         let mut any = false;
         for term in &mut self.terms {
+            let start = Instant::now();
             any |= term.augment(disc, state);
+            (self.record.timing).add_term(term.name(), start.elapsed().as_secs_f64());
         }
         any
     }

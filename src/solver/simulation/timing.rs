@@ -18,6 +18,14 @@ pub struct SolverTiming {
     pub solve: (usize, Real),
     /// Step preparation (integrator coefficients, history stresses) and commits (internal variables) \[s\].
     pub material: (usize, Real),
+    /// Each point term's own work outside the assembly's loop over points, by the term's name, counted apart
+    /// from the parts above: its step hooks (a step's start and end, multiplier updates, step limits: the search
+    /// of contact) and its coupled loads (contact between wires, taken out of `residual` and `tangent`) \[s\];
+    /// the count is of hooks and coupled assemblies.
+    pub terms: Vec<(String, (usize, Real))>,
+    /// Analyses of the linear systems' patterns again, when a coupling changed (contact between wires found
+    /// or lost) \[s\].
+    pub analysis: (usize, Real),
 }
 
 impl SolverTiming {
@@ -27,7 +35,26 @@ impl SolverTiming {
         slot.1 += start.elapsed().as_secs_f64();
     }
 
-    /// The split as named entries: `<part>_s` (seconds) and `<part>_count`.
+    /// Adds `seconds` of the point term `name`'s own work to [`SolverTiming::terms`].
+    pub(super) fn add_term(&mut self, name: &str, seconds: Real) {
+        let slot = match self.terms.iter().position(|(n, _)| n == name) {
+            Some(i) => &mut self.terms[i].1,
+            None => {
+                self.terms.push((name.to_string(), (0, 0.0)));
+                &mut self.terms.last_mut().expect("just pushed").1
+            }
+        };
+        slot.0 += 1;
+        slot.1 += seconds;
+    }
+
+    /// The seconds of every point term's own work ([`SolverTiming::terms`]).
+    pub fn terms_seconds(&self) -> Real {
+        self.terms.iter().map(|(_, (_, s))| s).sum()
+    }
+
+    /// The split as named entries: `<part>_s` (seconds) and `<part>_count`; a point term's as
+    /// `term_<name>_s` with its name's spaces as underscores.
     pub fn entries(&self) -> Vec<(String, Real)> {
         let parts = [
             ("residual", self.residual),
@@ -35,13 +62,16 @@ impl SolverTiming {
             ("factorisation", self.factorisation),
             ("solve", self.solve),
             ("material", self.material),
+            ("analysis", self.analysis),
         ];
-        parts
-            .iter()
+        let terms =
+            (self.terms.iter()).map(|(n, slot)| (format!("term_{}", n.replace(' ', "_")), *slot));
+        (parts.iter().map(|(n, slot)| (n.to_string(), *slot)))
+            .chain(terms)
             .flat_map(|(name, (count, secs))| {
                 [
-                    (format!("{name}_s"), *secs),
-                    (format!("{name}_count"), *count as Real),
+                    (format!("{name}_s"), secs),
+                    (format!("{name}_count"), count as Real),
                 ]
             })
             .collect()
