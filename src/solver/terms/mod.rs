@@ -42,7 +42,7 @@
 //! `Rᵀ_g ∂q_g/∂c_k` into the force rows of `g` and the translation columns of `k` after every other entry. The
 //! entries are part of the tangent's pattern: when a term's coupling changes (contact pairs found or lost between
 //! steps) the simulation analyses the pattern again before its next tangent; the block solver then takes the
-//! patches whose interiors couple as one block (module docs of [`crate::solver::block`]).
+//! patches whose interiors couple as one block (module docs of `src/solver/block.rs`).
 //!
 //! **[`Constraint`]** — equations held by Lagrange multipliers. A constraint of `m` rows adds `m` unknowns
 //! (its multipliers `λ_j`, stored after the rod's unknowns in `State::multipliers`) and `m` equations, linear
