@@ -22,15 +22,19 @@
 //! failed factorisation, and the caller falls back to the general sparse LU.
 //!
 //! **Coupled loads** (contact between wires, [`super::terms`]) make interior rows of one patch reach into
-//! another's. Such a pattern stays block-bordered by moving every interior control point that another patch's
-//! interior rows reach to the border (its six unknowns and its six equations), and by letting a patch's
-//! interior rows reach any border column besides its own ends: `A_IB,k` then has the 12 end columns and those
-//! extra ones (solved for in groups of 12), and the Schur complement grows by the moved points. Coupling
-//! within one patch only widens its band. So the contact of a few struts adds a few dozen border unknowns
-//! instead of handing the whole system to the general sparse LU.
+//! another's. The patches so joined are then one block `k` — their interiors renumbered together by reverse
+//! Cuthill–McKee, so the band stays narrow where struts lie side by side — and the block's `A_IB,k` has the 12
+//! end columns of each of its patches (solved for in groups of 12). The blocks follow a spanning forest of the
+//! joins: a join that would close a cycle (the struts of a crown all touching round the ring) moves the control
+//! points its rows reach to the border instead (their six unknowns and equations), which the block's rows then
+//! reach as extra columns; a ring ordered whole would grow its band from two fronts. Coupling within one patch
+//! only widens its band. Measured on the straight stent locked in its crimper (`cargo bench --bench wires`):
+//! the quarter model's crowns become blocks of three patches (324 unknowns, half-bandwidths 98 and 92 against
+//! 35 for one patch), and the whole bench took 2.70 s against 3.15 s with the general sparse LU (its analysis
+//! already deferred, [`super::linear`]).
 
-use super::sparse::SparseSystem;
-use super::{LinearError, SolverError};
+use super::SolverError;
+use super::sparse::{SparseSystem, inside};
 use crate::math::Real;
 use rayon::prelude::*;
 
@@ -189,9 +193,10 @@ fn scatter_add(scatter: &[(u32, u32)], values: &[Real], out: &mut [Real]) {
 
 /// The largest work (`Σ m kl (kl + ku)`, multiply–adds of the banded factorisations) the blocks of coupled
 /// patches may take; past it the general sparse LU, whose fill-reducing ordering does not depend on a band, is
-/// used instead (about 0.1 s of factorisation at the machine's rate, where the sparse LU of the paper's largest
-/// device takes a few milliseconds).
-const MAX_BLOCK_WORK: f64 = 2e9;
+/// used instead. Measured on the full straight stent locked in its crimper (12 240 unknowns): blocks of work
+/// 1.4e8 took 88 ms per factorisation (with their `X_k`), faer's sparse LU 110 ms; the bound leaves room for
+/// blocks a few times larger before the band's cost, growing with its square, passes the sparse LU's.
+const MAX_BLOCK_WORK: f64 = 5e8;
 
 /// Reverse Cuthill–McKee ordering of a graph given by its adjacency lists (sorted and deduplicated here): from a
 /// pseudo-peripheral start (the last node of a breadth-first search from a node of least degree), breadth-first
@@ -238,13 +243,13 @@ fn reverse_cuthill_mckee(adjacency: &mut [Vec<usize>]) -> Vec<usize> {
 
 /// One block's matrices and factors: a patch's, or several coupled patches'.
 #[derive(Debug, Clone)]
-struct PatchBlock {
-    /// Global index of each interior unknown, in the band's order (the patch's interior control points but
+struct Block {
+    /// Global index of each interior unknown, in the band's order (its patches' interior control points but
     /// those moved to the border).
     unknowns: Vec<usize>,
     lu: BandLu,
-    /// Border index of each border column the interior rows reach (`A_IB,k`): the patch's own 12 end columns
-    /// first, then any other in ascending order.
+    /// Border index of each border column the interior rows reach (`A_IB,k`: its patches' end columns and any
+    /// other), ascending.
     columns: Vec<usize>,
     /// `A_IB,k` on assembly, then `X_k = A_II,k⁻¹ A_IB,k`, in groups of [`END_COLUMNS`] columns (group `g`
     /// holds `columns[12 g..12 g + 12]`, zero-padded, `m × 12` row-major) so each group is one banded solve.
@@ -265,7 +270,7 @@ struct PatchBlock {
     y: Vec<Real>,
 }
 
-impl PatchBlock {
+impl Block {
     /// Number of column groups of `x`.
     fn groups(&self) -> usize {
         self.columns.len().div_ceil(END_COLUMNS)
@@ -278,14 +283,14 @@ impl PatchBlock {
     }
 }
 
-/// The global system solved by banded patch LUs and a Schur complement on the patch ends.
+/// The global system solved by banded LUs of the blocks and a Schur complement on the border.
 pub(crate) struct BlockSystem {
     n: usize,
     /// Pushed entries.
     entries: usize,
     /// Where the pushed entries of `A_BB` go in `schur_values`.
     corner_in: Scatter,
-    patches: Vec<PatchBlock>,
+    blocks: Vec<Block>,
     /// Global index of each border unknown.
     border: Vec<usize>,
     /// Values of the Schur complement's entries: `A_BB` first, then each patch's `−A_BI,k X_k`.
@@ -301,7 +306,7 @@ impl std::fmt::Debug for BlockSystem {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         f.debug_struct("BlockSystem")
             .field("n", &self.n)
-            .field("patches", &self.patches.len())
+            .field("blocks", &self.blocks.len())
             .field("border", &self.border.len())
             .finish()
     }
@@ -336,14 +341,7 @@ impl BlockSystem {
         // grows from one end instead of two fronts.
         let mut joins = Vec::new();
         for &(r, c) in entries {
-            if r >= n || c >= n {
-                return Err(LinearError::EntryOutside {
-                    row: r,
-                    column: c,
-                    size: n,
-                }
-                .into());
-            }
+            inside(n, r, c)?;
             if let (Some(a), Some(b)) = (patch_of[r], patch_of[c])
                 && a != b
             {
@@ -474,7 +472,7 @@ impl BlockSystem {
         if work > MAX_BLOCK_WORK {
             return Ok(None);
         }
-        let mut blocks: Vec<PatchBlock> = orders
+        let mut blocks: Vec<Block> = orders
             .into_iter()
             .zip(columns)
             .enumerate()
@@ -483,7 +481,7 @@ impl BlockSystem {
                 columns.dedup();
                 let m = unknowns.len();
                 let groups = columns.len().div_ceil(END_COLUMNS);
-                PatchBlock {
+                Block {
                     unknowns,
                     lu: BandLu::new(m, kl[b], ku[b]),
                     x: vec![0.0; groups * m * END_COLUMNS],
@@ -548,7 +546,7 @@ impl BlockSystem {
             n,
             entries: entries.len(),
             corner_in,
-            patches: blocks,
+            blocks,
             schur_values: vec![0.0; schur_entries.len()],
             corner_entries,
             border_rhs: vec![0.0; border.len()],
@@ -561,7 +559,7 @@ impl BlockSystem {
     /// Number of border unknowns (the Schur complement's size) and of blocks.
     #[cfg(test)]
     fn sizes(&self) -> (usize, usize) {
-        (self.border.len(), self.patches.len())
+        (self.border.len(), self.blocks.len())
     }
 
     /// Forgets the factorisation.
@@ -585,18 +583,18 @@ impl BlockSystem {
         self.factored = false;
         self.schur_values[..self.corner_entries].fill(0.0);
         scatter_add(&self.corner_in, entry_values, &mut self.schur_values);
-        // Per patch (in parallel): its blocks from the pushed entries, the banded LU, X_k = A_II,k⁻¹ A_IB,k, and
+        // Per block (in parallel): its matrices from the pushed entries, the banded LU, X_k = A_II,k⁻¹ A_IB,k, and
         // its block of −A_BI,k X_k.
         let (_, products) = self.schur_values.split_at_mut(self.corner_entries);
-        let mut chunks: Vec<&mut [Real]> = Vec::with_capacity(self.patches.len());
+        let mut chunks: Vec<&mut [Real]> = Vec::with_capacity(self.blocks.len());
         let mut rest = products;
-        for block in &self.patches {
+        for block in &self.blocks {
             let (head, tail) = rest.split_at_mut(block.rows * block.columns.len());
             chunks.push(head);
             rest = tail;
         }
         let failed = self
-            .patches
+            .blocks
             .par_iter_mut()
             .zip(chunks)
             .find_map_any(|(block, out)| {
@@ -648,10 +646,10 @@ impl BlockSystem {
     /// Solves `A x = b` in place with the last factorisation.
     pub(crate) fn solve_in_place(&mut self, rhs: &mut [Real]) {
         assert!(self.factored, "solve before a successful factorisation");
-        // y_k = A_II,k⁻¹ b_I,k, in each patch's buffer.
+        // y_k = A_II,k⁻¹ b_I,k, in each block's buffer.
         {
             let b: &[Real] = rhs;
-            self.patches.par_iter_mut().for_each(|block| {
+            self.blocks.par_iter_mut().for_each(|block| {
                 for (y, &g) in block.y.iter_mut().zip(&block.unknowns) {
                     *y = b[g];
                 }
@@ -662,7 +660,7 @@ impl BlockSystem {
         for (b, &g) in self.border_rhs.iter_mut().zip(&self.border) {
             *b = rhs[g];
         }
-        for block in &self.patches {
+        for block in &self.blocks {
             for (&(r, j), &a) in block.coupling.iter().zip(&block.coupling_values) {
                 self.border_rhs[r] -= a * block.y[j];
             }
@@ -673,7 +671,7 @@ impl BlockSystem {
         }
         // x_I,k = y_k − X_k x_B,k.
         let mut xb = Vec::new();
-        for block in &self.patches {
+        for block in &self.blocks {
             xb.clear();
             xb.extend(block.columns.iter().map(|&c| self.border_rhs[c]));
             xb.resize(block.groups() * END_COLUMNS, 0.0);

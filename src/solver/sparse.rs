@@ -13,6 +13,19 @@ use faer::sparse::linalg::lu::{LuRef, NumericLu, SymbolicLu, factorize_symbolic_
 use faer::sparse::{SparseColMatRef, SymbolicSparseColMatRef};
 use faer::{Conj, MatMut, Par};
 
+/// `Ok` when the entry `(r, c)` lies in an `n × n` matrix.
+pub(super) fn inside(n: usize, r: usize, c: usize) -> Result<(), SolverError> {
+    if r < n && c < n {
+        return Ok(());
+    }
+    Err(LinearError::EntryOutside {
+        row: r,
+        column: c,
+        size: n,
+    }
+    .into())
+}
+
 /// A square sparse matrix pattern, its symbolic LU analysis and reusable numeric storage.
 pub(crate) struct SparseSystem {
     n: usize,
@@ -51,14 +64,7 @@ impl SparseSystem {
         let mut last: Option<(usize, usize)> = None;
         for &k in &order {
             let (r, c) = entries[k];
-            if r >= n || c >= n {
-                return Err(LinearError::EntryOutside {
-                    row: r,
-                    column: c,
-                    size: n,
-                }
-                .into());
-            }
+            inside(n, r, c)?;
             if last != Some((r, c)) {
                 row_idx.push(r);
                 col_ptr[c + 1] += 1;

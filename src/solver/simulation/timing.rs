@@ -4,8 +4,9 @@ use crate::math::Real;
 use std::time::Instant;
 
 /// Where the solver's wall time went, with counts (DESIGN §6): residual assemblies, tangent assemblies,
-/// factorisations, solves and the per-step material work (history stresses before, internal-variable update
-/// after a step). Counts include the work of abandoned attempts (cut steps, retried reuse).
+/// factorisations, solves, the per-step material work (history stresses before, internal-variable update
+/// after a step), the point terms' own work (contact searches and updates) and the analyses of the linear
+/// system's pattern. Counts include the work of abandoned attempts (cut steps, retried reuse).
 #[derive(Debug, Clone, PartialEq, Default)]
 pub struct SolverTiming {
     /// Residual-only assemblies and their time \[s\].
@@ -46,11 +47,6 @@ impl SolverTiming {
         };
         slot.0 += 1;
         slot.1 += seconds;
-    }
-
-    /// The seconds of every point term's own work ([`SolverTiming::terms`]).
-    pub fn terms_seconds(&self) -> Real {
-        self.terms.iter().map(|(_, (_, s))| s).sum()
     }
 
     /// The split as named entries: `<part>_s` (seconds) and `<part>_count`; a point term's as
