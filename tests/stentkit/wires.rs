@@ -109,7 +109,9 @@ fn a_run_that_drives_wires_through_each_other_completes_with_a_warning() {
 /// they press on each other (both bent, the penetration within the contact's tolerance, 1 % of the diameter by
 /// default): no warning; `history.csv`'s `wire_contacts` and `wire_contact_force` are zero while they are apart
 /// (t ≤ 0.75, a drop of 0.2625) and positive at the end, its `wire_penetration` at most the tolerance; the last
-/// field file's `wire_contact_pressure` is positive at the crossing; the recording draws the pairs.
+/// field file's `wire_contact_pressure` is positive at the crossing; the recording draws the pairs; summary.json's
+/// solver clocks count the contact's own work apart (`term_wire_contact_s`), each part non-negative (the coupled
+/// loads are taken out of the assemblies' time, not counted twice) and all of them within the stepping's time.
 #[test]
 fn wires_with_contact_press_on_each_other_and_the_outputs_say_so() {
     let root = test_outputs("wires_contact");
@@ -165,4 +167,21 @@ fn wires_with_contact_press_on_each_other_and_the_outputs_say_so() {
         .filter(|l| l["type"] == 2)
         .count();
     assert_eq!(lists, 1, "the pairs' LINE_LIST at the end");
+    let summary: serde_json::Value = serde_json::from_str(
+        &std::fs::read_to_string(dir.join("summary.json")).expect("summary.json"),
+    )
+    .expect("JSON");
+    let clocks = summary["timing"]["solver"].as_object().expect("timing.solver");
+    let seconds = |name: &str| clocks[name].as_f64().expect(name);
+    assert!(
+        seconds("term_wire_contact_s") > 0.0 && seconds("term_wire_contact_count") > 0.0,
+        "{clocks:?}"
+    );
+    let parts: Vec<f64> = (clocks.iter())
+        .filter(|(k, _)| k.ends_with("_s"))
+        .map(|(_, v)| v.as_f64().expect("seconds"))
+        .collect();
+    assert!(parts.iter().all(|&s| s >= 0.0), "{clocks:?}");
+    let stepping = summary["timing"]["run_s"].as_f64().expect("run_s");
+    assert!(parts.iter().sum::<f64>() <= stepping, "{clocks:?} within {stepping}");
 }
