@@ -171,7 +171,9 @@ fn wires_with_contact_press_on_each_other_and_the_outputs_say_so() {
         &std::fs::read_to_string(dir.join("summary.json")).expect("summary.json"),
     )
     .expect("JSON");
-    let clocks = summary["timing"]["solver"].as_object().expect("timing.solver");
+    let clocks = summary["timing"]["solver"]
+        .as_object()
+        .expect("timing.solver");
     let seconds = |name: &str| clocks[name].as_f64().expect(name);
     assert!(
         seconds("term_wire_contact_s") > 0.0 && seconds("term_wire_contact_count") > 0.0,
@@ -183,5 +185,8 @@ fn wires_with_contact_press_on_each_other_and_the_outputs_say_so() {
         .collect();
     assert!(parts.iter().all(|&s| s >= 0.0), "{clocks:?}");
     let stepping = summary["timing"]["run_s"].as_f64().expect("run_s");
-    assert!(parts.iter().sum::<f64>() <= stepping, "{clocks:?} within {stepping}");
+    assert!(
+        parts.iter().sum::<f64>() <= stepping,
+        "{clocks:?} within {stepping}"
+    );
 }
