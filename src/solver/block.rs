@@ -129,8 +129,10 @@ impl BandLu {
     /// column by column, then the upper triangle (bandwidth `kl + ku`) backwards, each column an `axpy` of
     /// `W`-wide rows (`W` fixed so the inner loops unroll; one right-hand side is the plain vector `axpy`).
     /// Every block is updated at each column, so the factors are read once however many blocks there are (a
-    /// band larger than the cache would otherwise be streamed from memory once per block).
-    fn solve<const W: usize>(&self, b: &mut [Real]) {
+    /// band larger than the cache would otherwise be streamed from memory once per block). `first` gives, per
+    /// block, a row above which its right-hand sides are zero (or is empty): the lower triangle's columns that
+    /// reach no row from there on leave the block as it is, and are skipped.
+    fn solve<const W: usize>(&self, b: &mut [Real], first: &[usize]) {
         let (m, kl, ld) = (self.m, self.kl, self.ld());
         if m == 0 {
             return;
@@ -141,7 +143,11 @@ impl BandLu {
             let p = self.pivots[j];
             let col = j * ld + kv;
             let l = &self.ab[col + 1..=col + lm];
-            for block in b.chunks_exact_mut(m * W) {
+            for (g, block) in b.chunks_exact_mut(m * W).enumerate() {
+                // Column j swaps and updates rows j..=j + kl only.
+                if first.get(g).is_some_and(|&f| f > j + kl) {
+                    continue;
+                }
                 if p != j {
                     for q in 0..W {
                         block.swap(p * W + q, j * W + q);
@@ -254,6 +260,8 @@ struct Block {
     /// `A_IB,k` on assembly, then `X_k = A_II,k⁻¹ A_IB,k`, in groups of [`END_COLUMNS`] columns (group `g`
     /// holds `columns[12 g..12 g + 12]`, zero-padded, `m × 12` row-major) so each group is one banded solve.
     x: Vec<Real>,
+    /// Per column group of `x`, its first row with an entry of `A_IB,k` (`m` for none).
+    x_first: Vec<usize>,
     /// `A_BI,k` as `(border row, interior column)` with values.
     coupling: Vec<(usize, usize)>,
     coupling_values: Vec<Real>,
@@ -485,6 +493,7 @@ impl BlockSystem {
                     unknowns,
                     lu: BandLu::new(m, kl[b], ku[b]),
                     x: vec![0.0; groups * m * END_COLUMNS],
+                    x_first: vec![m; groups],
                     columns,
                     coupling: Vec::new(),
                     coupling_values: Vec::new(),
@@ -511,6 +520,8 @@ impl BlockSystem {
                     let q = block.columns.binary_search(&border_index[c]).unwrap_or(0);
                     let at = (q / END_COLUMNS * block.lu.m + i) * END_COLUMNS + q % END_COLUMNS;
                     block.border_in.push((e, at as u32));
+                    let first = &mut block.x_first[q / END_COLUMNS];
+                    *first = (*first).min(i);
                 }
                 (None, Some((b, j))) => {
                     let block = &mut blocks[b];
@@ -607,7 +618,7 @@ impl BlockSystem {
                 if let Err(j) = block.lu.factor() {
                     return Some(block.unknowns[j]);
                 }
-                block.lu.solve::<END_COLUMNS>(&mut block.x);
+                block.lu.solve::<END_COLUMNS>(&mut block.x, &block.x_first);
                 out.fill(0.0);
                 let width = block.columns.len();
                 for ((&(_, j), &a), &row) in block
@@ -653,7 +664,7 @@ impl BlockSystem {
                 for (y, &g) in block.y.iter_mut().zip(&block.unknowns) {
                     *y = b[g];
                 }
-                block.lu.solve::<1>(&mut block.y);
+                block.lu.solve::<1>(&mut block.y, &[]);
             });
         }
         // b_B − Σ_k A_BI,k y_k, then x_B = S⁻¹ (…).
@@ -724,8 +735,8 @@ mod tests {
             .collect();
         assert_eq!(lu.factor(), Ok(()));
         let mut wide: Vec<Real> = b.iter().flat_map(|&v| [v, 2.0 * v]).collect();
-        lu.solve::<1>(&mut b);
-        lu.solve::<2>(&mut wide);
+        lu.solve::<1>(&mut b, &[]);
+        lu.solve::<2>(&mut wide, &[]);
         for (i, v) in b.iter().enumerate() {
             assert!((wide[2 * i] - v).abs() < 1e-12 && (wide[2 * i + 1] - 2.0 * v).abs() < 1e-12);
         }
