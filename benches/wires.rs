@@ -98,14 +98,12 @@ fn measure(design_file: &Path, symmetry: Option<&str>) -> (usize, Run, Run) {
         (design.model, bench.closing)
     };
     let ((with, closing), (without, _)) = (model(true), model(false));
-    let touch = {
+    let (touch, unknowns) = {
         let mut sim = Simulation::new(&with).expect("discretised");
         while sim.wire_touch().is_none() && sim.step().expect("converges").is_some() {}
-        sim.wire_touch().expect("the struts touch").time
+        let touch = sim.wire_touch().expect("the struts touch").time;
+        (touch, sim.discretisation().num_unknowns())
     };
-    let unknowns = (Simulation::new(&with).expect("discretised"))
-        .discretisation()
-        .num_unknowns();
     let repeats = if symmetry.is_none() { 3 } else { 1 };
     let best = |model: &Model| {
         (0..repeats)

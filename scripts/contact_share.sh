@@ -9,13 +9,15 @@
 #   scripts/contact_share.sh            # prints the share
 #   STENTKIT_WRITE_ASSETS=1 scripts/contact_share.sh   # also writes assets/contact_share.csv
 #
-# Needs `perf` (Debian: linux-perf) and a release build with debug info (the crate's profile has it); the
-# sampling itself is `scripts/perf_children.sh`.
+# Needs `perf` (Debian: linux-perf) and a release build with debug info (the crate's profile has it).
 set -euo pipefail
 cd "$(dirname "$0")/.."
+cargo bench --bench contact --no-run >/dev/null 2>&1
+bin=$(ls -t target/release/deps/contact-* | grep -v '\.d$' | head -n 1)
 work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
-scripts/perf_children.sh contact crimped >"$work/report.txt"
+perf record -F 499 --call-graph dwarf,16384 -o "$work/perf.data" -- "$bin" crimped >/dev/null 2>"$work/record.log"
+perf report -i "$work/perf.data" --children --sort symbol --stdio -g none --percent-limit 0 2>/dev/null >"$work/report.txt"
 python3 - "$work/report.txt" <<'PY'
 import os, re, sys
 # Children shares of the contact term's entry points (a symbol may be listed more than once: its copies add up;

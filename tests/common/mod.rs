@@ -20,6 +20,12 @@ pub fn repo_file(relative: &str) -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join(relative)
 }
 
+/// The JSON document in the file `path` (a run's summary.json, a bench's bench.json).
+pub fn read_json(path: &Path) -> serde_json::Value {
+    let text = std::fs::read_to_string(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+    serde_json::from_str(&text).unwrap_or_else(|e| panic!("{}: {e}", path.display()))
+}
+
 /// The text of a design in `designs/`.
 pub fn design_text(name: &str) -> String {
     let path = repo_file(&format!("designs/{name}"));

@@ -2,6 +2,7 @@
 //! and what they measure, checked against the contact report they are made of, against the symmetry they
 //! multiply by and, for the crush, against the thin ring's diametral-load closed form.
 
+use crate::common::read_json;
 use crate::mesh::TempDir;
 use std::path::{Path, PathBuf};
 use std::process::Command;
@@ -43,6 +44,15 @@ fn bench_command(test: &str, design: &str, out_dir: &Path, extra: &[&str]) -> st
 /// `stentkit bench radial designs/straight_stent.yaml -o OUT_DIR` with the arguments `extra`.
 fn straight_stent_bench(out_dir: &Path, extra: &[&str]) -> std::process::Output {
     bench_command("radial", "straight_stent.yaml", out_dir, extra)
+}
+
+/// [`straight_stent_bench`] of the two-crown straight stent, quietly, with the overrides `sets` (`PATH=VALUE`).
+fn two_crown_bench(out_dir: &Path, sets: &[&str]) -> std::process::Output {
+    let mut args = vec!["--quiet", "--set", "stent.crowns=2"];
+    for set in sets {
+        args.extend(["--set", set]);
+    }
+    straight_stent_bench(out_dir, &args)
 }
 
 /// The overrides of `sets`.
@@ -520,28 +530,14 @@ fn a_crush_of_a_curved_stent_is_refused_in_the_benchs_words() {
 fn the_radial_bench_says_where_the_wires_first_touch() {
     let dir = TempDir::new("bench-touch");
     let out_dir = dir.join("run");
-    let out = straight_stent_bench(
-        &out_dir,
-        &[
-            "--quiet",
-            "--set",
-            "stent.crowns=2",
-            "--set",
-            "bench.min_diameter=8",
-            "--set",
-            "bench.diameters=10",
-        ],
-    );
+    let out = two_crown_bench(&out_dir, &["bench.min_diameter=8", "bench.diameters=10"]);
     let stdout = String::from_utf8_lossy(&out.stdout).into_owned();
     assert!(out.status.success(), "{stdout}");
     assert!(
         stdout.contains("wires first touched in the step from diameter "),
         "{stdout}"
     );
-    let results: serde_json::Value = serde_json::from_str(
-        &std::fs::read_to_string(out_dir.join("bench.json")).expect("bench.json"),
-    )
-    .expect("JSON");
+    let results = read_json(&out_dir.join("bench.json"));
     let touch = &results["touch"];
     assert_eq!(touch["branch"], "loading", "{touch}");
     let number = |v: &serde_json::Value| v.as_f64().expect("a number");
@@ -578,19 +574,12 @@ fn the_radial_bench_says_where_the_wires_first_touch() {
 fn the_radial_bench_with_the_wires_contact_reads_where_the_struts_lock() {
     let dir = TempDir::new("bench-lock");
     let out_dir = dir.join("run");
-    let out = straight_stent_bench(
+    let out = two_crown_bench(
         &out_dir,
         &[
-            "--quiet",
-            "--set",
-            "stent.crowns=2",
-            "--set",
             "contact.wires=true",
-            "--set",
             "contact.max_updates=30",
-            "--set",
             "bench.min_diameter=9",
-            "--set",
             "bench.diameters=60",
         ],
     );
@@ -601,10 +590,7 @@ fn the_radial_bench_with_the_wires_contact_reads_where_the_struts_lock() {
     assert!(out.status.success(), "{stdout}\n{stderr}");
     assert!(!stderr.contains("warning"), "{stderr}");
     assert!(stdout.contains("struts lock at diameter "), "{stdout}");
-    let results: serde_json::Value = serde_json::from_str(
-        &std::fs::read_to_string(out_dir.join("bench.json")).expect("bench.json"),
-    )
-    .expect("JSON");
+    let results = read_json(&out_dir.join("bench.json"));
     let number = |v: &serde_json::Value| v.as_f64().expect("a number");
     let (lock, touch) = (&results["lock"], &results["touch"]);
     let size = number(&lock["size"]);

@@ -3,6 +3,7 @@
 //! completes with a warning (summary.json, stderr) saying where and when. Issue 35 items 1 and 4: with
 //! `contact: {wires: true}` the same rods press on each other, and the outputs say where and how hard.
 
+use crate::common::read_json;
 use crate::outputs::{path_str, run_in_process, scratch_folder, stentkit, test_outputs, text};
 use crate::stabilisation::warning_said;
 use std::path::{Path, PathBuf};
@@ -89,9 +90,7 @@ fn a_run_that_drives_wires_through_each_other_completes_with_a_warning() {
     let dir = root.join("through_run");
     let (code, stderr) = run_in_process(&through, &dir, &[]);
     assert_eq!(code, 0, "{stderr}");
-    let summary: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(dir.join("summary.json")).expect("summary"))
-            .expect("JSON");
+    let summary = read_json(&dir.join("summary.json"));
     let said = warning_said(&summary, &stderr, "wires passed through each other");
     assert!(
         said.starts_with("wires passed through each other in 3 step(s) (first at t = 0.5), deepest at t = 0.625: patch `low` at u = 0.5000 and patch `high` at u = 0.5000 overlap by 2.0000e-1 mm"),
@@ -167,10 +166,7 @@ fn wires_with_contact_press_on_each_other_and_the_outputs_say_so() {
         .filter(|l| l["type"] == 2)
         .count();
     assert_eq!(lists, 1, "the pairs' LINE_LIST at the end");
-    let summary: serde_json::Value = serde_json::from_str(
-        &std::fs::read_to_string(dir.join("summary.json")).expect("summary.json"),
-    )
-    .expect("JSON");
+    let summary = read_json(&dir.join("summary.json"));
     let clocks = summary["timing"]["solver"]
         .as_object()
         .expect("timing.solver");

@@ -395,8 +395,8 @@ impl WireContact {
     }
 
     /// Searches the candidates again at `control` (module docs), keeping the multipliers of the groups found
-    /// again; the coupling changes with them.
-    fn search(&mut self, control: &[Vec3]) {
+    /// again; the coupling changes with them. Returns the new groups' gaps and pressures there ([`Self::gaps`]).
+    fn search(&mut self, control: &[Vec3]) -> Vec<(Real, Real)> {
         let points = self.wires.points(control);
         let near = self.wires.wires().near(&points, self.margin);
         let mut old = std::mem::take(&mut self.restored);
@@ -430,19 +430,29 @@ impl WireContact {
         }
         self.groups = groups;
         self.searched = control.to_vec();
-        self.couple(control);
+        let gaps = self.gaps(control);
+        self.couple(&gaps);
+        gaps
     }
 
-    /// Marks the groups whose tangent enters the coupling at `control` — those within half the margin of the
-    /// law's band, or pressing, and those marked before (until the next search) — and, when that brings entries
-    /// the coupling has not, adds them and changes its version (module docs, *Which pairs*).
-    fn couple(&mut self, control: &[Vec3]) {
-        let near = self.delta() + 0.5 * self.margin;
-        let flags: Vec<bool> = (self.groups.iter())
+    /// Each group's gap and pressure at `control`, under its multiplier.
+    fn gaps(&self, control: &[Vec3]) -> Vec<(Real, Real)> {
+        (self.groups.iter())
             .map(|g| {
                 let t = self.touch(control, g);
-                g.coupled || t.gap < near || t.pressure > 0.0
+                (t.gap, t.pressure)
             })
+            .collect()
+    }
+
+    /// Marks the groups whose tangent enters the coupling at the state of their `gaps` ([`Self::gaps`]) — those
+    /// within half the margin of the law's band, or pressing, and those marked before (until the next search) —
+    /// and, when that brings entries the coupling has not, adds them and changes its version (module docs,
+    /// *Which pairs*).
+    fn couple(&mut self, gaps: &[(Real, Real)]) {
+        let near = self.delta() + 0.5 * self.margin;
+        let flags: Vec<bool> = (self.groups.iter().zip(gaps))
+            .map(|(g, &(gap, pressure))| g.coupled || gap < near || pressure > 0.0)
             .collect();
         let changed = (self.groups.iter().zip(&flags)).any(|(g, f)| g.coupled != *f);
         for (g, f) in self.groups.iter_mut().zip(flags) {
@@ -517,19 +527,16 @@ impl WireContact {
             || (self.searched.iter().zip(control)).any(|(a, b)| 2.0 * (a - b).norm() >= self.margin)
     }
 
-    /// The deepest penetration over the samples at `control`, with its group.
-    fn deepest(&self, control: &[Vec3]) -> Option<(Real, usize)> {
-        (self.groups.iter().enumerate())
-            .map(|(k, g)| (-self.touch(control, g).gap, k))
+    /// The deepest penetration over the groups' `gaps` ([`Self::gaps`]), with its group.
+    fn deepest(gaps: &[(Real, Real)]) -> Option<(Real, usize)> {
+        (gaps.iter().enumerate())
+            .map(|(k, &(gap, _))| (-gap, k))
             .max_by(|a, b| a.0.total_cmp(&b.0))
     }
 
-    /// Sets every multiplier to its pressure at `control`.
-    fn update_multipliers(&mut self, control: &[Vec3]) {
-        let pressures: Vec<Real> = (self.groups.iter())
-            .map(|g| self.touch(control, g).pressure)
-            .collect();
-        for (g, p) in self.groups.iter_mut().zip(pressures) {
+    /// Sets every multiplier to its pressure in `gaps` ([`Self::gaps`]).
+    fn update_multipliers(&mut self, gaps: &[(Real, Real)]) {
+        for (g, &(_, p)) in self.groups.iter_mut().zip(gaps) {
             g.multiplier = p;
         }
     }
@@ -749,44 +756,49 @@ impl PointTerm for WireContact {
     fn prepare(&mut self, _disc: &Discretisation, state: &State, t: Real) {
         self.time = t;
         self.updates = 0;
-        if self.stale(&state.control) {
-            self.search(&state.control);
+        let gaps = if self.stale(&state.control) {
+            self.search(&state.control)
         } else {
-            self.couple(&state.control);
-        }
-        self.update_multipliers(&state.control);
+            let gaps = self.gaps(&state.control);
+            self.couple(&gaps);
+            gaps
+        };
+        self.update_multipliers(&gaps);
     }
 
     fn augment(&mut self, _disc: &Discretisation, state: &State) -> bool {
         let control = &state.control;
-        if self.stale(control) {
+        let gaps = if self.stale(control) {
             // The step moved the wires past what the candidates cover: search again, and solve again if a new
             // candidate acts.
             let before: std::collections::HashSet<Key> =
                 self.groups.iter().map(Group::key).collect();
-            self.search(control);
+            let gaps = self.search(control);
             let band = self.delta();
-            let new_touch = (self.groups.iter())
-                .filter(|g| !before.contains(&g.key()))
-                .any(|g| self.touch(control, g).gap < band);
+            let new_touch = (self.groups.iter().zip(&gaps))
+                .filter(|(g, _)| !before.contains(&g.key()))
+                .any(|(_, &(gap, _))| gap < band);
             if new_touch && self.updates < self.settings.max_updates {
                 self.updates += 1;
                 return true;
             }
-        }
-        let Some((depth, _)) = self.deepest(control) else {
+            gaps
+        } else {
+            self.gaps(control)
+        };
+        let Some((depth, _)) = Self::deepest(&gaps) else {
             return false;
         };
         if depth <= self.settings.tolerance || self.updates >= self.settings.max_updates {
             return false;
         }
         self.updates += 1;
-        self.update_multipliers(control);
+        self.update_multipliers(&gaps);
         true
     }
 
     fn commit(&mut self, _disc: &Discretisation, state: &State) {
-        let Some((depth, k)) = self.deepest(&state.control) else {
+        let Some((depth, k)) = Self::deepest(&self.gaps(&state.control)) else {
             return;
         };
         if depth <= self.settings.tolerance {
