@@ -6,7 +6,7 @@
 //! where each comes from.
 
 use stentkit::geometry::stent::{
-    BridgeShape, BridgeSpec, CentrelineSpec, CrownSpec, StentSpec, Symmetry,
+    BridgeShape, BridgeSpec, CentrelineSpec, CrownShape, CrownSpec, StentSpec, Symmetry,
 };
 use stentkit::material::{CircularSection, Integrator, Material, MaterialLaw};
 use stentkit::math::Vec3;
@@ -30,6 +30,7 @@ pub fn straight_stent(crowns: usize, (p, n): (usize, usize), step: f64) -> Model
                 radius: 20.0,
                 amplitude: 5.0,
                 peaks: 6,
+                shape: CrownShape::Sinusoidal,
             },
             crowns,
             spacing: Some(15.0),

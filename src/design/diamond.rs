@@ -53,6 +53,11 @@ impl FamilyBlock for Diamond {
             (dto.oversize.is_some(), "oversize", "give its `radius`"),
             (dto.taper, "taper", "its rings share one radius"),
             (
+                dto.crown_shape.is_some(),
+                "crown_shape",
+                "its struts follow the cylinder between the nodes",
+            ),
+            (
                 dto.materials.as_ref().is_some_and(|m| m.bridges.is_some()),
                 "materials.bridges",
                 "it has no bridges",

@@ -995,6 +995,10 @@ pub struct StentDto {
     pub amplitude: Positive,
     /// Crests per crown.
     pub peaks: usize,
+    /// The wire between a crest and a trough: `sinusoidal` (the default) or `zigzag` (straight struts, a
+    /// Z-ring; ring family only).
+    #[serde(default)]
+    pub crown_shape: Option<CrownShapeDto>,
     /// Crown spacing `d_c` along the centreline \[length\].
     #[serde(default)]
     pub spacing: Option<Positive>,
@@ -1086,6 +1090,16 @@ pub struct FrontDto {
     pub behind: TimeFn,
     /// The temperature ahead of it [°C].
     pub ahead: TimeFn,
+}
+
+/// Crown shape keyword.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, JsonSchema)]
+#[serde(rename_all = "snake_case")]
+pub enum CrownShapeDto {
+    /// Sinusoidal, smooth through crests and troughs.
+    Sinusoidal,
+    /// Straight struts between crests and troughs.
+    Zigzag,
 }
 
 /// Bridge shape keyword.

@@ -15,6 +15,7 @@
 //!   radius: 20            # crown radius R [length]
 //!   amplitude: 5          # h_c: the crown is 2 h_c high
 //!   peaks: 6              # crests per crown (the crown has 2 × peaks wire patches)
+//!   crown_shape: sinusoidal   # the default; `zigzag`: straight struts between crests and troughs (a Z-ring)
 //!   spacing: 15           # d_c along the centreline (optional on arcs and point lists)
 //!   rotation_deg: 90      # of each crown about the axis relative to the previous one (default 180/peaks)
 //!   bridges: {shape: straight}   # or {shape: sinusoidal, amplitude: 2.5, waves: 1, direction: radial}
@@ -33,8 +34,9 @@ use super::dto::*;
 use super::issue::{Result, issue, mesh_key_path};
 use super::vessel::{VesselCentreline, tightest_bend, vessel_centreline};
 use crate::geometry::stent::{
-    BridgeDirection, BridgeShape, BridgeSpec, CentrelineSpec, CrownSpec, FamilyCounts, StentFamily,
-    StentParameter, StentSpec, Symmetry, TemporaryCentreline, TemporarySpec, ring_counts,
+    BridgeDirection, BridgeShape, BridgeSpec, CentrelineSpec, CrownShape, CrownSpec, FamilyCounts,
+    StentFamily, StentParameter, StentSpec, Symmetry, TemporaryCentreline, TemporarySpec,
+    ring_counts,
 };
 use crate::math::{Real, Vec3};
 use crate::model::builder::StentField;
@@ -339,6 +341,10 @@ fn ring_spec(
             radius,
             amplitude: dto.amplitude.0,
             peaks: dto.peaks,
+            shape: match dto.crown_shape {
+                None | Some(CrownShapeDto::Sinusoidal) => CrownShape::Sinusoidal,
+                Some(CrownShapeDto::Zigzag) => CrownShape::Zigzag,
+            },
         },
         crowns: dto.crowns,
         spacing: dto.spacing.map(|d| d.0),

@@ -841,6 +841,10 @@ fn curve_length(curve: &crate::math::NurbsCurve) -> Real {
         .sum()
 }
 
+/// Parts per interval between collocation points in the arc-length quadrature (5-point Gauss–Legendre each):
+/// the reference speed `|c0'(u)|` is smooth there, so the arc length is exact to round-off.
+pub(crate) const ARC_LENGTH_PARTS: usize = 4;
+
 /// Arc length of `curve` from parameter `a` to `b`: 5-point Gauss–Legendre of the speed `|c'(u)|` on `parts`
 /// equal parts (exact to round-off where the speed is smooth and the parts short).
 pub(crate) fn arc_length_between(

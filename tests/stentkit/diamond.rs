@@ -6,8 +6,8 @@ use crate::outputs::{design, path_str, stentkit, test_outputs, text};
 use std::sync::Arc;
 use stentkit::design::load_design;
 use stentkit::geometry::stent::{
-    BridgeShape, BridgeSpec, CentrelineSpec, CrownSpec, DiamondSpec, StentFamily, StentSpec,
-    Symmetry,
+    BridgeShape, BridgeSpec, CentrelineSpec, CrownShape, CrownSpec, DiamondSpec, StentFamily,
+    StentSpec, Symmetry,
 };
 use stentkit::material::{CircularSection, ElasticLaw};
 use stentkit::math::{Real, Vec3};
@@ -96,6 +96,7 @@ fn every_family_counts_what_its_model_holds() {
             radius: 3.0,
             amplitude: 1.0,
             peaks: 6,
+            shape: CrownShape::Sinusoidal,
         },
         crowns: 3,
         spacing: Some(3.0),

@@ -424,7 +424,8 @@ fn half_model_matches_the_full_curved_device() {
 #[test]
 fn point_list_centreline_reproduces_the_arc() {
     use stentkit::geometry::stent::{
-        BridgeDirection, BridgeShape, BridgeSpec, CentrelineSpec, CrownSpec, StentSpec, Symmetry,
+        BridgeDirection, BridgeShape, BridgeSpec, CentrelineSpec, CrownShape, CrownSpec, StentSpec,
+        Symmetry,
     };
     let arc = CentrelineSpec::Arc {
         centre: Vec3::new(0.0, 0.0, -5.0),
@@ -444,6 +445,7 @@ fn point_list_centreline_reproduces_the_arc() {
             radius: 20.0,
             amplitude: 5.0,
             peaks: 6,
+            shape: CrownShape::Sinusoidal,
         },
         crowns: 4,
         spacing: None,

@@ -1,8 +1,8 @@
 //! The analytic centreline of a generated patch — a crown wire or a bridge — in local coordinates placed on the
 //! axis (see the module documentation of [`super`] for the formulas), with its closed-form derivative.
 
-use super::CrownSpec;
 use super::axis::Axis;
+use super::{CrownShape, CrownSpec};
 use crate::geometry::analytic::ParametricCurve;
 use crate::math::{Mat3, Real, Vec3};
 use std::f64::consts::{PI, TAU};
@@ -53,6 +53,8 @@ pub struct StentCurve {
     radius: (Real, Real),
     amplitude: Real,
     peaks: Real,
+    /// The crown wire's shape (a bridge and a strut ignore it).
+    shape: CrownShape,
     kind: CurveKind,
 }
 
@@ -75,6 +77,7 @@ impl StentCurve {
             radius,
             amplitude: crown.amplitude,
             peaks: crown.peaks as Real,
+            shape: crown.shape,
             kind,
         }
     }
@@ -111,11 +114,20 @@ impl StentCurve {
                 from,
                 to,
             } => {
+                let on_crown = |a: Real| {
+                    let (sa, ca) = a.sin_cos();
+                    Vec3::new(h * (m * (a - phase)).cos(), big_r * ca, big_r * sa)
+                };
+                if self.shape == CrownShape::Zigzag {
+                    // The chord between the nodes (module documentation of `super`, "Crown").
+                    let (pa, pb) = (on_crown(from), on_crown(to));
+                    return (pa * (1.0 - t) + pb * t, pb - pa, station, 0.0);
+                }
                 let a = from * (1.0 - t) + to * t;
                 let da = to - from;
                 let (sa, ca) = a.sin_cos();
                 let arg = m * (a - phase);
-                let p = Vec3::new(h * arg.cos(), big_r * ca, big_r * sa);
+                let p = on_crown(a);
                 let dp = Vec3::new(-h * m * arg.sin(), -big_r * sa, big_r * ca) * da;
                 (p, dp, station, 0.0)
             }

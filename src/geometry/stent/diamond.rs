@@ -37,8 +37,9 @@ use super::family::{FamilyCounts, StentFamily};
 use super::sector::{Sector, check_axis_symmetry};
 use super::temporary::{Placement, placement, temporary_axis};
 use super::{
-    CentrelineSpec, CrownSpec, GeneratedNode, GeneratedPatch, NodeKind, PLANARITY_TOLERANCE,
-    PartKind, PatchRole, StentGeometry, StentParameter, Symmetry, TemporarySpec, WireEnd, invalid,
+    CentrelineSpec, CrownShape, CrownSpec, GeneratedNode, GeneratedPatch, NodeKind,
+    PLANARITY_TOLERANCE, PartKind, PatchRole, StentGeometry, StentParameter, Symmetry,
+    TemporarySpec, WireEnd, invalid,
 };
 use crate::geometry::GeometryError;
 use crate::math::{Real, Vec3};
@@ -198,6 +199,7 @@ impl DiamondSpec {
             radius,
             amplitude: self.amplitude,
             peaks: m,
+            shape: CrownShape::Sinusoidal,
         };
         let mut patches = Vec::new();
         for k in 0..n {

@@ -24,7 +24,9 @@
 //! (and `ϑ = ±π/2` for even `m`), which are the symmetry cuts. With the appendix's phase (`sin`) the crown
 //! is odd about `ϑ = 0` and the half model about `x2 = 0` the paper describes would not be a symmetry.
 //! The crown is split into `2m` wire patches at its crests (`x = +h_c`, facing crown `k + 1`) and troughs
-//! (`x = −h_c`), which become its nodes.
+//! (`x = −h_c`), which become its nodes. A **zigzag** crown ([`CrownShape::Zigzag`], a Z-ring) has the same
+//! nodes and straight wires between them: the chord from a node to the next, `(1 − t) P_a + t P_b` in the
+//! station's frame, inside the cylinder by `R (1 − cos(π/2m))` at its middle.
 //!
 //! **Stations.** On a straight centreline, `s_k = k d_c`. On an arc or a point list of length `L`, the crowns
 //! are spread uniformly over the whole centreline (`d_c = L/(N − 1)`, the appendix's "equal circular sectors")
@@ -109,7 +111,7 @@ pub const ANGLE_TOLERANCE: Real = 1e-9;
 /// Relative tolerance (of the centreline length) when testing that a centreline lies in a symmetry plane.
 pub const PLANARITY_TOLERANCE: Real = 1e-9;
 
-/// The sinusoidal ring repeated along the device.
+/// The ring repeated along the device.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct CrownSpec {
     /// Radius `R` of the cylinder the crown lies on \[length\], > 0.
@@ -118,6 +120,19 @@ pub struct CrownSpec {
     pub amplitude: Real,
     /// Number of peaks (crests) `m` per crown, ≥ 1.
     pub peaks: usize,
+    /// The shape of the wire between a crest and a trough.
+    pub shape: CrownShape,
+}
+
+/// The shape of a crown's wire between a crest and the next trough (module documentation, "Crown").
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub enum CrownShape {
+    /// `x = h_c cos(m (ϑ − α_k))` on the cylinder: smooth through its crests and troughs (the paper's crowns).
+    #[default]
+    Sinusoidal,
+    /// A Z-ring: straight struts, each the chord from a crest to the next trough (inside the cylinder between
+    /// them), meeting at an angle at the crests and troughs — the open-stent calculator's ring.
+    Zigzag,
 }
 
 /// Which way a sinusoidal bridge oscillates.
@@ -572,6 +587,7 @@ mod tests {
                 radius: 20.0,
                 amplitude: 5.0,
                 peaks: 6,
+                shape: CrownShape::Sinusoidal,
             },
             crowns: 3,
             spacing: Some(15.0),

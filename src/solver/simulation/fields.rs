@@ -21,7 +21,9 @@ use crate::material::ConstitutiveLaw;
 use crate::math::so3::log;
 use crate::math::{Real, Rot3, Vec3};
 use crate::model::ProbeLocation;
-use crate::solver::assembly::{arc_length_between, point_position, point_strains};
+use crate::solver::assembly::{
+    ARC_LENGTH_PARTS, arc_length_between, point_position, point_strains,
+};
 use rayon::prelude::*;
 
 /// Angles sampled around the section before the peak is refined (every 30°).
@@ -33,10 +35,6 @@ const REFINEMENTS: usize = 30;
 /// The refinement stops when a vertex moves the angle by less than this \[rad\]: the strain is then within
 /// ~1e-16 of its peak (quadratic there).
 const ANGLE_TOLERANCE: Real = 1e-8;
-
-/// Parts per interval between collocation points in the arc-length quadrature (5-point Gauss–Legendre each):
-/// the reference speed `|c0'(u)|` is smooth there, so the arc length is exact to round-off.
-const ARC_LENGTH_PARTS: usize = 4;
 
 /// The fields of one collocation point (material quantities in the section frame `d1, d2, d3`; spatial ones in
 /// global coordinates; the model's units).

@@ -6,8 +6,23 @@
 //! rod contact at the Greville points the same way). `g` is the gap of the point's centreline position from the
 //! surface minus the wire's radius (the patch section's diameter over two), `n = ∇g` the unit normal into the
 //! rods' side: a circular section takes no contact moment. At the patch ends the balance laws are the nodes'
-//! equilibrium, which a line force does not enter; a node is kept out of a wall by the contact of the points
-//! next to it.
+//! equilibrium, which a line force does not enter; a node the wire passes through smoothly is kept out of a
+//! wall by the contact of the points next to it.
+//!
+//! **Corners.** Where wires meet at an angle — a Z-ring's crest, where two straight struts meet, a diamond cell's
+//! node — the wire is not smooth and the contact is concentrated there: the crest touches the crimper while the
+//! struts beside it are clear. The points next to a corner cannot hold it (the crest would go through the wall
+//! while they were held on it, bending the strut over the short length between: on the radial bench a Z-ring of
+//! the open-stent example read 1.7 N against the calculator's 4e-5 N). So at a node of two or more ends where
+//! no two ends continue into each other (their outward tangents in the reference turn by more than
+//! [`SMOOTH_TURN`] from opposite), the law acts at each end as a **concentrated force** on the node: the line
+//! force at the end's gap times its tributary length, half the reference arc length to the next collocation
+//! point, with its own multiplier (and friction anchor) like any point ([`PointTerm::end`]; its tangent
+//! `l ∂q/∂c` joins the node's equilibrium rows). The tributary length is the contact report's trapezoidal
+//! weight of the end, so the report's force there is the node's force. A node of one end is left out: on a
+//! symmetry cut the wire continues into its mirror image, smoothly; a free tip pressed onto a wall is held by
+//! the point next to it, as before. Wires that pass through a node smoothly (a sinusoidal crown's crest) keep
+//! the interior points alone, so the corners change nothing for them.
 //!
 //! **Law.** `p = ε Φ(λ/ε − g)` with the penalty `ε` \[force/length²\], the point's augmented-Lagrange multiplier
 //! `λ ≥ 0` \[force/length\] and the C¹ ramp `Φ(x) = 0` for `x ≤ −δ`, `(x + δ)² / (4δ)` for `|x| < δ`, `x` for
@@ -135,11 +150,12 @@ pub(crate) mod report;
 
 pub use report::{Apposition, ContactReport, ObstacleReport};
 
-use super::{InteriorLoad, PointTerm, PointView};
+use super::{EndLoad, InteriorLoad, PointTerm, PointView};
 use crate::math::basis::nurbs_basis;
 use crate::math::quote::quoted;
 use crate::math::{Mat3, Real, Vec3};
-use crate::model::{ContactSettings, Distance, Model, Obstacle, Surface, Wall};
+use crate::model::{ContactSettings, Distance, End, Model, Obstacle, Surface, Wall};
+use crate::solver::assembly::{ARC_LENGTH_PARTS, arc_length_between};
 use crate::solver::discretisation::{Discretisation, point_increment, point_position};
 use crate::solver::state::State;
 
@@ -161,23 +177,79 @@ pub(crate) fn ramp(x: Real, delta: Real) -> (Real, Real) {
 pub const SAMPLES_PER_SPAN: usize = 4;
 
 /// The tributary reference length of every collocation point (module docs): half the chord to each neighbour
-/// of its patch, a patch end's share given to the interior point next to it (the law acts at interior points
-/// only), zero at the ends.
-fn tributary_lengths(disc: &Discretisation, reference: &[Vec3]) -> Vec<Real> {
+/// of its patch, the share of a patch end where the law does not act given to the interior point next to it
+/// (zero at that end); at a corner's end (`acts`), half the reference arc length to its neighbour — the
+/// contact report's trapezoidal weight there, so that the report's force is the node's concentrated force.
+fn tributary_lengths(
+    model: &Model,
+    disc: &Discretisation,
+    reference: &[Vec3],
+    acts: &[bool],
+) -> Vec<Real> {
     let mut lengths = vec![0.0; disc.points.len()];
-    for range in &disc.patches {
+    for (range, patch) in disc.patches.iter().zip(&model.patches) {
         let (first, last) = (range.offset, range.offset + range.n - 1);
         for g in first..last {
             let chord = (reference[g + 1] - reference[g]).norm();
-            // The chord's halves to its two points; an end's half to its interior neighbour.
-            let (a, b) = (g.max(first + 1), (g + 1).min(last - 1));
-            if a <= b {
-                lengths[a] += 0.5 * chord;
-                lengths[b] += 0.5 * chord;
+            for (end, inner) in [(g, g + 1), (g + 1, g)] {
+                if !disc.is_end(end) {
+                    lengths[end] += 0.5 * chord;
+                } else if acts[end] {
+                    let (a, b) = (disc.points[g].u, disc.points[g + 1].u);
+                    lengths[end] += 0.5 * arc_length_between(&patch.curve, a, b, ARC_LENGTH_PARTS);
+                } else if !disc.is_end(inner) {
+                    lengths[inner] += 0.5 * chord;
+                }
             }
         }
     }
     lengths
+}
+
+/// The largest turn \[rad\] between two ends of a node that still counts as the wire passing smoothly through it
+/// (module docs, *Corners*): well above the fitted patches' own mismatch of end tangents, well below any kink a
+/// design draws.
+pub const SMOOTH_TURN: Real = 1e-2;
+
+/// Whether the contact law acts at each collocation point (module docs, *Corners*): at every interior point,
+/// and at the ends of a corner — a node whose wires, with their mirror images across the symmetry planes the
+/// node lies on, meet in two or more directions of which no two continue into each other within [`SMOOTH_TURN`]
+/// (a Z-ring's crest, whole or cut by a mirror plane; struts meeting at an angle). Not at a node through which a
+/// wire passes smoothly (a sinusoidal crown's crest, also where a bridge joins it or a symmetry plane cuts it),
+/// nor at a free tip.
+fn acting_points(model: &Model, disc: &Discretisation) -> Vec<bool> {
+    let mut acts: Vec<bool> = (0..disc.points.len()).map(|g| !disc.is_end(g)).collect();
+    let smooth = -SMOOTH_TURN.cos();
+    for node in &model.nodes {
+        // The outward unit tangent of each end in the reference, and their mirror images.
+        let mut outward: Vec<Vec3> = (node.ends.iter())
+            .map(|e| {
+                let curve = &model.patches[e.patch].curve;
+                let (lo, hi) = curve.knots().domain();
+                let (u, sign) = match e.end {
+                    End::Start => (lo, -1.0),
+                    End::End => (hi, 1.0),
+                };
+                curve.derivatives(u, 1)[1].normalize() * sign
+            })
+            .collect();
+        for (plane, (_, normal)) in model.symmetry_planes.iter().enumerate() {
+            if model.lies_on_symmetry_plane(plane, &node.position) {
+                let images: Vec<Vec3> = (outward.iter())
+                    .map(|t| t - normal * (2.0 * t.dot(normal)))
+                    .collect();
+                outward.extend(images);
+            }
+        }
+        let passes = (0..outward.len())
+            .any(|a| (a + 1..outward.len()).any(|b| outward[a].dot(&outward[b]) <= smooth));
+        if outward.len() >= 2 && !passes {
+            for e in &node.ends {
+                acts[disc.end_point(*e)] = true;
+            }
+        }
+    }
+    acts
 }
 
 /// The sample points of every patch (module docs): its two ends, and `SAMPLES_PER_SPAN` per non-empty knot
@@ -255,8 +327,12 @@ pub struct SurfaceContact {
     /// A lumen's closest centreline parameter per obstacle and collocation point at the last converged step,
     /// the first guess of its search (NaN: none; empty for the other surfaces; module docs).
     hints: Vec<Vec<Real>>,
-    /// Tributary reference length of each collocation point \[length\] (module docs; zero at the patch ends).
+    /// Tributary reference length of each collocation point \[length\] (module docs; zero at a patch end where
+    /// the law does not act).
     lengths: Vec<Real>,
+    /// Whether the law acts at each collocation point: the interior points and the corners' ends (module docs,
+    /// *Corners*).
+    acts: Vec<bool>,
     /// The sample points between the collocation points (module docs).
     samples: Vec<Sample>,
     /// Committed steps whose largest penetration anywhere exceeded the tolerance (module docs).
@@ -396,6 +472,7 @@ impl SurfaceContact {
             })
             .collect();
         let work = vec![[0.0; 2]; obstacles.len()];
+        let acts = acting_points(model, disc);
         let hints = obstacles
             .iter()
             .map(|o| match o.surface {
@@ -415,7 +492,8 @@ impl SurfaceContact {
             anchors,
             work,
             hints,
-            lengths: tributary_lengths(disc, &reference),
+            lengths: tributary_lengths(model, disc, &reference, &acts),
+            acts,
             samples: samples(model, disc),
             between: Between::default(),
             placed: Placed::default(),
@@ -428,6 +506,12 @@ impl SurfaceContact {
     /// point `g` times `lengths()[g]`, summed, is the force on the rods.
     pub fn lengths(&self) -> &[Real] {
         &self.lengths
+    }
+
+    /// Whether the law acts at collocation point `g`: an interior point, or a corner's end (module docs,
+    /// *Corners*).
+    pub fn acts_at(&self, g: usize) -> bool {
+        self.acts[g]
     }
 
     /// Friction work dissipated at obstacle `k` in the last committed step and since the start
@@ -608,7 +692,7 @@ impl SurfaceContact {
             .collect();
         let any = rigid.iter().any(|&(_, active)| active);
         for (g, point) in disc.points.iter().enumerate() {
-            if disc.is_end(g) {
+            if !self.acts[g] {
                 continue;
             }
             let x = any.then(|| point_position(disc, &state.control, g));
@@ -664,6 +748,31 @@ impl SurfaceContact {
         self.hints[k].get(g).copied().filter(|u| !u.is_nan())
     }
 
+    /// Calls `add(q, ∂q/∂c)` with the spatial line force `q` of every obstacle that acts on the point `at` (normal
+    /// pressure and friction) and, when the tangent is wanted, its derivative with respect to the point's position.
+    fn line_force(&self, at: &PointView<'_>, mut add: impl FnMut(Vec3, Option<Mat3>)) {
+        let x = at.position();
+        for k in 0..self.obstacles.len() {
+            if self.out_of_reach(k, at.g, at.point.patch, &x) {
+                continue;
+            }
+            let Some(c) = self.at(k, at.g, at.point.patch, &x) else {
+                continue;
+            };
+            if c.pressure == 0.0 && c.stiffness == 0.0 {
+                continue;
+            }
+            let n = c.distance.normal;
+            let friction = self.friction(k, at.g, &x, &c);
+            let q = n * c.pressure + friction.map_or(Vec3::zeros(), |f| f.force);
+            let dq = at.tangent.then(|| {
+                let dq = n * n.transpose() * c.stiffness + c.distance.hessian * c.pressure;
+                friction.map_or(dq, |f| dq + f.derivative)
+            });
+            add(q, dq);
+        }
+    }
+
     /// Records an obstacle put in place at the end of the step that converged at `state` with a wire deeper
     /// through it than the tolerance (module docs).
     fn record_placed(&mut self, disc: &Discretisation, state: &State) {
@@ -675,7 +784,7 @@ impl SurfaceContact {
             }
             let mut deepest: Option<(Real, Vec3)> = None;
             for (g, point) in disc.points.iter().enumerate() {
-                if disc.is_end(g) {
+                if !self.acts[g] {
                     continue;
                 }
                 let x = point_position(disc, &state.control, g);
@@ -708,28 +817,27 @@ impl PointTerm for SurfaceContact {
     }
 
     fn interior(&self, at: &PointView<'_>, load: &mut InteriorLoad) {
-        let x = at.position();
-        for k in 0..self.obstacles.len() {
-            if self.out_of_reach(k, at.g, at.point.patch, &x) {
-                continue;
-            }
-            let Some(c) = self.at(k, at.g, at.point.patch, &x) else {
-                continue;
-            };
-            if c.pressure == 0.0 && c.stiffness == 0.0 {
-                continue;
-            }
-            let n = c.distance.normal;
-            let friction = self.friction(k, at.g, &x, &c);
-            load.add_force(n * c.pressure + friction.map_or(Vec3::zeros(), |f| f.force));
-            if at.tangent {
-                let mut dq = n * n.transpose() * c.stiffness + c.distance.hessian * c.pressure;
-                if let Some(f) = friction {
-                    dq += f.derivative;
-                }
+        self.line_force(at, |q, dq| {
+            load.add_force(q);
+            if let Some(dq) = dq {
                 load.add_force_position(at.rotation_t * dq);
             }
+        });
+    }
+
+    fn end(&self, at: &PointView<'_>, load: &mut EndLoad) {
+        if !self.acts[at.g] {
+            return;
         }
+        // A corner's end (module docs, *Corners*): the line force over the end's tributary length, concentrated
+        // on its node.
+        let length = self.lengths[at.g];
+        self.line_force(at, |q, dq| {
+            load.add_force(q * length);
+            if let Some(dq) = dq {
+                load.add_force_position(dq * length);
+            }
+        });
     }
 
     fn prepare(&mut self, disc: &Discretisation, state: &State, t: Real) {
@@ -749,7 +857,7 @@ impl PointTerm for SurfaceContact {
     fn step_limit(&self, disc: &Discretisation, state: &State, delta: &[Real]) -> Real {
         let mut alpha: Real = 1.0;
         for (g, point) in disc.points.iter().enumerate() {
-            if disc.is_end(g) {
+            if !self.acts[g] {
                 continue;
             }
             let x = point_position(disc, &state.control, g);
@@ -875,7 +983,7 @@ impl PointTerm for SurfaceContact {
             }
             let mut step = 0.0;
             for (g, point) in disc.points.iter().enumerate() {
-                if disc.is_end(g) {
+                if !self.acts[g] {
                     continue;
                 }
                 let x = point_position(disc, &state.control, g);

@@ -182,9 +182,11 @@ fn contact(model: &Model, disc: &Discretisation) -> SurfaceContact {
     SurfaceContact::new(model, disc, obstacles, settings)
 }
 
-/// The contact of the tangent test acts where it should be tested: at the deformed state some interior points
-/// are clear of both surfaces, some in the law's quadratic band and some on its linear branch, and both
-/// obstacles press on some point (else the central-difference comparison would check nothing of it).
+/// The contact of the tangent test acts where it should be tested: at the deformed state some points are
+/// clear of both surfaces, some in the law's quadratic band and some on its linear branch, both obstacles press
+/// on some point, and the corner where the arc meets the leg at an angle has its ends pressed, so that the
+/// concentrated force at a corner ([`PointTerm::end`]) is in the comparison (else the central-difference
+/// comparison would check nothing of it).
 #[test]
 fn the_tangent_tests_contact_covers_every_branch_of_its_law() {
     let model = test_model();
@@ -194,11 +196,21 @@ fn the_tangent_tests_contact_covers_every_branch_of_its_law() {
     let (mut clear, mut band, mut linear) = (0, 0, 0);
     let (mut sticking, mut sliding) = ([0; 2], [0; 2]);
     let mut pressed = [false; 2];
+    let mut corners = 0;
     for (g, point) in disc.points.iter().enumerate() {
-        if disc.is_end(g) {
+        if !contact.acts_at(g) {
             continue;
         }
         let x = crate::solver::discretisation::point_position(&disc, &state.control, g);
+        if disc.is_end(g)
+            && (0..2).any(|k| {
+                contact
+                    .at(k, g, point.patch, &x)
+                    .is_some_and(|c| c.pressure > 0.0)
+            })
+        {
+            corners += 1;
+        }
         for (k, pressed) in pressed.iter_mut().enumerate() {
             let Some(c) = contact.at(k, g, point.patch, &x) else {
                 continue;
@@ -225,6 +237,7 @@ fn the_tangent_tests_contact_covers_every_branch_of_its_law() {
         "clear {clear}, band {band}, linear {linear}"
     );
     assert_eq!(pressed, [true, true]);
+    assert_eq!(corners, 2, "the corner's two ends pressed");
     println!("sticking {sticking:?}, sliding {sliding:?}");
     assert!(
         sticking.iter().chain(&sliding).all(|&n| n > 0),

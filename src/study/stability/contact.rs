@@ -13,7 +13,7 @@ use super::MapReport;
 use super::newton::{
     SolverMap, SolverPoint, describe, newton_run_with, solver_chart, solver_csv, solver_summary,
 };
-use crate::geometry::stent::{CentrelineSpec, CrownSpec, StentSpec, Symmetry};
+use crate::geometry::stent::{CentrelineSpec, CrownShape, CrownSpec, StentSpec, Symmetry};
 use crate::material::{CircularSection, ElasticLaw};
 use crate::math::{Mat3, Real, Vec3};
 use crate::model::builder::{ConditionSpec, ModelBuilder, TimeSpec};
@@ -31,6 +31,7 @@ const CROWN: CrownSpec = CrownSpec {
     radius: 20.0,
     amplitude: 5.0,
     peaks: 6,
+    shape: CrownShape::Sinusoidal,
 };
 /// Wire diameter \[mm\] (designs/straight_stent.yaml).
 const WIRE: Real = 0.6;

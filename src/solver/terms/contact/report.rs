@@ -15,11 +15,13 @@
 //! exact for a uniform line force (the weights sum to the patch's reference length) and second order in the
 //! spacing of the points otherwise (the trapezoidal rule's error `L h² max|q''| / 12`). The line force is per
 //! unit *reference* length, as in the balance laws (module docs of the term), so the integral is over the
-//! reference length. At a patch end the law does not act (the node's equations hold there); the report measures
-//! the pressure there with the contact law at the end's own gap and the multiplier of the patch's nearest
-//! interior point — the line force the rod carries up to its end — so that a uniformly pressed rod integrates
-//! to its pressure times its length, not short of the two end half-intervals. A crown crest pressed at a node
-//! is thus counted by its own penetration, not left out.
+//! reference length. At a patch end where the law does not act (a node the wire passes through smoothly: the
+//! node's equations hold there) the report measures the pressure with the contact law at the end's own gap and
+//! the multiplier of the patch's nearest interior point — the line force the rod carries up to its end — so
+//! that a uniformly pressed rod integrates to its pressure times its length, not short of the two end
+//! half-intervals; a crown crest pressed at such a node is thus counted by its own penetration, not left out.
+//! At a corner's end, where the law acts as a concentrated force on the node (the term's module docs,
+//! *Corners*), the end's weight is its tributary length, so the report's sum there is that force exactly.
 //!
 //! **Radial part.** For a cylinder the force on the rods is along the inward normal `n = −e` (`e` the unit
 //! radial direction from the axis to the point), so the inward component of `w_g p_g n_g` is `w_g p_g`: the
@@ -128,7 +130,7 @@ impl SurfaceContact {
         for (g, x) in positions.iter().enumerate() {
             total += weights[g];
             let patch = disc.points[g].patch;
-            let Some(c) = self.at(k, law_point(disc, g), patch, x) else {
+            let Some(c) = self.at(k, law_point(disc, &self.acts, g), patch, x) else {
                 continue;
             };
             gap[g] = c.gap;
@@ -170,11 +172,12 @@ impl SurfaceContact {
     }
 }
 
-/// The collocation point whose multiplier the report uses at point `g`: `g` itself inside a patch, the
-/// nearest interior point at a patch end (module docs), the end itself for a patch without interior points.
-fn law_point(disc: &Discretisation, g: usize) -> usize {
+/// The collocation point whose multiplier the report uses at point `g`: `g` itself where the law acts (inside a
+/// patch, a corner's end), the nearest interior point at another patch end (module docs), the end itself for a
+/// patch without interior points.
+fn law_point(disc: &Discretisation, acts: &[bool], g: usize) -> usize {
     let range = &disc.patches[disc.points[g].patch];
-    if range.n < 3 {
+    if acts[g] || range.n < 3 {
         g
     } else if g == range.offset {
         g + 1
