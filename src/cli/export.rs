@@ -102,7 +102,7 @@ pub(crate) fn run(run_dir: &Path, options: &ExportOptions) -> anyhow::Result<()>
     if let Some(ran) = summary["model_fingerprint"].as_str()
         && ran != fingerprint
     {
-        // The form's version (`v1-…`, io::summary::model_fingerprint_text) tells a run of an earlier stentkit,
+        // The form's version (`v2-…`, io::summary::model_fingerprint_text) tells a run of an earlier stentkit,
         // which hashed models otherwise, from a run of another model.
         let form = fingerprint.split('-').next().unwrap_or_default();
         let why = if ran.split('-').next() == Some(form) {

@@ -951,6 +951,12 @@ fn solver_settings(s: Option<&SolverDto>, contact: bool) -> SolverSettings {
                 LinearDto::SparseLu => LinearMethod::SparseLu,
             };
         }
+        if let Some(r) = s.rotations {
+            out.rotations = match r {
+                RotationsDto::Objective => RotationField::Objective,
+                RotationsDto::Incremental => RotationField::Incremental,
+            };
+        }
         if let Some(PathDto::ArcLength) = s.path {
             let mut a = ArcLengthSettings::default();
             if let Some(d) = &s.arc_length {

@@ -781,6 +781,10 @@ pub struct SolverDto {
     /// Linear solver: `block` (banded per patch + Schur complement on the patch ends, default) or `sparse-lu`.
     #[serde(default)]
     pub linear: Option<LinearDto>,
+    /// The rotation field: `incremental` (the paper's updates at the collocation points, default) or
+    /// `objective` (quaternions at the control points: path-independent and objective).
+    #[serde(default)]
+    pub rotations: Option<RotationsDto>,
     /// What drives the path: `time` (the schedules, default) or `arc-length` (Riks/Crisfield continuation of
     /// the loads at `time.end` scaled by a load factor; elastic materials, no programme).
     #[serde(default)]
@@ -850,6 +854,16 @@ pub struct ArcLengthDto {
     /// `cylindrical` (default) or `spherical`.
     #[serde(default)]
     pub constraint: Option<ArcConstraintDto>,
+}
+
+/// Rotation field names.
+#[derive(Debug, Clone, Copy, Deserialize, JsonSchema)]
+#[serde(rename_all = "kebab-case")]
+pub enum RotationsDto {
+    /// Quaternions at the control points, blended and normalised.
+    Objective,
+    /// The paper's incremental updates at the collocation points.
+    Incremental,
 }
 
 /// Linear solver names.

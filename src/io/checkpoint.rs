@@ -50,7 +50,7 @@ pub(crate) const FILE_NAME: &str = crate::io::run_folder::CHECKPOINT_FILE;
 const MAGIC: &[u8; 8] = b"STKCKPT\0";
 
 /// The format version this build writes and reads.
-pub(crate) const VERSION: u32 = 10;
+pub(crate) const VERSION: u32 = 11;
 
 /// Bytes before the payload: magic, version, length.
 const HEADER: usize = 8 + 4 + 8;
@@ -458,6 +458,11 @@ fn encode_state(e: &mut Encoder, s: &State) {
     e.vec3s(&s.kappa);
     e.vec3s(&s.kappa_s);
     e.f64s(&s.multipliers);
+    e.list(&s.orientation, |e, q| {
+        for &x in q.coords.iter() {
+            e.f64(x);
+        }
+    });
 }
 
 fn decode_state(d: &mut Decoder<'_>) -> Result<State, Problem> {
@@ -473,6 +478,15 @@ fn decode_state(d: &mut Decoder<'_>) -> Result<State, Problem> {
         kappa: d.vec3s()?,
         kappa_s: d.vec3s()?,
         multipliers: d.f64s()?,
+        orientation: d.list(32, |d| {
+            let mut v = [0.0; 4];
+            for x in &mut v {
+                *x = d.f64()?;
+            }
+            Ok(crate::math::quaternion_field::Quat::from(
+                nalgebra::Vector4::from(v),
+            ))
+        })?,
     })
 }
 
@@ -794,6 +808,7 @@ mod tests {
             kappa: vec![Vec3::new(0.1, 0.2, 0.3); 2],
             kappa_s: vec![Vec3::new(-1.0, 0.0, 1.0); 2],
             multipliers: vec![1e-20, -3.0],
+            orientation: vec![crate::math::quaternion_field::Quat::new(0.5, -0.5, 0.5, -0.5); 2],
         };
         let solver = Checkpoint {
             model: 0x0123_4567_89ab_cdef,

@@ -449,7 +449,7 @@ pub struct StabilisationSummary {
 
 /// A model's fingerprint as summary.json writes it: `v`, the version of the fingerprint's form
 /// ([`crate::model::fingerprint::VERSION`]), `-` and 16 hex digits of
-/// [`crate::solver::simulation::model_fingerprint`] (`v1-63e8c603b3fbccd4`). The version tells a fingerprint of
+/// [`crate::solver::simulation::model_fingerprint`] (`v2-9e2ebac6ae4221be`). The version tells a fingerprint of
 /// another form — a summary written by a stentkit that hashed the model otherwise (before version 1: 16 hex
 /// digits alone) — from one of another model.
 pub(crate) fn model_fingerprint_text(model: &Model) -> String {

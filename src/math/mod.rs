@@ -10,6 +10,7 @@ pub mod basis;
 pub mod curve;
 pub(crate) mod interp;
 pub mod knots;
+pub mod quaternion_field;
 pub mod quote;
 pub(crate) mod serial;
 pub mod so3;

@@ -339,6 +339,23 @@ pub enum LinearMethod {
     SparseLu,
 }
 
+/// How the section rotations along a rod are represented between its control points
+/// (`crate::math::quaternion_field`'s module docs). The default is still the paper's: the objective field is
+/// path-independent and objective, but less accurate on the 45° bend, inexact for a rod rolled into a circle,
+/// and it failed a stent test and a contact-map case that the paper's field passes (docs/choices.md, issue 36).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, serde::Serialize)]
+pub enum RotationField {
+    /// Unit quaternions at the control points, each the rotation from the reference, blended and normalised:
+    /// the configuration is a function of the control points' positions and rotations alone (path-independent)
+    /// and a rigid rotation strains nothing (objective).
+    Objective,
+    /// The paper's: a rotation and a curvature kept at every collocation point and updated by interpolated
+    /// increments (DESIGN §4 "Updates"), which makes the configuration depend on the increments that led to it
+    /// (Crisfield & Jelenić 1999).
+    #[default]
+    Incremental,
+}
+
 /// What drives the solution along its path: time (the schedules), or the load factor under an arc-length
 /// constraint ([`crate::solver::simulation`] module docs, *Arc-length continuation*).
 #[derive(Debug, Clone, Copy, PartialEq, Default, serde::Serialize)]
@@ -468,6 +485,8 @@ pub struct SolverSettings {
     pub extrapolate: bool,
     /// The linear solver.
     pub linear: LinearMethod,
+    /// How the section rotations along a rod are represented (issue 36).
+    pub rotations: RotationField,
     /// What drives the path: time, or the load factor under an arc-length constraint.
     pub path: PathControl,
     /// Viscous regularisation where Newton stalls (time-driven paths only); `None`: off (the default: a run
@@ -488,6 +507,7 @@ impl Default for SolverSettings {
             max_iterations: 25,
             extrapolate: false,
             linear: LinearMethod::Block,
+            rotations: RotationField::Incremental,
             path: PathControl::Time,
             stabilisation: None,
         }

@@ -30,7 +30,7 @@
 
 pub(crate) use super::actions::{Actions, ReleaseRamp};
 pub(crate) use super::discretisation::point_position;
-use super::discretisation::{CollocationPoint, Discretisation};
+use super::discretisation::{BasisRow, CollocationPoint, Discretisation};
 use super::state::State;
 use super::terms::{Coupled, EndLoad, InteriorLoad, PointView, Terms};
 use crate::material::{ConstitutiveLaw, SectionLaw, SectionStrains};
@@ -500,6 +500,7 @@ impl Assembler {
         }
         let t_th_ss = CM;
         let t_eta_s = ng * Rt;
+        let rotations = RotationBasis::at(disc, state, g);
         for (a, b) in point.basis.iter().enumerate() {
             let col = 6 * (point.first + a);
             let t_eta = match load.couple_position {
@@ -507,12 +508,16 @@ impl Assembler {
                 None => t_eta_s * b[1],
             };
             sink.block(row, col, &(f_eta * b[0] + f_eta_s * b[1] + f_eta_ss * b[2]));
-            sink.block(row, col + 3, &(f_th * b[0] + f_th_s * b[1]));
+            sink.block(
+                row,
+                col + 3,
+                &rotations.block(a, b, &f_th, Some(&f_th_s), None),
+            );
             sink.block(row + 3, col, &t_eta);
             sink.block(
                 row + 3,
                 col + 3,
-                &(t_th * b[0] + t_th_s * b[1] + t_th_ss * b[2]),
+                &rotations.block(a, b, &t_th, Some(&t_th_s), Some(&t_th_ss)),
             );
         }
     }
@@ -667,25 +672,27 @@ impl Assembler {
         let zero_row = nalgebra::RowVector3::zeros();
         for (ei, (e, t)) in node.ends.iter().zip(ends).enumerate() {
             let point = &disc.points[e.point];
+            let rotations = RotationBasis::at(disc, state, e.point);
             for (a, b) in point.basis.iter().enumerate() {
                 let col = 6 * (point.first + a);
                 let mut fe = Bt * t.n_eta_s * b[1];
-                let mut ft = Bt * t.n_th * b[0];
+                let mut ft = rotations.block(a, b, &(Bt * t.n_th), None, None);
                 let mut me = Mat3::zeros();
-                let mut mt = Bt * (t.m_th * b[0] + t.m_th_s * b[1]);
-                // The point terms' loads on the node, `−Bᵀ ∂(f, m)/∂(c, δΘ)` times the basis value.
+                let mut mt = Bt * rotations.block(a, b, &t.m_th, Some(&t.m_th_s), None);
+                // The point terms' loads on the node, `−Bᵀ ∂(f, m)/∂(c, δΘ)` times the basis value (its rotation
+                // matrix for the rotation columns).
                 let load = &t.load;
                 if let Some(block) = load.force_position {
                     fe -= Bt * (block * b[0]);
                 }
                 if let Some(block) = load.force_rotation {
-                    ft -= Bt * (block * b[0]);
+                    ft -= Bt * rotations.block(a, b, &block, None, None);
                 }
                 if let Some(block) = load.moment_position {
                     me -= Bt * (block * b[0]);
                 }
                 if let Some(block) = load.moment_rotation {
-                    mt -= Bt * (block * b[0]);
+                    mt -= Bt * rotations.block(a, b, &block, None, None);
                 }
                 for (i, kr) in kin_rows.iter().enumerate() {
                     let Some(kr) = kr else { continue };
@@ -758,6 +765,81 @@ impl Assembler {
             sink.block(row, c1col + 3, &zero);
             sink.block(row + 3, c1col, &zero);
             sink.block(row + 3, c1col + 3, &(-jl_inv * E * R1));
+        }
+    }
+}
+
+/// What a collocation point's rotation increment and its derivatives are in its control points' rotation
+/// unknowns: `δΘ = Σ_a B_a δθ_a`, `δΘ,s = Σ_a B_a,s δθ_a`, `δΘ,ss = Σ_a B_a,ss δθ_a` — the basis values times the
+/// identity for the paper's incremental field; for the objective field (`crate::math::quaternion_field`,
+/// *Linearisation*; `R = P R0` with `P` the blend of the control points' rotations from the reference, turned
+/// by `R0_a δθ_a`), with `X_a` the blend's matrices and `R0`, `K0`, `K0,s` the point's reference:
+/// ```text
+/// B_a = R0ᵀ X_a R0_a,   B_a,s = R0ᵀ X_a,s R0_a − K̂0 B_a,
+/// B_a,ss = R0ᵀ X_a,ss R0_a − 2 K̂0 R0ᵀ X_a,s R0_a + (K̂0 K̂0 − K̂0,s) B_a
+/// ```
+/// (`(R0ᵀ),s = −K̂0 R0ᵀ`). At a patch end `B_a` is the identity for the end's own control point and zero for the
+/// others, as in the incremental field, so the node rows' kinematic and continuity blocks are the same.
+struct RotationBasis(Option<Vec<[Mat3; 3]>>);
+
+impl RotationBasis {
+    /// The matrices of collocation point `g` at `state`.
+    fn at(disc: &Discretisation, state: &State, g: usize) -> Self {
+        if state.orientation.is_empty() {
+            return Self(None);
+        }
+        let point = &disc.points[g];
+        let quats = &state.orientation[point.first..point.first + point.basis.len()];
+        let q = crate::math::quaternion_field::blend(quats, &point.basis);
+        let r0t = point.rotation0.transpose();
+        let k0 = hat(&point.kappa0);
+        let k0k0 = k0 * k0 - hat(&point.kappa0_s);
+        let matrices = crate::math::quaternion_field::rotation_basis(&q, quats, &point.basis)
+            .into_iter()
+            .enumerate()
+            .map(|(a, [x0, x1, x2])| {
+                let r0a = &disc.points[point.first + a].rotation0;
+                let b0 = r0t * x0 * r0a;
+                let y1 = r0t * x1 * r0a;
+                [b0, y1 - k0 * b0, r0t * x2 * r0a - k0 * y1 * 2.0 + k0k0 * b0]
+            })
+            .collect();
+        Self(Some(matrices))
+    }
+
+    /// The block in control point `a`'s rotation columns (basis row `b`) of a row whose coefficients of `δΘ`,
+    /// `δΘ,s` and `δΘ,ss` are `x0`, `x1`, `x2`: `x0 B_a + x1 B_a,s + x2 B_a,ss`.
+    #[inline]
+    fn block(
+        &self,
+        a: usize,
+        b: &BasisRow,
+        x0: &Mat3,
+        x1: Option<&Mat3>,
+        x2: Option<&Mat3>,
+    ) -> Mat3 {
+        match &self.0 {
+            None => {
+                let mut m = x0 * b[0];
+                if let Some(x1) = x1 {
+                    m += x1 * b[1];
+                }
+                if let Some(x2) = x2 {
+                    m += x2 * b[2];
+                }
+                m
+            }
+            Some(matrices) => {
+                let [b0, b1, b2] = &matrices[a];
+                let mut m = x0 * b0;
+                if let Some(x1) = x1 {
+                    m += x1 * b1;
+                }
+                if let Some(x2) = x2 {
+                    m += x2 * b2;
+                }
+                m
+            }
         }
     }
 }

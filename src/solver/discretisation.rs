@@ -12,7 +12,7 @@ use crate::geometry::frame::{FrameField, FrameSettings};
 use crate::material::{ConstitutiveLaw, SectionShape};
 use crate::math::basis::nurbs_basis;
 use crate::math::{Mat3, Real, Vec3};
-use crate::model::{End, Model, PatchEnd};
+use crate::model::{End, Model, PatchEnd, RotationField};
 
 /// Basis values at one collocation point for one control point: `N`, `N,s`, `N,ss` (arc-length derivatives).
 pub(crate) type BasisRow = [Real; 3];
@@ -76,6 +76,8 @@ pub struct Discretisation {
     pub shapes: Vec<SectionShape>,
     /// Reference control points, globally numbered.
     pub control0: Vec<Vec3>,
+    /// How the section rotations are represented (the model's solver settings; [`super::state::State`]).
+    pub rotations: RotationField,
     /// A length scale of the model (bounding-box diagonal) used to normalise norms \[length\].
     pub length_scale: Real,
 }
@@ -169,6 +171,7 @@ impl Discretisation {
             points,
             shapes,
             control0,
+            rotations: model.solver().rotations,
             length_scale,
         })
     }

@@ -1,10 +1,15 @@
 //! The evolving discrete state: control points (additive updates) and, at every collocation point, the
-//! rotation, the curvature and its arc-length derivative (multiplicative updates, DESIGN §4 "Updates after a
-//! Newton increment").
+//! rotation, the curvature and its arc-length derivative. With the objective rotation field (the default) each
+//! control point also carries its rotation from the reference, a unit quaternion `ρ_a` turned by its increment,
+//! and the collocation points' rotations and curvatures follow from them (`crate::math::quaternion_field`);
+//! with the paper's incremental field they are updated at the collocation points by interpolated increments
+//! (multiplicative updates, DESIGN §4 "Updates after a Newton increment").
 
 use super::discretisation::Discretisation;
+use crate::math::quaternion_field::{self, Quat};
 use crate::math::so3::{exp, right_jacobian_rate};
 use crate::math::{Mat3, Vec3};
+use crate::model::RotationField;
 
 /// The configuration at one instant.
 #[derive(Debug, Clone, PartialEq)]
@@ -19,6 +24,9 @@ pub struct State {
     pub kappa_s: Vec<Vec3>,
     /// Lagrange multipliers of the active gauge constraints ([`super::gauge`]) \[force\].
     pub multipliers: Vec<f64>,
+    /// The control points' rotations from the reference, `ρ_a`, as unit quaternions (the objective field; empty
+    /// for the incremental one; module docs).
+    pub orientation: Vec<Quat>,
 }
 
 impl State {
@@ -30,6 +38,10 @@ impl State {
             kappa: disc.points.iter().map(|p| p.kappa0).collect(),
             kappa_s: disc.points.iter().map(|p| p.kappa0_s).collect(),
             multipliers: Vec::new(),
+            orientation: match disc.rotations {
+                RotationField::Objective => vec![Quat::identity(); disc.points.len()],
+                RotationField::Incremental => Vec::new(),
+            },
         }
     }
 
@@ -40,12 +52,16 @@ impl State {
         self.kappa.clone_from(&other.kappa);
         self.kappa_s.clone_from(&other.kappa_s);
         self.multipliers.clone_from(&other.multipliers);
+        self.orientation.clone_from(&other.orientation);
     }
 
-    /// Applies a Newton increment `δ` (6 per control point: `δη` then `δθ`):
-    /// `p_j ← p_j + δη_j` and, at each collocation point with `δΘ = Σ N_j δθ_j` (and its s-derivatives),
-    /// `R ← R Λ`, `K ← Λᵀ K + w`, `K,s ← Λᵀ K,s − w × (Λᵀ K) + w,s` with `Λ = exp(δΘ̃)`, `w = T(δΘ) δΘ,s`.
-    /// Entries of `delta` past the control points are the multipliers' increments.
+    /// Applies a Newton increment `δ` (6 per control point: `δη` then `δθ`): `p_j ← p_j + δη_j` and, with the
+    /// objective field, `ρ_j ← ρ_j ⊗ exp(R0_j δθ_j / 2)` (`δθ_j` a material increment of the control point's
+    /// rotation `P_j R0_j`, `R0_j` its collocation point's reference rotation) and the collocation points' `R`,
+    /// `K`, `K,s` from them ([`State::sync_rotations`]); with the incremental field, at each collocation point with `δΘ = Σ N_j δθ_j`
+    /// (and its s-derivatives), `R ← R Λ`, `K ← Λᵀ K + w`, `K,s ← Λᵀ K,s − w × (Λᵀ K) + w,s` with
+    /// `Λ = exp(δΘ̃)`, `w = T(δΘ) δΘ,s`. Entries of `delta` past the control points are the multipliers'
+    /// increments.
     pub fn apply_increment(&mut self, disc: &Discretisation, delta: &[f64]) {
         let n = disc.num_unknowns();
         for (m, d) in self
@@ -57,6 +73,24 @@ impl State {
         }
         for (j, p) in self.control.iter_mut().enumerate() {
             *p += Vec3::new(delta[6 * j], delta[6 * j + 1], delta[6 * j + 2]);
+        }
+        if !self.orientation.is_empty() {
+            for (j, q) in self.orientation.iter_mut().enumerate() {
+                let d = Vec3::new(delta[6 * j + 3], delta[6 * j + 4], delta[6 * j + 5]);
+                *q = quaternion_field::turned(q, &(disc.points[j].rotation0 * d));
+            }
+            // `q` and `−q` are the same rotation: each control quaternion is kept in the hemisphere of the one
+            // before it along its patch, so that a large increment (a Newton iterate far from the answer) cannot
+            // leave neighbours on opposite sides and their blend near zero.
+            for range in &disc.patches {
+                for j in range.offset + 1..range.offset + range.n {
+                    if self.orientation[j].dot(&self.orientation[j - 1]) < 0.0 {
+                        self.orientation[j] = -self.orientation[j];
+                    }
+                }
+            }
+            self.sync_rotations(disc);
+            return;
         }
         for (g, point) in disc.points.iter().enumerate() {
             let (mut th, mut th_s, mut th_ss) = (Vec3::zeros(), Vec3::zeros(), Vec3::zeros());
@@ -76,6 +110,22 @@ impl State {
             self.rotation[g] = r * (Mat3::identity() * 1.5 - r.transpose() * r * 0.5);
             self.kappa_s[g] = lt * self.kappa_s[g] - w.cross(&lk) + w_s;
             self.kappa[g] = lk + w;
+        }
+    }
+
+    /// The collocation points' rotations `R`, curvatures `K` and `K,s` from the control points' rotations from
+    /// the reference (the objective field, `crate::math::quaternion_field`): `R = P R0`,
+    /// `K = R0ᵀ ω + K0`, `K,s = R0ᵀ ω,s − K0 × (R0ᵀ ω) + K0,s` with the blend's `P`, `ω`, `ω,s`.
+    pub fn sync_rotations(&mut self, disc: &Discretisation) {
+        for (g, point) in disc.points.iter().enumerate() {
+            let quats = &self.orientation[point.first..point.first + point.basis.len()];
+            let (p, w, w_s) =
+                quaternion_field::kinematics(&quaternion_field::blend(quats, &point.basis));
+            let r0t = point.rotation0.transpose();
+            let k = r0t * w;
+            self.rotation[g] = p * point.rotation0;
+            self.kappa[g] = k + point.kappa0;
+            self.kappa_s[g] = r0t * w_s - point.kappa0.cross(&k) + point.kappa0_s;
         }
     }
 }

@@ -176,7 +176,7 @@ fn a_design_changed_since_the_run_is_not_exported() {
     let out = export_final("old.stl");
     assert_eq!(out.status.code(), Some(2), "{}", text(&out.stderr));
     assert!(
-        text(&out.stderr).contains("holds a model fingerprint of another form (0123456789abcdef; this stentkit writes v1-…)"),
+        text(&out.stderr).contains("holds a model fingerprint of another form (0123456789abcdef; this stentkit writes v2-…)"),
         "{}",
         text(&out.stderr)
     );

@@ -11,7 +11,7 @@ use crate::common::{
 use stentkit::material::ElasticLaw;
 use stentkit::math::{Real, Vec3};
 use stentkit::model::builder::{ConditionSpec, ModelBuilder, NodeEnds, PatchShape, TimeSpec};
-use stentkit::model::{Model, ProbeLocation, SolverSettings, TimeFunction};
+use stentkit::model::{Model, ProbeLocation, RotationField, SolverSettings, TimeFunction};
 use stentkit::solver::Simulation;
 
 /// A model the builder accepts without warnings.
@@ -586,5 +586,78 @@ fn the_elastic_bend_ends_where_it_ends_whatever_the_number_of_load_steps() {
         let d = (tip - tips[0].1).norm() / scale;
         println!("bend45 p = 8, n = 20: tip after {steps} steps vs 20 steps: {d:.2e}");
         assert!(d < 1e-8, "{steps} steps: {d:.2e}");
+    }
+}
+
+/// The 45° bend ([`bend45`]'s fixture) at degree `p` with `n` control points in `steps` load steps, with the
+/// rotation field `rotations` and Newton's tolerance `tolerance`; its tip displacement.
+fn bend45_tip(p: usize, n: usize, steps: usize, rotations: RotationField, tolerance: Real) -> Vec3 {
+    let mut b = fixtures::bend45_builder(1, p, n, steps);
+    b.solver(SolverSettings {
+        rotations,
+        tolerance,
+        ..SolverSettings::default()
+    });
+    let model = built(&b);
+    let (sim, _) = solve(&model);
+    node_displacement(&sim, "tip")
+}
+
+// Issue 36, item 2: with the objective rotation field (`stentkit::math::quaternion_field`) the elastic bend's end
+// state does not depend on the load steps. Source: path independence of an elastic end state; the paper's field
+// (the test above) leaves 4 steps 6e-5 and 10 steps 3e-7 (relative) from 50 at p = 8, n = 20. Here 2, 4, 10 and
+// 40 steps at p = 8, n = 20 against each other, at a Newton tolerance of 1e-12 (the default 1e-9 leaves 1.3e-8
+// between 2 and 10 steps, its stopping rule's error): within 1e-10 relative to the tip's displacement.
+#[test]
+fn with_the_objective_field_the_bend_ends_where_it_ends_whatever_the_load_steps() {
+    let tips: Vec<(usize, Vec3)> = [2, 4, 10, 40]
+        .into_iter()
+        .map(|steps| {
+            (
+                steps,
+                bend45_tip(8, 20, steps, RotationField::Objective, 1e-12),
+            )
+        })
+        .collect();
+    let scale = tips[0].1.norm();
+    for (steps, tip) in &tips[1..] {
+        let d = (tip - tips[0].1).norm() / scale;
+        println!("objective bend45 p = 8, n = 20: tip after {steps} steps vs 2 steps: {d:.2e}");
+        assert!(d < 1e-10, "{steps} steps: {d:.2e}");
+    }
+}
+
+// Issue 36, item 2: the objective field converges to the bend's shooting reference (scripts/bend45_reference.py,
+// accurate to ~1e-11). Measured, absolute errors of the tip displacement (10 load steps; the tip moves ~60),
+// objective against the paper's field: p = 6, n = 20, 40, 80: 6.75e-3 / 6.47e-3, 3.88e-5 / 2.74e-5,
+// 8.98e-7 / 2.16e-7; p = 8: 2.10e-4 / 1.34e-4, 3.16e-6 / 1.85e-7, 1.81e-7 / 2.25e-8. The issue asks for "at
+// least as close as today": not met (up to 17× further at p = 8, n = 40), which is why the objective field is
+// not the default yet (docs/choices.md). Checked here: it converges — each doubling of n from 20 divides the
+// error by at least 16 (measured 17 to 174), and at n = 80 it is within 1e-6 of the reference's 60.
+#[test]
+fn the_objective_field_converges_to_the_shooting_reference() {
+    let reference = bend45_shooting_displacement();
+    for p in [6, 8] {
+        let errors: Vec<(Real, Real)> = [20, 40, 80]
+            .into_iter()
+            .map(|n| {
+                let error = |rotations| (bend45_tip(p, n, 10, rotations, 1e-9) - reference).norm();
+                let (objective, paper) = (
+                    error(RotationField::Objective),
+                    error(RotationField::Incremental),
+                );
+                println!("bend45 p = {p}, n = {n}: objective {objective:.2e}, paper's {paper:.2e}");
+                (objective, paper)
+            })
+            .collect();
+        for pair in errors.windows(2) {
+            assert!(
+                pair[1].0 <= pair[0].0 / 16.0,
+                "p = {p}: {:.2e} after {:.2e}",
+                pair[1].0,
+                pair[0].0
+            );
+        }
+        assert!(errors[2].0 < 1e-6, "p = {p}, n = 80: {:.2e}", errors[2].0);
     }
 }
