@@ -26,6 +26,22 @@ pub fn read_json(path: &Path) -> serde_json::Value {
     serde_json::from_str(&text).unwrap_or_else(|e| panic!("{}: {e}", path.display()))
 }
 
+/// The `(time, value)` pairs of a `history.csv` column.
+pub fn history_column(history: &str, name: &str) -> Vec<(Real, Real)> {
+    let mut lines = history.lines();
+    let header: Vec<&str> = lines.next().expect("a header").split(',').collect();
+    let k = header
+        .iter()
+        .position(|h| *h == name)
+        .unwrap_or_else(|| panic!("no column {name}"));
+    lines
+        .map(|l| {
+            let f: Vec<&str> = l.split(',').collect();
+            (f[0].parse().expect("time"), f[k].parse().expect("value"))
+        })
+        .collect()
+}
+
 /// The text of a design in `designs/`.
 pub fn design_text(name: &str) -> String {
     let path = repo_file(&format!("designs/{name}"));

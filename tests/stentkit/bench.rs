@@ -670,22 +670,8 @@ fn a_z_ring_on_the_radial_bench_matches_the_open_stent_calculator() {
     let summary = crate::common::read_json(&run.join("summary.json"));
     assert_eq!(summary["warnings"], serde_json::json!([]), "{summary}");
     let history = std::fs::read_to_string(run.join("history.csv")).expect("history.csv");
-    let header: Vec<&str> = history
-        .lines()
-        .next()
-        .expect("a header")
-        .split(',')
-        .collect();
-    let column = header
-        .iter()
-        .position(|h| *h == "device_diameter")
-        .expect("the device's diameter");
-    let last: Real = history
-        .lines()
-        .last()
-        .and_then(|l| l.split(',').nth(column))
-        .and_then(|v| v.parse().ok())
-        .expect("a last row");
+    let diameter = crate::common::history_column(&history, "device_diameter");
+    let last = diameter.last().expect("a last row").1;
     let crimp = 0.002 * radius;
     assert!(
         (last - (set + wire)).abs() <= 1e-5 * crimp,

@@ -2,6 +2,7 @@
 //! `history.csv`, its recoil, foreshortening and crowns against the lumen in `summary.json`, checked where a
 //! prescribed programme fixes them exactly.
 
+use crate::common::history_column;
 use crate::mesh::TempDir;
 use std::path::Path;
 use std::process::Command;
@@ -38,8 +39,8 @@ fn a_released_stent_reports_its_recoil_foreshortening_and_crowns_against_its_ves
     );
     let history = std::fs::read_to_string(run.join("history.csv")).expect("history.csv");
     let (diameter, length) = (
-        column(&history, "device_diameter"),
-        column(&history, "device_length"),
+        history_column(&history, "device_diameter"),
+        history_column(&history, "device_length"),
     );
     let at = |series: &[(Real, Real)], t: Real| {
         series
@@ -83,22 +84,6 @@ fn a_released_stent_reports_its_recoil_foreshortening_and_crowns_against_its_ves
         let diameter = number(&c["diameter"]);
         assert!(diameter > 30.0 && diameter <= 36.0 + 2.0 * 0.006, "{c}");
     }
-}
-
-/// The `(time, value)` pairs of a `history.csv` column.
-fn column(history: &str, name: &str) -> Vec<(Real, Real)> {
-    let mut lines = history.lines();
-    let header: Vec<&str> = lines.next().expect("a header").split(',').collect();
-    let k = header
-        .iter()
-        .position(|h| *h == name)
-        .unwrap_or_else(|| panic!("no column {name}"));
-    lines
-        .map(|l| {
-            let f: Vec<&str> = l.split(',').collect();
-            (f[0].parse().expect("time"), f[k].parse().expect("value"))
-        })
-        .collect()
 }
 
 /// Runs the design `name` of `designs/` into `dir` and returns its `summary.json`.
