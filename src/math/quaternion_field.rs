@@ -25,6 +25,16 @@
 //! `ρ_a · ρ_b > 0`: the increments turn them continuously from 1, and a patch rolled into a full circle turns
 //! them by 2π/n apart).
 //!
+//! **Accuracy.** Keeping every `ρ_a` a unit quaternion costs accuracy: the spline of a smoothly turning field
+//! has control quaternions longer than 1 (its control polygon lies outside the sphere), which unit ones cannot
+//! match, and the normalised blend's error then decreases more slowly than the positions' (the 45° bend at
+//! p = 8, n = 40: 3.2e-6 from the shooting reference against the paper's field's 1.9e-7). Interpolating the
+//! rotation vectors `log(P_rᵀ P_a)` relative to one reference rotation per patch instead (Crisfield & Jelenić's
+//! remedy) measured 7.8e-8 there, with the same accuracy as the paper's field at p = 6 (n = 20, 40, 80:
+//! 6.63e-3, 2.82e-5, 2.28e-7 against 6.47e-3, 2.74e-5, 2.16e-7), but only its residual was tried, not its
+//! tangent, and it needs the patch's rotation from its reference to stay below π (a reference per collocation
+//! point instead measured 40 to 800 times further off). Issue 36.
+//!
 //! The functions here are those of the blend `P` alone (`q` below stands for `ρ`); `R0`, `K0` enter where the
 //! solver puts them together (`crate::solver::state::State::sync_rotations` and the assembly's rotation basis).
 //!
