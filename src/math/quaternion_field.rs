@@ -59,14 +59,9 @@ use nalgebra::{Quaternion, UnitQuaternion};
 /// A quaternion `(w, x, y, z)`.
 pub type Quat = Quaternion<Real>;
 
-/// The unit quaternion of the rotation matrix `rotation`, in the hemisphere of `near` (`q · near ≥ 0`) when
-/// given, so that neighbouring control quaternions blend without passing through zero.
-pub fn quaternion_of(rotation: &Mat3, near: Option<&Quat>) -> Quat {
-    let q = UnitQuaternion::from_matrix(rotation).into_inner();
-    match near {
-        Some(n) if q.dot(n) < 0.0 => -q,
-        _ => q,
-    }
+/// The unit quaternion of the rotation matrix `rotation`.
+pub fn quaternion_of(rotation: &Mat3) -> Quat {
+    UnitQuaternion::from_matrix(rotation).into_inner()
 }
 
 /// The rotation matrix of a non-zero quaternion (normalised here).
@@ -157,7 +152,7 @@ mod tests {
             .map(|a| {
                 let a = a as Real;
                 let r = exp(&Vec3::new(0.3 * a, -0.2 * a * a, 0.5));
-                quaternion_of(r.matrix(), None)
+                quaternion_of(r.matrix())
             })
             .collect()
     }
@@ -240,7 +235,7 @@ mod tests {
     #[test]
     fn a_rigid_rotation_turns_the_field_and_keeps_its_curvature() {
         let quats = controls();
-        let r = quaternion_of(exp(&Vec3::new(1.1, -2.0, 0.4)).matrix(), None);
+        let r = quaternion_of(exp(&Vec3::new(1.1, -2.0, 0.4)).matrix());
         let turned: Vec<Quat> = quats.iter().map(|q| r * q).collect();
         for t in [0.0, 0.4, 1.0] {
             let (r0, k0, k0_s) = kinematics(&blend(&quats, &bernstein(t)));

@@ -147,32 +147,28 @@ pub(super) fn perturbed(disc: &Discretisation, state: &State, j: usize, eps: Rea
 // assembled residual, step ε = 1e-6 (truncation O(ε²) ≈ 1e-12 relative, round-off ≈ 1e-16/ε = 1e-10 relative
 // to the residual scale), in a deformed state reached by a random finite increment from the reference.
 // Tolerance: 1e-6 relative to the largest entry of the tangent's row — well above the FD error, far below any
-// missing or wrong term (which shows as O(1) relative errors).
+// missing or wrong term (which shows as O(1) relative errors). With both rotation fields: the objective field's
+// rotation columns carry its matrices `B_a`, `B_a,s`, `B_a,ss` (module docs of the assembly's `RotationBasis`),
+// exercised where the deformed state turns the control points by ~0.3 rad, each differently.
 #[test]
 fn tangent_matches_central_differences_of_the_residual() {
-    let model = test_model();
-    let disc = Discretisation::new(&model).expect("discretisation");
-    let laws = initial_laws(&model, &disc);
-    check_tangent(&model, &disc, &laws, None);
+    with_each_rotation_field(|model, disc, laws| check_tangent(model, disc, laws, None));
 }
 
-// Source: as above, with the objective rotation field (`crate::math::quaternion_field`): the rotation columns'
-// blocks are the field's matrices `B_a`, `B_a,s`, `B_a,ss` (module docs of the assembly's `RotationBasis`),
-// exercised where the deformed state turns the control points by ~0.3 rad, each differently. Same reference and
-// tolerance.
-#[test]
-fn tangent_matches_central_differences_with_the_objective_rotation_field() {
-    let model = test_model_with(RotationField::Objective);
-    let disc = Discretisation::new(&model).expect("discretisation");
-    let laws = initial_laws(&model, &disc);
-    check_tangent(&model, &disc, &laws, None);
+/// Calls `check` with the test structure of each rotation field, its discretisation and its laws at rest.
+fn with_each_rotation_field(check: impl Fn(&Model, &Discretisation, &[SectionLaw])) {
+    for rotations in [RotationField::Incremental, RotationField::Objective] {
+        let model = test_model_with(rotations);
+        let disc = Discretisation::new(&model).expect("discretisation");
+        let laws = initial_laws(&model, &disc);
+        check(&model, &disc, &laws);
+    }
 }
 
-// Source: objectivity (`crate::math::quaternion_field`'s module docs). A rigid rotation `Q` of a deformed state
-// — every control point `c → Q c`, every control rotation `ρ → r ρ` — leaves every strain unchanged, to
-// round-off (1e-12 of the largest strain): the objective field does; the incremental one, given the same
-// rotation of its points' rotations, would too, but the issue is that its deformed states themselves depend on
-// the path, which `tests/stentkit/solver.rs` checks.
+// Source: objectivity (`crate::math::quaternion_field`'s module docs). A rigid rotation `Q` of a deformed state of
+// the objective field — every control point `c → Q c`, every control rotation `ρ → r ρ` — leaves every strain
+// unchanged, to round-off (1e-12 of the largest strain). (That the paper's field's deformed states depend on the
+// path is `tests/stentkit/solver.rs`'s.)
 #[test]
 fn a_rigid_rotation_of_a_deformed_state_leaves_every_strain_unchanged() {
     use crate::math::quaternion_field::quaternion_of;
@@ -180,7 +176,7 @@ fn a_rigid_rotation_of_a_deformed_state_leaves_every_strain_unchanged() {
     let disc = Discretisation::new(&model).expect("discretisation");
     let state = deformed_state(&disc, 0);
     let q = crate::math::so3::exp(&Vec3::new(0.7, -1.9, 2.4));
-    let r = quaternion_of(q.matrix(), None);
+    let r = quaternion_of(q.matrix());
     let mut turned = state.clone();
     for c in &mut turned.control {
         *c = q * *c;
@@ -221,17 +217,14 @@ fn a_rigid_rotation_of_a_deformed_state_leaves_every_strain_unchanged() {
 // relative error. Same reference and tolerance; with both rotation fields.
 #[test]
 fn tangent_matches_central_differences_with_viscous_damping() {
-    for rotations in [RotationField::Incremental, RotationField::Objective] {
-        let model = test_model_with(rotations);
-        let disc = Discretisation::new(&model).expect("discretisation");
-        let laws = initial_laws(&model, &disc);
-        let previous = State::reference(&disc);
+    with_each_rotation_field(|model, disc, laws| {
+        let previous = State::reference(disc);
         let damping = Damping {
             previous: &previous,
             rate: 1e5,
         };
-        check_tangent(&model, &disc, &laws, Some(&damping));
-    }
+        check_tangent(model, disc, laws, Some(&damping));
+    });
 }
 
 // Source: as above, where the temperature varies along the rods: every point's law has a modulus slope `Ē,s`

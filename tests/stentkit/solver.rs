@@ -573,19 +573,24 @@ fn at_the_default_tolerance_newton_leaves_errors_below_it() {
 // with 4 steps it falls from 6e-5 at n = 20 to 2e-7 at n = 40 and 2e-9 at n = 80 (measured).
 #[test]
 fn the_elastic_bend_ends_where_it_ends_whatever_the_number_of_load_steps() {
-    let tips: Vec<(usize, Vec3)> = [20, 25, 40, 50]
-        .into_iter()
-        .map(|steps| {
-            let model = built(&fixtures::bend45_builder(1, 8, 20, steps));
-            let (sim, _) = solve(&model);
-            (steps, node_displacement(&sim, "tip"))
-        })
+    assert_same_tip(&[20, 25, 40, 50], RotationField::Incremental, 1e-9, 1e-8);
+}
+
+/// Asserts that the bend at p = 8, n = 20 with the rotation field `rotations` and Newton's tolerance `tolerance`
+/// ends within `bound` (relative to the tip's displacement) of its first entry's tip after each number of load
+/// steps of `steps`.
+fn assert_same_tip(steps: &[usize], rotations: RotationField, tolerance: Real, bound: Real) {
+    let tips: Vec<Vec3> = (steps.iter())
+        .map(|&s| bend45_tip(8, 20, s, rotations, tolerance))
         .collect();
-    let scale = tips[0].1.norm();
-    for (steps, tip) in &tips[1..] {
-        let d = (tip - tips[0].1).norm() / scale;
-        println!("bend45 p = 8, n = 20: tip after {steps} steps vs 20 steps: {d:.2e}");
-        assert!(d < 1e-8, "{steps} steps: {d:.2e}");
+    let scale = tips[0].norm();
+    for (s, tip) in steps.iter().zip(&tips).skip(1) {
+        let d = (tip - tips[0]).norm() / scale;
+        println!(
+            "bend45 p = 8, n = 20, {rotations:?}: tip after {s} steps vs {}: {d:.2e}",
+            steps[0]
+        );
+        assert!(d < bound, "{s} steps: {d:.2e}");
     }
 }
 
@@ -610,21 +615,7 @@ fn bend45_tip(p: usize, n: usize, steps: usize, rotations: RotationField, tolera
 // between 2 and 10 steps, its stopping rule's error): within 1e-10 relative to the tip's displacement.
 #[test]
 fn with_the_objective_field_the_bend_ends_where_it_ends_whatever_the_load_steps() {
-    let tips: Vec<(usize, Vec3)> = [2, 4, 10, 40]
-        .into_iter()
-        .map(|steps| {
-            (
-                steps,
-                bend45_tip(8, 20, steps, RotationField::Objective, 1e-12),
-            )
-        })
-        .collect();
-    let scale = tips[0].1.norm();
-    for (steps, tip) in &tips[1..] {
-        let d = (tip - tips[0].1).norm() / scale;
-        println!("objective bend45 p = 8, n = 20: tip after {steps} steps vs 2 steps: {d:.2e}");
-        assert!(d < 1e-10, "{steps} steps: {d:.2e}");
-    }
+    assert_same_tip(&[2, 4, 10, 40], RotationField::Objective, 1e-12, 1e-10);
 }
 
 // Issue 36, item 2: the objective field converges to the bend's shooting reference (scripts/bend45_reference.py,
@@ -638,27 +629,23 @@ fn with_the_objective_field_the_bend_ends_where_it_ends_whatever_the_load_steps(
 fn the_objective_field_converges_to_the_shooting_reference() {
     let reference = bend45_shooting_displacement();
     for p in [6, 8] {
-        let errors: Vec<(Real, Real)> = [20, 40, 80]
+        let errors: Vec<Real> = [20, 40, 80]
             .into_iter()
             .map(|n| {
-                let error = |rotations| (bend45_tip(p, n, 10, rotations, 1e-9) - reference).norm();
-                let (objective, paper) = (
-                    error(RotationField::Objective),
-                    error(RotationField::Incremental),
-                );
-                println!("bend45 p = {p}, n = {n}: objective {objective:.2e}, paper's {paper:.2e}");
-                (objective, paper)
+                let e = (bend45_tip(p, n, 10, RotationField::Objective, 1e-9) - reference).norm();
+                println!("bend45 p = {p}, n = {n}, objective field: error {e:.2e}");
+                e
             })
             .collect();
         for pair in errors.windows(2) {
             assert!(
-                pair[1].0 <= pair[0].0 / 16.0,
+                pair[1] <= pair[0] / 16.0,
                 "p = {p}: {:.2e} after {:.2e}",
-                pair[1].0,
-                pair[0].0
+                pair[1],
+                pair[0]
             );
         }
-        assert!(errors[2].0 < 1e-6, "p = {p}, n = 80: {:.2e}", errors[2].0);
+        assert!(errors[2] < 1e-6, "p = {p}, n = 80: {:.2e}", errors[2]);
     }
 }
 
@@ -668,8 +655,9 @@ fn the_objective_field_converges_to_the_shooting_reference() {
 // p ∈ {4, 5, 6}, n ∈ [14, 40] (81 runs each): the paper's field finishes 66, failing at p = 4 for n = 14 … 19,
 // 21 and 25, p = 5 for 14, 15, 16, 20 and 21, and p = 6 for 14 and 17 — a failure that comes and goes with n,
 // not a resolution limit; the objective field finishes 74, all but the coarsest (p = 4, n ≤ 19; p = 5, n = 14).
-// Checked here: completed, nothing warned (no stabilisation, no unrecovered device), and recovered at the end
-// below the run's own threshold (0.1).
+// Checked here on the same mesh cut to two crowns (a small device: 1.9 s), which the paper's field fails at the
+// release (t = 1.7508 s, step 705): completed, nothing warned (no stabilisation, no unrecovered device), and
+// recovered at the end below the run's own threshold (0.1).
 #[test]
 fn with_the_objective_field_a_coarse_straight_stent_finishes_its_cycle() {
     let tmp = crate::mesh::TempDir::new("objective-coarse-stent");
@@ -683,6 +671,8 @@ fn with_the_objective_field_a_coarse_straight_stent_finishes_its_cycle() {
             "--quiet",
             "--set",
             "mesh={p: 5, n: 20}",
+            "--set",
+            "stent.crowns=2",
             "--set",
             "solver.rotations=objective",
         ],
