@@ -860,7 +860,8 @@ pub struct ArcLengthDto {
 #[derive(Debug, Clone, Copy, Deserialize, JsonSchema)]
 #[serde(rename_all = "kebab-case")]
 pub enum RotationsDto {
-    /// Quaternions at the control points, blended and normalised.
+    /// Rotations at the control points, interpolated as rotation vectors relative to a reference rotation per
+    /// patch: objective and path-independent.
     Objective,
     /// The paper's incremental updates at the collocation points.
     Incremental,

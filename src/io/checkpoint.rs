@@ -50,7 +50,7 @@ pub(crate) const FILE_NAME: &str = crate::io::run_folder::CHECKPOINT_FILE;
 const MAGIC: &[u8; 8] = b"STKCKPT\0";
 
 /// The format version this build writes and reads.
-pub(crate) const VERSION: u32 = 11;
+pub(crate) const VERSION: u32 = 12;
 
 /// Bytes before the payload: magic, version, length.
 const HEADER: usize = 8 + 4 + 8;
@@ -463,6 +463,7 @@ fn encode_state(e: &mut Encoder, s: &State) {
             e.f64(x);
         }
     });
+    e.vec3s(&s.relative);
 }
 
 fn decode_state(d: &mut Decoder<'_>) -> Result<State, Problem> {
@@ -487,6 +488,7 @@ fn decode_state(d: &mut Decoder<'_>) -> Result<State, Problem> {
                 nalgebra::Vector4::from(v),
             ))
         })?,
+        relative: d.vec3s()?,
     })
 }
 
@@ -809,6 +811,7 @@ mod tests {
             kappa_s: vec![Vec3::new(-1.0, 0.0, 1.0); 2],
             multipliers: vec![1e-20, -3.0],
             orientation: vec![crate::math::quaternion_field::Quat::new(0.5, -0.5, 0.5, -0.5); 2],
+            relative: vec![Vec3::new(0.25, -3.5, 1e-3); 2],
         };
         let solver = Checkpoint {
             model: 0x0123_4567_89ab_cdef,

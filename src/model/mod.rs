@@ -340,14 +340,14 @@ pub enum LinearMethod {
 }
 
 /// How the section rotations along a rod are represented between its control points
-/// (`crate::math::quaternion_field`'s module docs). The default is still the paper's: the objective field is
-/// path-independent and objective, but less accurate on the 45° bend, inexact for a rod rolled into a circle,
-/// and it failed a stent test and a contact-map case that the paper's field passes (docs/choices.md, issue 36).
+/// (`crate::math::quaternion_field`'s module docs). The default is still the paper's, until every committed
+/// figure has been measured again with the objective field (docs/choices.md, issue 36).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, serde::Serialize)]
 pub enum RotationField {
-    /// Unit quaternions at the control points, each the rotation from the reference, blended and normalised:
-    /// the configuration is a function of the control points' positions and rotations alone (path-independent)
-    /// and a rigid rotation strains nothing (objective).
+    /// Each control point's rotation from the reference; within a patch, their rotation vectors relative to one
+    /// reference rotation of the patch are interpolated (Crisfield & Jelenić's interpolation): the
+    /// configuration is a function of the control points' positions and rotations alone (path-independent) and
+    /// a rigid rotation strains nothing (objective).
     Objective,
     /// The paper's: a rotation and a curvature kept at every collocation point and updated by interpolated
     /// increments (DESIGN §4 "Updates"), which makes the configuration depend on the increments that led to it
@@ -507,7 +507,7 @@ impl Default for SolverSettings {
             max_iterations: 25,
             extrapolate: false,
             linear: LinearMethod::Block,
-            rotations: RotationField::Incremental,
+            rotations: RotationField::default(),
             path: PathControl::Time,
             stabilisation: None,
         }

@@ -153,9 +153,25 @@ pub(crate) struct Assembler {
     interior_total: usize,
 }
 
-/// Tangent entries pushed by one interior collocation point: four 3×3 blocks per control point of its basis.
-fn interior_entry_count(point: &CollocationPoint) -> usize {
-    4 * 9 * point.basis.len()
+/// Tangent entries pushed by one interior collocation point: four 3×3 blocks per control point of its basis, and
+/// two in the rotation columns of each of its patch's reference control points that the objective field's
+/// reference rotation depends on and the basis does not hold ([`RotationBasis`]).
+fn interior_entry_count(disc: &Discretisation, point: &CollocationPoint) -> usize {
+    4 * 9 * point.basis.len() + 2 * 9 * references_outside(disc, point).len()
+}
+
+/// The objective rotation field's reference control points of `point`'s patch
+/// ([`super::discretisation::PatchRange::references`], each once) that lie outside the point's basis: their
+/// rotation columns take blocks of their own ([`RotationBasis`]). Empty for the incremental field.
+fn references_outside(disc: &Discretisation, point: &CollocationPoint) -> Vec<usize> {
+    if disc.rotations != crate::model::RotationField::Objective {
+        return Vec::new();
+    }
+    let mut out: Vec<usize> = (disc.patches[point.patch].references().into_iter())
+        .filter(|&r| r < point.first || r >= point.first + point.basis.len())
+        .collect();
+    out.dedup();
+    out
 }
 
 /// Tangent and residual of one Newton iteration, and the row scales of the residual.
@@ -226,7 +242,7 @@ impl Assembler {
                 if disc.is_end(g) {
                     0
                 } else {
-                    interior_entry_count(point)
+                    interior_entry_count(disc, point)
                 }
             })
             .collect();
@@ -520,6 +536,11 @@ impl Assembler {
                 &rotations.block(a, b, &t_th, Some(&t_th_s), Some(&t_th_ss)),
             );
         }
+        for (r, m) in rotations.outside() {
+            sink.block(row, 6 * r + 3, &combine(m, &f_th, Some(&f_th_s), None));
+            let t = combine(m, &t_th, Some(&t_th_s), Some(&t_th_ss));
+            sink.block(row + 3, 6 * r + 3, &t);
+        }
     }
 
     /// The rows of node `k` (module docs): equilibrium or kinematic conditions in the rows of its first end,
@@ -711,6 +732,27 @@ impl Assembler {
                 sink.block(row1 + 3, col, &me);
                 sink.block(row1 + 3, col + 3, &mt);
             }
+            // The objective field's reference control points outside the end's support: rotation columns only,
+            // and zero in the kinematic rows (they hold the end's own control point).
+            for (r, m) in rotations.outside() {
+                let mut ft = combine(m, &(Bt * t.n_th), None, None);
+                let mut mt = Bt * combine(m, &t.m_th, Some(&t.m_th_s), None);
+                if let Some(block) = t.load.force_rotation {
+                    ft -= Bt * combine(m, &block, None, None);
+                }
+                if let Some(block) = t.load.moment_rotation {
+                    mt -= Bt * combine(m, &block, None, None);
+                }
+                for (i, kr) in kin_rows.iter().enumerate() {
+                    match (kr, i < 3) {
+                        (None, _) => {}
+                        (Some(_), true) => ft.set_row(i, &zero_row),
+                        (Some(_), false) => mt.set_row(i - 3, &zero_row),
+                    }
+                }
+                sink.block(row1, 6 * r + 3, &ft);
+                sink.block(row1 + 3, 6 * r + 3, &mt);
+            }
         }
     }
 
@@ -769,42 +811,76 @@ impl Assembler {
     }
 }
 
-/// What a collocation point's rotation increment and its derivatives are in its control points' rotation
-/// unknowns: `δΘ = Σ_a B_a δθ_a`, `δΘ,s = Σ_a B_a,s δθ_a`, `δΘ,ss = Σ_a B_a,ss δθ_a` — the basis values times the
-/// identity for the paper's incremental field; for the objective field (`crate::math::quaternion_field`,
-/// *Linearisation*; `R = P R0` with `P` the blend of the control points' rotations from the reference, turned
-/// by `R0_a δθ_a`), with `X_a` the blend's matrices and `R0`, `K0`, `K0,s` the point's reference:
+/// What a collocation point's rotation increment and its derivatives are in the rotation unknowns of its control
+/// points (and, with the objective field, of its patch's reference control point): `δΘ = Σ_a B_a δθ_a`,
+/// `δΘ,s = Σ_a B_a,s δθ_a`, `δΘ,ss = Σ_a B_a,ss δθ_a` — the basis values times the identity for the paper's
+/// incremental field; for the objective field (`crate::math::quaternion_field`, *Linearisation*; `R = P R0`
+/// with `P` the field of the control points' rotations from the reference, each turned by `R0_a δθ_a`), with
+/// `X_a` the field's matrices (`Y` for the reference) and `R0`, `K0`, `K0,s` the point's reference:
 /// ```text
 /// B_a = R0ᵀ X_a R0_a,   B_a,s = R0ᵀ X_a,s R0_a − K̂0 B_a,
 /// B_a,ss = R0ᵀ X_a,ss R0_a − 2 K̂0 R0ᵀ X_a,s R0_a + (K̂0 K̂0 − K̂0,s) B_a
 /// ```
 /// (`(R0ᵀ),s = −K̂0 R0ᵀ`). At a patch end `B_a` is the identity for the end's own control point and zero for the
-/// others, as in the incremental field, so the node rows' kinematic and continuity blocks are the same.
-struct RotationBasis(Option<Vec<[Mat3; 3]>>);
+/// others and the reference, as in the incremental field, so the node rows' kinematic and continuity blocks are
+/// the same.
+enum RotationBasis {
+    /// The paper's field: the basis rows themselves.
+    Incremental,
+    /// The objective field: `[B_a, B_a,s, B_a,ss]` per control point of the support and, for each of the
+    /// patch's reference control points outside it ([`references_outside`], in that order), its global index
+    /// and matrices.
+    Objective {
+        support: Vec<[Mat3; 3]>,
+        reference: Vec<(usize, [Mat3; 3])>,
+    },
+}
 
 impl RotationBasis {
     /// The matrices of collocation point `g` at `state`.
     fn at(disc: &Discretisation, state: &State, g: usize) -> Self {
         if state.orientation.is_empty() {
-            return Self(None);
+            return Self::Incremental;
         }
         let point = &disc.points[g];
-        let quats = &state.orientation[point.first..point.first + point.basis.len()];
-        let q = crate::math::quaternion_field::blend(quats, &point.basis);
+        let thetas = &state.relative[point.first..point.first + point.basis.len()];
+        let theta = crate::math::quaternion_field::interpolate(thetas, &point.basis);
+        let (x, y) = crate::math::quaternion_field::rotation_basis(&theta, thetas, &point.basis);
         let r0t = point.rotation0.transpose();
         let k0 = hat(&point.kappa0);
         let k0k0 = k0 * k0 - hat(&point.kappa0_s);
-        let matrices = crate::math::quaternion_field::rotation_basis(&q, quats, &point.basis)
-            .into_iter()
-            .enumerate()
-            .map(|(a, [x0, x1, x2])| {
-                let r0a = &disc.points[point.first + a].rotation0;
-                let b0 = r0t * x0 * r0a;
-                let y1 = r0t * x1 * r0a;
-                [b0, y1 - k0 * b0, r0t * x2 * r0a - k0 * y1 * 2.0 + k0k0 * b0]
-            })
+        let to_unknowns = |[x0, x1, x2]: [Mat3; 3], a: usize| {
+            let r0a = &disc.points[a].rotation0;
+            let b0 = r0t * x0 * r0a;
+            let y1 = r0t * x1 * r0a;
+            [b0, y1 - k0 * b0, r0t * x2 * r0a - k0 * y1 * 2.0 + k0k0 * b0]
+        };
+        // The reference rotation turns by `A_m v_m + A_m+1 v_m+1`: `Y A_m` and `Y A_m+1` are those points'.
+        let range = &disc.patches[point.patch];
+        let middle = range.references();
+        let (_, a) = crate::math::quaternion_field::reference_rotation(
+            &state.orientation[middle[0]],
+            &state.orientation[middle[1]],
+        );
+        let mut support: Vec<[Mat3; 3]> = (x.into_iter().enumerate())
+            .map(|(a, xa)| to_unknowns(xa, point.first + a))
             .collect();
-        Self(Some(matrices))
+        let mut reference: Vec<(usize, [Mat3; 3])> = Vec::new();
+        for (r, am) in middle.into_iter().zip(a) {
+            let b = to_unknowns(y.map(|m| m * am), r);
+            let target = if (point.first..point.first + support.len()).contains(&r) {
+                &mut support[r - point.first]
+            } else if let Some((_, m)) = reference.iter_mut().find(|(q, _)| *q == r) {
+                m
+            } else {
+                reference.push((r, [Mat3::zeros(); 3]));
+                &mut reference.last_mut().expect("just pushed").1
+            };
+            for (m, bm) in target.iter_mut().zip(b) {
+                *m += bm;
+            }
+        }
+        Self::Objective { support, reference }
     }
 
     /// The block in control point `a`'s rotation columns (basis row `b`) of a row whose coefficients of `δΘ`,
@@ -818,8 +894,8 @@ impl RotationBasis {
         x1: Option<&Mat3>,
         x2: Option<&Mat3>,
     ) -> Mat3 {
-        match &self.0 {
-            None => {
+        match self {
+            Self::Incremental => {
                 let mut m = x0 * b[0];
                 if let Some(x1) = x1 {
                     m += x1 * b[1];
@@ -829,19 +905,32 @@ impl RotationBasis {
                 }
                 m
             }
-            Some(matrices) => {
-                let [b0, b1, b2] = &matrices[a];
-                let mut m = x0 * b0;
-                if let Some(x1) = x1 {
-                    m += x1 * b1;
-                }
-                if let Some(x2) = x2 {
-                    m += x2 * b2;
-                }
-                m
-            }
+            Self::Objective { support, .. } => combine(&support[a], x0, x1, x2),
         }
     }
+
+    /// The objective field's reference control points outside the support: each one's global index and
+    /// `[B, B,s, B,ss]` (rows combine them with [`combine`], as [`RotationBasis::block`] does).
+    fn outside(&self) -> impl Iterator<Item = (usize, &[Mat3; 3])> {
+        let reference: &[(usize, [Mat3; 3])] = match self {
+            Self::Objective { reference, .. } => reference,
+            Self::Incremental => &[],
+        };
+        reference.iter().map(|(r, m)| (*r, m))
+    }
+}
+
+/// `x0 B + x1 B,s + x2 B,ss` for `[B, B,s, B,ss]`.
+#[inline]
+fn combine(b: &[Mat3; 3], x0: &Mat3, x1: Option<&Mat3>, x2: Option<&Mat3>) -> Mat3 {
+    let mut m = x0 * b[0];
+    if let Some(x1) = x1 {
+        m += x1 * b[1];
+    }
+    if let Some(x2) = x2 {
+        m += x2 * b[2];
+    }
+    m
 }
 
 /// Per end of a node, the derivatives of its equilibrium terms (spatial) and the point terms' load on it.

@@ -324,13 +324,16 @@ impl BlockSystem {
     /// Analyses the pattern (`(row, column)` per pushed entry, in assembly order) of an `n × n` system whose
     /// first unknowns are the control points of the patches given as `(first control point, count)`, six
     /// unknowns each; unknowns past them join the border. Patches whose interiors reach each other (coupled
-    /// loads, module docs) are one block. `None` when the patches cannot be blocked (a patch of fewer than
-    /// three control points, or past the unknowns) or a coupled block would cost more than [`MAX_BLOCK_WORK`]
-    /// to factorise, so the caller uses the general sparse LU.
+    /// loads, module docs) are one block. The control points `border_points` (the objective rotation field's
+    /// patch references, whose rotation columns every row of their patch reaches) join the border with their six
+    /// unknowns and equations. `None` when the patches cannot be blocked (a patch of fewer than three control
+    /// points, or past the unknowns) or a coupled block would cost more than [`MAX_BLOCK_WORK`] to factorise, so
+    /// the caller uses the general sparse LU.
     pub(crate) fn new(
         n: usize,
         entries: &[(usize, usize)],
         patches: &[(usize, usize)],
+        border_points: &[usize],
     ) -> Result<Option<Self>, SolverError> {
         if entries.len() > u32::MAX as usize || n > u32::MAX as usize {
             return Ok(None);
@@ -342,6 +345,12 @@ impl BlockSystem {
                 return Ok(None);
             }
             patch_of[6 * (first + 1)..6 * (first + count - 1)].fill(Some(k));
+        }
+        for &j in border_points {
+            if 6 * j + 6 > n {
+                return Ok(None);
+            }
+            patch_of[6 * j..6 * j + 6].fill(None);
         }
         // Blocks: the patches joined by interior rows reaching another patch's interior, along a spanning forest
         // of those joins (union–find); a join that would close a cycle (a ring of struts touching all round)
@@ -811,7 +820,7 @@ mod tests {
         }
         let b: Vec<Real> = (0..n).map(|i| (i as Real * 0.61).cos()).collect();
         let solve = |entries: &[(usize, usize)], values: &[Real]| {
-            let mut block = BlockSystem::new(n, entries, &patches)
+            let mut block = BlockSystem::new(n, entries, &patches, &[])
                 .expect("analysed")
                 .expect("blocked");
             block.factor(values).expect("factored");

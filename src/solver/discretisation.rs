@@ -55,6 +55,14 @@ pub struct PatchRange {
 }
 
 impl PatchRange {
+    /// The global indices of the control points whose rotations make the patch's reference rotation for the
+    /// objective rotation field: its middle one twice, or its two middle ones for an even count — the same pair
+    /// whichever end the patch starts from (`crate::math::quaternion_field`, *The reference*).
+    pub fn references(&self) -> [usize; 2] {
+        let m = self.offset + (self.n - 1) / 2;
+        [m, self.offset + self.n / 2]
+    }
+
     /// The global index of the collocation (= control) point at a patch end.
     pub fn end_point(&self, end: End) -> usize {
         match end {

@@ -33,15 +33,17 @@ impl std::fmt::Debug for LinearSystem {
 
 impl LinearSystem {
     /// Analyses the pattern (see [`SparseSystem::new`]) for `method`; `patches` lists each patch's first
-    /// control point and count (see [`BlockSystem::new`]).
+    /// control point and count and `border_points` the control points the block solver puts on its border (see
+    /// [`BlockSystem::new`]).
     pub fn new(
         n: usize,
         entries: &[(usize, usize)],
         patches: &[(usize, usize)],
+        border_points: &[usize],
         method: LinearMethod,
     ) -> Result<Self, SolverError> {
         let block = match method {
-            LinearMethod::Block => BlockSystem::new(n, entries, patches)?,
+            LinearMethod::Block => BlockSystem::new(n, entries, patches, border_points)?,
             LinearMethod::SparseLu => None,
         };
         let sparse = match block {

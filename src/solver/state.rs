@@ -27,6 +27,9 @@ pub struct State {
     /// The control points' rotations from the reference, `ρ_a`, as unit quaternions (the objective field; empty
     /// for the incremental one; module docs).
     pub orientation: Vec<Quat>,
+    /// Their rotation vectors relative to their patch's reference rotation, `θ_a`, unwrapped (the objective field,
+    /// derived from `orientation` by [`State::sync_rotations`]; empty for the incremental one).
+    pub relative: Vec<Vec3>,
 }
 
 impl State {
@@ -42,6 +45,10 @@ impl State {
                 RotationField::Objective => vec![Quat::identity(); disc.points.len()],
                 RotationField::Incremental => Vec::new(),
             },
+            relative: match disc.rotations {
+                RotationField::Objective => vec![Vec3::zeros(); disc.points.len()],
+                RotationField::Incremental => Vec::new(),
+            },
         }
     }
 
@@ -53,6 +60,7 @@ impl State {
         self.kappa_s.clone_from(&other.kappa_s);
         self.multipliers.clone_from(&other.multipliers);
         self.orientation.clone_from(&other.orientation);
+        self.relative.clone_from(&other.relative);
     }
 
     /// Applies a Newton increment `δ` (6 per control point: `δη` then `δθ`): `p_j ← p_j + δη_j` and, with the
@@ -79,16 +87,6 @@ impl State {
                 let d = Vec3::new(delta[6 * j + 3], delta[6 * j + 4], delta[6 * j + 5]);
                 *q = quaternion_field::turned(q, &(disc.points[j].rotation0 * d));
             }
-            // `q` and `−q` are the same rotation: each control quaternion is kept in the hemisphere of the one
-            // before it along its patch, so that a large increment (a Newton iterate far from the answer) cannot
-            // leave neighbours on opposite sides and their blend near zero.
-            for range in &disc.patches {
-                for j in range.offset + 1..range.offset + range.n {
-                    if self.orientation[j].dot(&self.orientation[j - 1]) < 0.0 {
-                        self.orientation[j] = -self.orientation[j];
-                    }
-                }
-            }
             self.sync_rotations(disc);
             return;
         }
@@ -113,14 +111,33 @@ impl State {
         }
     }
 
-    /// The collocation points' rotations `R`, curvatures `K` and `K,s` from the control points' rotations from
-    /// the reference (the objective field, `crate::math::quaternion_field`): `R = P R0`,
-    /// `K = R0ᵀ ω + K0`, `K,s = R0ᵀ ω,s − K0 × (R0ᵀ ω) + K0,s` with the blend's `P`, `ω`, `ω,s`.
+    /// The control points' rotation vectors relative to their patch's reference and, from them, the collocation
+    /// points' rotations `R`, curvatures `K` and `K,s` (the objective field, `crate::math::quaternion_field`):
+    /// `R = P R0`, `K = R0ᵀ ω + K0`, `K,s = R0ᵀ ω,s − K0 × (R0ᵀ ω) + K0,s` with the field's `P`, `ω`, `ω,s`.
     pub fn sync_rotations(&mut self, disc: &Discretisation) {
+        let references: Vec<Quat> = (disc.patches.iter())
+            .map(|range| {
+                let [m, m1] = range.references();
+                let span = range.offset..range.offset + range.n;
+                let (reference, _) = quaternion_field::reference_rotation(
+                    &self.orientation[m],
+                    &self.orientation[m1],
+                );
+                quaternion_field::relative_rotations(
+                    &self.orientation[span.clone()],
+                    &reference,
+                    m - range.offset,
+                    &mut self.relative[span],
+                );
+                reference
+            })
+            .collect();
         for (g, point) in disc.points.iter().enumerate() {
-            let quats = &self.orientation[point.first..point.first + point.basis.len()];
-            let (p, w, w_s) =
-                quaternion_field::kinematics(&quaternion_field::blend(quats, &point.basis));
+            let thetas = &self.relative[point.first..point.first + point.basis.len()];
+            let (p, w, w_s) = quaternion_field::kinematics(
+                &references[point.patch],
+                &quaternion_field::interpolate(thetas, &point.basis),
+            );
             let r0t = point.rotation0.transpose();
             let k = r0t * w;
             self.rotation[g] = p * point.rotation0;

@@ -44,7 +44,7 @@ pub(super) fn test_model_with(rotations: RotationField) -> Model {
             to: Vec3::new(1.2, 0.9, 0.4),
         },
         4,
-        9,
+        12,
     );
     b.joints(JointRule {
         automatic: true,

@@ -611,20 +611,26 @@ fn bend45_tip(p: usize, n: usize, steps: usize, rotations: RotationField, tolera
 // Issue 36, item 2: with the objective rotation field (`stentkit::math::quaternion_field`) the elastic bend's end
 // state does not depend on the load steps. Source: path independence of an elastic end state; the paper's field
 // (the test above) leaves 4 steps 6e-5 and 10 steps 3e-7 (relative) from 50 at p = 8, n = 20. Here 2, 4, 10 and
-// 40 steps at p = 8, n = 20 against each other, at a Newton tolerance of 1e-12 (the default 1e-9 leaves 1.3e-8
-// between 2 and 10 steps, its stopping rule's error): within 1e-10 relative to the tip's displacement.
+// 40 steps at p = 8, n = 20 against each other, at a Newton tolerance of 1e-13 (the default 1e-9 leaves ~1e-8
+// between 2 and 10 steps, its stopping rule's error; 1e-12 left 1.1e-10; 1e-13 leaves 3e-11 to 8e-11, no longer
+// falling with the tolerance: the round-off of the p = 8 system): within 1e-10 relative to the tip's displacement.
 #[test]
 fn with_the_objective_field_the_bend_ends_where_it_ends_whatever_the_load_steps() {
-    assert_same_tip(&[2, 4, 10, 40], RotationField::Objective, 1e-12, 1e-10);
+    assert_same_tip(&[2, 4, 10, 40], RotationField::Objective, 1e-13, 1e-10);
 }
 
 // Issue 36, item 2: the objective field converges to the bend's shooting reference (scripts/bend45_reference.py,
-// accurate to ~1e-11). Measured, absolute errors of the tip displacement (10 load steps; the tip moves ~60),
-// objective against the paper's field: p = 6, n = 20, 40, 80: 6.75e-3 / 6.47e-3, 3.88e-5 / 2.74e-5,
-// 8.98e-7 / 2.16e-7; p = 8: 2.10e-4 / 1.34e-4, 3.16e-6 / 1.85e-7, 1.81e-7 / 2.25e-8. The issue asks for "at
-// least as close as today": not met (up to 17× further at p = 8, n = 40), which is why the objective field is
-// not the default yet (docs/choices.md). Checked here: it converges — each doubling of n from 20 divides the
-// error by at least 16 (measured 17 to 174), and at n = 80 it is within 1e-6 of the reference's 60.
+// accurate to ~1e-11) as the paper's field does. Measured, absolute errors of the tip displacement (10 load steps,
+// Newton tolerance 1e-12; the tip moves ~60), objective / paper's field: p = 6, n = 20, 40, 80: 6.63e-3 /
+// 6.47e-3, 2.82e-5 / 2.74e-5, 2.60e-7 / 2.16e-7; p = 8: 1.50e-4 / 1.34e-4, 8.61e-8 / 1.79e-7, 1.88e-8 /
+// 1.73e-8 (both near the floor the round-off of the p = 8 system sets). So the issue's "at least as close as
+// today" holds at p = 8, n = 40 (2.1 times closer) and misses by 2.5–3 % at p = 6, n = 20 and 40, 9–12 % at
+// p = 8, n = 20 and 80 and 20 % at p = 6, n = 80: two discretisations of the same order with their own constants
+// (the reference rotation's choice moves them too: with the middle control point alone, which breaks the mirror
+// symmetry of a patch with an even count, p = 6, n = 80 measured 2.25e-7 and p = 8, n = 80 6.5e-9). Checked
+// here, both fields solved side by side: each doubling of n divides the objective field's error by at least
+// 2^p, half the rate p + 1 (measured 235 and 108 at p = 6, 1742 at p = 8 from 20 to 40; its last doubling, at the
+// floor, is not held to the rate), and it is nowhere more than 25 % further from the reference than the paper's.
 #[test]
 fn the_objective_field_converges_to_the_shooting_reference() {
     let reference = bend45_shooting_displacement();
@@ -632,20 +638,28 @@ fn the_objective_field_converges_to_the_shooting_reference() {
         let errors: Vec<Real> = [20, 40, 80]
             .into_iter()
             .map(|n| {
-                let e = (bend45_tip(p, n, 10, RotationField::Objective, 1e-9) - reference).norm();
-                println!("bend45 p = {p}, n = {n}, objective field: error {e:.2e}");
-                e
+                let [objective, paper] = [RotationField::Objective, RotationField::Incremental]
+                    .map(|field| (bend45_tip(p, n, 10, field, 1e-12) - reference).norm());
+                println!(
+                    "bend45 p = {p}, n = {n}: error {objective:.2e} (objective), {paper:.2e} (paper's field)"
+                );
+                assert!(
+                    objective <= 1.25 * paper,
+                    "p = {p}, n = {n}: {objective:.2e} against the paper's field's {paper:.2e}"
+                );
+                objective
             })
             .collect();
-        for pair in errors.windows(2) {
+        let rate = (1usize << p) as Real;
+        let held = if p == 8 { 1 } else { 2 };
+        for pair in errors.windows(2).take(held) {
             assert!(
-                pair[1] <= pair[0] / 16.0,
+                pair[1] <= pair[0] / rate,
                 "p = {p}: {:.2e} after {:.2e}",
                 pair[1],
                 pair[0]
             );
         }
-        assert!(errors[2] < 1e-6, "p = {p}, n = 80: {:.2e}", errors[2]);
     }
 }
 
