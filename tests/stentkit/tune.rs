@@ -95,3 +95,41 @@ fn a_tuned_arch_stays_within_its_tolerance_of_the_paper_settings() {
     assert!(String::from_utf8_lossy(&again.stderr).contains("exists; pass --force to replace it"));
     assert_eq!(std::fs::read_to_string(&tuned_path).expect("kept"), text);
 }
+
+// Issue 36 item 1: tune treats a model that folds as unresolved. The 45° bend overloaded to a tip force of 3000
+// in steps of 0.5 with no cut allowed and a damping factor given outright (1e9: the stabilisation test
+// `overloaded_bend`'s case, where every step stalls and the damping carries the load, which the run warns of)
+// folds in every error-controlled run of tune's time stage: each such comparison must be refused, saying that
+// the run folds, and with no other candidate tune must fail, naming the fold, rather than choose a model whose
+// results the damping made.
+#[test]
+fn tune_does_not_choose_a_model_that_folds() {
+    let dir = TempDir::new("tune-fold");
+    let design = crate::common::fixtures::bend45()
+        .set("conditions[1].force", "[0, 0, [[0, 0], [1, 3000]]]")
+        .time(1.0, 0.5)
+        .set("time.min_step", "0.5")
+        .set("solver.stabilisation", "{factor: 1.0e9}")
+        .write(&dir.join("bend45_folds.yaml"));
+    let out = Command::new(env!("CARGO_BIN_EXE_stentkit"))
+        .arg("tune")
+        .arg(&design)
+        .args(["--tol", "1e-3", "--degrees", "6", "--max-points", "40"])
+        .output()
+        .expect("stentkit runs");
+    let (stdout, stderr) = (
+        String::from_utf8_lossy(&out.stdout),
+        String::from_utf8_lossy(&out.stderr),
+    );
+    assert!(!out.status.success(), "{stdout}{stderr}");
+    let time_trials: Vec<&str> = stdout.lines().filter(|l| l.starts_with("time")).collect();
+    assert!(!time_trials.is_empty(), "{stdout}");
+    for line in &time_trials {
+        assert!(line.contains("folds") && line.ends_with("no"), "{line}");
+    }
+    assert!(
+        stderr.contains("folds (unresolved)")
+            && stderr.contains("the damping, not the structure, carried the load"),
+        "{stderr}"
+    );
+}
