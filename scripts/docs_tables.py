@@ -584,6 +584,29 @@ def contact_map():
     return head + "\n" + table(header, body)
 
 
+def meshes_map():
+    """docs/speed.md: the meshes map of the stability study (the straight stent's cycle on coarse meshes), per
+    rotation field: how many meshes finish and where the others fail."""
+    asset = "assets/stability/meshes.csv"
+    head = stamp(asset)  # first: the asset must be the one its provenance describes
+    data, _ = rows(asset)
+    release = 1.75
+
+    def where(t):
+        return "before the release" if t < release else "at the release" if t <= release + 0.01 else "in the recovery"
+
+    body = []
+    for flag, field in (("0", "paper's (`incremental`)"), ("1", "`objective`")):
+        runs = [r for r in data if r["objective_rotations"] == flag]
+        failed = [r for r in runs if r["completed"] != "true"]
+        cells = "; ".join(
+            f"p = {r['p']}, n = {r['n']} {where(float(r['time_reached']))} ({float(r['time_reached']):.3f} s)"
+            for r in failed
+        )
+        body.append([field, str(len(runs)), str(len(runs) - len(failed)), cells or "none"])
+    return head + "\n" + table(["rotation field", "meshes", "finish", "failing"], body)
+
+
 def contact_speed():
     """README and docs/speed.md: the crimped straight stent against the prescribed one, and contact's share."""
     speed, share = "assets/contact_speed.csv", "assets/contact_share.csv"
@@ -769,6 +792,7 @@ GENERATORS = {
     "wires-speed": wires_speed,
     "bench-study": bench_study,
     "contact-map": contact_map,
+    "meshes-map": meshes_map,
     "contact-speed": contact_speed,
     "curved-sensitivity": curved_sensitivity,
     "print-solids": print_solids,

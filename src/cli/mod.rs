@@ -527,7 +527,8 @@ pub(crate) enum StudyCommand {
         /// refused, exit status 2; other files in the folder are never touched).
         #[arg(long)]
         force: bool,
-        /// Maps to draw: any of material, bend45, heating, release, coarse, contact.
+        /// Maps to draw: any of material, bend45, heating, release, coarse, contact, meshes (the straight
+        /// stent's cycle on 81 meshes with each rotation field, about 20 minutes: not drawn unless named).
         #[arg(
             long,
             value_delimiter = ',',

@@ -1059,6 +1059,7 @@ fn suggestions(model: &crate::model::Model, failure: &FailureReport) -> Vec<Stri
             .iter()
             .position(|p| w.contains(&format!("`{}`", p.name)))
     });
+    let mut refine_named = false;
     if let Some(index) = worst {
         let patch = &model.patches[index];
         let d = model.sections[patch.section].diameter();
@@ -1066,6 +1067,7 @@ fn suggestions(model: &crate::model::Model, failure: &FailureReport) -> Vec<Stri
             .fit_error
             .is_some_and(|e| e > crate::model::builder::FIT_WARNING_FRACTION * d)
         {
+            refine_named = true;
             out.push(format!(
                 "more control points on patch `{}` (`mesh.n`, now {}): its spline fit deviates {:.1} % of the wire diameter from the curve",
                 patch.name,
@@ -1080,6 +1082,19 @@ fn suggestions(model: &crate::model::Model, failure: &FailureReport) -> Vec<Stri
                 patch.name
             ));
         }
+    }
+    // A coarse model's own path can fold where the converged model's does not (issue 36: the straight stent's
+    // meshes map), which a smaller step does not cure and stabilisation only carries the run through.
+    if let Some(patch) = (!refine_named)
+        .then(|| worst.or((!model.patches.is_empty()).then_some(0)))
+        .flatten()
+        .map(|k| &model.patches[k])
+    {
+        out.push(format!(
+            "a finer mesh (`mesh.n`, now {} with p = {}): a coarse model's own equilibrium path can fold where a finer one's does not (`stentkit tune` finds the mesh that resolves the results)",
+            patch.curve.num_points(),
+            patch.curve.degree()
+        ));
     }
     if model.solver().stabilisation.is_none() {
         out.push(

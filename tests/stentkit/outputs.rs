@@ -635,7 +635,8 @@ fn failed_run_leaves_every_file_valid() {
         "{stderr}"
     );
     // Issue 19 item 5: the residuals printed once, the equation where the residual is largest named (a moment
-    // balance inside patch `bend`, which the overload bends), and what to change.
+    // balance inside patch `bend`, which the overload bends), and what to change — a finer mesh among it (issue
+    // 38 item 3: the cure of the coarse stents that fail, issue 36's meshes map).
     assert_eq!(
         stderr.matches("normalised residuals [").count(),
         1,
@@ -645,6 +646,7 @@ fn failed_run_leaves_every_file_valid() {
         stderr.contains("largest residual: in the equation of patch `bend`, collocation point")
             && stderr.contains("moment balance")
             && stderr.contains("try: a smaller `time.step` (now 0.1 s)")
+            && stderr.contains("or a finer mesh (`mesh.n`, now 20 with p = 6)")
             && stderr.contains("or automatic stabilisation")
             && stderr.contains("no convergence in step 4 to t = 0.4 s (the failure report above)"),
         "{stderr}"

@@ -699,3 +699,46 @@ fn with_the_objective_field_a_coarse_straight_stent_finishes_its_cycle() {
     let (t, last) = *recovery.last().expect("rows");
     assert!((t - 3.25).abs() < 1e-9 && last < 0.1, "{t}: {last}");
 }
+
+// Issue 36 item 1's map in `study stability` (`--maps meshes`), on the test above's mesh cut to two crowns: the
+// paper's field fails at the release there (t = 1.7508 s, measured) and the objective field finishes, and the
+// map's paragraph counts them so, per field, naming the phase of the failure.
+#[test]
+fn the_meshes_map_counts_the_coarse_stent_that_fails_with_the_papers_field_only() {
+    use stentkit::model::RotationField;
+    use stentkit::study::stability::scenarios::{MeshCase, meshes_map, meshes_report};
+    let cases = [RotationField::Incremental, RotationField::Objective].map(|rotations| MeshCase {
+        p: 5,
+        n: 20,
+        rotations,
+    });
+    let map = meshes_map(
+        &cases,
+        Some(2),
+        &stentkit::design::variants::read_varied,
+        |_| {},
+    )
+    .expect("runs");
+    let [paper, objective] = &map.points[..] else {
+        panic!("two runs");
+    };
+    assert!(
+        !paper.run.completed && (paper.run.time - 1.75).abs() < 0.01,
+        "{:?}",
+        paper.run
+    );
+    assert!(objective.run.completed, "{:?}", objective.run);
+    let report = meshes_report(&map);
+    assert!(
+        report.summary.contains("**incremental** rotation field: 0 of 1 meshes finish the cycle; failing: p = 5, n = 20 at the release")
+            && report.summary.contains("**objective** rotation field: 1 of 1 meshes finish the cycle."),
+        "{}",
+        report.summary
+    );
+    assert_eq!(
+        report.csv.lines().count(),
+        2 + cases.len(),
+        "{}",
+        report.csv
+    );
+}

@@ -1,7 +1,7 @@
 //! The stability study: where each method fails and what the program does there (DESIGN §4, §6;
 //! `stentkit study stability`).
 //!
-//! Six maps, each a CSV, an SVG chart and a paragraph of `stability.md` ([`MapReport`]):
+//! Seven maps, each a CSV, an SVG chart and a paragraph of `stability.md` ([`MapReport`]):
 //!
 //! * **material** ([`material`]) — one Maxwell branch (`E∞ = E₁ = 1`) after a unit strain jump, for `h/τ` from
 //!   `1e-2` to `1e4`, with the rod's own integrators, held at constant temperature or held while cooling, against
@@ -20,8 +20,11 @@
 //! * **contact** ([`contact`]) — one crown of the straight stent crimped by a rigid cylinder, held and released
 //!   (issue 33), at several time steps and contact penalties: points entering contact while the crimper closes
 //!   and leaving it while it opens; failed attempts and the smallest step in each phase.
+//! * **meshes** — the straight stent's whole cycle at p ∈ {4, 5, 6}, n ∈ [14, 40] with each rotation field
+//!   (issue 36): which meshes finish and where the others fail (about 20 minutes: not among the default maps
+//!   of `stentkit study stability`, and empty in [`StabilityStudy::default`]).
 //!
-//! bend45, heating, release and coarse are [`scenarios`] run through [`newton::newton_run`], which records what
+//! bend45, heating, release, coarse and meshes are [`scenarios`] run through [`newton::newton_run`], which records what
 //! the solver did; contact is built in code ([`contact::crimped_crown`]) and run the same way.
 
 pub mod contact;
@@ -71,6 +74,8 @@ pub struct StabilityStudy {
     pub coarse: Vec<(scenarios::CoarseDesign, usize, usize)>,
     /// The runs of the crimped crown.
     pub contact: Vec<contact::ContactCase>,
+    /// The runs of the meshes map ([`scenarios::stent_meshes`] for the whole map; empty by default).
+    pub meshes: Vec<scenarios::MeshCase>,
 }
 
 impl Default for StabilityStudy {
@@ -145,6 +150,7 @@ impl Default for StabilityStudy {
             .into_iter()
             .map(|(h, penalty)| contact::ContactCase { h, penalty })
             .collect(),
+            meshes: Vec::new(),
         }
     }
 }
@@ -155,7 +161,7 @@ impl Default for StabilityStudy {
 pub type ReadDesign = dyn Fn(&str, &Path) -> Result<Box<dyn VariedDesign>, StudyError>;
 
 /// Runs every map of `study` whose list is not empty, in the order material, bend45, heating, release, coarse,
-/// contact. Each finished map is handed to `done` (which writes it), so the maps finished before a failure are
+/// contact, meshes. Each finished map is handed to `done` (which writes it), so the maps finished before a failure are
 /// kept; the text of `stability.md` (a title and every map's paragraph) is returned. `read` reads the embedded
 /// designs the maps vary; `progress` is told about each run.
 ///
@@ -209,6 +215,12 @@ pub fn stability<E: From<StudyError>>(
     if !study.contact.is_empty() {
         let map = contact::contact_map(&study.contact, &mut progress)?;
         let report = contact::contact_report(&map);
+        done(&report)?;
+        summary.push_str(&report.summary);
+    }
+    if !study.meshes.is_empty() {
+        let map = scenarios::meshes_map(&study.meshes, None, read, &mut progress)?;
+        let report = scenarios::meshes_report(&map);
         done(&report)?;
         summary.push_str(&report.summary);
     }

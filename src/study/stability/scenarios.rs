@@ -10,8 +10,8 @@ use super::newton::{
 use super::{MapReport, ReadDesign};
 use crate::math::Real;
 use crate::model::{
-    ArcLengthSettings, Model, PathControl, SolverSettings, StabilisationSettings, TimeFunction,
-    TimeSettings,
+    ArcLengthSettings, Model, PathControl, RotationField, SolverSettings, StabilisationSettings,
+    TimeFunction, TimeSettings,
 };
 use crate::study::variant::{Remesh, TimeVariant, VariedDesign};
 use crate::study::{StudyError, positive};
@@ -490,6 +490,153 @@ pub fn release_report(map: &SolverMap) -> MapReport {
             1,
             "release ramp [s]",
             &[2, 0, 3, 4],
+        ),
+        summary,
+    }
+}
+
+/// One run of the meshes map (issue 36 item 1): the straight stent as designed (its whole cycle) but for its
+/// degree, control points per patch and rotation field.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct MeshCase {
+    /// Degree `p`.
+    pub p: usize,
+    /// Control points per patch `n`.
+    pub n: usize,
+    /// The rotation field.
+    pub rotations: RotationField,
+}
+
+/// The meshes map's cases: p ∈ {4, 5, 6}, n ∈ [14, 40], with each rotation field (162 runs of the six-crown
+/// stent: about 20 minutes on one core).
+pub fn stent_meshes() -> Vec<MeshCase> {
+    let mut cases = Vec::new();
+    for rotations in [RotationField::Incremental, RotationField::Objective] {
+        for p in 4..=6 {
+            cases.extend((14..=40).map(|n| MeshCase { p, n, rotations }));
+        }
+    }
+    cases
+}
+
+/// The straight stent's whole cycle at each mesh and rotation field of `cases`, with `crowns` crowns instead of
+/// the design's when given.
+pub fn meshes_map(
+    cases: &[MeshCase],
+    crowns: Option<usize>,
+    read: &ReadDesign,
+    mut progress: impl FnMut(&str),
+) -> Result<SolverMap, StudyError> {
+    let stent = embedded(read, designs::STRAIGHT_STENT, "straight_stent.yaml")?;
+    let mut points = Vec::new();
+    for &MeshCase { p, n, rotations } in cases {
+        let remesh = Remesh {
+            degree: Some(p),
+            points: Some(n),
+            crowns,
+        };
+        let model = stent.rebuild(&remesh)?;
+        let solver = SolverSettings {
+            rotations,
+            ..model.solver().clone()
+        };
+        let model = model.with_solver(solver)?;
+        let run = newton_run(&model)?;
+        progress(&format!(
+            "straight stent, p = {p}, n = {n}, {} rotation field: {}",
+            field_name(rotations),
+            describe(&run)
+        ));
+        points.push(SolverPoint {
+            parameters: vec![
+                p as Real,
+                n as Real,
+                Real::from(u8::from(rotations == RotationField::Objective)),
+            ],
+            run,
+        });
+    }
+    Ok(SolverMap {
+        name: "meshes",
+        columns: vec!["p", "n", "objective_rotations"],
+        points,
+    })
+}
+
+/// The design-language name of a rotation field.
+fn field_name(rotations: RotationField) -> &'static str {
+    match rotations {
+        RotationField::Incremental => "incremental",
+        RotationField::Objective => "objective",
+    }
+}
+
+/// Where in the stent's cycle a failure at `t` falls: before, at (within 0.01 s of) or after the release.
+fn phase(t: Real) -> &'static str {
+    if t < RELEASE {
+        "before the release"
+    } else if t <= RELEASE + 0.01 {
+        "at the release"
+    } else {
+        "in the recovery"
+    }
+}
+
+/// The meshes map's report: per rotation field, how many meshes finish the cycle and where each other one failed.
+pub fn meshes_report(map: &SolverMap) -> MapReport {
+    let mut summary = format!(
+        "## meshes: the straight stent's whole cycle on coarse meshes, with each rotation field ({0}.csv, {0}.svg)\n\n",
+        map.name
+    );
+    for (flag, field) in [
+        (0.0, RotationField::Incremental),
+        (1.0, RotationField::Objective),
+    ] {
+        let runs: Vec<&SolverPoint> = (map.points.iter())
+            .filter(|q| q.parameters[2] == flag)
+            .collect();
+        if runs.is_empty() {
+            continue;
+        }
+        let finished = runs.iter().filter(|q| q.run.completed).count();
+        let _ = write!(
+            summary,
+            "- **{}** rotation field: {finished} of {} meshes finish the cycle",
+            field_name(field),
+            runs.len()
+        );
+        let failed: Vec<String> = (runs.iter().filter(|q| !q.run.completed))
+            .map(|q| {
+                format!(
+                    "p = {}, n = {} {} (t = {:.4} s)",
+                    q.parameters[0],
+                    q.parameters[1],
+                    phase(q.run.time),
+                    q.run.time
+                )
+            })
+            .collect();
+        if failed.is_empty() {
+            summary.push_str(".\n");
+        } else {
+            let _ = writeln!(summary, "; failing: {}.", failed.join("; "));
+        }
+    }
+    summary.push_str(
+        "\nThe stent (designs/straight_stent.yaml) runs its whole programme — crimped, cooled, released at 1.75 s, re-heated — at each degree and number of control points per patch, Newton alone (no stabilisation). A failure is the solver's: no convergence at the smallest step. The paper's field's failures come and go with n, which a resolution limit would not do: its discrete configuration depends on the increments that led to it (docs/choices.md, *Rotation field*). Where the objective field fails the meshes are the coarsest; the release map (`--maps release`) shows one of them (p = 5, n = 14) folding in its own release path.\n\n",
+    );
+    MapReport {
+        name: map.name,
+        csv: solver_csv(
+            map,
+            "the straight stent's whole cycle (designs/straight_stent.yaml) at each degree p, control points per patch n and rotation field (objective_rotations: 1 for the objective field, 0 for the paper's)",
+        ),
+        chart: solver_chart(
+            map,
+            "the straight stent on coarse meshes: Newton against n",
+            1,
+            "control points per patch n",
+            &[0, 2],
         ),
         summary,
     }
