@@ -782,7 +782,8 @@ pub struct SolverDto {
     #[serde(default)]
     pub linear: Option<LinearDto>,
     /// The rotation field: `incremental` (the paper's updates at the collocation points, default) or
-    /// `objective` (quaternions at the control points: path-independent and objective).
+    /// `objective` (rotations at the control points interpolated relative to a reference rotation per patch:
+    /// path-independent and objective).
     #[serde(default)]
     pub rotations: Option<RotationsDto>,
     /// What drives the path: `time` (the schedules, default) or `arc-length` (Riks/Crisfield continuation of

@@ -812,7 +812,8 @@ impl Assembler {
 }
 
 /// What a collocation point's rotation increment and its derivatives are in the rotation unknowns of its control
-/// points (and, with the objective field, of its patch's reference control point): `δΘ = Σ_a B_a δθ_a`,
+/// points (and, with the objective field, of the one or two control points its patch's reference rotation is
+/// made of): `δΘ = Σ_a B_a δθ_a`,
 /// `δΘ,s = Σ_a B_a,s δθ_a`, `δΘ,ss = Σ_a B_a,ss δθ_a` — the basis values times the identity for the paper's
 /// incremental field; for the objective field (`crate::math::quaternion_field`, *Linearisation*; `R = P R0`
 /// with `P` the field of the control points' rotations from the reference, each turned by `R0_a δθ_a`), with

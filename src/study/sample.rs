@@ -95,9 +95,10 @@ pub struct WatchedRun {
     pub states: Vec<Watched>,
     /// Wall time of the run \[s\].
     pub wall: Real,
-    /// The stabilisation's warnings at the end (the damping carried the load, a fold the undamped model does
-    /// not pass quasi-statically: [`Simulation::stabilisation_warnings`]); empty when it did not.
-    pub folded: Vec<String>,
+    /// The stabilisation's warnings at the end ([`Simulation::stabilisation_warnings`]: the damping carried the
+    /// load or dissipated more than its limit — a fold or snap the run did not pass quasi-statically — or could
+    /// not be scaled); empty when it did not warn.
+    pub stabilised: Vec<String>,
     /// The solver's totals.
     pub summary: RunSummary,
 }
@@ -126,7 +127,7 @@ pub fn watched_run(
     Ok(WatchedRun {
         states: watch.states,
         wall: started.elapsed().as_secs_f64(),
-        folded: sim.stabilisation_warnings(),
+        stabilised: sim.stabilisation_warnings(),
         summary,
     })
 }

@@ -39,10 +39,11 @@
 //!    tolerance, `n` goes one rung up and steps 2–3 are repeated, the time ladder starting at the tolerance
 //!    just chosen (at most [`MAX_ROUNDS`] rounds, else tune fails and says what it reached).
 //!
-//! **Folds.** A run that fails is unresolved, and so is one the stabilisation carried through a fold (its
-//! warning that the damping carried the load: the coarse straight stent at p = 5, n = 14 folds at its release
-//! and follows a branch of its own): a comparison with such a run, as the candidate or as the finer one, is
-//! not accepted, and the trial says why.
+//! **Folds.** A run that fails is unresolved, and so is one whose stabilisation warned (the damping carried the
+//! load or dissipated more than its limit: a fold or snap the run did not pass quasi-statically, as the coarse
+//! straight stent at p = 5, n = 14 folds at its release and follows a branch of its own; or the damping could
+//! not be scaled): a comparison with such a run, as the candidate or as the finer one, is not accepted, and the
+//! trial says why.
 //!
 //! The expected saving compares the tuned run's wall time (measured, step 2) with the design's own settings:
 //! measured over the first twentieth of its fixed steps and extrapolated to all of them (run in full when the
@@ -301,14 +302,16 @@ impl Runner<'_> {
                 let d = difference(&a.states, &b.states, &self.names);
                 trial.accepted = d.value <= share;
                 trial.difference = Some(d);
-                // A run the stabilisation carried through a fold followed a path of its own: its difference
-                // says nothing of its resolution (module docs, *Folds*).
+                // A run whose stabilisation warned followed a path of its own: its difference says nothing of
+                // its resolution (module docs, *Folds*).
                 if let Some((key, warning)) = [(candidate, a), (finer, b)]
                     .into_iter()
-                    .find_map(|(key, run)| run.folded.first().map(|w| (key, w)))
+                    .find_map(|(key, run)| run.stabilised.first().map(|w| (key, w)))
                 {
                     trial.accepted = false;
-                    trial.failure = Some(format!("{key} folds (unresolved): {warning}"));
+                    trial.failure = Some(format!(
+                        "{key} folds or snaps (unresolved, the stabilisation warned): {warning}"
+                    ));
                 }
             }
         }

@@ -694,18 +694,19 @@ time: {end: 1, step: 0.5}
 }
 
 // Reference: the general sparse LU of the whole system (faer). The block solver (banded LU per patch interior,
-// sparse LU of the Schur complement on the patch ends and the gauge multipliers) must solve the same linear
-// systems. Both runs start from the same state and take the same steps: pulled in over [0, 0.5], released at
-// 0.75 (so the free device's gauge multipliers join the border) up to t = 0.7526, a few steps after the release
-// (the elastic crown then springs back through a near-bifurcation where 1e-9 differences grow, so we stop before
-// it: the paper's rotation field gets through it after five step cuts, the objective field fails there at the
-// smallest step, t = 0.7529, with either solver and in the half and full models too). Each
-// solution of a linear system differs from the other solver's by round-off times the condition number of these
-// slender-rod collocation systems (~1e9 measured as 1e-10 relative differences of the converged displacements
-// before the release), and the Newton iterations stop within the tolerance (1e-9 of the patch length, ~5e-9 mm).
-// We require 1e-8 mm on displacements of ~3 mm at every step, and 1e-6 relative on one Newton increment solved
-// by both at the last state: a wrong block (a misplaced entry, a missing coupling) gives differences of the
-// order of the solution itself.
+// sparse LU of the Schur complement on the patch ends, the gauge multipliers and, with the objective rotation
+// field, the patch references' control points) must solve the same linear systems. Both runs start from the
+// same state and take the same steps: pulled in over [0, 0.5], released at 0.75 (so the free device's gauge
+// multipliers join the border) up to the second step after the release with the paper's rotation field, t =
+// 0.757 (the elastic crown then springs back through a near-bifurcation where 1e-9 differences grow, so we stop
+// before it), and up to t = 0.7526 with the objective field, which fails there at the smallest step (t = 0.7529,
+// with either solver and in the half and full models too, where the paper's field gets through after five step
+// cuts). Each solution of a linear system differs from the other solver's by round-off times the condition
+// number of these slender-rod collocation systems (~1e9 measured as 1e-10 relative differences of the converged
+// displacements before the release), and the Newton iterations stop within the tolerance (1e-9 of the patch
+// length, ~5e-9 mm). We require 1e-8 mm on displacements of ~3 mm at every step, and 1e-6 relative on one Newton
+// increment solved by both at the last state: a wrong block (a misplaced entry, a missing coupling, a border
+// point's column left out) gives differences of the order of the solution itself.
 #[test]
 fn block_solver_matches_the_sparse_lu() {
     let layout = "spacing: 10
@@ -713,14 +714,31 @@ fn block_solver_matches_the_sparse_lu() {
   centreline: {straight: {origin: [0, 0, 0], direction: [1, 0, 0], reference: [0, 1, 0]}}";
     let programme =
         "{kind: radial_contraction, nodes: crown_1, delta_r: 0.6, ramp: [0, 0.5], release: 0.75}";
-    let block = small_stent(layout, "symmetry: quarter", programme);
-    let sparse = block
-        .clone()
-        .with_solver(stentkit::model::SolverSettings {
-            linear: stentkit::model::LinearMethod::SparseLu,
-            ..block.solver().clone()
-        })
-        .expect("valid settings");
+    let base = small_stent(layout, "symmetry: quarter", programme);
+    for (rotations, until) in [
+        (stentkit::model::RotationField::Incremental, 0.757),
+        (stentkit::model::RotationField::Objective, 0.7526),
+    ] {
+        let with = |linear| {
+            base.clone()
+                .with_solver(stentkit::model::SolverSettings {
+                    linear,
+                    rotations,
+                    ..base.solver().clone()
+                })
+                .expect("valid settings")
+        };
+        let (block, sparse) = (
+            with(stentkit::model::LinearMethod::Block),
+            with(stentkit::model::LinearMethod::SparseLu),
+        );
+        compare_solvers(&block, &sparse, until, &format!("{rotations:?}"));
+    }
+}
+
+/// Runs `block` and `sparse` (one model with each linear solver) to `until` and asserts that their displacements
+/// agree at every step and one Newton increment at the last state ([`block_solver_matches_the_sparse_lu`]).
+fn compare_solvers(block: &Model, sparse: &Model, until: Real, label: &str) {
     /// Every node's displacement after every step, up to a given time.
     struct Histories(Vec<Vec3>, Real);
     impl Observer for Histories {
@@ -738,13 +756,13 @@ fn block_solver_matches_the_sparse_lu() {
     let mut methods = Vec::new();
     let mut increments = Vec::new();
     let mut times = Vec::new();
-    let results: Vec<Vec<Vec3>> = [&block, &sparse]
+    let results: Vec<Vec<Vec3>> = [block, sparse]
         .iter()
         .map(|model| {
             let mut sim = Simulation::new(model).unwrap_or_else(|e| panic!("{e}"));
-            let mut histories = Histories(Vec::new(), 0.7526);
+            let mut histories = Histories(Vec::new(), until);
             sim.run(&mut [&mut histories])
-                .unwrap_or_else(|e| panic!("{e}"));
+                .unwrap_or_else(|e| panic!("{label}: {e}"));
             times.push(sim.time());
             sim.assemble(sim.time() + 0.01, true)
                 .unwrap_or_else(|e| panic!("{e}"));
@@ -757,9 +775,12 @@ fn block_solver_matches_the_sparse_lu() {
             histories.0
         })
         .collect();
-    assert_eq!(methods, ["block", "sparse-lu"]);
-    assert!(times[0] > 0.75 && times[0] == times[1], "{times:?}");
-    assert_eq!(results[0].len(), results[1].len(), "same steps");
+    assert_eq!(methods, ["block", "sparse-lu"], "{label}");
+    assert!(
+        times[0] > 0.75 && times[0] == times[1],
+        "{label}: {times:?}"
+    );
+    assert_eq!(results[0].len(), results[1].len(), "{label}: same steps");
     let diff = results[0]
         .iter()
         .zip(&results[1])
@@ -774,16 +795,16 @@ fn block_solver_matches_the_sparse_lu() {
         .collect();
     let relative = norm(&gap) / norm(&increments[1]);
     println!(
-        "block vs sparse LU: largest displacement difference {diff:.3e} mm (largest displacement {magnitude:.3} mm); one increment after the release (with {} gauge unknowns): relative difference {relative:.1e}",
-        increments[0].len() - 6 * sim_points(&block)
+        "{label}: block vs sparse LU: largest displacement difference {diff:.3e} mm (largest displacement {magnitude:.3} mm); one increment after the release (with {} gauge unknowns): relative difference {relative:.1e}",
+        increments[0].len() - 6 * sim_points(block)
     );
-    assert!(magnitude > 0.3);
-    assert!(diff < 1e-8, "{diff:e}");
+    assert!(magnitude > 0.3, "{label}");
+    assert!(diff < 1e-8, "{label}: {diff:e}");
     assert!(
-        increments[0].len() > 6 * sim_points(&block),
-        "gauge unknowns present"
+        increments[0].len() > 6 * sim_points(block),
+        "{label}: gauge unknowns present"
     );
-    assert!(relative < 1e-6, "{relative:e}");
+    assert!(relative < 1e-6, "{label}: {relative:e}");
 }
 
 /// Control points of a model's discretisation.

@@ -128,7 +128,7 @@ fn tune_does_not_choose_a_model_that_folds() {
         assert!(line.contains("folds") && line.ends_with("no"), "{line}");
     }
     assert!(
-        stderr.contains("folds (unresolved)")
+        stderr.contains("folds or snaps (unresolved, the stabilisation warned)")
             && stderr.contains("the damping, not the structure, carried the load"),
         "{stderr}"
     );

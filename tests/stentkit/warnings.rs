@@ -36,10 +36,10 @@ fn summary(dir: &Path) -> serde_json::Value {
 /// every material's Tg completed with `warnings: []` (the stent on the aorta, stabilised, ended at a
 /// recovery ratio of 1.8). The two-crown straight stent heated to 71 °C for 0.05 s keeps 0.80 of its
 /// temporary shape (recovery ratio mean, measured), far above the threshold of 0.1; the same device heated to
-/// 90 °C as the design does ends at 0.011 (measured; 0.011 at n = 40 too, and with either time tolerance 1e-2
-/// or 1e-3 — the paper's rotation field gave 0.004 at the design's n = 20 and 0.011 at n = 40), far below: no
-/// warning there; the bound below, 0.02, is a fifth of the threshold. The run still completes (exit status 0:
-/// the numbers are the simulation's), with the warning in summary.json and on stderr.
+/// 90 °C as the design does ends at 0.004 (measured, with the design's rotation field, the paper's; at n = 40 it
+/// is 0.011, as with the objective field at n = 20 and 40, with either time tolerance 1e-2 or 1e-3), far below:
+/// no warning there. The run still completes (exit status 0: the numbers are the simulation's), with the warning
+/// in summary.json and on stderr.
 #[test]
 fn a_run_that_ends_heated_but_not_recovered_completes_with_a_warning() {
     let root = test_outputs("recovery_warning");
@@ -70,7 +70,7 @@ fn a_run_that_ends_heated_but_not_recovered_completes_with_a_warning() {
         s["final_state"]["recovery_ratio_mean"]
             .as_f64()
             .expect("ratio")
-            < 0.02,
+            < 0.01,
         "{}",
         s["final_state"]
     );
