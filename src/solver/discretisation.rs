@@ -91,6 +91,18 @@ pub struct Discretisation {
 }
 
 impl Discretisation {
+    /// The control points the objective rotation field's patch references are made of
+    /// ([`PatchRange::references`], each once): every row of their patch reaches their rotation columns, so the
+    /// block solver puts them on its border. Empty for the incremental field.
+    pub fn reference_points(&self) -> Vec<usize> {
+        if self.rotations != RotationField::Objective {
+            return Vec::new();
+        }
+        let mut out: Vec<usize> = self.patches.iter().flat_map(|r| r.references()).collect();
+        out.dedup();
+        out
+    }
+
     /// Builds the collocation points, basis tables and reference kinematics of every patch.
     pub fn new(model: &Model) -> Result<Self, SolverError> {
         let shapes = model

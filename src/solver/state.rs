@@ -35,20 +35,21 @@ pub struct State {
 impl State {
     /// The reference (unstressed) configuration.
     pub fn reference(disc: &Discretisation) -> Self {
+        let (orientation, relative) = match disc.rotations {
+            RotationField::Objective => (
+                vec![Quat::identity(); disc.points.len()],
+                vec![Vec3::zeros(); disc.points.len()],
+            ),
+            RotationField::Incremental => (Vec::new(), Vec::new()),
+        };
         Self {
             control: disc.control0.clone(),
             rotation: disc.points.iter().map(|p| p.rotation0).collect(),
             kappa: disc.points.iter().map(|p| p.kappa0).collect(),
             kappa_s: disc.points.iter().map(|p| p.kappa0_s).collect(),
             multipliers: Vec::new(),
-            orientation: match disc.rotations {
-                RotationField::Objective => vec![Quat::identity(); disc.points.len()],
-                RotationField::Incremental => Vec::new(),
-            },
-            relative: match disc.rotations {
-                RotationField::Objective => vec![Vec3::zeros(); disc.points.len()],
-                RotationField::Incremental => Vec::new(),
-            },
+            orientation,
+            relative,
         }
     }
 

@@ -411,18 +411,8 @@ fn analyse(
         &mut Sink::Pattern(&mut pattern),
     );
     let n = at.disc.num_unknowns() + terms.multipliers();
-    // The objective field's patch references: every row of their patch reaches their rotation columns.
-    let mut references: Vec<usize> = match at.disc.rotations {
-        crate::model::RotationField::Objective => at
-            .disc
-            .patches
-            .iter()
-            .flat_map(|r| r.references())
-            .collect(),
-        crate::model::RotationField::Incremental => Vec::new(),
-    };
-    references.dedup();
-    let system = LinearSystem::new(n, &pattern, &patch_ranges(at.disc), &references, method)?;
+    let borders = at.disc.reference_points();
+    let system = LinearSystem::new(n, &pattern, &patch_ranges(at.disc), &borders, method)?;
     Ok((system, vec![0.0; pattern.len()]))
 }
 
