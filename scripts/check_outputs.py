@@ -167,7 +167,9 @@ def check_mcap(path):
         require(all(b > a for a, b in zip(state_times, state_times[1:])), "/state times do not increase")
         if summary_json is not None:
             killed = summary_json["status"] == "killed"
-            states, snapshots = summary_json["steps"] + 1, len(summary_json["snapshots"])
+            # A state per step, the initial one and each requested time reached between steps.
+            between = summary_json.get("time_error_control", {}).get("requested_states", 0)
+            states, snapshots = summary_json["steps"] + 1 + between, len(summary_json["snapshots"])
             require(counts[STATE] <= states if killed else counts[STATE] == states,
                     f"{counts[STATE]} states for {summary_json['steps']} steps")
             if DEVICE in counts:
@@ -244,11 +246,21 @@ def check_run_folder(folder):
     with open(folder / "history.csv", newline="") as f:
         rows = list(csv.reader(f))
     require(rows and rows[0][0] == "time", "history.csv header")
-    require(len(rows) - 1 == summary["steps"] + 1, f"history.csv has {len(rows) - 1} rows for {summary['steps']} steps")
+    # A row per state: the initial one, every step, and each requested time an error-controlled run reached
+    # between its steps (its continuous extension).
+    between = summary.get("time_error_control", {}).get("requested_states", 0)
+    require(len(rows) - 1 == summary["steps"] + 1 + between,
+            f"history.csv has {len(rows) - 1} rows for {summary['steps']} steps and {between} requested states")
+    times = [float(r[0]) for r in rows[1:]]
+    require(all(a < b for a, b in zip(times, times[1:])), "history.csv's times not increasing")
     require(summary["snapshots"], "no snapshots")
     steps = [s["step"] for s in summary["snapshots"]]
     require(steps[0] == 0, "no initial snapshot")
-    require(steps == sorted(set(steps)), "snapshot steps not increasing")
+    # A snapshot at a requested time between two steps carries the step before it: steps never decrease, times
+    # increase.
+    require(steps == sorted(steps), "snapshot steps decreasing")
+    snapshot_times = [s["time"] for s in summary["snapshots"]]
+    require(all(a < b for a, b in zip(snapshot_times, snapshot_times[1:])), "snapshot times not increasing")
     for s in summary["snapshots"]:
         # The design chooses the mesh formats (STL by default, OBJ on request); each file listed must exist.
         listed = [key for key in ("stl", "obj", "vtp") if key in s]

@@ -158,15 +158,14 @@ pub(crate) fn build(dto: &DesignDto, default_name: &str, temporary_shape: bool) 
         builder.probe(p.name.clone(), at);
     }
     let mut output = output_settings(dto, &settings)?;
-    builder.record_times(
-        output
-            .snapshots
-            .times
-            .iter()
-            .copied()
-            .filter(|&t| t > 0.0)
-            .collect(),
-    );
+    let mut record_times: Vec<Real> = (output.snapshots.times.iter())
+        .chain(&output.history_times)
+        .copied()
+        .filter(|&t| t > 0.0)
+        .collect();
+    record_times.sort_by(Real::total_cmp);
+    record_times.dedup();
+    builder.record_times(record_times);
     let crate::model::builder::Built {
         model,
         mut warnings,
@@ -472,26 +471,17 @@ pub(crate) fn field_path(field: &Field, dto: &DesignDto) -> String {
     }
 }
 
-/// The `output:` block's snapshot, recording and field-file settings with their defaults, and the materials' strain limits.
-fn output_settings(dto: &DesignDto, time: &TimeSettings) -> Result<super::OutputSettings> {
-    let output = dto.output.as_ref();
-    use super::{OutputSettings, RecordingSettings, SnapshotSettings};
-    let at_least = |value: Option<usize>, default: usize, min: usize, path: &str| match value {
-        None => Ok(default),
-        Some(v) if v >= min => Ok(v),
-        Some(v) => Err(issue(path, format!("{v} must be at least {min}"))),
-    };
-    let snapshots = output.and_then(|o| o.snapshots.as_ref());
+/// The times of `list` (the design's field `path`), sorted and without repeats, each within `[0, time.end]`.
+fn requested_times(
+    list: Option<&Vec<NonNegative>>,
+    path: &str,
+    time: &TimeSettings,
+) -> Result<Vec<Real>> {
     let mut times = Vec::new();
-    for (k, NonNegative(t)) in snapshots
-        .and_then(|s| s.times.as_ref())
-        .into_iter()
-        .flatten()
-        .enumerate()
-    {
+    for (k, NonNegative(t)) in list.into_iter().flatten().enumerate() {
         if *t > time.end {
             return Err(issue(
-                format!("output.snapshots.times[{k}]"),
+                format!("{path}[{k}]"),
                 format!(
                     "{t} is after the end of the run (time.end = {}); allowed: 0 ≤ t ≤ time.end",
                     time.end
@@ -502,6 +492,31 @@ fn output_settings(dto: &DesignDto, time: &TimeSettings) -> Result<super::Output
     }
     times.sort_by(Real::total_cmp);
     times.dedup();
+    Ok(times)
+}
+
+/// The `output:` block's snapshot, recording and field-file settings with their defaults, and the materials' strain limits.
+fn output_settings(dto: &DesignDto, time: &TimeSettings) -> Result<super::OutputSettings> {
+    let output = dto.output.as_ref();
+    use super::{OutputSettings, RecordingSettings, SnapshotSettings};
+    let at_least = |value: Option<usize>, default: usize, min: usize, path: &str| match value {
+        None => Ok(default),
+        Some(v) if v >= min => Ok(v),
+        Some(v) => Err(issue(path, format!("{v} must be at least {min}"))),
+    };
+    let snapshots = output.and_then(|o| o.snapshots.as_ref());
+    let times = requested_times(
+        snapshots.and_then(|s| s.times.as_ref()),
+        "output.snapshots.times",
+        time,
+    )?;
+    let history_times = requested_times(
+        output
+            .and_then(|o| o.history.as_ref())
+            .and_then(|h| h.times.as_ref()),
+        "output.history.times",
+        time,
+    )?;
     let formats: Vec<&str> = match snapshots.and_then(|s| s.formats.as_ref()) {
         None => crate::io::formats::DEFAULT_FORMATS.to_vec(),
         Some(names) => names
@@ -604,6 +619,7 @@ fn output_settings(dto: &DesignDto, time: &TimeSettings) -> Result<super::Output
     };
     Ok(OutputSettings {
         snapshots: snapshot_settings,
+        history_times,
         recording: recording_settings,
         strain_limits: std::iter::once(&dto.material)
             .chain(&dto.materials)

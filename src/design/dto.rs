@@ -889,6 +889,9 @@ pub struct OutputDto {
     /// phase of the shape-memory cycle).
     #[serde(default)]
     pub snapshots: Option<SnapshotsDto>,
+    /// `history.csv`: a row at every converged step, and at the times asked here.
+    #[serde(default)]
+    pub history: Option<HistoryDto>,
     /// What `run.mcap` holds besides the state per step.
     #[serde(default)]
     pub recording: Option<RecordingDto>,
@@ -899,6 +902,17 @@ pub struct OutputDto {
     /// The configuration figures (`charts/configurations.svg`).
     #[serde(default)]
     pub configurations: Option<ConfigurationsDto>,
+}
+
+/// `history.csv`'s rows besides the steps'.
+#[derive(Debug, Clone, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct HistoryDto {
+    /// Times at which to write a row \[time\], within [0, time.end]: fixed steps land on each; an
+    /// error-controlled run (`time.tolerance`) takes the state there from its continuous extension, within its
+    /// tolerance, without a step there. Rows at these times (and at the snapshot times) have `requested` = 1.
+    #[serde(default)]
+    pub times: Option<Vec<NonNegative>>,
 }
 
 /// The configuration figures: which views.
@@ -921,7 +935,9 @@ pub struct ConfigurationsDto {
 #[derive(Debug, Clone, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct SnapshotsDto {
-    /// Times at which to write a snapshot \[time\], within [0, time.end]; time stepping lands on each.
+    /// Times at which to write a snapshot \[time\], within [0, time.end]: fixed steps land on each; an
+    /// error-controlled run (`time.tolerance`) takes the state there from its continuous extension, without a
+    /// step there.
     #[serde(default)]
     pub times: Option<Vec<NonNegative>>,
     /// A snapshot every this many converged steps (0: none). Default: none (on an arc-length path, about 20

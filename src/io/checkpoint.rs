@@ -50,7 +50,7 @@ pub(crate) const FILE_NAME: &str = crate::io::run_folder::CHECKPOINT_FILE;
 const MAGIC: &[u8; 8] = b"STKCKPT\0";
 
 /// The format version this build writes and reads.
-pub(crate) const VERSION: u32 = 12;
+pub(crate) const VERSION: u32 = 13;
 
 /// Bytes before the payload: magic, version, length.
 const HEADER: usize = 8 + 4 + 8;
@@ -759,7 +759,14 @@ fn encode_outputs(e: &mut Encoder, o: &OutputsCheckpoint) {
         e.0.extend_from_slice(bytes);
     });
     let t = &o.totals;
-    for v in [t.steps, t.iterations, t.cuts, t.rejected, t.factorisations] {
+    for v in [
+        t.steps,
+        t.iterations,
+        t.cuts,
+        t.rejected,
+        t.factorisations,
+        t.requested,
+    ] {
         e.usize(v);
     }
     e.f64(t.time);
@@ -785,6 +792,7 @@ fn decode_outputs(d: &mut Decoder<'_>) -> Result<OutputsCheckpoint, Problem> {
             cuts: d.usize()?,
             rejected: d.usize()?,
             factorisations: d.usize()?,
+            requested: d.usize()?,
             time: d.f64()?,
             stopped: d.bool()?,
         },
@@ -908,6 +916,7 @@ mod tests {
                 cuts: 1,
                 rejected: 3,
                 factorisations: 5,
+                requested: 2,
                 time: 0.9,
                 stopped: false,
             },

@@ -281,6 +281,9 @@ impl HistoryWriter {
         if sim.model().time().tolerance.is_some() {
             header.push_str(",dt,error_estimate,rejected");
         }
+        if !sim.model().record_times().is_empty() {
+            header.push_str(",requested");
+        }
         if sim.model().solver().stabilisation.is_some() {
             header
                 .push_str(",stabilisation_factor,strain_energy,dissipated_energy,dissipated_ratio");
@@ -448,6 +451,13 @@ impl HistoryWriter {
             });
             line.push_str(&format!(",{dt:.6e},{estimate:.3e},{rejected}"));
         }
+        let requested = sim.model().record_times();
+        if !requested.is_empty() {
+            // A row at a requested time: the step landing on it, or the continuous extension's state there.
+            let snap = sim.model().time().landing_tolerance();
+            let hit = crate::math::near_one_of(requested, t, snap);
+            line.push_str(if hit { ",1" } else { ",0" });
+        }
         if sim.model().solver().stabilisation.is_some() {
             let s = report.and_then(|r| r.stabilisation);
             let factor = s.map_or(0.0, |s| s.factor);
@@ -574,6 +584,11 @@ impl Observer for HistoryWriter {
 
     fn step(&mut self, sim: &Simulation<'_>, report: &StepReport) -> ControlFlow<()> {
         self.row(sim, Some(report))
+    }
+
+    fn requested(&mut self, sim: &Simulation<'_>, report: &StepReport) {
+        // (A write error is kept and stops the run at the next step, whose row cannot be written either.)
+        let _ = self.row(sim, Some(report));
     }
 }
 

@@ -10,8 +10,8 @@ use std::path::Path;
 /// Which tube meshes of the full device a run writes (the design's `output.snapshots`).
 #[derive(Debug, Clone, PartialEq, serde::Serialize)]
 pub struct SnapshotSettings {
-    /// Requested snapshot times \[time\], sorted, within `[0, end]` (the model's record times: steps land on
-    /// them).
+    /// Requested snapshot times \[time\], sorted, within `[0, end]` (with the history's, the model's record
+    /// times: fixed steps land on them, error-controlled steps reach them by their continuous extension).
     pub times: Vec<Real>,
     /// A snapshot every this many converged steps; 0 for none.
     pub every: usize,
@@ -89,6 +89,9 @@ impl RecordingSettings {
 pub struct OutputSettings {
     /// Snapshot meshes.
     pub snapshots: SnapshotSettings,
+    /// Times at which `history.csv` has a row besides the steps' (`output.history.times`) \[time\], sorted,
+    /// within `[0, end]`: with the snapshot times, the model's record times.
+    pub history_times: Vec<Real>,
     /// The MCAP recording.
     pub recording: RecordingSettings,
     /// Per material of the model (`material` first, then `materials`), the surface strain it survives

@@ -2,7 +2,8 @@
 //! section frames, written in the design's formats (`super::formats`; binary STL by default, OBJ on request)
 //! at the initial state, at the final one, at the events of the shape-memory cycle ([`crate::model::cycle`]:
 //! programmed, fixed, released), at a few times between them, every `every` steps and at the requested times
-//! (time stepping lands on those: they are the model's record times). Each is named by its time and phase,
+//! (they are the model's record times: fixed steps land on them, and an error-controlled run reaches each by its
+//! continuous extension, [`Observer::requested`]). Each is named by its time and phase,
 //! `snapshots/t1.750_fixed.stl` ([`snapshot_name`]). With each snapshot, unless the design turns them off, the
 //! fields along the rods for ParaView (`.vtp`, [`super::vtk`], listed with their times in `run.pvd`); and the
 //! full device's centrelines are kept for the configuration figures drawn at the end (`super::configurations`).
@@ -32,6 +33,8 @@ use std::path::{Path, PathBuf};
 pub struct SnapshotSchedule {
     /// The times due, sorted: the requested ones, the cycle's events, the cuts between them.
     times: Vec<Real>,
+    /// The requested times (`output.snapshots.times`), sorted.
+    requested: Vec<Real>,
     /// Every this many steps (0: never).
     every: usize,
     /// End time of the run.
@@ -45,7 +48,14 @@ impl SnapshotSchedule {
     /// The schedule of a design's snapshot settings for its model.
     pub fn new(settings: &SnapshotSettings, model: &Model) -> Self {
         let snap = model.time().landing_tolerance();
-        let mut times = settings.times.clone();
+        let requested = settings.times.clone();
+        // An error-controlled run reaches the requested times between its steps (its continuous extension): they
+        // are not "the first step at or after".
+        let mut times = if model.time().tolerance.is_some() {
+            Vec::new()
+        } else {
+            requested.clone()
+        };
         // An arc-length path's `time` is its path parameter, which passes `time.end` anywhere: its last state
         // is written by the writers' `finish`, and it has neither events nor times between them.
         let end = match model.solver().path.arc_length() {
@@ -63,25 +73,34 @@ impl SnapshotSchedule {
         times.dedup_by(|a, b| (*a - *b).abs() <= snap);
         Self {
             times,
+            requested,
             every: settings.every,
             end,
             snap,
         }
     }
 
-    /// The times due (sorted), besides step 0, the end and every `every` steps: the first step at or after
-    /// each gets a snapshot.
+    /// The times due (sorted), besides step 0, the end, every `every` steps and the requested times: the first
+    /// step at or after each gets a snapshot.
     pub fn times(&self) -> &[Real] {
         &self.times
     }
 
+    /// Whether `time` is a requested snapshot time (within the landing tolerance).
+    pub fn is_requested(&self, time: Real) -> bool {
+        crate::math::near_one_of(&self.requested, time, self.snap)
+    }
+
     /// Whether the state of step `step` at `time`, reached from `previous` (the time of the step before),
-    /// gets a snapshot: step 0 and the end always; every `every` steps; and the first step at or after each
-    /// time due (which is the step landing on it, for requested times and events).
+    /// gets a snapshot: step 0 and the end always; every `every` steps; a step on a requested time; and the
+    /// first step at or after each time due (which is the step landing on it, for requested times with fixed
+    /// steps and for events). (A requested time inside a step of an error-controlled run is the continuous
+    /// extension's state, [`Observer::requested`], not a step's.)
     pub fn is_due(&self, step: usize, previous: Real, time: Real) -> bool {
         step == 0
             || (self.every > 0 && step.is_multiple_of(self.every))
             || time >= self.end - self.snap
+            || self.is_requested(time)
             || self
                 .times
                 // Sorted: the first time due after `previous` decides (one binary search per step).
@@ -591,7 +610,10 @@ impl SnapshotWriter {
     fn observe(&mut self, sim: &Simulation<'_>, step: usize) -> ControlFlow<()> {
         let previous = self.last.map_or(0.0, |(_, t)| t);
         self.last = Some((step, sim.time()));
-        if self.error.is_some() || !self.schedule.is_due(step, previous, sim.time()) {
+        if self.error.is_some() {
+            return ControlFlow::Break(());
+        }
+        if !self.schedule.is_due(step, previous, sim.time()) {
             return ControlFlow::Continue(());
         }
         match self.write(sim, step) {
@@ -611,6 +633,20 @@ impl Observer for SnapshotWriter {
 
     fn step(&mut self, sim: &Simulation<'_>, report: &StepReport) -> ControlFlow<()> {
         self.observe(sim, report.step)
+    }
+
+    /// A requested snapshot time inside a step of an error-controlled run: the snapshot is the continuous
+    /// extension's state there, with the step before it. (The steps' schedule is not changed by it: the last
+    /// state seen stays the last step's.) A requested history time alone writes nothing here.
+    fn requested(&mut self, sim: &Simulation<'_>, _: &StepReport) {
+        let time = sim.time();
+        if self.error.is_some() || !self.schedule.is_requested(time) {
+            return;
+        }
+        if let Err(e) = self.write(sim, sim.step_count()) {
+            // (Kept: the next step asks the run to stop.)
+            self.error = Some(e);
+        }
     }
 }
 

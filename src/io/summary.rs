@@ -408,6 +408,9 @@ pub struct TimeErrorControl {
     pub accepted_steps: usize,
     /// Attempts rejected because their estimate exceeded the tolerance.
     pub rejected_steps: usize,
+    /// States at requested times between the steps (the continuous extension): each a row of `history.csv`
+    /// besides the steps' (and a snapshot, at a snapshot time).
+    pub requested_states: usize,
     /// The largest estimate of an accepted step (above the tolerance only at the smallest step, with a notice).
     pub largest_estimate: Real,
     /// The smallest step taken \[s\].
@@ -493,6 +496,7 @@ impl RunSummaryFile {
                 tolerance,
                 accepted_steps: 0,
                 rejected_steps: 0,
+                requested_states: 0,
                 largest_estimate: 0.0,
                 smallest_step: 0.0,
                 largest_step: 0.0,

@@ -56,6 +56,12 @@ impl Short {
     }
 }
 
+/// Whether one of the sorted values `sorted` lies within `tolerance` of `x` (one binary search).
+pub fn near_one_of(sorted: &[Real], x: Real, tolerance: Real) -> bool {
+    let at = sorted.partition_point(|&v| v < x - tolerance);
+    sorted.get(at).is_some_and(|&v| v <= x + tolerance)
+}
+
 /// Errors raised by the math layer when data (not the programmer) is wrong.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum MathError {

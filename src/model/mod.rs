@@ -573,9 +573,10 @@ pub struct Model {
     /// own mirror image and carries half its section in the reduced model.
     #[serde(serialize_with = "crate::math::serial::components")]
     pub symmetry_planes: Vec<(Vec3, Vec3)>,
-    /// Times within `(0, end]` at which the state is recorded (snapshots) \[time\], sorted and without repeats:
-    /// time stepping lands on each, as on a schedule breakpoint ([`Model::record_times`]; changed through
-    /// [`Model::with_record_times`]).
+    /// Times within `(0, end]` at which the state is recorded (history rows, snapshots) \[time\], sorted and
+    /// without repeats: fixed steps land on each, as on a schedule breakpoint; error-controlled steps reach them
+    /// by their continuous extension (`crate::solver::simulation`, dense output) and are not changed by them
+    /// ([`Model::record_times`]; changed through [`Model::with_record_times`]).
     record_times: Vec<Real>,
     /// The vessel a stent was placed on (a centreline read from a file), for the outputs to show beside it.
     pub vessel: Option<Vessel>,
@@ -756,10 +757,11 @@ impl Model {
         plan
     }
 
-    /// Every time at which a schedule changes slope or a condition switches, and every record time, within
-    /// `(0, end]`, sorted and deduplicated: time stepping lands on each.
+    /// Every time at which a schedule changes slope or a condition switches, and with fixed steps every record
+    /// time, within `(0, end]`, sorted and deduplicated: time stepping lands on each. (Error-controlled steps do
+    /// not land on the record times: the solver reaches those by its continuous extension.)
     pub fn schedule_breakpoints(&self) -> Vec<Real> {
-        self.breakpoints(true)
+        self.breakpoints(self.time.tolerance.is_none())
     }
 
     /// [`Model::schedule_breakpoints`] without the record times: where the temperature, a load or a prescribed

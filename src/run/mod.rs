@@ -453,6 +453,7 @@ impl Outputs<'_> {
         if let Some(control) = &mut s.time_error_control {
             control.accepted_steps = t.steps;
             control.rejected_steps = t.rejected;
+            control.requested_states = t.requested;
         }
         if let (Some(summary), Some(settings)) =
             (&mut s.stabilisation, &sim.model().solver().stabilisation)
@@ -579,6 +580,7 @@ impl Observer for RunObserver<'_, '_> {
         totals.iterations += report.newton.iterations;
         totals.factorisations += report.newton.factorisations;
         totals.cuts += report.cuts;
+        totals.requested += report.requested;
         totals.time = report.time;
         let flow = self
             .outputs
@@ -594,6 +596,14 @@ impl Observer for RunObserver<'_, '_> {
             self.checkpoints.write(sim, self.outputs, wall, &manifest);
         }
         flow
+    }
+
+    fn requested(&mut self, sim: &Simulation<'_>, report: &StepReport) {
+        // (A recorder that failed asks to stop at the next step.)
+        let _ = self.outputs.observe(self.interrupt, |o| {
+            o.requested(sim, report);
+            ControlFlow::Continue(())
+        });
     }
 
     fn step_failed(&mut self, time: Real, dt: Real, newton: &NewtonReport) {

@@ -103,8 +103,9 @@ pub struct WatchedRun {
     pub summary: RunSummary,
 }
 
-/// Runs `model` to its end time and records, at each of its record times ([`Model::record_times`], which every run
-/// lands on), the displacements at `locations`, the recovery measures and, with `grid_samples`, the grid.
+/// Runs `model` to its end time and records, at each of its record times ([`Model::record_times`]: fixed steps
+/// land on them, an error-controlled run reaches them by its continuous extension), the displacements at
+/// `locations`, the recovery measures and, with `grid_samples`, the grid.
 ///
 /// # Errors
 /// The solver's, when the run fails.
@@ -143,7 +144,8 @@ struct Watch<'a> {
 impl Watch<'_> {
     fn record(&mut self, sim: &Simulation<'_>) {
         let t = sim.time();
-        // Runs land on record times; the tolerance only absorbs the rounding of the accumulated time.
+        // Fixed steps land on record times, error-controlled runs report them between their steps (the continuous
+        // extension); the tolerance only absorbs the rounding of the accumulated time.
         let eps = 1e-9 * sim.model().time().end.max(1.0);
         while let Some(&target) = self.times.get(self.states.len()) {
             if t + eps < target {
@@ -176,5 +178,9 @@ impl Observer for Watch<'_> {
     fn step(&mut self, sim: &Simulation<'_>, _: &StepReport) -> ControlFlow<()> {
         self.record(sim);
         ControlFlow::Continue(())
+    }
+
+    fn requested(&mut self, sim: &Simulation<'_>, _: &StepReport) {
+        self.record(sim);
     }
 }

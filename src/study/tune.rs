@@ -7,7 +7,8 @@
 //! A design's *results* are what its outputs report: every probe's displacement, and for a programme the
 //! recovery ratios (mean and largest) and the radial contraction Δr; a design with neither probes nor a
 //! programme is watched at all its nodes. They are sampled at the *comparison times*: every breakpoint of the
-//! schedule (loads, temperatures, releases), ten evenly spaced times and the end; every run lands on them. The
+//! schedule (loads, temperatures, releases), ten evenly spaced times and the end; fixed steps land on them, and
+//! an error-controlled run reaches them by its continuous extension (without steps there). The
 //! difference of two runs is the largest over those times and quantities of
 //! - a displacement's difference over the largest displacement of the finer run (any probe, any time),
 //! - Δr's difference over the largest |Δr| of the finer run,

@@ -3,7 +3,7 @@
 //!
 //! | topic | schema | when | content |
 //! |---|---|---|---|
-//! | `/state` | `stentkit.State` | every step and the initial state | time, step size, temperature, loads, Newton iterations and residuals, step cuts, probe displacements, recovery measures |
+//! | `/state` | `stentkit.State` | every step, the initial state and each requested time an error-controlled run reaches between its steps | time, step size, temperature, loads, Newton iterations and residuals, step cuts, probe displacements, recovery measures |
 //! | `/centrelines` | `foxglove.SceneUpdate` | every step | entity `centrelines`: one `LINE_STRIP` per rod of the full device (mirrored back), coloured by temperature; with contact, the samples touching an obstacle in green (`mcap/obstacles.rs`); with the wires' contact, its pairs as a magenta `LINE_LIST` (each pressing sample to its closest point on the other wire, of the model as simulated) |
 //! | `/device` | `foxglove.SceneUpdate` | snapshot steps | entity `device`: the full device's closed tube mesh (`TriangleListPrimitive` with indices) |
 //! | `/vessel` | `foxglove.SceneUpdate` | once, at the start (a stent on a file centreline) | entity `vessel`: the vessel's centreline (`LINE_STRIP`) and its lumen (a translucent closed tube) |
@@ -158,6 +158,8 @@ pub struct McapRecorder {
     sequence: u32,
     /// Log time, step and time of the last state recorded.
     last: Option<(u64, usize, Real)>,
+    /// Time of the last step recorded (a requested state between steps is not one), for the snapshot schedule.
+    last_step_time: Option<Real>,
     /// Step of the last mesh recorded.
     last_mesh: Option<usize>,
     error: Option<McapError>,
@@ -318,6 +320,7 @@ impl McapRecorder {
             ),
             sequence: 0,
             last: None,
+            last_step_time: None,
             last_mesh: None,
             error: None,
         })
@@ -374,6 +377,8 @@ impl McapRecorder {
         self.sequence = position.sequence;
         self.last = position.last;
         self.last_mesh = position.last_mesh;
+        // A checkpoint is taken after a step: its last state is a step's.
+        self.last_step_time = position.last.map(|(_, _, t)| t);
         let mut copied = 0;
         for message in ::mcap::MessageStream::new(previous).map_err(read_error)? {
             let message = message.map_err(read_error)?;
@@ -615,20 +620,32 @@ impl McapRecorder {
         triangles
     }
 
+    /// Records the state of `sim` (`report`: of a step, or of a requested time inside one when `requested`;
+    /// `None`: the initial state), with a mesh when the snapshot schedule has one due. A requested state's
+    /// record does not move the schedule's last step (`previous`): its mesh is due at a requested snapshot time
+    /// only.
     fn record(
         &mut self,
         sim: &Simulation<'_>,
         report: Option<&StepReport>,
+        requested: bool,
     ) -> Result<(), McapError> {
-        let step = report.map_or(0, |r| r.step);
+        let step = match report {
+            Some(_) if requested => sim.step_count(),
+            Some(r) => r.step,
+            None => 0,
+        };
         let time = sim.time();
         let nominal = (time.max(0.0) * 1e9).round() as u64;
         let log_time = match self.last {
             Some((last, _, _)) => nominal.max(last + 1),
             None => nominal,
         };
-        let previous = self.last.map_or(0.0, |(_, _, t)| t);
+        let previous = self.last_step_time.unwrap_or(0.0);
         self.last = Some((log_time, step, time));
+        if !requested {
+            self.last_step_time = Some(time);
+        }
         let sample = StateSample::of(sim, &self.channels, report);
         let state = self.state_message(&sample).to_string();
         self.write(self.state_channel, log_time, state.as_bytes())?;
@@ -643,7 +660,12 @@ impl McapRecorder {
             let message = self.vessel_message(vessel, log_time)?;
             self.write(channel, log_time, message.as_bytes())?;
         }
-        if self.device_channel.is_some() && self.schedule.is_due(step, previous, time) {
+        let due = if requested {
+            self.schedule.is_requested(time)
+        } else {
+            self.schedule.is_due(step, previous, time)
+        };
+        if self.device_channel.is_some() && due {
             self.record_mesh(sim, step, log_time)?;
         }
         Ok(())
@@ -663,11 +685,16 @@ impl McapRecorder {
         Ok(())
     }
 
-    fn observe(&mut self, sim: &Simulation<'_>, report: Option<&StepReport>) -> ControlFlow<()> {
+    fn observe(
+        &mut self,
+        sim: &Simulation<'_>,
+        report: Option<&StepReport>,
+        requested: bool,
+    ) -> ControlFlow<()> {
         if self.error.is_some() {
             return ControlFlow::Break(());
         }
-        match self.record(sim, report) {
+        match self.record(sim, report, requested) {
             Ok(()) => ControlFlow::Continue(()),
             Err(e) => {
                 self.error = Some(e);
@@ -728,10 +755,17 @@ impl Drop for McapRecorder {
 
 impl Observer for McapRecorder {
     fn start(&mut self, sim: &Simulation<'_>) -> ControlFlow<()> {
-        self.observe(sim, None)
+        self.observe(sim, None, false)
     }
 
     fn step(&mut self, sim: &Simulation<'_>, report: &StepReport) -> ControlFlow<()> {
-        self.observe(sim, Some(report))
+        self.observe(sim, Some(report), false)
+    }
+
+    /// The state at a requested time inside a step, with its mesh at a requested snapshot time, as the snapshots
+    /// have it.
+    fn requested(&mut self, sim: &Simulation<'_>, report: &StepReport) {
+        // (A write error is kept: the next step asks the run to stop.)
+        let _ = self.observe(sim, Some(report), true);
     }
 }

@@ -50,7 +50,14 @@ pub(super) const HISTORY: RecorderKind = RecorderKind {
     },
     estimate: |s| {
         let design = s.design;
-        let rows = s.states + 1.0;
+        // An error-controlled run writes a row at each record time besides its steps (fixed steps land there).
+        let model = &design.model;
+        let requested = if model.time().tolerance.is_some() {
+            model.record_times().len()
+        } else {
+            0
+        };
+        let rows = s.states + 1.0 + requested as Real;
         let bytes = rows * row_bytes(&design.model, &design.output.strain_limits);
         DiskPart {
             advice: Some(("time.step", "take larger time steps")),
@@ -67,7 +74,8 @@ const HISTORY_FILE: &str = "history.csv";
 /// Δr (17), the device's diameter and length (17 each) of a programme, the largest node displacement (16), the peak surface strain (16), its patch
 /// (the longest name) and arc length (16), one peak per material with a strain limit (16), per obstacle of a
 /// model with contact its force components and radial force (17 each), points (6), penetration, friction
-/// work and the three apposition columns (14 each), the line end.
+/// work and the three apposition columns (14 each), the `requested` mark (2) of a model with record times, the
+/// line end.
 fn row_bytes(model: &Model, strain_limits: &[Option<Real>]) -> Real {
     let name = model
         .patches
@@ -90,6 +98,11 @@ fn row_bytes(model: &Model, strain_limits: &[Option<Real>]) -> Real {
         + recovery
         + peaks
         + contact
+        + if model.record_times().is_empty() {
+            0.0
+        } else {
+            2.0
+        }
         + 1.0
 }
 

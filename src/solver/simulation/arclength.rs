@@ -226,6 +226,7 @@ impl Simulation<'_> {
                         rejected: 0,
                         load_factor: Some(state.load_factor),
                         stabilisation: None,
+                        requested: 0,
                     };
                     if !landed && self.clock.step >= settings.max_increments {
                         self.record.notices.push(format!(

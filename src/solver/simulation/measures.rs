@@ -20,6 +20,9 @@ pub(super) struct Measures {
     pub(super) control_length: Vec<Real>,
     /// The schedule breakpoints the steps land on ([`Model::schedule_breakpoints`]), sorted.
     pub(super) breakpoints: Vec<Real>,
+    /// The record times an error-controlled run reaches by its continuous extension (module `dense`), sorted;
+    /// empty for a fixed-step run, whose steps land on them.
+    pub(super) requested: Vec<Real>,
     /// Reference arc length of every collocation point from its patch's start, for the fields
     /// ([`super::fields`]): computed at the first use (a run without field outputs never needs it).
     arc_length: OnceLock<Vec<Real>>,
@@ -45,6 +48,11 @@ impl Measures {
         Self {
             control_length,
             breakpoints: model.schedule_breakpoints(),
+            requested: if model.time().tolerance.is_some() {
+                model.record_times().to_vec()
+            } else {
+                Vec::new()
+            },
             arc_length: OnceLock::new(),
             point_weights: OnceLock::new(),
         }

@@ -30,7 +30,10 @@
 //! keep the configuration from showing it, the strain that carries the two updates' stress difference — and a
 //! step whose estimate exceeds its share of the tolerance is rejected and retried shorter; the next step comes from a PI controller
 //! with growth and shrink limits (`adaptive`). Steps still land on every schedule breakpoint (releases, load
-//! and temperature breakpoints, snapshot times), Newton failures still halve the step, and a step at
+//! and temperature breakpoints) but not on the record times (`output.history.times`, `output.snapshots.times`):
+//! the state at a record time inside an accepted step comes from the integrator's continuous extension and is
+//! told to the observers ([`Observer::requested`]; `dense`), so asking for an output does not change the steps.
+//! Newton failures still halve the step, and a step at
 //! `min_step` whose estimate is above the tolerance is accepted with a notice (said once). Fixed steps (no
 //! tolerance) are unchanged. [`StepReport::error_estimate`] and [`StepReport::rejected`] report each step.
 //!
@@ -67,7 +70,8 @@
 //! run's records.
 //!
 //! The concepts live in their own files: `report` (what a step and a run report), `observer` (who is told),
-//! `adaptive` (the time-error estimate and the step-size controller), `arclength` (arc-length continuation),
+//! `adaptive` (the time-error estimate and the step-size controller), `dense` (the states at requested times
+//! between error-controlled steps), `arclength` (arc-length continuation),
 //! `timing` (where the wall time went), `stepping` (the step loop and roll-back), `newton`
 //! (Newton's method on normalised norms and its diagnostics), `releases` (release ramps and gauge constraints),
 //! `constitutive` (the materials at the points: step preparation, commit, roll-back), `snapshot` (what a step
@@ -78,6 +82,7 @@ pub(crate) mod checkpoint;
 mod clock;
 mod constitutive;
 mod contact;
+mod dense;
 pub(crate) mod fields;
 mod measures;
 mod newton;

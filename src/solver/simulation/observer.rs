@@ -17,6 +17,16 @@ pub trait Observer {
     /// Called after each converged step.
     fn step(&mut self, sim: &Simulation<'_>, report: &StepReport) -> ControlFlow<()>;
 
+    /// Called with the state at a requested time that no step landed on ([`crate::model::Model::record_times`]
+    /// of an error-controlled run: the continuous extension of the step that holds it, module docs of
+    /// `super::dense`), in time order and before that step's [`Observer::step`]. `sim` is at `report.time`,
+    /// with [`Simulation::step_count`] the last step before it; `report.step` is that step too, `report.dt` the
+    /// time from it and `report.newton` the extension's solve. An observer that must stop (a write error) keeps
+    /// its error and asks at the next step.
+    fn requested(&mut self, sim: &Simulation<'_>, report: &StepReport) {
+        let _ = (sim, report);
+    }
+
     /// Called when Newton fails on a step that is then cut (`time` is the target that was not reached).
     fn step_failed(&mut self, time: Real, dt: Real, newton: &NewtonReport) {
         let _ = (time, dt, newton);
@@ -63,6 +73,12 @@ impl<O: Observer> Observer for Option<O> {
     fn step(&mut self, sim: &Simulation<'_>, report: &StepReport) -> ControlFlow<()> {
         self.as_mut()
             .map_or(ControlFlow::Continue(()), |o| o.step(sim, report))
+    }
+
+    fn requested(&mut self, sim: &Simulation<'_>, report: &StepReport) {
+        if let Some(o) = self {
+            o.requested(sim, report);
+        }
     }
 
     fn step_failed(&mut self, time: Real, dt: Real, newton: &NewtonReport) {
@@ -114,6 +130,12 @@ impl Observer for Observers<'_, '_> {
 
     fn step(&mut self, sim: &Simulation<'_>, report: &StepReport) -> ControlFlow<()> {
         self.each(|o| o.step(sim, report))
+    }
+
+    fn requested(&mut self, sim: &Simulation<'_>, report: &StepReport) {
+        for observer in self.list.iter_mut() {
+            observer.requested(sim, report);
+        }
     }
 
     fn step_failed(&mut self, time: Real, dt: Real, newton: &NewtonReport) {

@@ -54,6 +54,9 @@ pub struct StepReport {
     pub load_factor: Option<Real>,
     /// What the stabilisation did (runs with `solver.stabilisation`; `None` otherwise).
     pub stabilisation: Option<super::StepStabilisation>,
+    /// States at requested times inside this step, reported before it ([`super::Observer::requested`]); 0 for
+    /// such a state's own report.
+    pub requested: usize,
 }
 
 /// Totals of a run.
@@ -69,6 +72,9 @@ pub struct RunSummary {
     pub rejected: usize,
     /// LU factorisations over all converged steps.
     pub factorisations: usize,
+    /// States reported at requested times between the steps (error control's continuous extension,
+    /// [`super::Observer::requested`]).
+    pub requested: usize,
     /// Time reached.
     pub time: Real,
     /// True when an observer asked to stop before the end.

@@ -6,9 +6,10 @@ use super::checkpoint::Revert;
 use super::newton::{NewtonFailure, round_off_notice};
 use super::observer::Observers;
 use super::snapshot::StepSnapshot;
-use super::{NoObserver, Observer, RunSummary, Simulation, StepReport};
+use super::{NewtonReport, NoObserver, Observer, RunSummary, Simulation, StepReport};
 use crate::math::Real;
 use crate::solver::SolverError;
+use crate::solver::state::State;
 use std::time::Instant;
 
 /// Allowance, in units in the last place of the time reached, when a step size computed as `(t + h) − t` is
@@ -155,57 +156,7 @@ impl Simulation<'_> {
             if self.model.solver().extrapolate {
                 self.solution.predict(&self.disc, dt);
             }
-            let reuse = self.model.solver().reuse_factorisation;
-            let mut attempt = self.newton(target, reuse, &*observer);
-            if reuse && let Err(NewtonFailure::NotConverged(failed)) = &attempt {
-                // A reused factorisation may be what failed: retry the same step with Newton's method proper
-                // before cutting it.
-                observer.step_failed(target, dt, failed);
-                let factorisations = failed.factorisations;
-                self.solution.state = start.solution.state.clone();
-                self.solution.step_increment.clear();
-                attempt = if observer.interrupted() {
-                    Err(NewtonFailure::Interrupted)
-                } else {
-                    self.newton(target, false, &*observer)
-                };
-                if let Ok(newton) = &mut attempt {
-                    newton.factorisations += factorisations;
-                }
-            }
-            // Augmented Lagrange: a term that enforces a condition by multipliers (contact) may ask for the
-            // converged step to be solved again with updated multipliers (each term bounds its own updates).
-            // The solve starts from the converged iterate with its last factorisation, as a step does, and is
-            // made again with Newton's method proper should that fail.
-            while let Ok(newton) = &attempt
-                && self.augment_terms()
-            {
-                let mut done = (newton.iterations, newton.factorisations);
-                let converged = reuse.then(|| {
-                    let s = &self.solution;
-                    (s.state.clone(), s.step_increment.clone())
-                });
-                attempt = if observer.interrupted() {
-                    Err(NewtonFailure::Interrupted)
-                } else {
-                    self.newton(target, reuse, &*observer)
-                };
-                if let (Err(NewtonFailure::NotConverged(failed)), Some((state, increment))) =
-                    (&attempt, converged)
-                {
-                    done.1 += failed.factorisations;
-                    (self.solution.state, self.solution.step_increment) = (state, increment);
-                    attempt = if observer.interrupted() {
-                        Err(NewtonFailure::Interrupted)
-                    } else {
-                        self.newton(target, false, &*observer)
-                    };
-                }
-                if let Ok(newton) = &mut attempt {
-                    newton.iterations += done.0;
-                    newton.factorisations += done.1;
-                }
-            }
+            let attempt = self.solve_attempt(target, dt, &start.solution.state, observer);
             // Error control: a converged step whose time-error estimate exceeds the tolerance is rejected and
             // retried shorter (module `adaptive`), unless it is already the smallest step.
             let mut estimate = None;
@@ -237,14 +188,20 @@ impl Simulation<'_> {
             match attempt {
                 Ok(newton) => {
                     self.work.tangent.end_attempt();
+                    // Error control: the states at the requested times within the step, from its continuous
+                    // extension (module `dense`), before the step is committed.
+                    let requested = match self.reach_requested_times(&start, target, observer) {
+                        Ok(count) => count,
+                        Err(e) => {
+                            self.roll_back(&start, Abandon::Failed);
+                            return Err(e);
+                        }
+                    };
                     self.commit_step();
                     let stabilisation = self.account_stabilisation(target);
                     // A schedule's rate changes at its breakpoints: no extrapolation across them.
                     let breakpoints = &self.measures.breakpoints;
-                    let nearest = breakpoints.partition_point(|&b| b < target - snap);
-                    let at_break = breakpoints
-                        .get(nearest)
-                        .is_some_and(|&b| (b - target).abs() <= snap);
+                    let at_break = crate::math::near_one_of(breakpoints, target, snap);
                     let increment = std::mem::take(&mut self.solution.step_increment);
                     self.solution.last_increment = (!at_break).then_some((increment, dt));
                     let cuts = std::mem::take(&mut self.clock.step_cuts);
@@ -269,6 +226,7 @@ impl Simulation<'_> {
                         rejected: std::mem::take(&mut self.clock.control.rejections),
                         load_factor: None,
                         stabilisation,
+                        requested,
                     };
                     return Ok(StepOutcome::Stepped(Box::new(report)));
                 }
@@ -305,6 +263,71 @@ impl Simulation<'_> {
         }
     }
 
+    /// Solves the step prepared for `target` (of size `dt`) from the iterate in place, whose attempt started at
+    /// the converged `start`: Newton's method (reusing the factorisation when the solver does, and retried with
+    /// Newton's method proper from `start` when a reused factorisation failed, which `observer` is told of), then
+    /// solved again for as long as a term updates its multipliers (augmented Lagrange).
+    pub(super) fn solve_attempt(
+        &mut self,
+        target: Real,
+        dt: Real,
+        start: &State,
+        observer: &mut dyn Observer,
+    ) -> Result<NewtonReport, NewtonFailure> {
+        let reuse = self.model.solver().reuse_factorisation;
+        let mut attempt = self.newton(target, reuse, &*observer);
+        if reuse && let Err(NewtonFailure::NotConverged(failed)) = &attempt {
+            // A reused factorisation may be what failed: retry the same step with Newton's method proper
+            // before cutting it.
+            observer.step_failed(target, dt, failed);
+            let factorisations = failed.factorisations;
+            self.solution.state = start.clone();
+            self.solution.step_increment.clear();
+            attempt = if observer.interrupted() {
+                Err(NewtonFailure::Interrupted)
+            } else {
+                self.newton(target, false, &*observer)
+            };
+            if let Ok(newton) = &mut attempt {
+                newton.factorisations += factorisations;
+            }
+        }
+        // Augmented Lagrange: a term that enforces a condition by multipliers (contact) may ask for the
+        // converged step to be solved again with updated multipliers (each term bounds its own updates).
+        // The solve starts from the converged iterate with its last factorisation, as a step does, and is
+        // made again with Newton's method proper should that fail.
+        while let Ok(newton) = &attempt
+            && self.augment_terms()
+        {
+            let mut done = (newton.iterations, newton.factorisations);
+            let converged = reuse.then(|| {
+                let s = &self.solution;
+                (s.state.clone(), s.step_increment.clone())
+            });
+            attempt = if observer.interrupted() {
+                Err(NewtonFailure::Interrupted)
+            } else {
+                self.newton(target, reuse, &*observer)
+            };
+            if let (Err(NewtonFailure::NotConverged(failed)), Some((state, increment))) =
+                (&attempt, converged)
+            {
+                done.1 += failed.factorisations;
+                (self.solution.state, self.solution.step_increment) = (state, increment);
+                attempt = if observer.interrupted() {
+                    Err(NewtonFailure::Interrupted)
+                } else {
+                    self.newton(target, false, &*observer)
+                };
+            }
+            if let Ok(newton) = &mut attempt {
+                newton.iterations += done.0;
+                newton.factorisations += done.1;
+            }
+        }
+        attempt
+    }
+
     /// Runs from the current time to the model's end time — a loop over [`Simulation::step_with`] — telling
     /// every observer of `observers` (a list the caller owns, called in its order) of the initial state (when
     /// at step 0) and of each converged step.
@@ -333,6 +356,7 @@ impl Simulation<'_> {
                     summary.steps += 1;
                     summary.iterations += report.newton.iterations;
                     summary.factorisations += report.newton.factorisations;
+                    summary.requested += report.requested;
                     summary.cuts += report.cuts;
                     summary.rejected += report.rejected;
                     summary.time = report.time;
@@ -373,22 +397,31 @@ impl Simulation<'_> {
     /// attempt made none, made again from its recorded origin otherwise — so that continuing (a later `step`, or
     /// a restored checkpoint taken now) repeats the uninterrupted run exactly.
     pub(super) fn roll_back(&mut self, start: &StepSnapshot, why: Abandon) {
+        self.restore_step(start);
+        self.stabiliser.damping = None;
+        match why {
+            Abandon::Interrupted => self.return_to_attempt_factorisation(),
+            Abandon::Rejected => self.work.tangent.end_attempt(),
+            Abandon::Failed => self.forget_factorisation(),
+        }
+    }
+
+    /// Every part a step changes back as `start` has it ([`Self::put_back`]), and the materials back at the data
+    /// of their last converged step.
+    pub(super) fn restore_step(&mut self, start: &StepSnapshot) {
         let restored = self.put_back(start);
         assert!(
             restored.is_ok(),
             "a part refused the snapshot it saved itself: {restored:?}"
         );
-        self.stabiliser.damping = None;
         self.materials.roll_back(self.model.materials());
-        let revert = match why {
-            Abandon::Interrupted => self.work.tangent.revert_attempt(),
-            Abandon::Rejected => {
-                self.work.tangent.end_attempt();
-                Revert::Keep
-            }
-            Abandon::Failed => Revert::Forget,
-        };
-        let kept = match revert {
+    }
+
+    /// The factorisation goes back to the one the attempt in progress started with: kept if the attempt made
+    /// none, made again from its recorded origin otherwise, forgotten if there was none (or it cannot be made
+    /// again: the next attempt then starts with a fresh tangent).
+    pub(super) fn return_to_attempt_factorisation(&mut self) {
+        let kept = match self.work.tangent.revert_attempt() {
             Revert::Keep => true,
             // (It factorised before; should it fail now, the next attempt starts with a fresh tangent.)
             Revert::Refactor => self.refactor_recorded().is_ok(),
