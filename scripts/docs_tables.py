@@ -599,8 +599,13 @@ def meshes_map():
     for flag, field in (("0", "paper's (`incremental`)"), ("1", "`objective`")):
         runs = [r for r in data if r["objective_rotations"] == flag]
         failed = [r for r in runs if r["completed"] != "true"]
+        def crossed(r):
+            t = r.get("wires_crossed") or ""
+            return f", wires through each other from {float(t):.3f} s" if t else ""
+
         cells = "; ".join(
-            f"p = {r['p']}, n = {r['n']} {where(float(r['time_reached']))} ({float(r['time_reached']):.3f} s)"
+            f"p = {r['p']}, n = {r['n']} {where(float(r['time_reached']))} ({float(r['time_reached']):.3f} s"
+            f"{crossed(r)})"
             for r in failed
         )
         body.append([field, str(len(runs)), str(len(runs) - len(failed)), cells or "none"])

@@ -86,6 +86,12 @@ impl SnapshotSchedule {
         &self.times
     }
 
+    /// The requested times (`output.snapshots.times`), sorted: among [`Self::times`] with fixed steps; an
+    /// error-controlled run reaches them between its steps.
+    pub fn requested(&self) -> &[Real] {
+        &self.requested
+    }
+
     /// Whether `time` is a requested snapshot time (within the landing tolerance).
     pub fn is_requested(&self, time: Real) -> bool {
         crate::math::near_one_of(&self.requested, time, self.snap)

@@ -73,6 +73,10 @@ pub struct FailureReport {
     /// collocation point or node, and which balance.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub worst_equation: Option<String>,
+    /// What the run met before it failed that may be why, in words (filled by `stentkit run`): wires that had
+    /// passed through each other, and since when.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub before: Vec<String>,
     /// What to change, most likely first (filled by `stentkit run` from the model and where it failed).
     #[serde(skip_serializing_if = "Vec::is_empty")]
     pub suggestions: Vec<String>,
@@ -105,6 +109,7 @@ impl FailureReport {
             residuals: Vec::new(),
             diagnosis: None,
             worst_equation: None,
+            before: Vec::new(),
             suggestions: Vec::new(),
             last_converged_step: step,
             last_converged_time: time,

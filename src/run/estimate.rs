@@ -155,7 +155,8 @@ impl DiskEstimate {
 pub struct Sizing<'a> {
     /// The design run.
     pub design: &'a Design,
-    /// States recorded: the planned steps and the initial state.
+    /// States recorded: the planned steps, the initial state and, with error control, the record times (reached
+    /// between the steps).
     pub states: Real,
     /// Snapshots written (the initial state, every `every` steps, the requested times, the end): an upper
     /// bound, as a time due may fall on an `every` step.
@@ -217,9 +218,15 @@ const SUMMARY_SNAPSHOT_BYTES: Real = 250.0;
 /// documentation for how conservative each part is.
 pub fn estimated_disk(design: &Design) -> DiskEstimate {
     let steps = design.steps.total();
+    let model = &design.model;
+    let between_steps = if model.time().tolerance.is_some() {
+        model.record_times().len()
+    } else {
+        0
+    };
     let sizing = Sizing {
         design,
-        states: steps as Real + 1.0,
+        states: (steps + 1 + between_steps) as Real,
         snapshots: snapshot_count(&design.model, steps, &design.output.snapshots),
     };
     let mut parts: Vec<DiskPart> = RECORDERS
@@ -247,11 +254,16 @@ fn snapshot_count(model: &Model, steps: usize, settings: &SnapshotSettings) -> u
     let every = settings.every;
     let periodic = steps.checked_div(every).unwrap_or(0);
     let last = usize::from(every == 0 || !steps.is_multiple_of(every));
-    let due = SnapshotSchedule::new(settings, model)
-        .times()
-        .iter()
-        .filter(|&&t| t > 0.0 && t < model.time().end)
-        .count();
+    let schedule = SnapshotSchedule::new(settings, model);
+    let inside = |t: &&Real| **t > 0.0 && **t < model.time().end;
+    // An error-controlled run's requested times are not among the times due of its steps (it reaches them between
+    // its steps).
+    let between_steps = if model.time().tolerance.is_some() {
+        schedule.requested().iter().filter(inside).count()
+    } else {
+        0
+    };
+    let due = schedule.times().iter().filter(inside).count() + between_steps;
     1 + periodic + last + due
 }
 

@@ -874,6 +874,14 @@ fn run_in(
     };
     let failure = result.as_ref().err().map(|e| {
         let mut report = FailureReport::of(e, outputs.totals.steps, sim.time());
+        if let Some(t) = sim.wires_crossed() {
+            report.before.push(format!(
+                "the wires had passed through each other since t = {} s (where: the warning above; a wire through \
+                 another, or a quarter model's wire through its own mirror image), so the model was no longer the \
+                 device from then on, which may be why it failed",
+                short_time(t)
+            ));
+        }
         report.suggestions = suggestions(model, &report);
         report
     });
@@ -1141,6 +1149,9 @@ fn failure_report(failure: &FailureReport, summary: &RunSummaryFile) -> String {
     }
     if let Some(w) = &failure.diagnosis {
         lines.push(format!("  diagnosis: {w}"));
+    }
+    for b in &failure.before {
+        lines.push(format!("  before it failed: {b}"));
     }
     let snapshot = summary
         .snapshots

@@ -103,6 +103,39 @@ fn a_run_that_drives_wires_through_each_other_completes_with_a_warning() {
     assert!(!stderr.contains("wires passed"), "{stderr}");
 }
 
+/// Source: the failure report's contract (issue 36 item 1: a failure states what the run met before it). The
+/// rods driven through each other from t = 0.5 (as above), then one end twisted by 10 rad about y in one step that
+/// may not be cut (`min_step` = `step`): Newton fails at t = 1.125, and the failure report (stderr and
+/// summary.json's `failure.before`) says the wires had passed through each other since t = 0.5.
+#[test]
+fn a_failed_run_says_its_wires_had_passed_through_each_other_before() {
+    let root = test_outputs("wires_failed");
+    let design = crossing_rods(&root, "then_twisted", 0.5, 0.8);
+    let text = std::fs::read_to_string(&design).expect("design");
+    let text = crate::common::edit(
+        &text,
+        "{node: c, displacement: [0, 0, [[0, 0], [1, -0.8]]], rotation: [0, 0, 0]}",
+        "{node: c, displacement: [0, 0, [[0, 0], [1, -0.8]]], rotation: [0, [[1, 0], [1.125, 10]], 0]}",
+    );
+    let text = crate::common::edit(
+        &text,
+        "time: {end: 1.0, step: 0.125}",
+        "time: {end: 1.125, step: 0.125, min_step: 0.125}",
+    );
+    std::fs::write(&design, text).expect("design written");
+    let dir = root.join("then_twisted_run");
+    let (code, stderr) = run_in_process(&design, &dir, &[]);
+    assert_ne!(code, 0, "the twist fails: {stderr}");
+    let said = "the wires had passed through each other since t = 0.5 s";
+    assert!(
+        stderr.contains(&format!("before it failed: {said}")),
+        "{stderr}"
+    );
+    let summary = read_json(&dir.join("summary.json"));
+    let before = summary["failure"]["before"][0].as_str().expect("a line");
+    assert!(before.starts_with(said), "{before}");
+}
+
 /// Source: the geometry and the outputs' definitions. The same crossing rods 0.5 apart with the wires' contact
 /// on, the upper one's ends moved down by 0.35: the rods touch from a drop of 0.3 (`0.5 − 0.2`), so at the end
 /// they press on each other (both bent, the penetration within the contact's tolerance, 1 % of the diameter by

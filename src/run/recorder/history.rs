@@ -50,14 +50,7 @@ pub(super) const HISTORY: RecorderKind = RecorderKind {
     },
     estimate: |s| {
         let design = s.design;
-        // An error-controlled run writes a row at each record time besides its steps (fixed steps land there).
-        let model = &design.model;
-        let requested = if model.time().tolerance.is_some() {
-            model.record_times().len()
-        } else {
-            0
-        };
-        let rows = s.states + 1.0 + requested as Real;
+        let rows = s.states + 1.0;
         let bytes = rows * row_bytes(&design.model, &design.output.strain_limits);
         DiskPart {
             advice: Some(("time.step", "take larger time steps")),

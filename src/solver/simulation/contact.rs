@@ -37,6 +37,15 @@ impl Simulation<'_> {
             .first_touch()
     }
 
+    /// When the device's wires first passed through each other in the steps so far (beyond the check's tolerance,
+    /// [`crate::solver::terms::crossing::WireCrossing::first_crossing`]); `None` if they have not.
+    pub fn wires_crossed(&self) -> Option<crate::math::Real> {
+        self.terms
+            .iter()
+            .find_map(|t| t.as_any()?.downcast_ref::<WireCrossing>())?
+            .first_crossing()
+    }
+
     /// What the contact between the device's wires does in the current state
     /// ([`crate::solver::terms::wires::WireContactReport`]); `None` without it (`contact: {wires: true}`).
     pub fn wire_contact(&self) -> Option<WireContactReport> {

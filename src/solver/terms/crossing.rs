@@ -108,6 +108,12 @@ impl WireCrossing {
         }
     }
 
+    /// The time of the first committed step whose wires had passed through each other (an overlap beyond the
+    /// tolerance: module docs, *What counts*), if any.
+    pub fn first_crossing(&self) -> Option<Real> {
+        (self.steps > 0).then_some(self.first)
+    }
+
     /// The first step whose wires touched (module docs): its time, the deepest overlap then (beyond the design's
     /// own) and where, in words.
     pub fn first_touch(&self) -> Option<WireTouch> {

@@ -45,6 +45,8 @@ pub struct NewtonRun {
     pub final_probe: Option<crate::math::Vec3>,
     /// What automatic stabilisation did (runs with `solver.stabilisation`).
     pub stabilisation: Option<crate::solver::StabiliserState>,
+    /// When the device's wires first passed through each other (`Simulation::wires_crossed`), if they did.
+    pub wires_crossed: Option<Real>,
 }
 
 impl NewtonRun {
@@ -120,6 +122,7 @@ pub fn newton_run_with(model: &Model, also: &mut dyn Observer) -> Result<NewtonR
     // The stabilisation's warnings and the point terms' (contact left above its penetration tolerance).
     run.notices.extend(sim.warnings());
     run.stabilisation = model.solver().stabilisation.map(|_| *sim.stabilisation());
+    run.wires_crossed = sim.wires_crossed();
     run.final_probe = model
         .probes
         .first()
@@ -180,7 +183,7 @@ pub fn solver_csv(map: &SolverMap, header: &str) -> String {
     let _ = writeln!(s, "# {header}");
     let _ = writeln!(
         s,
-        "{},converged_without_cuts,completed,time_reached,steps,newton_iterations,iterations_per_step,max_step_iterations,cuts,failed_attempts,smallest_step,wall_s,first_limit_load_factor,damped_steps,dissipated_ratio,failure",
+        "{},converged_without_cuts,completed,time_reached,steps,newton_iterations,iterations_per_step,max_step_iterations,cuts,failed_attempts,smallest_step,wall_s,first_limit_load_factor,damped_steps,dissipated_ratio,wires_crossed,failure",
         map.columns.join(",")
     );
     for p in &map.points {
@@ -188,7 +191,7 @@ pub fn solver_csv(map: &SolverMap, header: &str) -> String {
         let params: Vec<String> = p.parameters.iter().map(|v| format!("{v}")).collect();
         let _ = writeln!(
             s,
-            "{},{},{},{},{},{},{:.3},{},{},{},{:e},{:.3},{},{},{},{}",
+            "{},{},{},{},{},{},{:.3},{},{},{},{:e},{:.3},{},{},{},{},{}",
             params.join(","),
             r.completed && r.cuts == 0,
             r.completed,
@@ -210,6 +213,7 @@ pub fn solver_csv(map: &SolverMap, header: &str) -> String {
             r.stabilisation
                 .map(|s| format!("{:.3e}", s.ratio()))
                 .unwrap_or_default(),
+            r.wires_crossed.map(|t| t.to_string()).unwrap_or_default(),
             r.failure
                 .as_deref()
                 .map(|f| first_sentence(f).replace([',', '\n'], " "))

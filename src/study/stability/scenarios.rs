@@ -607,8 +607,11 @@ pub fn meshes_report(map: &SolverMap) -> MapReport {
         );
         let failed: Vec<String> = (runs.iter().filter(|q| !q.run.completed))
             .map(|q| {
+                let crossed = (q.run.wires_crossed)
+                    .map(|t| format!(", its wires through each other from t = {t:.4} s"))
+                    .unwrap_or_default();
                 format!(
-                    "p = {}, n = {} {} (t = {:.4} s)",
+                    "p = {}, n = {} {} (t = {:.4} s{crossed})",
                     q.parameters[0],
                     q.parameters[1],
                     phase(q.run.time),
@@ -623,7 +626,7 @@ pub fn meshes_report(map: &SolverMap) -> MapReport {
         }
     }
     summary.push_str(
-        "\nThe stent (designs/straight_stent.yaml) runs its whole programme — crimped, cooled, released at 1.75 s, re-heated — at each degree and number of control points per patch, Newton alone (no stabilisation). A failure is the solver's: no convergence at the smallest step. The paper's field's failures come and go with n, which a resolution limit would not do: its discrete configuration depends on the increments that led to it (docs/choices.md, *Rotation field*). Where the objective field fails the meshes are the coarsest; the release map (`--maps release`) shows one of them (p = 5, n = 14) folding in its own release path.\n\n",
+        "\nThe stent (designs/straight_stent.yaml) runs its whole programme — crimped, cooled, released at 1.75 s, re-heated — at each degree and number of control points per patch, Newton alone (no stabilisation). A failure is the solver's: no convergence at the smallest step. The paper's field's failures come and go with n, which a resolution limit would not do: its discrete configuration depends on the increments that led to it (docs/choices.md, *Rotation field*). Where the objective field fails the meshes are the coarsest; the release map (`--maps release`) shows one of them (p = 5, n = 14) folding in its own release path. A failure after the device's wires had passed through each other (the crossing check: a wire through another, or a quarter model's wire through its own mirror image across a symmetry plane) says since when: the model was then no longer the device, the physical reason it gives. Rod contact (`contact: {wires: true}`) does not rescue these coarse meshes: with it the objective field's p = 4, n = 16 and 18 and p = 5, n = 14 fail too, earlier (measured 2026-11-28: at 2.649, 1.751 and 1.752 s).\n\n",
     );
     MapReport {
         name: map.name,
