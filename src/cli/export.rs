@@ -8,6 +8,8 @@
 //! deterministic, so that step is the run's own state to the bit; a phase's time is an event of the cycle
 //! ([`crate::model::cycle`]), on which the run landed. The design is checked against the run's model
 //! fingerprint (`summary.json`'s `model_fingerprint`) first: a changed design would export another device.
+//! (An error-controlled run's snapshot at a requested time inside a step is its continuous extension there,
+//! `crate::solver::simulation`'s dense output, not a step: `--time` exports the first step at or after it.)
 //! Costs what the run's solver cost up to that time (the straight stent to its end: about 6 s).
 //!
 //! With `--print` the state is written as one printable solid ([`crate::post::print`]), with its rods sampled

@@ -93,7 +93,7 @@ pub(crate) fn run(dir: &Path) -> anyhow::Result<()> {
             done.push(format!(
                 "summary.json: status `killed`, the run folder holds steps 0–{} up to t = {} s",
                 rows.len().saturating_sub(1),
-                short_time(rows.last().copied().unwrap_or(0.0))
+                short_time(rows.last().map_or(0.0, |r| r.0))
             ));
         }
     } else {
@@ -112,9 +112,13 @@ pub(crate) fn run(dir: &Path) -> anyhow::Result<()> {
     Ok(())
 }
 
-/// Cuts `history.csv` back to its last complete row; returns the time of every row (row `k` is step `k`) and
-/// the bytes cut.
-fn repair_history(path: &Path) -> anyhow::Result<(Vec<f64>, usize)> {
+/// A row of `history.csv`: its time, and whether it is a step's (or the initial state's) rather than the
+/// continuous extension's at a requested time between steps (`requested` = 2).
+type Row = (f64, bool);
+
+/// Cuts `history.csv` back to its last complete row; returns every row ([`Row`]: the `k`-th step row is step
+/// `k`) and the bytes cut.
+fn repair_history(path: &Path) -> anyhow::Result<(Vec<Row>, usize)> {
     use crate::io::no_follow;
     use std::io::Read as _;
     let mut text = Vec::new();
@@ -128,26 +132,47 @@ fn repair_history(path: &Path) -> anyhow::Result<(Vec<f64>, usize)> {
             .and_then(|f| f.set_len(complete as u64).and_then(|()| f.sync_all()));
         file.with_context(|| format!("cannot cut {}", path.display()))?;
     }
-    let rows = String::from_utf8_lossy(&text[..complete])
-        .lines()
-        .skip(1)
-        .map_while(|l| l.split(',').next().and_then(|t| t.parse::<f64>().ok()))
+    let text = String::from_utf8_lossy(&text[..complete]);
+    let mut lines = text.lines();
+    let requested = lines
+        .next()
+        .and_then(|header| header.split(',').position(|h| h == "requested"));
+    let rows = lines
+        .map_while(|l| {
+            let cells: Vec<&str> = l.split(',').collect();
+            let time = cells.first()?.parse::<f64>().ok()?;
+            let extension = requested.is_some_and(|k| cells.get(k) == Some(&"2"));
+            Some((time, !extension))
+        })
         .collect();
     Ok((rows, cut))
 }
 
 /// Turns a `running` summary into the summary of a killed run: status, error, the time and steps the history
-/// holds, the recording's size, and every snapshot whose files are all on disk (a snapshot written after the
-/// last summary is added with the step and time of the history row of the time in its name).
+/// holds (and the states between steps an error-controlled run reached), the recording's size, and every snapshot
+/// whose files are all on disk (a snapshot written after the last summary is added with the step and time of the
+/// history row of the time in its name: the step of that row, or the last before it for a state between steps).
 fn mark_killed(
     summary: &mut Value,
-    rows: &[f64],
+    rows: &[Row],
     dir: &Path,
     listed: &std::collections::BTreeSet<PathBuf>,
     mcap_bytes: Option<u64>,
 ) {
-    let last_step = rows.len().saturating_sub(1);
-    let last_time = rows.last().copied().unwrap_or(0.0);
+    // The step each row is (or follows, for a state between steps).
+    let steps_of: Vec<usize> = rows
+        .iter()
+        .scan(0usize, |steps, &(_, is_step)| {
+            *steps += usize::from(is_step);
+            Some(steps.saturating_sub(1))
+        })
+        .collect();
+    let last_step = steps_of.last().copied().unwrap_or(0);
+    let last_time = rows.last().map_or(0.0, |r| r.0);
+    let between = rows.iter().filter(|r| !r.1).count();
+    if summary["time_error_control"].is_object() {
+        summary["time_error_control"]["requested_states"] = json!(between);
+    }
     summary["status"] = json!("killed");
     summary["error"] = json!(format!(
         "the run was killed (SIGKILL, a power loss or a crash) after t = {} s; repaired by `stentkit repair`",
@@ -177,9 +202,10 @@ fn mark_killed(
             !files.is_empty() && files.iter().all(|f| dir.join(f).is_file())
         })
         .collect();
-    let known: Vec<u64> = snapshots
+    // Listed snapshots by time (a state between steps carries the step before it, which may have its own).
+    let known: Vec<f64> = snapshots
         .iter()
-        .filter_map(|s| s["step"].as_u64())
+        .filter_map(|s| s["time"].as_f64())
         .collect();
     // A snapshot written after the last summary: the files the manifest lists under one name
     // (`snapshots/t1.750_fixed.stl`, `.obj`, `.vtp`), complete when all of them are on disk. Its step is the
@@ -209,17 +235,19 @@ fn mark_killed(
         let Some((at, phase)) = parse_snapshot_name(name) else {
             continue;
         };
-        let step = match at {
-            SnapshotAt::Step(step) => Some(step),
-            // Within the name's rounding: half its sixth decimal.
-            SnapshotAt::Time(t) => rows
-                .iter()
-                .position(|&r| (r - t).abs() <= 0.5e-6 * t.abs().max(1.0) + 5e-7),
+        // Within the name's rounding: half its sixth decimal.
+        let near = |r: f64, t: f64| (r - t).abs() <= 0.5e-6 * t.abs().max(1.0) + 5e-7;
+        let row = match at {
+            SnapshotAt::Step(step) => steps_of.iter().position(|&s| s == step),
+            SnapshotAt::Time(t) => rows.iter().position(|&(r, _)| near(r, t)),
         };
-        let Some(step) = step.map(|k| k as u64) else {
+        let Some(row) = row else {
             continue;
         };
-        if known.contains(&step) || !files.iter().all(|f| dir.join(f).is_file()) {
+        let step = steps_of[row] as u64;
+        if known.iter().any(|&k| near(k, rows[row].0))
+            || !files.iter().all(|f| dir.join(f).is_file())
+        {
             continue;
         }
         let time = files
@@ -230,7 +258,7 @@ fn mark_killed(
                     .find(|(_, listed)| Path::new(listed) == f.as_path())
             })
             .map(|&(t, _)| t)
-            .or_else(|| rows.get(step as usize).copied());
+            .unwrap_or(rows[row].0);
         let mut entry = json!({
             "step": step,
             "time": time,
@@ -250,7 +278,10 @@ fn mark_killed(
         }
         snapshots.push(entry);
     }
-    snapshots.sort_by_key(|s| s["step"].as_u64());
+    snapshots.sort_by(|a, b| {
+        let t = |s: &Value| s["time"].as_f64().unwrap_or(0.0);
+        t(a).total_cmp(&t(b))
+    });
     summary["snapshots"] = Value::Array(snapshots);
 }
 
@@ -262,4 +293,50 @@ fn stl_triangles(path: &Path) -> Option<u32> {
     file.seek(std::io::SeekFrom::Start(80)).ok()?;
     file.read_exact(&mut count).ok()?;
     Some(u32::from_le_bytes(count))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Source: the history's and the summary's contracts (issue 36 item 3). An error-controlled run's history
+    /// holds, besides the initial state and its steps, rows the continuous extension wrote at requested times
+    /// between steps (`requested` = 2): repair counts only the steps as steps, the others as the summary's
+    /// `requested_states`, so that the repaired folder keeps `rows = steps + 1 + requested_states`.
+    #[test]
+    fn a_killed_error_controlled_run_counts_its_states_between_steps_apart() {
+        let dir = std::env::temp_dir().join(format!("stentkit-repair-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).expect("folder");
+        let history = dir.join("history.csv");
+        std::fs::write(
+            &history,
+            "time,iterations,requested\n0,0,0\n0.1,3,0\n0.15,2,2\n0.2,3,1\n0.3,3,0\n0.35,2,2\n0.4,1",
+        )
+        .expect("written");
+        let (rows, cut) = repair_history(&history).expect("read");
+        assert_eq!(cut, 5, "the partial last row is cut");
+        assert_eq!(
+            rows,
+            [
+                (0.0, true),
+                (0.1, true),
+                (0.15, false),
+                (0.2, true),
+                (0.3, true),
+                (0.35, false)
+            ]
+        );
+        let mut summary = json!({
+            "status": "running",
+            "steps": 1,
+            "time_error_control": {"requested_states": 0},
+            "snapshots": [],
+            "files": {},
+        });
+        mark_killed(&mut summary, &rows, &dir, &Default::default(), None);
+        assert_eq!(summary["steps"], 3);
+        assert_eq!(summary["final_time"], 0.35);
+        assert_eq!(summary["time_error_control"]["requested_states"], 2);
+        let _ = std::fs::remove_dir_all(&dir);
+    }
 }

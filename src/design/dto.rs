@@ -910,7 +910,8 @@ pub struct OutputDto {
 pub struct HistoryDto {
     /// Times at which to write a row \[time\], within [0, time.end]: fixed steps land on each; an
     /// error-controlled run (`time.tolerance`) takes the state there from its continuous extension, within its
-    /// tolerance, without a step there. Rows at these times (and at the snapshot times) have `requested` = 1.
+    /// tolerance, without a step there. Rows at these times (and at the snapshot times) have `requested` = 1 (a
+    /// step there) or 2 (the continuous extension's state between steps).
     #[serde(default)]
     pub times: Option<Vec<NonNegative>>,
 }

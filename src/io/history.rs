@@ -420,7 +420,14 @@ impl HistoryWriter {
         self.error.take()
     }
 
-    fn row(&mut self, sim: &Simulation<'_>, report: Option<&StepReport>) -> ControlFlow<()> {
+    /// Writes the row of the state of `sim` (`report`: its step's, or with `extension` the continuous extension's
+    /// at a requested time between steps; `None`: the initial state).
+    fn row(
+        &mut self,
+        sim: &Simulation<'_>,
+        report: Option<&StepReport>,
+        extension: bool,
+    ) -> ControlFlow<()> {
         let t = sim.time();
         let mut line = format!("{t:.10e}");
         if sim.model().solver().path.arc_length().is_some() {
@@ -453,10 +460,15 @@ impl HistoryWriter {
         }
         let requested = sim.model().record_times();
         if !requested.is_empty() {
-            // A row at a requested time: the step landing on it, or the continuous extension's state there.
+            // A row at a requested time: the step landing on it (1), or the continuous extension's state there (2).
             let snap = sim.model().time().landing_tolerance();
-            let hit = crate::math::near_one_of(requested, t, snap);
-            line.push_str(if hit { ",1" } else { ",0" });
+            line.push_str(if extension {
+                ",2"
+            } else if crate::math::near_one_of(requested, t, snap) {
+                ",1"
+            } else {
+                ",0"
+            });
         }
         if sim.model().solver().stabilisation.is_some() {
             let s = report.and_then(|r| r.stabilisation);
@@ -579,16 +591,16 @@ impl HistoryWriter {
 
 impl Observer for HistoryWriter {
     fn start(&mut self, sim: &Simulation<'_>) -> ControlFlow<()> {
-        self.row(sim, None)
+        self.row(sim, None, false)
     }
 
     fn step(&mut self, sim: &Simulation<'_>, report: &StepReport) -> ControlFlow<()> {
-        self.row(sim, Some(report))
+        self.row(sim, Some(report), false)
     }
 
     fn requested(&mut self, sim: &Simulation<'_>, report: &StepReport) {
         // (A write error is kept and stops the run at the next step, whose row cannot be written either.)
-        let _ = self.row(sim, Some(report));
+        let _ = self.row(sim, Some(report), true);
     }
 }
 

@@ -876,9 +876,9 @@ fn run_in(
         let mut report = FailureReport::of(e, outputs.totals.steps, sim.time());
         if let Some(t) = sim.wires_crossed() {
             report.before.push(format!(
-                "the wires had passed through each other since t = {} s (where: the warning above; a wire through \
-                 another, or a quarter model's wire through its own mirror image), so the model was no longer the \
-                 device from then on, which may be why it failed",
+                "the wires had passed through each other since t = {} s (where: the run's warning on wires passing \
+                 through each other; a wire through another, or a quarter model's wire through its own mirror \
+                 image), so the model was no longer the device from then on, which may be why it failed",
                 short_time(t)
             ));
         }

@@ -836,7 +836,7 @@ fn history_rows(history: &str) -> Vec<BTreeMap<String, String>> {
 // the times asked, from the integrator's continuous extension, without steps there. The solver's accuracy at those
 // times is measured against the stiff-ODE reference in `viscoelastic::error_controlled_steps_keep_the_bending_
 // error_below_the_tolerance`; here the run folder: a row at each time asked, exactly there and marked
-// `requested` = 1, the other rows those of the same run asking for nothing (the same steps, to the last digit
+// `requested` = 2 (the extension's), the other rows those of the same run asking for nothing (the same steps, to the last digit
 // printed), and a snapshot at each snapshot time asked (named by that time, with its `.vtp`; the folder is left
 // for `scripts/check_outputs.py`, which reads the field files with VTK).
 #[test]
@@ -858,12 +858,12 @@ fn an_error_controlled_run_writes_rows_and_snapshots_at_the_times_asked() {
     let read = |dir: &Path| std::fs::read_to_string(dir.join("history.csv")).expect("history");
     let (plain_rows, rows) = (history_rows(&read(&plain)), history_rows(&read(&asked)));
     let requested: Vec<Real> = (rows.iter())
-        .filter(|r| r["requested"] == "1")
+        .filter(|r| r["requested"] == "2")
         .map(|r| r["time"].parse().expect("time"))
         .collect();
     assert_eq!(requested, [0.3, 0.62, 1.1, 2.05], "rows at the times asked");
     let steps: Vec<_> = (rows.iter())
-        .filter(|r| r["requested"] == "0")
+        .filter(|r| r["requested"] != "2")
         .map(|r| {
             let mut r = r.clone();
             r.remove("requested");

@@ -417,6 +417,10 @@ fn error_control_catches_the_trapezoidal_ringing_after_a_jump() {
             asked.len(),
             "each time reached once"
         );
+        assert!(
+            requested.len() > asked.len() / 2,
+            "the steps landed on most requested times"
+        );
         let dense_error = error(&requested);
         println!(
             "  error control at {tolerance:e}: {} steps, error {adaptive_error:.2e} (measured/requested {:.2}); at the \
