@@ -158,14 +158,14 @@ pub(crate) fn build(dto: &DesignDto, default_name: &str, temporary_shape: bool) 
         builder.probe(p.name.clone(), at);
     }
     let mut output = output_settings(dto, &settings)?;
-    let mut record_times: Vec<Real> = (output.snapshots.times.iter())
-        .chain(&output.history_times)
-        .copied()
-        .filter(|&t| t > 0.0)
-        .collect();
-    record_times.sort_by(Real::total_cmp);
-    record_times.dedup();
-    builder.record_times(record_times);
+    // (The builder sorts them and drops repeats.)
+    builder.record_times(
+        (output.snapshots.times.iter())
+            .chain(&output.history_times)
+            .copied()
+            .filter(|&t| t > 0.0)
+            .collect(),
+    );
     let crate::model::builder::Built {
         model,
         mut warnings,
@@ -337,8 +337,8 @@ fn builder_issue(e: BuildError, dto: &DesignDto) -> Issue {
 pub(crate) fn field_path(field: &Field, dto: &DesignDto) -> String {
     match *field {
         Field::Name => "name".into(),
-        // The design's snapshot times are checked (and those at 0 dropped) before they are given.
-        Field::RecordTime { .. } => "output.snapshots.times".into(),
+        // The design's snapshot and history times are checked (and those at 0 dropped) before they are given.
+        Field::RecordTime { .. } => "output.snapshots.times / output.history.times".into(),
         Field::Obstacle { index, field } => {
             let base = format!("obstacles[{index}]");
             // The obstacles after the design's are a crimp programme's crimper or a crush programme's plates.

@@ -139,7 +139,7 @@ impl StepCount {
 }
 
 /// The field of the design's time table with the most points (`temperature`, `conditions[0].force[2]`,
-/// `output.snapshots.times`, …), if any has more than one.
+/// `output.snapshots.times`, `output.history.times`, …), if any has more than one.
 fn busiest_schedule(dto: &DesignDto) -> Option<String> {
     let table = |f: &TimeFn| match f {
         TimeFn::Table(points) => points.len(),
@@ -170,13 +170,20 @@ fn busiest_schedule(dto: &DesignDto) -> Option<String> {
             }
         }
     }
-    if let Some(times) = dto
-        .output
-        .as_ref()
-        .and_then(|o| o.snapshots.as_ref())
-        .and_then(|s| s.times.as_ref())
-    {
-        tables.push(("output.snapshots.times".into(), times.len()));
+    let output = dto.output.as_ref();
+    for (field, times) in [
+        (
+            "output.snapshots.times",
+            output.and_then(|o| o.snapshots.as_ref()?.times.as_ref()),
+        ),
+        (
+            "output.history.times",
+            output.and_then(|o| o.history.as_ref()?.times.as_ref()),
+        ),
+    ] {
+        if let Some(times) = times {
+            tables.push((field.into(), times.len()));
+        }
     }
     tables
         .into_iter()

@@ -117,11 +117,7 @@ impl Simulation<'_> {
         self.stabiliser.damping = damping;
         self.stabiliser.first_increment = first_increment;
         self.prepare_step(t_n, target)?;
-        let restored = self.put_back(&accepted);
-        assert!(
-            restored.is_ok(),
-            "a part refused the snapshot it saved itself: {restored:?}"
-        );
+        self.put_back_own(&accepted);
         self.solution.step_increment = increment;
         self.return_to_attempt_factorisation();
         Ok(reported)

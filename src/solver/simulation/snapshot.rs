@@ -144,6 +144,16 @@ impl Simulation<'_> {
         }
     }
 
+    /// Puts back a snapshot this simulation took itself ([`Self::put_back`]): a part that refuses it is a
+    /// programmer error, and panics.
+    pub(super) fn put_back_own(&mut self, snapshot: &StepSnapshot) {
+        let restored = self.put_back(snapshot);
+        assert!(
+            restored.is_ok(),
+            "a part refused the snapshot it saved itself: {restored:?}"
+        );
+    }
+
     /// Puts every part a step changes back as `snapshot` has it (module docs).
     ///
     /// # Errors
