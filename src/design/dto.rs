@@ -781,9 +781,9 @@ pub struct SolverDto {
     /// Linear solver: `block` (banded per patch + Schur complement on the patch ends, default) or `sparse-lu`.
     #[serde(default)]
     pub linear: Option<LinearDto>,
-    /// The rotation field: `incremental` (the paper's updates at the collocation points, default) or
-    /// `objective` (rotations at the control points interpolated relative to a reference rotation per patch:
-    /// path-independent and objective).
+    /// The rotation field: `objective` (rotations at the control points interpolated relative to a reference
+    /// rotation per patch: path-independent and objective; the default) or `incremental` (the paper's updates at
+    /// the collocation points, which the paper's designs name).
     #[serde(default)]
     pub rotations: Option<RotationsDto>,
     /// What drives the path: `time` (the schedules, default) or `arc-length` (Riks/Crisfield continuation of

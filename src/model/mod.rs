@@ -340,19 +340,20 @@ pub enum LinearMethod {
 }
 
 /// How the section rotations along a rod are represented between its control points
-/// (`crate::math::quaternion_field`'s module docs). The default is still the paper's, until every committed
-/// figure has been measured again with the objective field (docs/choices.md, issue 36).
+/// (`crate::math::quaternion_field`'s module docs). The default is the objective field; the designs of the paper's
+/// four cases (and their tuned copies) name the paper's, `incremental`, so that they reproduce its numbers
+/// (docs/choices.md, issue 36).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, serde::Serialize)]
 pub enum RotationField {
     /// Each control point's rotation from the reference; within a patch, their rotation vectors relative to one
     /// reference rotation of the patch are interpolated (Crisfield & Jelenić's interpolation): the
     /// configuration is a function of the control points' positions and rotations alone (path-independent) and
     /// a rigid rotation strains nothing (objective).
+    #[default]
     Objective,
     /// The paper's: a rotation and a curvature kept at every collocation point and updated by interpolated
     /// increments (DESIGN §4 "Updates"), which makes the configuration depend on the increments that led to it
     /// (Crisfield & Jelenić 1999).
-    #[default]
     Incremental,
 }
 

@@ -79,7 +79,7 @@ pub struct StabilityStudy {
 }
 
 impl Default for StabilityStudy {
-    /// The default maps (about a minute on one core, and a minute and a half more for the contact map).
+    /// The default maps (8 s together on the development machine, 2026-11-28).
     fn default() -> Self {
         Self {
             ratios: (-4..=8).map(|k| 10f64.powf(k as Real / 2.0)).collect(),
