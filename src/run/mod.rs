@@ -1114,6 +1114,14 @@ fn suggestions(model: &crate::model::Model, failure: &FailureReport) -> Vec<Stri
             patch.curve.degree()
         ));
     }
+    // The paper's rotation field composes Newton's increments into the state (issue 36): coarse stents, the 10-peak
+    // radial bench and contact runs that it failed finished with the objective field (docs/choices.md).
+    if model.solver().rotations == crate::model::RotationField::Incremental {
+        out.push(
+            "the objective rotation field, `solver: {rotations: objective}` (the default; this design names the paper's, whose configuration depends on the increments that reach it): runs the paper's field failed finished with it (docs/choices.md, *Rotation field*)"
+                .to_string(),
+        );
+    }
     if model.solver().stabilisation.is_none() {
         out.push(
             "automatic stabilisation, `solver: {stabilisation: {}}`, carries a run through a buckle or a snap; summary.json then says how much energy it dissipated"

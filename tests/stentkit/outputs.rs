@@ -778,7 +778,7 @@ fn a_stent_whose_bridges_buckle_is_told_to_change_its_bridges() {
     // balance of bridge `b5_7`). The failure report must name a bridge as the place of the largest residual and
     // say what to change: a slower programme (it failed while programming), more control points on that
     // bridge (its fit deviates 5.1 % of the wire diameter, above the 1 % the fit warns at), stiffer or shorter
-    // bridges, and stabilisation.
+    // bridges, the objective rotation field (the design names the paper's) and stabilisation.
     let dir = test_outputs("buckling_bridges");
     let out = stentkit(&[
         "run",
@@ -808,6 +808,7 @@ fn a_stent_whose_bridges_buckle_is_told_to_change_its_bridges() {
             .to_string(),
         format!("or more control points on patch `{bridge}` (`mesh.n`, now 20)"),
         format!("or stiffer or shorter bridges: the largest residual is on bridge `{bridge}`"),
+        "or the objective rotation field, `solver: {rotations: objective}`".to_string(),
         "or automatic stabilisation".to_string(),
     ] {
         assert!(stderr.contains(&expected), "{expected}\n{stderr}");
@@ -815,7 +816,7 @@ fn a_stent_whose_bridges_buckle_is_told_to_change_its_bridges() {
     let s = summary(&dir);
     assert_eq!(
         s["failure"]["suggestions"].as_array().map(Vec::len),
-        Some(4)
+        Some(5)
     );
 }
 
