@@ -341,8 +341,8 @@ pub enum LinearMethod {
 
 /// How the section rotations along a rod are represented between its control points
 /// (`crate::math::quaternion_field`'s module docs). The default is the objective field; the designs of the paper's
-/// four cases (and their tuned copies) name the paper's, `incremental`, so that they reproduce its numbers
-/// (docs/choices.md, issue 36).
+/// four cases (with their tuned copies and the two crimped stents) name the paper's, `incremental`, so that they
+/// reproduce its numbers (docs/choices.md, issue 36).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, serde::Serialize)]
 pub enum RotationField {
     /// Each control point's rotation from the reference; within a patch, their rotation vectors relative to one

@@ -13,7 +13,7 @@
 //! solution's curvature instead, which the estimate does not control (issue 36 item 3 reports a history read at
 //! the 61 times of an independent creep–recovery reference by linear interpolation 18× the tolerance off, while
 //! its accepted steps were within 0.52–0.69 of it; on our references `tests/stentkit/viscoelastic.rs` prints
-//! both, the extension within the tolerance and the interpolation up to 0.94 of it).
+//! both, the extension within the tolerance and the interpolation up to 1.44 of it: above it).
 //!
 //! Each state is handed to the observers ([`Observer::requested`]) with the simulation at `t*`, in time order
 //! and before the accepted step is reported; then everything goes back to the accepted step exactly — the
