@@ -12,10 +12,11 @@ use stentkit::material::{CircularSection, Integrator, Material, MaterialLaw};
 use stentkit::math::Vec3;
 use stentkit::model::builder::{ModelBuilder, TimeSpec};
 use stentkit::model::stent::{ProgrammeSpec, ProgrammeTarget, StentMesh};
-use stentkit::model::{TimeFunction, Units};
+use stentkit::model::{RotationField, SolverSettings, TimeFunction, Units};
 
 /// The paper's straight stent with `crowns` crowns, every wire of degree `p` with `n` control points, time
-/// step `step` [s] (the paper: 6 crowns, p = 6, n = 20, 2.5e-3 s), ready to build or to change further.
+/// step `step` [s] (the paper: 6 crowns, p = 6, n = 20, 2.5e-3 s) and the paper's rotation field, ready to build
+/// or to change further.
 pub fn straight_stent(crowns: usize, (p, n): (usize, usize), step: f64) -> ModelBuilder {
     let wire = CircularSection::try_new(0.6).expect("a 0.6 mm wire is a valid section"); // diameter [mm]
     let mut b = ModelBuilder::new(
@@ -72,5 +73,10 @@ pub fn straight_stent(crowns: usize, (p, n): (usize, usize), step: f64) -> Model
         .expect("the table's times increase"),
     );
     b.time(TimeSpec::new(3.25, step));
+    // The paper's rotation field, as the design names it (docs/choices.md, *Rotation field*).
+    b.solver(SolverSettings {
+        rotations: RotationField::Incremental,
+        ..SolverSettings::default()
+    });
     b
 }

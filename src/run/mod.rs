@@ -1114,11 +1114,12 @@ fn suggestions(model: &crate::model::Model, failure: &FailureReport) -> Vec<Stri
             patch.curve.degree()
         ));
     }
-    // The paper's rotation field composes Newton's increments into the state (issue 36): coarse stents, the 10-peak
-    // radial bench and contact runs that it failed finished with the objective field (docs/choices.md).
+    // The paper's rotation field composes Newton's increments into the state (issue 36): some coarse stents, the
+    // 10-peak radial bench and contact runs that it failed finished with the objective field, not all
+    // (docs/choices.md).
     if model.solver().rotations == crate::model::RotationField::Incremental {
         out.push(
-            "the objective rotation field, `solver: {rotations: objective}` (the default; this design names the paper's, whose configuration depends on the increments that reach it): runs the paper's field failed finished with it (docs/choices.md, *Rotation field*)"
+            "the objective rotation field, `solver: {rotations: objective}` (the default; this run uses the paper's, whose configuration depends on the increments that reach it): some runs the paper's field failed finish with it, not all (docs/choices.md, *Rotation field*)"
                 .to_string(),
         );
     }

@@ -1,5 +1,5 @@
 //! The evolving discrete state: control points (additive updates) and, at every collocation point, the
-//! rotation, the curvature and its arc-length derivative. With the objective rotation field (an option) each
+//! rotation, the curvature and its arc-length derivative. With the objective rotation field (the default) each
 //! control point also carries its rotation from the reference, a unit quaternion `ρ_a` turned by its increment,
 //! and the collocation points' rotations and curvatures follow from them (`crate::math::quaternion_field`);
 //! with the paper's incremental field they are updated at the collocation points by interpolated increments

@@ -45,15 +45,8 @@ pub const CLEAR: Real = 0.5;
 const RUBBERY: (Real, Real) = (80.59, 0.33);
 /// When the crimper is closed, when it starts to open, when it is open again \[s\].
 pub const SCHEDULE: [Real; 3] = [1.0, 1.25, 2.25];
-/// Degree and control points of every wire. At n = 12 the map's own notices said the wires penetrated the crimper
-/// between collocation points by up to 2.7e-3 mm, nine times the tolerance (refine), and that model is
-/// under-resolved in a second way: with the objective rotation field its equilibrium path has a limit point at
-/// t = 0.76560 s (every step from 0.01 to 0.1 s and every penalty from 0.1 to 10 stops there; Newton with a fresh
-/// tangent converges by exactly 4× per iteration, a double root), which the same field passes at n = 24 and at
-/// p = 6, n = 20 and 40 (step 0.05 s, penalty 10 N/mm²). At n = 24 the penetration between points falls to
-/// 7.6e-4 to 9.5e-4 mm, and the objective field completes every case of the map and 0.025 s at 10 N/mm² besides,
-/// the paper's field all but 0.05 and 0.025 s at 0.1 N/mm² (measured 2026-11-28; docs/choices.md, *Rotation
-/// field*).
+/// Degree and control points of every wire: n = 24, since at n = 12 the map's crown was under-resolved, by its own
+/// notices and by a limit point of its path with the objective rotation field (docs/choices.md, *Rotation field*).
 pub const MESH: (usize, usize) = (4, 24);
 /// The contact law's transition band `2δ`, and the penetration its augmented-Lagrange updates allow \[mm\]: a
 /// thousandth of the wire's radius. The crimper moves 460 to 1800 times as far in one step of the map, so
