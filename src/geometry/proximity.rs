@@ -40,6 +40,13 @@
 //! have come: a run need not search again (the solver's wire-crossing check). Pairs left out as neighbours
 //! along the wires or as a joint's own overlap are taken to stay out while the device moves that little.
 //!
+//! **Candidates.** A search also lists the pairs of segments it measured within their radii and the margin of
+//! each other, in the order it measured them. While no control point has moved half the margin since, no other
+//! pair can have come within their radii (each of two places moved less than half the margin), so measuring
+//! these pairs alone finds every overlap a new search would, the same and in the same order
+//! ([`Wires::recheck`]): a wire that lies through its own mirror image for good (whose slack stays below zero)
+//! no longer costs an R*-tree join at every step.
+//!
 //! **Mirror images.** For a set of symmetry planes the images are the device reflected in every non-empty
 //! subset of them (one plane: one image; two: three). A pair between a wire and an image is found as between two
 //! wires, its distance along the wires through the nodes lying in every plane of the image (where the wire
@@ -423,6 +430,27 @@ impl Wires {
             margin,
         )
     }
+
+    /// [`Wires::search`] over the `candidates` of an earlier search with the same `depth` and `margin` only,
+    /// which finds the same overlaps while no control point has moved half the margin since (module docs,
+    /// *Candidates*); its slack is that of the candidates (the caller bounds the others').
+    pub fn recheck(
+        &self,
+        points: &[Vec<Vec3>],
+        depth: Real,
+        margin: Real,
+        candidates: &[Candidate],
+    ) -> Search {
+        recheck(
+            &self.wires,
+            &self.mirrors,
+            &self.graph,
+            points,
+            depth,
+            margin,
+            candidates,
+        )
+    }
 }
 
 impl Wires {
@@ -482,6 +510,18 @@ pub struct Search {
     /// How much closer any two places can come before they overlap by more than the depth (negative where they
     /// do), at most the margin asked \[length\].
     pub slack: Real,
+    /// The pairs of segments within their radii and the margin of each other, in the order measured (module
+    /// docs, *Candidates*; empty from [`Wires::recheck`]).
+    pub candidates: Vec<Candidate>,
+}
+
+/// Two segments a search found within reach of each other (module docs, *Candidates*): segment `a.1` of wire
+/// `a.0` and segment `b.1` of wire `b.0` of the image `image`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Candidate {
+    a: (usize, usize),
+    b: (usize, usize),
+    image: usize,
 }
 
 /// Two segments within reach of each other (their radii and the scan's margin, by their boxes), not
@@ -547,6 +587,100 @@ impl ScanContext<'_> {
     }
 }
 
+/// The image `image` of the wires at `own` (module docs, *Mirror images*): the planes it reflects in, the nodes a
+/// path across all of them goes through, and its points (`None` for the wires themselves, `image = 0`).
+struct Image {
+    planes: Vec<usize>,
+    through: Option<Vec<usize>>,
+    points: Option<Vec<Vec<Vec3>>>,
+}
+
+impl Image {
+    fn of(mirrors: &[Mirror], own: &[Vec<Vec3>], image: usize) -> Self {
+        let planes: Vec<usize> = (0..mirrors.len())
+            .filter(|k| image & (1 << k) != 0)
+            .collect();
+        let through = (image > 0).then(|| {
+            let mut nodes = mirrors[planes[0]].nodes.clone();
+            nodes.retain(|m| planes.iter().all(|&k| mirrors[k].nodes.contains(m)));
+            nodes
+        });
+        let reflect = |x: &Vec3| planes.iter().fold(*x, |y, &k| mirrors[k].reflect(&y));
+        let points = (image > 0).then(|| {
+            own.iter()
+                .map(|pts| pts.iter().map(reflect).collect())
+                .collect()
+        });
+        Self {
+            planes,
+            through,
+            points,
+        }
+    }
+
+    /// The scan's context for this image of the wires at `own`.
+    fn context<'a>(
+        &'a self,
+        wires: &'a [Wire],
+        graph: &'a Graph,
+        own: &'a [Vec<Vec3>],
+    ) -> ScanContext<'a> {
+        ScanContext {
+            wires,
+            graph,
+            own,
+            other: self.points.as_deref().unwrap_or(own),
+            through: self.through.as_deref(),
+        }
+    }
+}
+
+/// Segment `i` of wire `wa` and segment `j` of wire `wb` of the image `image` of `context`, measured: their
+/// closest points, or `None` where their own boxes grown by their radii and `margin` do not meet or they are
+/// neighbours along the wires (module docs: narrow phase).
+fn measure(
+    context: &ScanContext<'_>,
+    image: usize,
+    (wa, i): (usize, usize),
+    (wb, j): (usize, usize),
+    margin: Real,
+) -> Option<SegmentPair> {
+    let wires = context.wires;
+    let (ra, rb) = (wires[wa].radius, wires[wb].radius);
+    let (p0, p1) = (&context.own[wa][i], &context.own[wa][i + 1]);
+    let (q0, q1) = (&context.other[wb][j], &context.other[wb][j + 1]);
+    // The segments' own boxes, grown by the radii and the margin, first.
+    let reach = Vec3::repeat(ra + rb + margin);
+    if (p0.inf(p1) - q0.sup(q1) - reach).max() > 0.0
+        || (q0.inf(q1) - p0.sup(p1) - reach).max() > 0.0
+    {
+        return None;
+    }
+    if near_along(wires, (wa, i, i + 1), (wb, j, j + 1), context.through) < 2.0 * (ra + rb) {
+        return None;
+    }
+    let (s, t) = closest_points(p0, p1, q0, q1);
+    let (x, y) = (p0 + (p1 - p0) * s, q0 + (q1 - q0) * t);
+    let point = |w: usize, i: usize, f: Real, position: Vec3| {
+        let wire = &wires[w];
+        let lerp = |v: &[Real]| v[i] + (v[i + 1] - v[i]) * f;
+        WirePoint {
+            wire: w,
+            parameter: lerp(&wire.parameters),
+            arc: lerp(&wire.arc),
+            position,
+        }
+    };
+    Some(SegmentPair {
+        i,
+        j,
+        image,
+        distance: (x - y).norm(),
+        a: point(wa, i, s, x),
+        b: point(wb, j, t, y),
+    })
+}
+
 /// Every pair of segments of the wires at `own` (and of the wires with each mirror image) whose boxes, grown by
 /// their radii and `margin`, meet and that are not neighbours along the wires segment by segment, each pair once,
 /// given to `visit` with the scan's context (module docs: broad and narrow phase).
@@ -561,15 +695,8 @@ fn scan(
     let largest = wires.iter().map(|w| w.radius).fold(0.0, Real::max);
     let tree = RTree::bulk_load(chunks(wires, own, margin, |_, _| true));
     for image in 0..(1usize << mirrors.len()) {
-        let planes: Vec<usize> = (0..mirrors.len())
-            .filter(|k| image & (1 << k) != 0)
-            .collect();
-        let reflect = |x: &Vec3| planes.iter().fold(*x, |y, &k| mirrors[k].reflect(&y));
-        let through: Option<Vec<usize>> = (image > 0).then(|| {
-            let mut nodes = mirrors[planes[0]].nodes.clone();
-            nodes.retain(|m| planes.iter().all(|&k| mirrors[k].nodes.contains(m)));
-            nodes
-        });
+        let this = Image::of(mirrors, own, image);
+        let planes = &this.planes;
         // A segment can touch an image only within the two largest radii of each of its planes: the image is on
         // the other side.
         let near_planes = |w: usize, i: usize| {
@@ -582,31 +709,16 @@ fn scan(
                 d0 * d1 <= 0.0 || d0.abs().min(d1.abs()) < 2.0 * largest + margin
             })
         };
-        let images: Vec<Vec<Vec3>>;
-        let other = if image == 0 {
-            own
-        } else {
-            images = own
-                .iter()
-                .map(|pts| pts.iter().map(reflect).collect())
-                .collect();
-            &images
-        };
-        let context = ScanContext {
-            wires,
-            graph,
-            own,
-            other,
-            through: through.as_deref(),
-        };
+        let context = this.context(wires, graph, own);
         let (near_tree, image_tree);
         let candidates = if image == 0 {
             tree.intersection_candidates_with_other_tree(&tree)
         } else {
             near_tree = RTree::bulk_load(chunks(wires, own, margin, near_planes));
-            image_tree = RTree::bulk_load(chunks(wires, other, margin, near_planes));
+            image_tree = RTree::bulk_load(chunks(wires, context.other, margin, near_planes));
             near_tree.intersection_candidates_with_other_tree(&image_tree)
         };
+        let through = this.through.as_deref();
         // Each pair once: (a, b) and (b, a) are the same contact, with an image as without (the chunks of an
         // image are those of the wires); a segment and itself are no pair, but a segment and its own mirror
         // image are.
@@ -618,7 +730,7 @@ fn scan(
                     .any(|k| wires[wa].lies_in.contains(k) || wires[wb].lies_in.contains(k))
                 // Neighbours along the wires wherever their closest points fall: most candidates (a chunk's
                 // box meets those of its neighbours on its own wire and across its nodes).
-                && near_along(wires, (wa, ca.first, ca.last), (wb, cb.first, cb.last), through.as_deref())
+                && near_along(wires, (wa, ca.first, ca.last), (wb, cb.first, cb.last), through)
                     >= 2.0 * (wires[wa].radius + wires[wb].radius)
         });
         let pairs = chunk_pairs.flat_map(|(ca, cb)| {
@@ -629,42 +741,84 @@ fn scan(
             if (wa, i) > (wb, j) || ((wa, i) == (wb, j) && image == 0) {
                 continue;
             }
-            let (ra, rb) = (wires[wa].radius, wires[wb].radius);
-            let (p0, p1) = (&own[wa][i], &own[wa][i + 1]);
-            let (q0, q1) = (&other[wb][j], &other[wb][j + 1]);
-            // The segments' own boxes, grown by the radii and the margin, first.
-            let reach = Vec3::repeat(ra + rb + margin);
-            if (p0.inf(p1) - q0.sup(q1) - reach).max() > 0.0
-                || (q0.inf(q1) - p0.sup(p1) - reach).max() > 0.0
-            {
-                continue;
+            if let Some(pair) = measure(&context, image, (wa, i), (wb, j), margin) {
+                visit(&context, pair);
             }
-            if near_along(wires, (wa, i, i + 1), (wb, j, j + 1), through.as_deref())
-                < 2.0 * (ra + rb)
-            {
-                continue;
-            }
-            let (s, t) = closest_points(p0, p1, q0, q1);
-            let (x, y) = (p0 + (p1 - p0) * s, q0 + (q1 - q0) * t);
-            let point = |w: usize, i: usize, f: Real, position: Vec3| {
-                let wire = &wires[w];
-                let lerp = |v: &[Real]| v[i] + (v[i + 1] - v[i]) * f;
-                WirePoint {
-                    wire: w,
-                    parameter: lerp(&wire.parameters),
-                    arc: lerp(&wire.arc),
-                    position,
-                }
-            };
-            let pair = SegmentPair {
-                i,
-                j,
+        }
+    }
+}
+
+/// What a search or a recheck gathers from the pairs it measures (module docs, *Slack* and *Candidates*): the
+/// deepest overlap beyond `depth` per pair of wires and image, the slack, and the pairs within reach.
+struct Gather {
+    depth: Real,
+    margin: Real,
+    slack: Real,
+    found: Vec<Overlap>,
+    /// How far from a shared node two wires overlap without a break (joint_reach), per wire, other wire, image
+    /// and end.
+    reaches: std::collections::HashMap<(usize, usize, usize, usize), Real>,
+    candidates: Vec<Candidate>,
+}
+
+impl Gather {
+    fn new(depth: Real, margin: Real) -> Self {
+        Self {
+            depth,
+            margin,
+            slack: margin,
+            found: Vec::new(),
+            reaches: std::collections::HashMap::new(),
+            candidates: Vec::new(),
+        }
+    }
+
+    fn visit(&mut self, context: &ScanContext<'_>, pair: SegmentPair) {
+        let wires = context.wires;
+        let (wa, wb, image) = (pair.a.wire, pair.b.wire, pair.image);
+        let radii = wires[wa].radius + wires[wb].radius;
+        if pair.distance < radii + self.margin {
+            self.candidates.push(Candidate {
+                a: (wa, pair.i),
+                b: (wb, pair.j),
                 image,
-                distance: (x - y).norm(),
-                a: point(wa, i, s, x),
-                b: point(wb, j, t, y),
-            };
-            visit(&context, pair);
+            });
+        }
+        let overlap = radii - pair.distance;
+        if overlap <= self.depth {
+            self.slack = self.slack.min(self.depth - overlap);
+            return;
+        }
+        // A pair no deeper than the one already kept for its wires and image changes nothing: the tests of
+        // neighbours and joints are only made for a pair that would be kept.
+        let key = (wa, wb, image);
+        let kept = (self.found.iter()).position(|o| (o.a.wire, o.b.wire, o.image) == key);
+        if kept.is_some_and(|k| self.found[k].depth >= overlap)
+            || context.joined(&pair, &mut self.reaches)
+        {
+            return;
+        }
+        let o = Overlap {
+            depth: overlap,
+            a: pair.a,
+            b: pair.b,
+            image,
+        };
+        match kept {
+            Some(k) => self.found[k] = o,
+            None => self.found.push(o),
+        }
+    }
+
+    fn finish(mut self) -> Search {
+        self.found.sort_by(|x, y| y.depth.total_cmp(&x.depth));
+        if let Some(deepest) = self.found.first() {
+            self.slack = self.slack.min(self.depth - deepest.depth);
+        }
+        Search {
+            overlaps: self.found,
+            slack: self.slack,
+            candidates: self.candidates,
         }
     }
 }
@@ -678,45 +832,37 @@ fn search(
     depth: Real,
     margin: Real,
 ) -> Search {
-    let mut slack = margin;
-    let mut found: Vec<Overlap> = Vec::new();
-    // How far from a shared node two wires overlap without a break (joint_reach), per wire, other wire, image
-    // and end.
-    let mut reaches = std::collections::HashMap::new();
+    let mut gather = Gather::new(depth, margin);
     scan(wires, mirrors, graph, own, margin, &mut |context, pair| {
-        let (wa, wb, image) = (pair.a.wire, pair.b.wire, pair.image);
-        let overlap = wires[wa].radius + wires[wb].radius - pair.distance;
-        if overlap <= depth {
-            slack = slack.min(depth - overlap);
-            return;
-        }
-        // A pair no deeper than the one already kept for its wires and image changes nothing: the tests of
-        // neighbours and joints are only made for a pair that would be kept.
-        let key = (wa, wb, image);
-        let kept = found
-            .iter()
-            .position(|o| (o.a.wire, o.b.wire, o.image) == key);
-        if kept.is_some_and(|k| found[k].depth >= overlap) || context.joined(&pair, &mut reaches) {
-            return;
-        }
-        let o = Overlap {
-            depth: overlap,
-            a: pair.a,
-            b: pair.b,
-            image,
-        };
-        match kept {
-            Some(k) => found[k] = o,
-            None => found.push(o),
-        }
+        gather.visit(context, pair);
     });
-    found.sort_by(|x, y| y.depth.total_cmp(&x.depth));
-    if !found.is_empty() {
-        slack = slack.min(depth - found[0].depth);
+    gather.finish()
+}
+
+/// [`Wires::recheck`]: the candidates measured again at `own`, in the order the search found them (so a tie
+/// between two equally deep pairs is kept as the search would), image by image.
+fn recheck(
+    wires: &[Wire],
+    mirrors: &[Mirror],
+    graph: &Graph,
+    own: &[Vec<Vec3>],
+    depth: Real,
+    margin: Real,
+    candidates: &[Candidate],
+) -> Search {
+    let mut gather = Gather::new(depth, margin);
+    for run in candidates.chunk_by(|x, y| x.image == y.image) {
+        let image = Image::of(mirrors, own, run[0].image);
+        let context = image.context(wires, graph, own);
+        for c in run {
+            if let Some(pair) = measure(&context, c.image, c.a, c.b, margin) {
+                gather.visit(&context, pair);
+            }
+        }
     }
     Search {
-        overlaps: found,
-        slack,
+        candidates: Vec::new(),
+        ..gather.finish()
     }
 }
 
@@ -938,5 +1084,66 @@ mod tests {
         );
         inside.0.lies_in = vec![0];
         assert!(overlaps(&[cut, inside], &[plane], 6).is_empty());
+    }
+
+    #[test]
+    fn a_recheck_of_the_candidates_finds_what_a_new_search_finds_after_a_small_motion() {
+        // Radii 0.1, margin 0.1: `a` and `b` cross 0.15 apart (overlap 0.05); `c` runs beside `a`'s end 0.27 away
+        // (within reach, no overlap); `d` lies 0.07 from the plane y = −1 (through its image by 0.06). Then `a`
+        // moves 0.045 towards `c` and `c` 0.045 towards `a` (under half the margin each): they overlap by 0.02,
+        // a pair the first search found within reach but not overlapping.
+        let a = straight(
+            Vec3::new(-1.0, 0.0, 0.0),
+            Vec3::new(1.0, 0.0, 0.0),
+            10,
+            0.1,
+            [0, 1],
+        );
+        let b = straight(
+            Vec3::new(0.0, -0.9, 0.15),
+            Vec3::new(0.0, 0.9, 0.15),
+            10,
+            0.1,
+            [2, 3],
+        );
+        let c = straight(
+            Vec3::new(0.5, 0.27, 0.0),
+            Vec3::new(2.0, 0.27, 0.0),
+            10,
+            0.1,
+            [4, 5],
+        );
+        let d = straight(
+            Vec3::new(3.0, -0.93, 0.0),
+            Vec3::new(4.0, -0.93, 0.0),
+            10,
+            0.1,
+            [6, 7],
+        );
+        let plane = Mirror {
+            point: Vec3::new(0.0, -1.0, 0.0),
+            normal: Vec3::y(),
+            nodes: Vec::new(),
+        };
+        let all = [a, b, c, d];
+        let wires = Wires::new(all.iter().map(|w| w.0.clone()).collect(), vec![plane], 8);
+        let before: Vec<Vec<Vec3>> = all.iter().map(|w| w.1.clone()).collect();
+        let (depth, margin) = (0.0, 0.1);
+        let first = wires.search(&before, depth, margin);
+        assert_eq!(first.overlaps.len(), 2, "{:?}", first.overlaps);
+        let mut after = before.clone();
+        for (w, shift) in [(0, 0.045), (2, -0.045)] {
+            for x in &mut after[w] {
+                x.y += shift;
+            }
+        }
+        let again = wires.search(&after, depth, margin);
+        let rechecked = wires.recheck(&after, depth, margin, &first.candidates);
+        assert_eq!(again.overlaps.len(), 3, "{:?}", again.overlaps);
+        assert_eq!(rechecked.overlaps, again.overlaps);
+        let ac = (again.overlaps.iter()).find(|o| (o.a.wire, o.b.wire) == (0, 2));
+        assert!(ac.is_some_and(|o| (o.depth - 0.02).abs() < 1e-12), "{ac:?}");
+        // The candidates' slack is below zero where they overlap, as the search's.
+        assert!(rechecked.slack < 0.0 && again.slack < 0.0);
     }
 }

@@ -13,7 +13,7 @@
 //! basis values kept from the start.
 
 use super::{End, Model};
-use crate::geometry::proximity::{Mirror, Overlap, Search, Wire, Wires};
+use crate::geometry::proximity::{Candidate, Mirror, Overlap, Search, Wire, Wires};
 use crate::math::basis::nurbs_basis;
 use crate::math::{Real, Vec3};
 
@@ -164,6 +164,17 @@ impl DeviceWires {
     /// up to `margin`.
     pub fn search(&self, control: &[Vec3], depth: Real, margin: Real) -> Search {
         self.wires.search(&self.points(control), depth, margin)
+    }
+
+    /// [`DeviceWires::search`] over the candidates of an earlier one alone ([`Wires::recheck`]).
+    pub fn recheck(
+        &self,
+        control: &[Vec3],
+        depth: Real,
+        margin: Real,
+        candidates: &[Candidate],
+    ) -> Search {
+        (self.wires).recheck(&self.points(control), depth, margin, candidates)
     }
 
     /// The patches' names, by wire.

@@ -20,12 +20,16 @@
 //! search also finds its *slack* (module docs of [`crate::geometry::proximity`]): how much closer any two places
 //! can come before an overlap would be recorded, up to the largest wire radius. While no control point has moved
 //! half the slack since the last search, no step can have a new overlap, and none is searched for: on the
-//! crimped straight stent that leaves out most steps' searches until the struts close on each other. After a
-//! restored checkpoint the first step searches (the positions of the last search are not kept), which finds the
-//! same as skipping would have.
+//! crimped straight stent that leaves out most steps' searches until the struts close on each other. Once wires
+//! overlap the slack is below zero at every step; then, while no control point has moved half the margin (the
+//! largest wire radius) since the last search, only the pairs that search found within reach are measured again
+//! (its *candidates*), which finds the same overlaps without the R*-tree: the curved stent's bridge lying through
+//! its own mirror image costs a search per step no more. After a restored checkpoint the first step searches
+//! (the positions and candidates of the last search are not kept), which finds the same as skipping would
+//! have.
 
 use super::{InteriorLoad, PointTerm, PointView};
-use crate::geometry::proximity::Overlap;
+use crate::geometry::proximity::{Candidate, Overlap};
 use crate::math::{Real, Vec3};
 use crate::model::Model;
 use crate::model::wires::{DeviceWires, ROUND_OFF};
@@ -68,8 +72,11 @@ pub struct WireCrossing {
     touch: Real,
     /// The first committed step whose wires touch, with its deepest overlap (module docs).
     first_touch: Option<Deepest>,
-    /// The control points at the last search and its slack (module docs); empty before the first.
+    /// The control points at the last search and the candidates it found (module docs); empty before the first.
     searched: Vec<Vec3>,
+    candidates: Vec<Candidate>,
+    /// The control points at the last search or recheck and its slack (module docs); empty before the first.
+    checked: Vec<Vec3>,
     slack: Real,
     /// The margin of the searches: the largest wire radius \[length\].
     margin: Real,
@@ -102,6 +109,8 @@ impl WireCrossing {
             touch,
             first_touch: None,
             searched: Vec::new(),
+            candidates: Vec::new(),
+            checked: Vec::new(),
             slack: 0.0,
             margin: wires.largest_radius(),
             wires,
@@ -155,14 +164,33 @@ impl PointTerm for WireCrossing {
     }
 
     fn commit(&mut self, _disc: &Discretisation, state: &State) {
-        let moved = (self.searched.iter().zip(&state.control))
-            .map(|(a, b)| (a - b).norm())
-            .fold(0.0, Real::max);
-        if self.searched.len() == state.control.len() && 2.0 * moved < self.slack {
+        // How far the control points have moved since `from` (infinitely far before the first).
+        let moved = |from: &[Vec3]| {
+            if from.len() != state.control.len() {
+                return Real::INFINITY;
+            }
+            (from.iter().zip(&state.control))
+                .map(|(a, b)| (a - b).norm())
+                .fold(0.0, Real::max)
+        };
+        if 2.0 * moved(&self.checked) < self.slack {
             return;
         }
-        let search = self.wires.search(&state.control, self.touch, self.margin);
-        self.searched.clone_from(&state.control);
+        let since = moved(&self.searched);
+        let search = if 2.0 * since < self.margin {
+            // No pair outside the candidates has come closer than their radii and the margin less twice the
+            // motion since the search (module docs, *Cost*).
+            let mut search =
+                (self.wires).recheck(&state.control, self.touch, self.margin, &self.candidates);
+            search.slack = search.slack.min(self.margin - 2.0 * since);
+            search
+        } else {
+            let mut search = self.wires.search(&state.control, self.touch, self.margin);
+            self.searched.clone_from(&state.control);
+            self.candidates = std::mem::take(&mut search.candidates);
+            search
+        };
+        self.checked.clone_from(&state.control);
         self.slack = search.slack;
         let Some(&o) = search.overlaps.first() else {
             return;
