@@ -749,7 +749,7 @@ fn scan(
 }
 
 /// What a search or a recheck gathers from the pairs it measures (module docs, *Slack* and *Candidates*): the
-/// deepest overlap beyond `depth` per pair of wires and image, the slack, and the pairs within reach.
+/// deepest overlap beyond `depth` per pair of wires and image, the slack, and for a search the pairs within reach.
 struct Gather {
     depth: Real,
     margin: Real,
@@ -758,18 +758,19 @@ struct Gather {
     /// How far from a shared node two wires overlap without a break (joint_reach), per wire, other wire, image
     /// and end.
     reaches: std::collections::HashMap<(usize, usize, usize, usize), Real>,
-    candidates: Vec<Candidate>,
+    /// The pairs within reach, kept by a search (`None` for a recheck, which measures an earlier search's).
+    candidates: Option<Vec<Candidate>>,
 }
 
 impl Gather {
-    fn new(depth: Real, margin: Real) -> Self {
+    fn new(depth: Real, margin: Real, candidates: Option<Vec<Candidate>>) -> Self {
         Self {
             depth,
             margin,
             slack: margin,
             found: Vec::new(),
             reaches: std::collections::HashMap::new(),
-            candidates: Vec::new(),
+            candidates,
         }
     }
 
@@ -777,8 +778,10 @@ impl Gather {
         let wires = context.wires;
         let (wa, wb, image) = (pair.a.wire, pair.b.wire, pair.image);
         let radii = wires[wa].radius + wires[wb].radius;
-        if pair.distance < radii + self.margin {
-            self.candidates.push(Candidate {
+        if let Some(candidates) =
+            (self.candidates.as_mut()).filter(|_| pair.distance < radii + self.margin)
+        {
+            candidates.push(Candidate {
                 a: (wa, pair.i),
                 b: (wb, pair.j),
                 image,
@@ -818,7 +821,7 @@ impl Gather {
         Search {
             overlaps: self.found,
             slack: self.slack,
-            candidates: self.candidates,
+            candidates: self.candidates.unwrap_or_default(),
         }
     }
 }
@@ -832,7 +835,7 @@ fn search(
     depth: Real,
     margin: Real,
 ) -> Search {
-    let mut gather = Gather::new(depth, margin);
+    let mut gather = Gather::new(depth, margin, Some(Vec::new()));
     scan(wires, mirrors, graph, own, margin, &mut |context, pair| {
         gather.visit(context, pair);
     });
@@ -850,7 +853,7 @@ fn recheck(
     margin: Real,
     candidates: &[Candidate],
 ) -> Search {
-    let mut gather = Gather::new(depth, margin);
+    let mut gather = Gather::new(depth, margin, None);
     for run in candidates.chunk_by(|x, y| x.image == y.image) {
         let image = Image::of(mirrors, own, run[0].image);
         let context = image.context(wires, graph, own);
@@ -860,10 +863,7 @@ fn recheck(
             }
         }
     }
-    Search {
-        candidates: Vec::new(),
-        ..gather.finish()
-    }
+    gather.finish()
 }
 
 /// A point of one wire within reach of a segment of another wire (or of a mirror image), for contact between

@@ -129,12 +129,7 @@ fn check_deployment(summary: &serde_json::Value, reach: Real, sheath: Real, wire
     );
     let fore = number(&d["foreshortening"]["foreshortening"]);
     assert!(fore.abs() < 0.1, "{fore}");
-    let vessel = summary["contact"]
-        .as_array()
-        .expect("contact")
-        .iter()
-        .find(|c| c["obstacle"] == "vessel")
-        .expect("the vessel's contact");
+    let vessel = contact_of(summary, "vessel");
     let give = number(&vessel["largest_penetration"]["value"]);
     for c in d["crowns"].as_array().expect("crowns") {
         let (diameter, lumen) = (number(&c["diameter"]), number(&c["lumen_diameter"]));
@@ -181,9 +176,7 @@ fn sheath_carries_nothing(run: &Path, summary: &serde_json::Value) {
             panic!("{}: {name} is {v} at t = {t}", run.display());
         }
     }
-    let sheath = (summary["contact"].as_array().expect("contact").iter())
-        .find(|c| c["obstacle"] == "sheath")
-        .expect("the sheath's contact");
+    let sheath = contact_of(summary, "sheath");
     for entry in ["peak_force", "largest_penetration"] {
         assert_eq!(
             sheath[entry]["value"].as_f64(),
@@ -192,4 +185,11 @@ fn sheath_carries_nothing(run: &Path, summary: &serde_json::Value) {
             run.display()
         );
     }
+}
+
+/// The entry of `obstacle` in `summary.json`'s `contact` list.
+fn contact_of<'a>(summary: &'a serde_json::Value, obstacle: &str) -> &'a serde_json::Value {
+    (summary["contact"].as_array().expect("contact").iter())
+        .find(|c| c["obstacle"] == obstacle)
+        .unwrap_or_else(|| panic!("no contact entry for `{obstacle}`"))
 }

@@ -693,21 +693,21 @@ time: {end: 1, step: 0.5}
     }
 }
 
-// Reference: the general sparse LU of the whole system (faer). The block solver (banded LU per patch interior,
-// sparse LU of the Schur complement on the patch ends, the gauge multipliers and, with the objective rotation
-// field, the patch references' control points) must solve the same linear systems. Both runs start from the
-// same state and take the same steps: pulled in over [0, 0.5], released at 0.75 (so the free device's gauge
-// multipliers join the border) up to the second step after the release with the paper's rotation field, t =
-// 0.757 (the elastic crown then springs back through a near-bifurcation where 1e-9 differences grow, so we stop
-// before it), and up to t = 0.7526 with the objective field, which fails there at the smallest step (t = 0.7529,
-// with either solver and in the half and full models too). That release is a snap, not a defect of either field:
-// the paper's field fails it too at n = 24 and 32, and gets through at this n = 16 only on another branch its
-// programming took (docs/speed.md, *Coarse stents and the rotation field*). Each solution of a linear system differs from the other solver's by round-off times the condition
-// number of these slender-rod collocation systems (~1e9 measured as 1e-10 relative differences of the converged
-// displacements before the release), and the Newton iterations stop within the tolerance (1e-9 of the patch
-// length, ~5e-9 mm). We require 1e-8 mm on displacements of ~3 mm at every step, and 1e-6 relative on one Newton
-// increment solved by both at the last state: a wrong block (a misplaced entry, a missing coupling, a border
-// point's column left out) gives differences of the order of the solution itself.
+// Reference: the general sparse LU of the whole system (faer). The block solver (banded LU per patch interior, sparse
+// LU of the Schur complement on the patch ends, the gauge multipliers and, with the objective rotation field, the patch
+// references' control points) must solve the same linear systems. Both runs start from the same state and take the same
+// steps: pulled in over [0, 0.5], released at 0.75 (so the free device's gauge multipliers join the border) up to the
+// second step after the release with the paper's rotation field, t = 0.757 (the elastic crown then springs back through
+// a near-bifurcation where 1e-9 differences grow, so we stop before it), and up to t = 0.7526 with the objective field,
+// which fails there at the smallest step (t = 0.7529, with either solver and in the half and full models too). That
+// release is a snap, not a defect of either field: the paper's field fails it too at n = 24 and 32, and gets through at
+// this n = 16 only on another branch its programming took (docs/speed.md, *Coarse stents and the rotation field*). Each
+// solution of a linear system differs from the other solver's by round-off times the condition number of these
+// slender-rod collocation systems (~1e9 measured as 1e-10 relative differences of the converged displacements before
+// the release), and the Newton iterations stop within the tolerance (1e-9 of the patch length, ~5e-9 mm). We require
+// 1e-8 mm on displacements of ~3 mm at every step, and 1e-6 relative on one Newton increment solved by both at the last
+// state: a wrong block (a misplaced entry, a missing coupling, a border point's column left out) gives differences of
+// the order of the solution itself.
 #[test]
 fn block_solver_matches_the_sparse_lu() {
     let layout = "spacing: 10

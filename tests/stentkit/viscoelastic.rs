@@ -183,23 +183,23 @@ fn pure_bending_follows_the_one_dimensional_maxwell_law_through_a_shape_memory_c
     }
 }
 
-// Source: the same stiff-ODE reference as above (scripts/maxwell_bending_reference.py, scipy Radau at rtol
-// 1e-12), now for error-controlled steps. The estimate is normalised as Newton's increments: for this rod of
-// length L = 1 the tip rotation φ = κ L is in radians, so the error measured is |φ − κ_ref L|. It is measured at
-// every 20 ms (150 times, the reference's own samples), asked of the run as record times: an error-controlled run
-// does not land on them but reaches each by the continuous extension of the step that holds it (dense output,
-// issue 36 item 3; module docs of `solver::simulation::dense`). The error of the rod itself (p = 6, n = 16) is
-// ~1e-6 of κ_max (0.39). An estimator that under-reports, or an extension that loses the method's accuracy
-// between steps, is a defect: the error at every requested time must be at most the tolerance asked, at every
-// tolerance (measured with the paper's rotation field: 0.26, 0.20, 0.31 of it at 1e-3, 1e-4, 1e-5 when the steps
-// landed on these times; from the extension, 146 of the 150 states, 0.40, 0.20, 0.28; with the objective field,
-// the default since 2026-11-28, from the extension 0.61, 0.19, 0.37), and error control must pay: far fewer steps
-// than the 3000 fixed steps of 1 ms. The requested times must not change the steps: the accepted states are the
-// same, bit for bit, as a run asking for none. For comparison the test prints the error of the accepted steps
-// interpolated linearly at the same times (what a reader of history.csv without the extension would get:
-// measured 0.94, 0.46, 0.39 of the tolerance with the paper's field, 1.44, 0.50, 0.42 with the objective one). The other updates have no estimate that holds this (backward Euler
-// measured 3–45 times the tolerance, the exponential update 1.2–2.3 times, before they were refused,
-// `Integrator::companion`): a design asking for both gets a located error.
+// Source: the same stiff-ODE reference as above (scripts/maxwell_bending_reference.py, scipy Radau at rtol 1e-12), now
+// for error-controlled steps. The estimate is normalised as Newton's increments: for this rod of length L = 1 the tip
+// rotation φ = κ L is in radians, so the error measured is |φ − κ_ref L|. It is measured at every 20 ms (150 times, the
+// reference's own samples), asked of the run as record times: an error-controlled run does not land on them but reaches
+// each by the continuous extension of the step that holds it (dense output, issue 36 item 3; module docs of
+// `solver::simulation::dense`). The error of the rod itself (p = 6, n = 16) is ~1e-6 of κ_max (0.39). An estimator that
+// under-reports, or an extension that loses the method's accuracy between steps, is a defect: the error at every
+// requested time must be at most the tolerance asked, at every tolerance (measured with the paper's rotation field:
+// 0.26, 0.20, 0.31 of it at 1e-3, 1e-4, 1e-5 when the steps landed on these times; from the extension, 146 of the 150
+// states, 0.40, 0.20, 0.28; with the objective field, the default since 2026-11-28, from the extension 0.61, 0.19,
+// 0.37), and error control must pay: far fewer steps than the 3000 fixed steps of 1 ms. The requested times must not
+// change the steps: the accepted states are the same, bit for bit, as a run asking for none. For comparison the test
+// prints the error of the accepted steps interpolated linearly at the same times (what a reader of history.csv without
+// the extension would get: measured 0.94, 0.46, 0.39 of the tolerance with the paper's field, 1.44, 0.50, 0.42 with the
+// objective one). The other updates have no estimate that holds this (backward Euler measured 3–45 times the tolerance,
+// the exponential update 1.2–2.3 times, before they were refused, `Integrator::companion`): a design asking for both
+// gets a located error.
 #[test]
 fn error_controlled_steps_keep_the_bending_error_below_the_tolerance() {
     let reference = reference();
@@ -445,16 +445,16 @@ fn error_control_catches_the_trapezoidal_ringing_after_a_jump() {
 }
 
 // Source: the straight stent of paper §4.3.1 at the paper's settings (p = 6, n = 20, fixed steps of 2.5 ms, the
-// trapezoidal rule) as the reference; its own time error against a run of tenth steps is 1.6e-5 in the measure
-// below (measured), 1.6 % of the tolerance. Measure: every node's translation difference over the length of the
-// shortest patch at the node (`study::sample::node_lengths`), the translation part of the norm the estimate is
-// held to, at the tenths of the run, the schedule's breakpoints (the release at 1.75 s and the end of its ramp)
-// and 1.8 s (the error-controlled run reaches those between its steps by its continuous extension; the fixed one
-// lands on them). Same mesh, so the difference is time error, which must stay within the tolerance asked
-// (measured 0.15 of it in 415 steps; 0.14 in 381 when the steps landed on those times). While the driven nodes are held, an error of the internal variables barely moves the constrained
-// configuration and shows only once the nodes are freed: with the configuration difference alone as the
-// estimate this measured 1.94 times the tolerance at the release (1.0 whatever share of the tolerance the steps
-// were held to, 1/4 to 1/8); the section-stress part of the estimate is what catches it.
+// trapezoidal rule) as the reference; its own time error against a run of tenth steps is 1.6e-5 in the measure below
+// (measured), 1.6 % of the tolerance. Measure: every node's translation difference over the length of the shortest
+// patch at the node (`study::sample::node_lengths`), the translation part of the norm the estimate is held to, at the
+// tenths of the run, the schedule's breakpoints (the release at 1.75 s and the end of its ramp) and 1.8 s (the
+// error-controlled run reaches those between its steps by its continuous extension; the fixed one lands on them). Same
+// mesh, so the difference is time error, which must stay within the tolerance asked (measured 0.15 of it in 415 steps;
+// 0.14 in 381 when the steps landed on those times). While the driven nodes are held, an error of the internal
+// variables barely moves the constrained configuration and shows only once the nodes are freed: with the configuration
+// difference alone as the estimate this measured 1.94 times the tolerance at the release (1.0 whatever share of the
+// tolerance the steps were held to, 1/4 to 1/8); the section-stress part of the estimate is what catches it.
 #[test]
 fn error_control_sees_the_errors_made_while_nodes_are_held() {
     use stentkit::design::load_design;
