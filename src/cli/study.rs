@@ -119,7 +119,7 @@ pub(crate) fn degree_and_points(text: &str) -> Result<(usize, usize), String> {
 
 /// The maps `study stability --maps` draws.
 pub(crate) const MAPS: &[&str] = &[
-    "material", "bend45", "heating", "release", "coarse", "contact", "meshes",
+    "material", "bend45", "heating", "release", "coarse", "contact", "meshes", "curved",
 ];
 
 /// Refuses (exit status 2, naming `argument`) a study run of `design` changed by `variant` whose time steps
@@ -252,7 +252,7 @@ pub(crate) fn time(
 }
 
 /// `stentkit study stability`: the maps named in `maps` (any of material, bend45, heating, release, coarse,
-/// contact, meshes), each written as `<map>.csv` and `<map>.svg` as soon as it is done, then `stability.md`, into the
+/// contact, meshes, curved), each written as `<map>.csv` and `<map>.svg` as soon as it is done, then `stability.md`, into the
 /// folder `output` (its files replaced only with `--force`).
 pub(crate) fn stability_maps(output: Target<'_>, maps: &[String]) -> anyhow::Result<()> {
     let Target {
@@ -287,6 +287,9 @@ pub(crate) fn stability_maps(output: Target<'_>, maps: &[String]) -> anyhow::Res
     }
     if wanted("meshes") {
         study.meshes = crate::study::stability::scenarios::stent_meshes();
+    }
+    if wanted("curved") {
+        study.curved = crate::study::stability::scenarios::curved_meshes();
     }
     create(output)?;
     let summary = stability(

@@ -709,19 +709,44 @@ fn with_the_objective_field_a_coarse_straight_stent_finishes_its_cycle() {
     assert!((t - 3.25).abs() < 1e-9 && last < 0.1, "{t}: {last}");
 }
 
+// The meshes maps name a failure's phase (before, at or after the release) from the release time each holds for
+// its stent: it must be the one the design's model releases at, the earliest release of a prescribed component.
+#[test]
+fn the_meshes_maps_know_their_stents_release() {
+    use stentkit::model::Component;
+    use stentkit::study::stability::scenarios::MeshStent;
+    for (stent, file) in [
+        (MeshStent::Straight, "straight_stent.yaml"),
+        (MeshStent::Curved, "curved_stent.yaml"),
+    ] {
+        let model = crate::common::model_from_text(&crate::common::design_text(file), file);
+        let releases: Vec<f64> = (model.nodes.iter())
+            .flat_map(|node| &node.conditions.components)
+            .filter_map(|c| match c {
+                Component::Prescribed { release, .. } => *release,
+                Component::Load(_) => None,
+            })
+            .collect();
+        let first = releases.iter().copied().fold(f64::INFINITY, f64::min);
+        assert!(!releases.is_empty(), "{file}: no release");
+        assert_eq!(stent.release(), first, "{file}");
+    }
+}
+
 // Issue 36 item 1's map in `study stability` (`--maps meshes`), on the test above's mesh cut to two crowns: the
 // paper's field fails at the release there (t = 1.7508 s, measured) and the objective field finishes, and the
 // map's paragraph counts them so, per field, naming the phase of the failure.
 #[test]
 fn the_meshes_map_counts_the_coarse_stent_that_fails_with_the_papers_field_only() {
     use stentkit::model::RotationField;
-    use stentkit::study::stability::scenarios::{MeshCase, meshes_map, meshes_report};
+    use stentkit::study::stability::scenarios::{MeshCase, MeshStent, meshes_map, meshes_report};
     let cases = [RotationField::Incremental, RotationField::Objective].map(|rotations| MeshCase {
         p: 5,
         n: 20,
         rotations,
     });
     let map = meshes_map(
+        MeshStent::Straight,
         &cases,
         Some(2),
         &stentkit::design::variants::read_varied,
@@ -737,7 +762,7 @@ fn the_meshes_map_counts_the_coarse_stent_that_fails_with_the_papers_field_only(
         paper.run
     );
     assert!(objective.run.completed, "{:?}", objective.run);
-    let report = meshes_report(&map);
+    let report = meshes_report(MeshStent::Straight, &map);
     assert!(
         report.summary.contains("**incremental** rotation field: 0 of 1 meshes finish the cycle; failing: p = 5, n = 20 at the release")
             && report.summary.contains("**objective** rotation field: 1 of 1 meshes finish the cycle."),

@@ -23,8 +23,10 @@
 //! * **meshes** — the straight stent's whole cycle at p ∈ {4, 5, 6}, n ∈ [14, 40] with each rotation field
 //!   (issue 36): which meshes finish and where the others fail (about 20 minutes: not among the default maps
 //!   of `stentkit study stability`, and empty in [`StabilityStudy::default`]).
+//! * **curved** — the same for the curved stent at p ∈ {5, 6}, n ∈ [30, 81] (about an hour and a half on two
+//!   cores: not among the default maps either).
 //!
-//! bend45, heating, release, coarse and meshes are [`scenarios`] run through [`newton::newton_run`], which records what
+//! bend45, heating, release, coarse, meshes and curved are [`scenarios`] run through [`newton::newton_run`], which records what
 //! the solver did; contact is built in code ([`contact::crimped_crown`]) and run the same way.
 
 pub mod contact;
@@ -76,6 +78,9 @@ pub struct StabilityStudy {
     pub contact: Vec<contact::ContactCase>,
     /// The runs of the meshes map ([`scenarios::stent_meshes`] for the whole map; empty by default).
     pub meshes: Vec<scenarios::MeshCase>,
+    /// The runs of the curved stent's meshes map ([`scenarios::curved_meshes`] for the whole map; empty by
+    /// default).
+    pub curved: Vec<scenarios::MeshCase>,
 }
 
 impl Default for StabilityStudy {
@@ -151,6 +156,7 @@ impl Default for StabilityStudy {
             .map(|(h, penalty)| contact::ContactCase { h, penalty })
             .collect(),
             meshes: Vec::new(),
+            curved: Vec::new(),
         }
     }
 }
@@ -161,7 +167,7 @@ impl Default for StabilityStudy {
 pub type ReadDesign = dyn Fn(&str, &Path) -> Result<Box<dyn VariedDesign>, StudyError>;
 
 /// Runs every map of `study` whose list is not empty, in the order material, bend45, heating, release, coarse,
-/// contact, meshes. Each finished map is handed to `done` (which writes it), so the maps finished before a failure are
+/// contact, meshes, curved. Each finished map is handed to `done` (which writes it), so the maps finished before a failure are
 /// kept; the text of `stability.md` (a title and every map's paragraph) is returned. `read` reads the embedded
 /// designs the maps vary; `progress` is told about each run.
 ///
@@ -218,9 +224,15 @@ pub fn stability<E: From<StudyError>>(
         done(&report)?;
         summary.push_str(&report.summary);
     }
-    if !study.meshes.is_empty() {
-        let map = scenarios::meshes_map(&study.meshes, None, read, &mut progress)?;
-        let report = scenarios::meshes_report(&map);
+    for (stent, cases) in [
+        (scenarios::MeshStent::Straight, &study.meshes),
+        (scenarios::MeshStent::Curved, &study.curved),
+    ] {
+        if cases.is_empty() {
+            continue;
+        }
+        let map = scenarios::meshes_map(stent, cases, None, read, &mut progress)?;
+        let report = scenarios::meshes_report(stent, &map);
         done(&report)?;
         summary.push_str(&report.summary);
     }

@@ -28,6 +28,8 @@ pub mod designs {
     pub const STRAIGHT_STENT: &str = include_str!("../../../designs/straight_stent.yaml");
     /// designs/rollup.yaml.
     pub const ROLLUP: &str = include_str!("../../../designs/rollup.yaml");
+    /// designs/curved_stent.yaml.
+    pub const CURVED_STENT: &str = include_str!("../../../designs/curved_stent.yaml");
 }
 
 /// The 45° bend with each number of equal load steps.
@@ -495,8 +497,53 @@ pub fn release_report(map: &SolverMap) -> MapReport {
     }
 }
 
-/// One run of the meshes map (issue 36 item 1): the straight stent as designed (its whole cycle) but for its
-/// degree, control points per patch and rotation field.
+/// A stent of the meshes maps (issue 36 item 1): the paper's straight or curved stent, whose whole cycle each
+/// map runs on coarse meshes.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum MeshStent {
+    /// designs/straight_stent.yaml: the map `meshes`.
+    Straight,
+    /// designs/curved_stent.yaml: the map `curved`.
+    Curved,
+}
+
+impl MeshStent {
+    /// The map's name (its files' stem).
+    pub const fn map_name(self) -> &'static str {
+        match self {
+            Self::Straight => "meshes",
+            Self::Curved => "curved",
+        }
+    }
+
+    /// The design's file name and text.
+    const fn source(self) -> (&'static str, &'static str) {
+        match self {
+            Self::Straight => ("straight_stent.yaml", designs::STRAIGHT_STENT),
+            Self::Curved => ("curved_stent.yaml", designs::CURVED_STENT),
+        }
+    }
+
+    /// What the stent is called in progress lines and the paragraph.
+    const fn label(self) -> &'static str {
+        match self {
+            Self::Straight => "straight stent",
+            Self::Curved => "curved stent",
+        }
+    }
+
+    /// The design's release time \[s\] (`programme.release`; the test
+    /// `the_meshes_maps_know_their_stents_release` holds it to the design's model).
+    pub const fn release(self) -> Real {
+        match self {
+            Self::Straight => RELEASE,
+            Self::Curved => 2.25,
+        }
+    }
+}
+
+/// One run of a meshes map (issue 36 item 1): a stent as designed (its whole cycle) but for its degree, control
+/// points per patch and rotation field.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct MeshCase {
     /// Degree `p`.
@@ -507,57 +554,97 @@ pub struct MeshCase {
     pub rotations: RotationField,
 }
 
-/// The meshes map's cases: p ∈ {4, 5, 6}, n ∈ [14, 40], with each rotation field (162 runs of the six-crown
-/// stent: about 20 minutes on one core).
-pub fn stent_meshes() -> Vec<MeshCase> {
+/// `degrees` × `points` with each rotation field, the paper's first.
+fn mesh_cases(
+    degrees: std::ops::RangeInclusive<usize>,
+    points: std::ops::RangeInclusive<usize>,
+) -> Vec<MeshCase> {
     let mut cases = Vec::new();
     for rotations in [RotationField::Incremental, RotationField::Objective] {
-        for p in 4..=6 {
-            cases.extend((14..=40).map(|n| MeshCase { p, n, rotations }));
+        for p in degrees.clone() {
+            cases.extend(points.clone().map(|n| MeshCase { p, n, rotations }));
         }
     }
     cases
 }
 
-/// The straight stent's whole cycle at each mesh and rotation field of `cases`, with `crowns` crowns instead of
-/// the design's when given.
+/// The straight stent's meshes map: p ∈ {4, 5, 6}, n ∈ [14, 40], with each rotation field (162 runs of the
+/// six-crown stent: about 20 minutes on one core).
+pub fn stent_meshes() -> Vec<MeshCase> {
+    mesh_cases(4..=6, 14..=40)
+}
+
+/// The curved stent's meshes map: p ∈ {5, 6}, n ∈ [30, 81] (the design's own mesh is p = 6, n = 81), with each
+/// rotation field (208 runs of 4000 steps: about an hour and a half on two cores).
+pub fn curved_meshes() -> Vec<MeshCase> {
+    mesh_cases(5..=6, 30..=81)
+}
+
+/// `stent`'s whole cycle at each mesh and rotation field of `cases`, with `crowns` crowns instead of the
+/// design's when given. The runs are independent and run in parallel (rayon's pool), each reported to
+/// `progress` as it finishes; the map keeps the order of `cases`, and each run's wall time is its own (longer
+/// when the runs share the cores).
 pub fn meshes_map(
+    stent: MeshStent,
     cases: &[MeshCase],
     crowns: Option<usize>,
     read: &ReadDesign,
     mut progress: impl FnMut(&str),
 ) -> Result<SolverMap, StudyError> {
-    let stent = embedded(read, designs::STRAIGHT_STENT, "straight_stent.yaml")?;
-    let mut points = Vec::new();
-    for &MeshCase { p, n, rotations } in cases {
-        let remesh = Remesh {
-            degree: Some(p),
-            points: Some(n),
-            crowns,
-        };
-        let model = stent.rebuild(&remesh)?;
-        let solver = SolverSettings {
-            rotations,
-            ..model.solver().clone()
-        };
-        let model = model.with_solver(solver)?;
-        let run = newton_run(&model)?;
-        progress(&format!(
-            "straight stent, p = {p}, n = {n}, {} rotation field: {}",
-            field_name(rotations),
-            describe(&run)
-        ));
-        points.push(SolverPoint {
+    use rayon::prelude::*;
+    let (file, text) = stent.source();
+    let design = embedded(read, text, file)?;
+    let models = (cases.iter())
+        .map(|&MeshCase { p, n, rotations }| {
+            let remesh = Remesh {
+                degree: Some(p),
+                points: Some(n),
+                crowns,
+            };
+            let model = design.rebuild(&remesh)?;
+            let solver = SolverSettings {
+                rotations,
+                ..model.solver().clone()
+            };
+            Ok(model.with_solver(solver)?)
+        })
+        .collect::<Result<Vec<Model>, StudyError>>()?;
+    let (sender, lines) = std::sync::mpsc::channel::<String>();
+    let runs = std::thread::scope(|scope| {
+        let worker = scope.spawn(|| {
+            (models.par_iter().zip(cases))
+                .map_with(sender, |sender, (model, &MeshCase { p, n, rotations })| {
+                    let run = newton_run(model)?;
+                    // The receiver outlives every sender; a send fails only after it panicked.
+                    let _ = sender.send(format!(
+                        "{}, p = {p}, n = {n}, {} rotation field: {}",
+                        stent.label(),
+                        field_name(rotations),
+                        describe(&run)
+                    ));
+                    Ok::<_, StudyError>(run)
+                })
+                .collect::<Result<Vec<_>, _>>()
+        });
+        // Every sender is dropped when the runs are done, which ends this loop.
+        for line in lines {
+            progress(&line);
+        }
+        worker.join()
+    })
+    .unwrap_or_else(|panic| std::panic::resume_unwind(panic))?;
+    let points = (cases.iter().zip(runs))
+        .map(|(&MeshCase { p, n, rotations }, run)| SolverPoint {
             parameters: vec![
                 p as Real,
                 n as Real,
                 Real::from(u8::from(rotations == RotationField::Objective)),
             ],
             run,
-        });
-    }
+        })
+        .collect();
     Ok(SolverMap {
-        name: "meshes",
+        name: stent.map_name(),
         columns: vec!["p", "n", "objective_rotations"],
         points,
     })
@@ -571,22 +658,25 @@ fn field_name(rotations: RotationField) -> &'static str {
     }
 }
 
-/// Where in the stent's cycle a failure at `t` falls: before, at (within 0.01 s of) or after the release.
-fn phase(t: Real) -> &'static str {
-    if t < RELEASE {
+/// Where in a stent's cycle released at `release` a failure at `t` falls: before, at (within 0.01 s of) or
+/// after the release.
+fn phase(t: Real, release: Real) -> &'static str {
+    if t < release {
         "before the release"
-    } else if t <= RELEASE + 0.01 {
+    } else if t <= release + 0.01 {
         "at the release"
     } else {
         "in the recovery"
     }
 }
 
-/// The meshes map's report: per rotation field, how many meshes finish the cycle and where each other one failed.
-pub fn meshes_report(map: &SolverMap) -> MapReport {
+/// A meshes map's report: per rotation field, how many meshes finish the cycle and where each other one failed.
+pub fn meshes_report(stent: MeshStent, map: &SolverMap) -> MapReport {
+    let (file, _) = stent.source();
     let mut summary = format!(
-        "## meshes: the straight stent's whole cycle on coarse meshes, with each rotation field ({0}.csv, {0}.svg)\n\n",
-        map.name
+        "## {0}: the {1}'s whole cycle on coarse meshes, with each rotation field ({0}.csv, {0}.svg)\n\n",
+        map.name,
+        stent.label()
     );
     for (flag, field) in [
         (0.0, RotationField::Incremental),
@@ -605,17 +695,32 @@ pub fn meshes_report(map: &SolverMap) -> MapReport {
             field_name(field),
             runs.len()
         );
+        let crossed: Vec<Real> = runs.iter().filter_map(|q| q.run.wires_crossed).collect();
+        if let (Some(first), Some(last)) = (
+            crossed.iter().copied().reduce(Real::min),
+            crossed.iter().copied().reduce(Real::max),
+        ) {
+            let _ = write!(
+                summary,
+                " ({} of the {} with wires through each other, from t = {first:.4} s to {last:.4} s)",
+                crossed.len(),
+                runs.len()
+            );
+        }
+        let crossing = |q: &SolverPoint| {
+            (q.run.wires_crossed)
+                .map(|t| format!(", its wires through each other from t = {t:.4} s"))
+                .unwrap_or_default()
+        };
         let failed: Vec<String> = (runs.iter().filter(|q| !q.run.completed))
             .map(|q| {
-                let crossed = (q.run.wires_crossed)
-                    .map(|t| format!(", its wires through each other from t = {t:.4} s"))
-                    .unwrap_or_default();
                 format!(
-                    "p = {}, n = {} {} (t = {:.4} s{crossed})",
+                    "p = {}, n = {} {} (t = {:.4} s{})",
                     q.parameters[0],
                     q.parameters[1],
-                    phase(q.run.time),
-                    q.run.time
+                    phase(q.run.time, stent.release()),
+                    q.run.time,
+                    crossing(q)
                 )
             })
             .collect();
@@ -625,22 +730,30 @@ pub fn meshes_report(map: &SolverMap) -> MapReport {
             let _ = writeln!(summary, "; failing: {}.", failed.join("; "));
         }
     }
-    summary.push_str(
-        "\nThe stent (designs/straight_stent.yaml) runs its whole programme — crimped, cooled, released at 1.75 s, re-heated — at each degree and number of control points per patch, Newton alone (no stabilisation). A failure is the solver's: no convergence at the smallest step. The paper's field's failures come and go with n, which a resolution limit would not do: its discrete configuration depends on the increments that led to it (docs/choices.md, *Rotation field*). Where the objective field fails the meshes are the coarsest; the release map (`--maps release`) shows one of them (p = 5, n = 14) folding in its own release path. A failure after the device's wires had passed through each other (the crossing check: a wire through another, or a quarter model's wire through its own mirror image across a symmetry plane) says since when: the model was then no longer the device, the physical reason it gives. Rod contact (`contact: {wires: true}`) does not rescue these coarse meshes (docs/speed.md, *Coarse stents and the rotation field*).\n\n",
+    let _ = write!(
+        summary,
+        "\nThe stent (designs/{file}) runs its whole programme — {} — at each degree and number of control points per patch, Newton alone (no stabilisation). A failure is the solver's: no convergence at the smallest step. A failure after the device's wires had passed through each other (the crossing check: a wire through another, or a wire through its own mirror image across a symmetry plane) says since when: the model was then no longer the device, the physical reason it gives. {}\n\n",
+        match stent {
+            MeshStent::Straight => "crimped, cooled, released at 1.75 s, re-heated",
+            MeshStent::Curved =>
+                "straightened and compacted, cooled, released at 2.25 s, re-heated",
+        },
+        match stent {
+            MeshStent::Straight =>
+                "The paper's field's failures come and go with n, which a resolution limit would not do: its discrete configuration depends on the increments that led to it (docs/choices.md, *Rotation field*). Where the objective field fails the meshes are the coarsest; the release map (`--maps release`) shows one of them (p = 5, n = 14) folding in its own release path. Rod contact (`contact: {wires: true}`) does not rescue these coarse meshes (docs/speed.md, *Coarse stents and the rotation field*).",
+            MeshStent::Curved =>
+                "The paper's programme pushes a bridge lying in the symmetry plane across it while the stent is straightened (the crossing check warns of it on the design's own mesh too, README *Wires through each other are said*): a run with its wires through each other from the programming on is the paper's programme's, on any mesh.",
+        }
     );
+    let header = format!(
+        "the {}'s whole cycle (designs/{file}) at each degree p, control points per patch n and rotation field (objective_rotations: 1 for the objective field, 0 for the paper's)",
+        stent.label()
+    );
+    let title = format!("the {} on coarse meshes: Newton against n", stent.label());
     MapReport {
         name: map.name,
-        csv: solver_csv(
-            map,
-            "the straight stent's whole cycle (designs/straight_stent.yaml) at each degree p, control points per patch n and rotation field (objective_rotations: 1 for the objective field, 0 for the paper's)",
-        ),
-        chart: solver_chart(
-            map,
-            "the straight stent on coarse meshes: Newton against n",
-            1,
-            "control points per patch n",
-            &[0, 2],
-        ),
+        csv: solver_csv(map, &header),
+        chart: solver_chart(map, &title, 1, "control points per patch n", &[0, 2]),
         summary,
     }
 }
