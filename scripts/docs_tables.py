@@ -547,11 +547,14 @@ def print_solids():
         ),
         ("volume", lambda r: f"{r['volume_mm3']} mm³"),
         (
-            "union of the same wires' tubes in Manifold (128-gon tubes, balls at the rod ends; "
+            "union of the same wires' tubes in Manifold (64-segment tubes, balls at the rod ends; "
             "`scripts/check_print.py`)",
             lambda r: f"{r['manifold_mm3']} mm³ ({percent(r)})",
         ),
-        ("time, files", lambda r: f"{r['time_s']} s; {r['size_3mf_mb']} MB 3MF, {r['size_stl_mb']} MB STL"),
+        (
+            "time (to STL, median of three), files",
+            lambda r: f"{r['time_s']} s; {r['size_3mf_mb']} MB 3MF, {r['size_stl_mb']} MB STL",
+        ),
     ]
     body = [[name] + [cell(r) for r in data] for name, cell in lines]
     return head + "\n" + table([""] + [r["stent"] for r in data], body)

@@ -155,13 +155,13 @@ pub(crate) fn run(
 }
 
 /// The print solid of `model` in the shape `shapes` ([`print_solid`]), saying that it is being made (it takes
-/// about 20 s for the paper's stents) and how it was made.
+/// a few seconds for the paper's stents) and how it was made.
 pub(super) fn print_solid_mesh(
     model: &Model,
     shapes: &[crate::solver::shape::PatchShape],
     settings: &PrintSettings,
 ) -> anyhow::Result<crate::geometry::mesh::TriangleMesh> {
-    eprintln!("making the print solid (about 20 s for the paper's stents)");
+    eprintln!("making the print solid (a few seconds for the paper's stents)");
     let solid = print_solid(model, shapes, settings).map_err(|e| BadInput(e.to_string()))?;
     println!("{}", solid.describe(model.units.length()));
     if solid.mesh.triangles.is_empty() {

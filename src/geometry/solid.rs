@@ -24,13 +24,20 @@
 //! vertices give the chords' shortfall to second order ([`UnionSurface::volume_second_order`]: 1.4e-4 of a
 //! capsule's volume at r/3, 2.6e-5 at r/4), which [`offset_to_volume`] can restore.
 //!
+//! **In parallel.** The distances at the grid points are computed a run of capsules per task and entered in
+//! the field in the capsules' order; each batch of cubes has its corners looked up in parallel, its crossed
+//! edges numbered in order, then its new crossings placed and its triangles oriented in parallel. The surface
+//! is the same, vertex for vertex and triangle for triangle, on any number of threads. Grid points and edges
+//! are hashed with rustc's Fx hash (a grid edge as one 128-bit number).
+//!
 //! **Size.** The triangles grow as the surface over `h²`: the straight stent's full device (4080 capsules of
-//! its centrelines sampled twice per control point) gives 2.0 million triangles at h = r/3 (about 4 s) and
-//! 5.6 million at r/5 (16 s), against 100 000 for its snapshot's swept tubes; `super::simplify` reduces them.
+//! its centrelines sampled twice per control point) gives 2.0 million triangles at h = r/3 and 5.6 million at
+//! r/5, against 100 000 for its snapshot's swept tubes; `super::simplify` reduces them.
 
 use super::mesh::TriangleMesh;
 use crate::math::{Real, Vec3};
-use std::collections::{HashMap, HashSet};
+use rayon::prelude::*;
+use rustc_hash::{FxHashMap, FxHashSet};
 
 /// A segment `a`–`b` swept by a ball of radius `radius`.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -142,6 +149,76 @@ const ROOT_ITERATIONS: usize = 8;
 /// Grid point index.
 type Point = [i64; 3];
 
+/// Capsules per task of the parallel sampling in [`union_surface`] (a few hundred thousand distances each).
+const CAPSULES_PER_TASK: usize = 64;
+
+/// Capsules per batch of that sampling, whose distances within the band wait to be entered in the field
+/// (about 500 each on the default grid, 40 bytes per distance: some 20 MB a batch).
+const CAPSULES_PER_BATCH: usize = 1024;
+
+/// One number for the grid edge between neighbouring points `p` and `q` (either way round): the lower end's
+/// indices in 40 bits each (two's complement, so any grid of fewer than 2⁴⁰ cells a side) and the step to the
+/// other end, each index up by 0 or 1 (the edges of Kuhn's tetrahedra), in 3 bits.
+fn edge_key(p: &Point, q: &Point) -> u128 {
+    let (lo, hi) = if p < q { (p, q) } else { (q, p) };
+    let mask = (1u128 << 40) - 1;
+    let key = lo
+        .iter()
+        .fold(0u128, |key, &i| (key << 40) | (i as u128 & mask));
+    hi.iter()
+        .zip(lo)
+        .fold(key, |key, (h, l)| (key << 1) | u128::from(h != l))
+}
+
+/// Where the surface crosses the grid edge from `p` (inside) to `q` (outside), on a grid of spacing `h`, and the
+/// union's normal there: the crossing of the nearer of the two end points' nearest capsules (each end's sample
+/// is its capsule's distance), by regula falsi from the linear interpolant's root.
+fn crossing(capsules: &[Capsule], h: Real, p: &Corner, q: &Corner) -> (Vec3, Vec3) {
+    let position = |p: &Point| Vec3::new(p[0] as Real, p[1] as Real, p[2] as Real) * h;
+    let (x, y) = (position(&p.point), position(&q.point));
+    let near = [p, q].map(|e| e.capsule.map(|c| &capsules[c as usize]));
+    let distance = |t: Real| {
+        let z = x + (y - x) * t;
+        near.iter()
+            .flatten()
+            .map(|c| c.distance(&z))
+            .fold(Real::INFINITY, Real::min)
+    };
+    let (mut a, mut fa, mut b, mut fb) = (0.0, p.value, 1.0, q.value);
+    let mut t = fa / (fa - fb);
+    for _ in 0..ROOT_ITERATIONS {
+        let ft = distance(t);
+        if ft.abs() <= 1e-12 * h {
+            break;
+        }
+        if ft < 0.0 {
+            (a, fa) = (t, ft);
+        } else {
+            (b, fb) = (t, ft);
+        }
+        t = a + (b - a) * fa / (fa - fb);
+    }
+    // Kept off the grid points, so that two crossings never coincide.
+    let t = t.clamp(1e-3, 1.0 - 1e-3);
+    let z = x + (y - x) * t;
+    let nearest = near
+        .iter()
+        .flatten()
+        .min_by(|c, d| c.distance(&z).total_cmp(&d.distance(&z)));
+    (z, nearest.map_or_else(Vec3::zeros, |c| c.normal(&z)))
+}
+
+/// Cubes per batch of [`union_surface`]'s contouring (their corners, 8 × 48 bytes each, wait in memory).
+const CUBES_PER_BATCH: usize = 1 << 16;
+
+/// A grid cube's corner as the contour sees it: the point, its sample (positive outside; a point outside
+/// every band is outside) and the capsule nearest it, if it is in some capsule's band.
+struct Corner {
+    point: Point,
+    value: Real,
+    capsule: Option<u32>,
+}
+
 /// The six tetrahedra of a cube, as corner numbers (bit 0: +x, bit 1: +y, bit 2: +z): every path from corner
 /// 0 to corner 7 along three edges of different axes (Kuhn's triangulation).
 const TETRAHEDRA: [[usize; 4]; 6] = [
@@ -238,36 +315,52 @@ pub fn union_surface(capsules: &[Capsule], spacing: Real) -> UnionSurface {
     let h = spacing;
     let band = band_width(h);
     let index = |x: Real| (x / h).floor() as i64;
-    // The samples: the least signed distance at every grid point in some capsule's band.
-    let mut field: HashMap<Point, (Real, u32)> = HashMap::new();
-    for (n, c) in capsules.iter().enumerate() {
-        let n = n as u32;
-        let reach = c.radius + band;
-        let lo = c.a.inf(&c.b).add_scalar(-reach);
-        let hi = c.a.sup(&c.b).add_scalar(reach);
-        for i in index(lo.x)..=index(hi.x) + 1 {
-            for j in index(lo.y)..=index(hi.y) + 1 {
-                for k in index(lo.z)..=index(hi.z) + 1 {
-                    let p = Vec3::new(i as Real, j as Real, k as Real) * h;
-                    let d = c.distance(&p);
-                    if d < band {
-                        field
-                            .entry([i, j, k])
-                            .and_modify(|v| {
-                                if d < v.0 {
-                                    *v = (d, n)
+    // The samples: the least signed distance at every grid point in some capsule's band, and the first capsule
+    // (in the input order) at that distance. The distances are computed in parallel, a run of capsules at a
+    // time, and entered in the input order, so the field does not depend on the threads; a batch of runs at a
+    // time, so that the distances waiting to be entered take little memory.
+    let mut field: FxHashMap<Point, (Real, u32)> = FxHashMap::default();
+    for (batch, group) in capsules.chunks(CAPSULES_PER_BATCH).enumerate() {
+        let hits: Vec<Vec<(Point, Real, u32)>> = (group.par_chunks(CAPSULES_PER_TASK).enumerate())
+            .map(|(task, run)| {
+                let first = batch * CAPSULES_PER_BATCH + task * CAPSULES_PER_TASK;
+                let mut hits = Vec::new();
+                for (k, c) in run.iter().enumerate() {
+                    let n = (first + k) as u32;
+                    let reach = c.radius + band;
+                    let lo = c.a.inf(&c.b).add_scalar(-reach);
+                    let hi = c.a.sup(&c.b).add_scalar(reach);
+                    for i in index(lo.x)..=index(hi.x) + 1 {
+                        for j in index(lo.y)..=index(hi.y) + 1 {
+                            for k in index(lo.z)..=index(hi.z) + 1 {
+                                let p = Vec3::new(i as Real, j as Real, k as Real) * h;
+                                let d = c.distance(&p);
+                                if d < band {
+                                    hits.push(([i, j, k], d, n));
                                 }
-                            })
-                            .or_insert((d, n));
+                            }
+                        }
                     }
                 }
-            }
+                hits
+            })
+            .collect();
+        for (p, d, n) in hits.into_iter().flatten() {
+            field
+                .entry(p)
+                .and_modify(|v| {
+                    if d < v.0 {
+                        *v = (d, n)
+                    }
+                })
+                .or_insert((d, n));
         }
     }
     // A sample exactly on the surface counts as outside: the level is then a regular value.
-    let value = |p: &Point| match field.get(p) {
-        Some(&(d, _)) if d != 0.0 => d,
-        _ => Real::MIN_POSITIVE,
+    let sample = |p: &Point| match field.get(p) {
+        Some(&(d, c)) if d != 0.0 => (d, Some(c)),
+        Some(&(_, c)) => (Real::MIN_POSITIVE, Some(c)),
+        None => (Real::MIN_POSITIVE, None),
     };
     // Every cube with a corner inside, in a fixed order (the mesh does not depend on the hash order).
     let mut cubes: Vec<Point> = field
@@ -276,95 +369,92 @@ pub fn union_surface(capsules: &[Capsule], spacing: Real) -> UnionSurface {
         .flat_map(|(p, _)| {
             (0..8).map(move |b| [p[0] - (b & 1), p[1] - (b >> 1 & 1), p[2] - (b >> 2 & 1)])
         })
-        .collect::<HashSet<_>>()
+        .collect::<FxHashSet<_>>()
         .into_iter()
         .collect();
-    cubes.sort_unstable();
+    cubes.par_sort_unstable();
     let position = |p: &Point| Vec3::new(p[0] as Real, p[1] as Real, p[2] as Real) * h;
-    let mut mesh = TriangleMesh::default();
-    let mut normals = Vec::new();
-    let mut vertex_of: HashMap<(Point, Point), u32> = HashMap::new();
-    // The vertex where the surface crosses the grid edge from `p` (inside) to `q` (outside).
-    let mut crossing =
-        |p: Point, q: Point, mesh: &mut TriangleMesh, normals: &mut Vec<Vec3>| -> u32 {
-            let key = if p < q { (p, q) } else { (q, p) };
-            *vertex_of.entry(key).or_insert_with(|| {
-                let (x, y) = (position(&p), position(&q));
-                // The crossing of the nearer of the two end points' nearest capsules (each end's sample is its
-                // capsule's distance), by regula falsi from the linear interpolant's root.
-                let near = [&p, &q].map(|e| field.get(e).map(|&(_, c)| &capsules[c as usize]));
-                let distance = |t: Real| {
-                    let z = x + (y - x) * t;
-                    near.iter()
-                        .flatten()
-                        .map(|c| c.distance(&z))
-                        .fold(Real::INFINITY, Real::min)
-                };
-                let (mut a, mut fa, mut b, mut fb) = (0.0, value(&p), 1.0, value(&q));
-                let mut t = fa / (fa - fb);
-                for _ in 0..ROOT_ITERATIONS {
-                    let ft = distance(t);
-                    if ft.abs() <= 1e-12 * h {
-                        break;
+    // A batch of cubes at a time: their corners sampled in parallel; then in order, the grid edges the surface
+    // crosses numbered as the cubes first meet them (inside end first) and the triangles on them; then the
+    // batch's new crossings placed and its triangles oriented, in parallel. Only the batch waits in memory.
+    let mut vertices: Vec<Vec3> = Vec::new();
+    let mut normals: Vec<Vec3> = Vec::new();
+    let mut triangles: Vec<[u32; 3]> = Vec::new();
+    let mut vertex_of: FxHashMap<u128, u32> = FxHashMap::default();
+    for batch in cubes.chunks(CUBES_PER_BATCH) {
+        let corners_of: Vec<[Corner; 8]> = (batch.par_iter())
+            .map(|cube| {
+                // The cube's eight corners, each sampled once (bit 0: +x, bit 1: +y, bit 2: +z).
+                std::array::from_fn(|b| {
+                    let point = [
+                        cube[0] + (b & 1) as i64,
+                        cube[1] + (b >> 1 & 1) as i64,
+                        cube[2] + (b >> 2 & 1) as i64,
+                    ];
+                    let (value, capsule) = sample(&point);
+                    Corner {
+                        point,
+                        value,
+                        capsule,
                     }
-                    if ft < 0.0 {
-                        (a, fa) = (t, ft);
-                    } else {
-                        (b, fb) = (t, ft);
-                    }
-                    t = a + (b - a) * fa / (fa - fb);
-                }
-                // Kept off the grid points, so that two crossings never coincide.
-                let t = t.clamp(1e-3, 1.0 - 1e-3);
-                let z = x + (y - x) * t;
-                let nearest = near
-                    .iter()
-                    .flatten()
-                    .min_by(|c, d| c.distance(&z).total_cmp(&d.distance(&z)));
-                normals.push(nearest.map_or_else(Vec3::zeros, |c| c.normal(&z)));
-                mesh.vertices.push(z);
-                (mesh.vertices.len() - 1) as u32
+                })
             })
-        };
-    for cube in &cubes {
-        let corner = |b: usize| -> Point {
-            [
-                cube[0] + (b & 1) as i64,
-                cube[1] + (b >> 1 & 1) as i64,
-                cube[2] + (b >> 2 & 1) as i64,
-            ]
-        };
-        for tet in TETRAHEDRA {
-            // The corners inside first, each side in the tetrahedron's order (no allocation: this runs six
-            // times per cube of the band).
-            let mut points = tet.map(corner);
-            points.sort_by_key(|p| value(p) >= 0.0);
-            let count = points.iter().filter(|p| value(p) < 0.0).count();
-            let (inside, outside) = points.split_at(count);
-            // The polygon's corners as (inside, outside) ends of the edges it crosses, in cyclic order.
-            let edges: &[(usize, usize)] = match count {
-                1 => &[(0, 0), (0, 1), (0, 2)],
-                3 => &[(0, 0), (1, 0), (2, 0)],
-                2 => &[(0, 0), (0, 1), (1, 1), (1, 0)],
-                _ => continue,
-            };
-            let mut polygon = [0u32; 4];
-            for (k, &(i, o)) in edges.iter().enumerate() {
-                polygon[k] = crossing(inside[i], outside[o], &mut mesh, &mut normals);
-            }
-            let polygon = &polygon[..edges.len()];
-            // Oriented with the outside in front: from an inside corner to an outside one.
-            let direction = position(&outside[0]) - position(&inside[0]);
-            for k in 1..polygon.len() - 1 {
-                let mut tri = [polygon[0], polygon[k], polygon[k + 1]];
-                let [a, b, c] = tri.map(|v| mesh.vertices[v as usize]);
-                if (b - a).cross(&(c - a)).dot(&direction) < 0.0 {
-                    tri.swap(1, 2);
+            .collect();
+        let first = vertices.len();
+        let mut edges: Vec<(&Corner, &Corner)> = Vec::new();
+        let mut faces: Vec<([u32; 3], Point, Point)> = Vec::new();
+        for corners in &corners_of {
+            for tet in TETRAHEDRA {
+                // The corners inside first, each side in the tetrahedron's order (a stable sort).
+                let mut points = tet.map(|b| &corners[b]);
+                points.sort_by_key(|c| c.value >= 0.0);
+                let count = points.iter().filter(|c| c.value < 0.0).count();
+                let (inside, outside) = points.split_at(count);
+                // The polygon's corners as (inside, outside) ends of the edges it crosses, in cyclic order.
+                let crossed: &[(usize, usize)] = match count {
+                    1 => &[(0, 0), (0, 1), (0, 2)],
+                    3 => &[(0, 0), (1, 0), (2, 0)],
+                    2 => &[(0, 0), (0, 1), (1, 1), (1, 0)],
+                    _ => continue,
+                };
+                let mut polygon = [0u32; 4];
+                for (k, &(i, o)) in crossed.iter().enumerate() {
+                    let (p, q) = (inside[i], outside[o]);
+                    polygon[k] = *vertex_of
+                        .entry(edge_key(&p.point, &q.point))
+                        .or_insert_with(|| {
+                            edges.push((p, q));
+                            (first + edges.len() - 1) as u32
+                        });
                 }
-                mesh.triangles.push(tri);
+                for k in 1..crossed.len() - 1 {
+                    let tri = [polygon[0], polygon[k], polygon[k + 1]];
+                    faces.push((tri, inside[0].point, outside[0].point));
+                }
             }
         }
+        let placed: Vec<(Vec3, Vec3)> = (edges.par_iter())
+            .map(|&(p, q)| crossing(capsules, h, p, q))
+            .collect();
+        for (z, n) in placed {
+            vertices.push(z);
+            normals.push(n);
+        }
+        // Oriented with the outside in front: from an inside corner to an outside one.
+        let vertices = &vertices;
+        triangles.par_extend(faces.par_iter().map(|&(mut tri, inside, outside)| {
+            let direction = position(&outside) - position(&inside);
+            let [a, b, c] = tri.map(|v| vertices[v as usize]);
+            if (b - a).cross(&(c - a)).dot(&direction) < 0.0 {
+                tri.swap(1, 2);
+            }
+            tri
+        }));
     }
+    let mesh = TriangleMesh {
+        vertices,
+        triangles,
+    };
     UnionSurface { mesh, normals }
 }
 

@@ -84,8 +84,11 @@ pub fn write_3mf_to<W: Write + Seek>(
 ) -> io::Result<()> {
     check_writable(mesh, false)?;
     let mut zip = zip::ZipWriter::new(w);
+    // Deflate's fastest level: the straight stent's print solid is written about 0.5 s sooner than at the
+    // default level 6, as a 5.1 MB file instead of 3.2 MB (measured 2026-11-28).
     let options = zip::write::SimpleFileOptions::default()
-        .compression_method(zip::CompressionMethod::Deflated);
+        .compression_method(zip::CompressionMethod::Deflated)
+        .compression_level(Some(1));
     zip.start_file("[Content_Types].xml", options)?;
     zip.write_all(CONTENT_TYPES.as_bytes())?;
     zip.start_file("_rels/.rels", options)?;

@@ -46,16 +46,21 @@ pub const MAX_SPACING_PER_RADIUS: Real = 1.0;
 /// `r (1 − cos π/m)` is at most r/4 for m ≥ 5); a tolerance of the order of the radius lets the collapses
 /// flatten a wire, and one beyond the gaps between the wires lets them join wires
 /// (`crate::geometry::simplify` is meant for tolerances far below both). Measured on the straight stent
-/// (r = 0.3 mm, processor time): the default r/50 gives 152 836 triangles in 22.9 s, r/10 17 306 in 24.9 s,
-/// r/4 5370 in 25.6 s, r/2 2450 and r 1454 in 27 s; `--deviation 1e9` had not finished after 15 minutes.
+/// (r = 0.3 mm, processor time, with the sequential simplifier before 2026-11-28): the default r/50 gave
+/// 152 836 triangles in 22.9 s, r/10 17 306 in 24.9 s, r/4 5370 in 25.6 s, r/2 2450 and r 1454 in 27 s;
+/// `--deviation 1e9` had not finished after 15 minutes.
 pub const MAX_TOLERANCE_PER_RADIUS: Real = 0.25;
 
 /// Peak memory of a print solid per triangle of its contour \[bytes\]: the contour's vertices, normals and
-/// edge-to-vertex map, the simplification's quadrics, edges and queue, and the output. With
-/// [`BYTES_PER_BAND_POINT`] fitted to the peak resident memory of `stentkit mesh --print` on the straight
-/// stent, 224, 535 and 960 MB at h = r/2, r/3 and r/4 (0.89, 2.02 and 3.60 million triangles): the estimate
-/// gives 238, 545 and 982 MB; and at r/6 (8.12 million), 2.29 GB measured, 2.28 GB estimated.
-pub const BYTES_PER_CONTOUR_TRIANGLE: Real = 235.0;
+/// edge-to-vertex map, the simplification's quadrics, edges and queue, and the output. With [`BASE_BYTES`]
+/// fitted (and [`BYTES_PER_BAND_POINT`] held) to the peak resident memory of `stentkit mesh --print` on the
+/// straight stent, 2026-11-28: 221, 394, 655 MB and 1.34 GB at h = r/2, r/3, r/4 and r/6 (0.89, 2.02, 3.60 and
+/// 8.12 million triangles); the estimate gives 236, 395, 628 MB and 1.34 GB (within 7 %).
+pub const BYTES_PER_CONTOUR_TRIANGLE: Real = 105.0;
+
+/// Peak memory of a print solid that does not grow with its grid \[bytes\]: the process, the design and the
+/// device's shapes (fitted with [`BYTES_PER_CONTOUR_TRIANGLE`]).
+pub const BASE_BYTES: Real = 111e6;
 
 /// Peak memory of a print solid per grid point sampled \[bytes\]: an entry of the sampled field (a point, its
 /// distance and capsule: 40 bytes) in a hash map filled to at most 7/8, whose table doubles as it grows.
@@ -67,27 +72,29 @@ pub const BYTES_PER_CAPSULE: Real = 80.0;
 /// Processor time of a print solid of [`REFERENCE_TRIANGLES`] contour triangles \[s\]: contouring,
 /// simplifying and placing it; it grows as the triangles to the power [`TIME_GROWTH`] (the larger maps miss
 /// the caches more often). Fitted (least squares on the logarithms) to the user + system time of `stentkit mesh
-/// --print` on the straight stent on this machine (2 cores shared with other work): 8.7 s for 0.89 million
-/// triangles at h = r/2, 22.9 s for 2.02 million at r/3 (its default), 178 s for 8.12 million at r/6; the fit
-/// gives 8.2, 25.4 and 172.8 s (within 11 %).
-pub const REFERENCE_SECONDS: Real = 25.0;
+/// --print` on the straight stent on this machine, 2026-11-28 (nothing else running): 2.28, 5.60, 10.52 and
+/// 27.19 s for 0.89, 2.02, 3.60 and 8.12 million triangles at h = r/2, r/3 (its default), r/4 and r/6; the fit
+/// gives 2.28, 5.62, 10.75 and 26.96 s (within 3 %). (Before the parallel contour and the simplifier's slabs,
+/// 2026-11-26: 8.7, 22.9 and 178 s at r/2, r/3 and r/6.)
+pub const REFERENCE_SECONDS: Real = 5.2;
 
 /// The contour triangles [`REFERENCE_SECONDS`] is the time of.
 pub const REFERENCE_TRIANGLES: Real = 2.0e6;
 
 /// How a print solid's time grows with its contour's triangles (see [`REFERENCE_SECONDS`]).
-pub const TIME_GROWTH: Real = 1.38;
+pub const TIME_GROWTH: Real = 1.14;
 
 /// Processor time per grid point a print solid visits \[s\] (a capsule's distance there, and its entry in the
 /// sampled field when within the band). Measured: the straight stent's print solid at 100 samples per control
-/// point (204 000 capsules, about 1500 points visited each) took 6.2 s longer than at the default 4 (8160).
-pub const SECONDS_PER_GRID_VISIT: Real = 21e-9;
+/// point (204 000 capsules, about 1500 points visited each) took 5.1 s longer than at the default 4 (8160),
+/// 2026-11-28.
+pub const SECONDS_PER_GRID_VISIT: Real = 18e-9;
 
-/// The longest a print solid may be estimated to take \[s\]: 10 minutes, 26 times the straight stent's
-/// default solid (23 s). On the paper's 0.3 mm wires it stops the grid at about 0.032 mm (r/9.5, about 20
-/// million contour triangles and 6 GB, below stentkit's 8 GB memory limit) and the samples at about 8800 per
-/// control point (the polyline's segments then 1/1500 of the grid's spacing; `--samples 1000000` would take
-/// about 18 hours and 270 GB).
+/// The longest a print solid may be estimated to take \[s\]: 10 minutes, about a hundred times the straight
+/// stent's default solid (5.6 s of processor time). On the paper's 0.3 mm wires the memory limit (8 GB) binds
+/// first on the grid, at about 0.022 mm (r/14, about 42 million contour triangles, estimated 3 minutes), and
+/// this one on the samples, at about 10 700 per control point (the polyline's segments then 1/1800 of the
+/// grid's spacing; `--samples 1000000` would take about 15 hours and 266 GB).
 pub const TIME_LIMIT_SECONDS: Real = 600.0;
 
 /// How finely a print solid is made (lengths in the model's unit).
@@ -187,7 +194,8 @@ pub fn estimated_print(wires: impl IntoIterator<Item = WireSize>, spacing: Real)
     PrintEstimate {
         contour,
         capsules,
-        bytes: contour.triangles * BYTES_PER_CONTOUR_TRIANGLE
+        bytes: BASE_BYTES
+            + contour.triangles * BYTES_PER_CONTOUR_TRIANGLE
             + contour.band_points * BYTES_PER_BAND_POINT
             + capsules * BYTES_PER_CAPSULE,
         seconds: REFERENCE_SECONDS * (contour.triangles / REFERENCE_TRIANGLES).powf(TIME_GROWTH)
