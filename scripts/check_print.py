@@ -13,9 +13,12 @@ For every `<name>_print.stl` / `<name>_print.3mf` there:
    them all: the sum of the tubes minus their overlaps. A 64-gon keeps 99.84 % of the circle's area, so the
    reference is that close (128 segments, 99.96 %, cost 2.2x the time for a 0.12 % closer reference, against a
    1 % tolerance).
-3. Debian's PrusaSlicer slices it to G-code (`--export-gcode`) with a profile for wires this thin (0.25 mm
+3. Its first layer has ground to stand on, without a slicer: its section half a first layer above its lowest
+   point (where a slicer cuts that layer) encloses some area.
+4. Debian's PrusaSlicer slices it to G-code (`--export-gcode`) with a profile for wires this thin (0.25 mm
    nozzle, 0.1 mm layers: a 0.6 mm wire is marginal for the 0.4 mm default, whose perimeters drop some of the
-   curved stent's layers as "negligibly small extrusions"), and prints no repair message, warning or error.
+   curved stent's layers as "negligibly small extrusions"; two raft layers, below), and prints no repair
+   message, warning or error.
 
 Usage: check_print.py FOLDER...  Exits non-zero on any failure, naming it.
 """
@@ -34,14 +37,17 @@ import trimesh
 SEGMENTS = 64
 # A stent stands on its crown tips, whose sections in the first layer are a few tenths of a millimetre wide:
 # without a raft PrusaSlicer 2.5 may leave that layer empty ("There is an object with no extrusions in the first
-# layer", exit 1) at some first-layer heights and not at others, for a solid that differs by micrometres (the
-# straight stent's final state, 2026-11-28: refused at 0.12 mm and accepted at 0.1 and 0.15 mm with one
-# simplification of the same contour; refused at 0.12 and 0.15 mm, accepted at 0.1 and 0.17 mm with another).
-# Two raft layers, as one prints such parts, give the first layer its own footprint at every height tried.
+# layer", exit 1) at some first-layer heights and not at others, for solids that differ by micrometres. The
+# straight stent's final state (tests/stentkit/print.rs, print_export_full), 2026-11-28: 57c3885's simplifier's
+# solid was refused at 0.12 mm and accepted at 0.1 and 0.15 mm; f0fd52e's was refused at 0.12 and 0.15 mm
+# (this profile's height, which is how it was found) and accepted at 0.1 and 0.17 mm; its section at 0.075 mm
+# holds six islands, 1.73 mm² in all, against the old solid's six of 1.54 mm². Two raft layers, as one prints such parts,
+# give the first layer its own footprint at every height tried; check 3 looks at the first layer itself.
+FIRST_LAYER = 0.15
 SLICER_PROFILE = [
     "--nozzle-diameter", "0.25",
     "--layer-height", "0.1",
-    "--first-layer-height", "0.15",
+    "--first-layer-height", str(FIRST_LAYER),
     "--raft-layers", "2",
 ]
 FORBIDDEN = ("repair", "warning", "error", "empty layer", "printable", "manifold")
@@ -135,6 +141,19 @@ def union_volume(centrelines):
     return union.volume(), len(parts)
 
 
+def first_layer(mesh):
+    """The areas of the islands of `mesh`'s section half a first layer above its lowest point (the shoelace
+    formula on each closed loop of trimesh's section; a stent standing on its end has no holes there)."""
+    section = mesh.section(plane_origin=[0, 0, mesh.bounds[0][2] + FIRST_LAYER / 2], plane_normal=[0, 0, 1])
+    if section is None:
+        return []
+    areas = []
+    for loop in section.discrete:
+        x, y = loop[:, 0], loop[:, 1]
+        areas.append(abs(np.dot(x, np.roll(y, -1)) - np.dot(y, np.roll(x, -1))) / 2)
+    return areas
+
+
 def check_solid(solid):
     """[(passed, what)] for one print solid."""
     lines = []
@@ -154,6 +173,10 @@ def check_solid(solid):
     check(abs(error) < 0.01,
           f"{solid.name}: volume {mesh.volume:.4f} against the union of {parts} tubes and balls "
           f"{reference:.4f} ({error:+.3%})")
+    islands = first_layer(mesh)
+    check(islands and sum(islands) > 0,
+          f"{solid.name}: its first layer has {len(islands)} island(s) of {sum(islands):.3f} mm² "
+          f"({FIRST_LAYER / 2} mm above its lowest point)")
     gcode = solid.parent / f"{solid.stem}.gcode"
     run = subprocess.run(
         ["prusa-slicer", "--export-gcode", str(solid), *SLICER_PROFILE, "--output", str(gcode)],

@@ -529,7 +529,7 @@ pub(crate) enum StudyCommand {
         force: bool,
         /// Maps to draw: any of material, bend45, heating, release, coarse, contact, meshes (the straight
         /// stent's cycle on 81 meshes with each rotation field, about 20 minutes) and curved (the curved
-        /// stent's on 104, about an hour and a half on two cores); meshes and curved are drawn only when named.
+        /// stent's on 104, hours on two cores); meshes and curved are drawn only when named.
         #[arg(
             long,
             value_delimiter = ',',

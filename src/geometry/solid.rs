@@ -170,12 +170,16 @@ fn edge_key(p: &Point, q: &Point) -> u128 {
         .fold(key, |key, (h, l)| (key << 1) | u128::from(h != l))
 }
 
+/// The position of grid point `p` on a grid of spacing `h`.
+fn grid_position(p: &Point, h: Real) -> Vec3 {
+    Vec3::new(p[0] as Real, p[1] as Real, p[2] as Real) * h
+}
+
 /// Where the surface crosses the grid edge from `p` (inside) to `q` (outside), on a grid of spacing `h`, and the
 /// union's normal there: the crossing of the nearer of the two end points' nearest capsules (each end's sample
 /// is its capsule's distance), by regula falsi from the linear interpolant's root.
 fn crossing(capsules: &[Capsule], h: Real, p: &Corner, q: &Corner) -> (Vec3, Vec3) {
-    let position = |p: &Point| Vec3::new(p[0] as Real, p[1] as Real, p[2] as Real) * h;
-    let (x, y) = (position(&p.point), position(&q.point));
+    let (x, y) = (grid_position(&p.point, h), grid_position(&q.point, h));
     let near = [p, q].map(|e| e.capsule.map(|c| &capsules[c as usize]));
     let distance = |t: Real| {
         let z = x + (y - x) * t;
@@ -208,7 +212,7 @@ fn crossing(capsules: &[Capsule], h: Real, p: &Corner, q: &Corner) -> (Vec3, Vec
     (z, nearest.map_or_else(Vec3::zeros, |c| c.normal(&z)))
 }
 
-/// Cubes per batch of [`union_surface`]'s contouring (their corners, 8 × 48 bytes each, wait in memory).
+/// Cubes per batch of [`union_surface`]'s contouring (their corners, 8 × 40 bytes each, wait in memory).
 const CUBES_PER_BATCH: usize = 1 << 16;
 
 /// A grid cube's corner as the contour sees it: the point, its sample (positive outside; a point outside
@@ -373,7 +377,6 @@ pub fn union_surface(capsules: &[Capsule], spacing: Real) -> UnionSurface {
         .into_iter()
         .collect();
     cubes.par_sort_unstable();
-    let position = |p: &Point| Vec3::new(p[0] as Real, p[1] as Real, p[2] as Real) * h;
     // A batch of cubes at a time: their corners sampled in parallel; then in order, the grid edges the surface
     // crosses numbered as the cubes first meet them (inside end first) and the triangles on them; then the
     // batch's new crossings placed and its triangles oriented, in parallel. Only the batch waits in memory.
@@ -443,7 +446,7 @@ pub fn union_surface(capsules: &[Capsule], spacing: Real) -> UnionSurface {
         // Oriented with the outside in front: from an inside corner to an outside one.
         let vertices = &vertices;
         triangles.par_extend(faces.par_iter().map(|&(mut tri, inside, outside)| {
-            let direction = position(&outside) - position(&inside);
+            let direction = grid_position(&outside, h) - grid_position(&inside, h);
             let [a, b, c] = tri.map(|v| vertices[v as usize]);
             if (b - a).cross(&(c - a)).dot(&direction) < 0.0 {
                 tri.swap(1, 2);
@@ -500,6 +503,68 @@ mod tests {
                 "h = {h}: second order {second} vs {exact}, chords {volume}"
             );
         }
+    }
+
+    #[test]
+    fn grid_edges_have_keys_of_their_own_on_either_side_of_the_origin() {
+        // Every edge of Kuhn's tetrahedra from a point (a step of 0 or +1 along each axis) gets one key,
+        // whichever way round, and no two of them share one, at negative indices too (two's complement in 40
+        // bits).
+        let mut keys = std::collections::HashSet::new();
+        for p in [
+            [-3, -1, 0],
+            [-1, 0, 2],
+            [0, 0, 0],
+            [5, -7, 9],
+            [-(1 << 39), 1 << 38, -1],
+        ] {
+            for step in 1..8 {
+                let q = [
+                    p[0] + (step & 1),
+                    p[1] + (step >> 1 & 1),
+                    p[2] + (step >> 2 & 1),
+                ];
+                assert_eq!(edge_key(&p, &q), edge_key(&q, &p));
+                assert!(keys.insert(edge_key(&p, &q)), "{p:?} → {q:?}");
+            }
+        }
+    }
+
+    #[test]
+    fn the_contour_and_its_simplification_do_not_depend_on_the_threads() {
+        // Two crossing capsules contoured and simplified on one thread and on four: the same vertices and
+        // triangles, bit for bit (the distances are entered in the capsules' order, the crossings numbered in
+        // the cubes' order, and the simplifier's slabs, not the threads, decide its order).
+        let capsules = [
+            Capsule {
+                a: Vec3::new(-1.0, 0.0, 0.0),
+                b: Vec3::new(2.0, 0.3, 0.1),
+                radius: 0.3,
+            },
+            Capsule {
+                a: Vec3::new(0.5, -1.2, -0.4),
+                b: Vec3::new(0.4, 1.5, 0.6),
+                radius: 0.25,
+            },
+        ];
+        let on = |threads: usize| {
+            let pool = rayon::ThreadPoolBuilder::new()
+                .num_threads(threads)
+                .build()
+                .expect("a pool");
+            pool.install(|| {
+                let contour = union_surface(&capsules, 0.05).mesh;
+                let (simplified, _) = crate::geometry::simplify::simplify(&contour, 0.002);
+                (contour, simplified)
+            })
+        };
+        let (one, four) = (on(1), on(4));
+        for (a, b) in [(&one.0, &four.0), (&one.1, &four.1)] {
+            assert_eq!(a.triangles, b.triangles);
+            assert_eq!(a.vertices, b.vertices);
+        }
+        one.1.check_closed().expect("closed");
+        assert!((one.1.volume() / one.0.volume() - 1.0).abs() < 1e-12);
     }
 
     #[test]

@@ -23,8 +23,8 @@
 //! * **meshes** — the straight stent's whole cycle at p ∈ {4, 5, 6}, n ∈ [14, 40] with each rotation field
 //!   (issue 36): which meshes finish and where the others fail (about 20 minutes: not among the default maps
 //!   of `stentkit study stability`, and empty in [`StabilityStudy::default`]).
-//! * **curved** — the same for the curved stent at p ∈ {5, 6}, n ∈ [30, 81] (about an hour and a half on two
-//!   cores: not among the default maps either).
+//! * **curved** — the same for the curved stent at p ∈ {5, 6}, n ∈ [30, 81] (hours on two cores: not among the
+//!   default maps either).
 //!
 //! bend45, heating, release, coarse, meshes and curved are [`scenarios`] run through [`newton::newton_run`], which records what
 //! the solver did; contact is built in code ([`contact::crimped_crown`]) and run the same way.

@@ -5,7 +5,8 @@
 //! ([`VariedDesign::rebuild`]) — runs it through [`newton_run`] and presents its map ([`MapReport`]).
 
 use super::newton::{
-    SolverMap, SolverPoint, describe, newton_run, solver_chart, solver_csv, solver_summary,
+    NewtonRun, SolverMap, SolverPoint, describe, newton_run, solver_chart, solver_csv,
+    solver_summary,
 };
 use super::{MapReport, ReadDesign};
 use crate::math::Real;
@@ -575,15 +576,15 @@ pub fn stent_meshes() -> Vec<MeshCase> {
 }
 
 /// The curved stent's meshes map: p ∈ {5, 6}, n ∈ [30, 81] (the design's own mesh is p = 6, n = 81), with each
-/// rotation field (208 runs of 4000 steps: about an hour and a half on two cores).
+/// rotation field (208 runs of 4000 steps: hours on two cores; 108 of them took about 96 minutes, 2026-11-28).
 pub fn curved_meshes() -> Vec<MeshCase> {
     mesh_cases(5..=6, 30..=81)
 }
 
 /// `stent`'s whole cycle at each mesh and rotation field of `cases`, with `crowns` crowns instead of the
-/// design's when given. The runs are independent and run in parallel (rayon's pool), each reported to
-/// `progress` as it finishes; the map keeps the order of `cases`, and each run's wall time is its own (longer
-/// when the runs share the cores).
+/// design's when given. The runs are independent: one thread per core takes them one after the other, each
+/// reported to `progress` as it finishes; the map keeps the order of `cases`, and each run's wall time is its
+/// own (longer than alone when the runs share the cores).
 pub fn meshes_map(
     stent: MeshStent,
     cases: &[MeshCase],
@@ -591,7 +592,7 @@ pub fn meshes_map(
     read: &ReadDesign,
     mut progress: impl FnMut(&str),
 ) -> Result<SolverMap, StudyError> {
-    use rayon::prelude::*;
+    use std::sync::atomic::{AtomicUsize, Ordering};
     let (file, text) = stent.source();
     let design = embedded(read, text, file)?;
     let models = (cases.iter())
@@ -609,30 +610,47 @@ pub fn meshes_map(
             Ok(model.with_solver(solver)?)
         })
         .collect::<Result<Vec<Model>, StudyError>>()?;
-    let (sender, lines) = std::sync::mpsc::channel::<String>();
-    let runs = std::thread::scope(|scope| {
-        let worker = scope.spawn(|| {
-            (models.par_iter().zip(cases))
-                .map_with(sender, |sender, (model, &MeshCase { p, n, rotations })| {
-                    let run = newton_run(model)?;
-                    // The receiver outlives every sender; a send fails only after it panicked.
-                    let _ = sender.send(format!(
-                        "{}, p = {p}, n = {n}, {} rotation field: {}",
-                        stent.label(),
-                        field_name(rotations),
-                        describe(&run)
-                    ));
-                    Ok::<_, StudyError>(run)
-                })
-                .collect::<Result<Vec<_>, _>>()
-        });
-        // Every sender is dropped when the runs are done, which ends this loop.
-        for line in lines {
-            progress(&line);
+    // Plain threads, each taking the next case: a rayon task waiting in a run's own parallel work could start
+    // another whole run on its stack (rayon-rs/rayon#854), and that run's time would count in this one's.
+    let workers = std::thread::available_parallelism().map_or(1, usize::from);
+    let next = AtomicUsize::new(0);
+    let (sender, finished) = std::sync::mpsc::channel();
+    let mut runs: Vec<Option<NewtonRun>> = cases.iter().map(|_| None).collect();
+    std::thread::scope(|scope| -> Result<(), StudyError> {
+        for _ in 0..workers.min(models.len()) {
+            let (sender, models, next) = (sender.clone(), &models, &next);
+            scope.spawn(move || {
+                loop {
+                    let k = next.fetch_add(1, Ordering::Relaxed);
+                    let Some(model) = models.get(k) else {
+                        break;
+                    };
+                    // The receiver is gone only after an error: stop.
+                    if sender.send((k, newton_run(model))).is_err() {
+                        break;
+                    }
+                }
+            });
         }
-        worker.join()
-    })
-    .unwrap_or_else(|panic| std::panic::resume_unwind(panic))?;
+        // The workers' senders are dropped as they finish, which ends this loop (a panic too: the scope
+        // then passes it on).
+        drop(sender);
+        for (k, run) in finished {
+            let run = run?;
+            let MeshCase { p, n, rotations } = cases[k];
+            progress(&format!(
+                "{}, p = {p}, n = {n}, {} rotation field: {}",
+                stent.label(),
+                field_name(rotations),
+                describe(&run)
+            ));
+            runs[k] = Some(run);
+        }
+        Ok(())
+    })?;
+    let runs = runs.into_iter().map(|run| {
+        run.expect("every case ran: the workers stop early only after an error, returned above")
+    });
     let points = (cases.iter().zip(runs))
         .map(|(&MeshCase { p, n, rotations }, run)| SolverPoint {
             parameters: vec![
