@@ -210,8 +210,6 @@ struct Collapser {
     frozen: Vec<bool>,
     queue: CostQueue,
     triangles_left: usize,
-    /// A buffer for the neighbours of a collapsed vertex.
-    scratch: Vec<u32>,
 }
 
 impl Collapser {
@@ -247,7 +245,6 @@ impl Collapser {
             version: vec![0; n],
             frozen,
             queue: CostQueue::new(limit),
-            scratch: Vec::new(),
         }
     }
 
@@ -256,7 +253,7 @@ impl Collapser {
     /// collapse may not do; one whose full cost belongs to a later bucket than its bound's is queued there
     /// (module docs, *Lazy costs*). Returns the largest cost of a collapse made (zero if none).
     fn run(&mut self) -> Real {
-        let (mut nu, mut nv) = (Vec::new(), Vec::new());
+        let (mut nu, mut nv, mut ring) = (Vec::new(), Vec::new(), Vec::new());
         let mut largest_cost: Real = 0.0;
         for _ in 0..MAX_PASSES {
             // Each edge once: as the directed edge of a triangle that runs from the lower index to the
@@ -304,13 +301,11 @@ impl Collapser {
                 }
                 largest_cost = largest_cost.max(cost);
                 // The merged vertex's neighbours are both ends' but the ends themselves.
-                let mut ring = std::mem::take(&mut self.scratch);
                 ring.clear();
                 ring.extend(nu.iter().chain(&nv).filter(|&&w| w != u && w != v));
                 ring.sort_unstable();
                 ring.dedup();
                 self.collapse(u, v, x, &ring);
-                self.scratch = ring;
             }
             if self.triangles_left == before {
                 break;
@@ -485,11 +480,9 @@ pub(crate) fn simplify(mesh: &TriangleMesh, tolerance: Real) -> (TriangleMesh, S
     let mut positions = mesh.vertices.clone();
     let mut triangles = mesh.triangles.clone();
     let mut alive = vec![true; triangles.len()];
-    let slab = slab_of(&mesh.vertices);
-    let slabs: Vec<Left> = (0..SLABS)
-        .into_par_iter()
-        .map(|k| {
-            let (part, mut work) = Slab::cut(mesh, &slab, k, &quadrics, limit);
+    let slabs: Vec<Left> = (Slab::cut(mesh).into_par_iter())
+        .map(|mut part| {
+            let mut work = part.collapser(mesh, &quadrics, limit);
             let cost = work.run();
             part.left(&work, cost)
         })
@@ -561,12 +554,15 @@ fn slab_of(vertices: &[Vec3]) -> Vec<usize> {
 }
 
 /// One slab of the surface as a mesh of its own: the triangles whose three corners lie in it, their corners
-/// renumbered (global numbers in `vertices` and `triangles`). A corner of a triangle that crosses into another
-/// slab is frozen: the slab's triangles around every other vertex are all there are, so a collapse inside
-/// the slab sees what it would see in the whole surface, and no two slabs touch the same vertex or triangle.
+/// renumbered (global numbers in `vertices` and `triangles`, its own in `corners`). A corner of a triangle that
+/// crosses into another slab is frozen: the slab's triangles around every other vertex are all there are, so a
+/// collapse inside the slab sees what it would see in the whole surface, and no two slabs touch the same vertex
+/// or triangle.
 struct Slab {
     vertices: Vec<u32>,
     triangles: Vec<u32>,
+    corners: Vec<[u32; 3]>,
+    frozen: Vec<bool>,
 }
 
 /// What is left of a slab after its collapses, in the surface's numbering: its surviving vertices with their
@@ -601,53 +597,61 @@ impl Slab {
         }
     }
 
-    /// Slab `k` of `mesh` (vertices assigned by `slab`) and its collapser.
-    fn cut(
-        mesh: &TriangleMesh,
-        slab: &[usize],
-        k: usize,
-        quadrics: &[Quadric],
-        limit: Real,
-    ) -> (Self, Collapser) {
-        let in_slab = |i: u32| slab[i as usize] == k;
+    /// The [`SLABS`] slabs of `mesh` ([`slab_of`]), in one pass over its triangles: each slab's vertices
+    /// numbered in the order its triangles first meet them.
+    fn cut(mesh: &TriangleMesh) -> Vec<Slab> {
+        let slab = slab_of(&mesh.vertices);
+        let mut slabs: Vec<Slab> = (0..SLABS)
+            .map(|_| Slab {
+                vertices: Vec::new(),
+                triangles: Vec::new(),
+                corners: Vec::new(),
+                frozen: Vec::new(),
+            })
+            .collect();
+        // Each vertex lies in one slab: its number there, and whether a crossing triangle holds it.
         let mut local = vec![u32::MAX; mesh.vertices.len()];
-        let mut part = Slab {
-            vertices: Vec::new(),
-            triangles: Vec::new(),
-        };
-        let mut seam = Vec::new();
-        let mut triangles = Vec::new();
+        let mut seam = vec![false; mesh.vertices.len()];
         for (t, tri) in mesh.triangles.iter().enumerate() {
-            let inside = tri.iter().filter(|&&i| in_slab(i)).count();
-            if inside == 3 {
-                let renumbered = tri.map(|i| {
-                    if local[i as usize] == u32::MAX {
-                        local[i as usize] = part.vertices.len() as u32;
-                        part.vertices.push(i);
-                    }
-                    local[i as usize]
-                });
-                triangles.push(renumbered);
-                part.triangles.push(t as u32);
-            } else if inside > 0 {
-                seam.extend(tri.iter().copied().filter(|&i| in_slab(i)));
+            let k = slab[tri[0] as usize];
+            if tri.iter().any(|&i| slab[i as usize] != k) {
+                for &i in tri {
+                    seam[i as usize] = true;
+                }
+                continue;
             }
+            let part = &mut slabs[k];
+            let corners = tri.map(|i| {
+                if local[i as usize] == u32::MAX {
+                    local[i as usize] = part.vertices.len() as u32;
+                    part.vertices.push(i);
+                }
+                local[i as usize]
+            });
+            part.corners.push(corners);
+            part.triangles.push(t as u32);
         }
-        let mut frozen = vec![false; part.vertices.len()];
-        for i in seam {
-            if local[i as usize] != u32::MAX {
-                frozen[local[i as usize] as usize] = true;
-            }
+        for part in &mut slabs {
+            part.frozen = part.vertices.iter().map(|&i| seam[i as usize]).collect();
         }
-        let positions = (part.vertices.iter())
+        slabs
+    }
+
+    /// The collapser of this slab of `mesh`, with the vertices' `quadrics`, collapsing at costs up to `limit`
+    /// (it takes the slab's corners and frozen flags).
+    fn collapser(&mut self, mesh: &TriangleMesh, quadrics: &[Quadric], limit: Real) -> Collapser {
+        let positions = (self.vertices.iter())
             .map(|&i| mesh.vertices[i as usize])
             .collect();
-        let quadrics = (part.vertices.iter())
+        let quadrics = (self.vertices.iter())
             .map(|&i| quadrics[i as usize])
             .collect();
-        let alive = vec![true; triangles.len()];
-        let work = Collapser::new(positions, quadrics, triangles, alive, frozen, limit);
-        (part, work)
+        let alive = vec![true; self.corners.len()];
+        let (corners, frozen) = (
+            std::mem::take(&mut self.corners),
+            std::mem::take(&mut self.frozen),
+        );
+        Collapser::new(positions, quadrics, corners, alive, frozen, limit)
     }
 }
 

@@ -533,6 +533,26 @@ impl MeshStent {
         }
     }
 
+    /// What its programme does before the release, for the map's paragraph.
+    const fn programme(self) -> &'static str {
+        match self {
+            Self::Straight => "crimped, cooled",
+            Self::Curved => "straightened and compacted, cooled",
+        }
+    }
+
+    /// What the map's paragraph says of this stent's failures.
+    const fn remark(self) -> &'static str {
+        match self {
+            Self::Straight => {
+                "The paper's field's failures come and go with n, which a resolution limit would not do: its discrete configuration depends on the increments that led to it (docs/choices.md, *Rotation field*). Where the objective field fails the meshes are the coarsest; the release map (`--maps release`) shows one of them (p = 5, n = 14) folding in its own release path. Rod contact (`contact: {wires: true}`) does not rescue these coarse meshes (docs/speed.md, *Coarse stents and the rotation field*)."
+            }
+            Self::Curved => {
+                "The paper's programme pushes a bridge lying in the symmetry plane across it while the stent is straightened (the crossing check warns of it on the design's own mesh too, README *Wires through each other are said*): a run with its wires through each other from the programming on is the paper's programme's, on any mesh."
+            }
+        }
+    }
+
     /// The design's release time \[s\] (`programme.release`; the test
     /// `the_meshes_maps_know_their_stents_release` holds it to the design's model).
     pub const fn release(self) -> Real {
@@ -750,18 +770,10 @@ pub fn meshes_report(stent: MeshStent, map: &SolverMap) -> MapReport {
     }
     let _ = write!(
         summary,
-        "\nThe stent (designs/{file}) runs its whole programme — {} — at each degree and number of control points per patch, Newton alone (no stabilisation). A failure is the solver's: no convergence at the smallest step. A failure after the device's wires had passed through each other (the crossing check: a wire through another, or a wire through its own mirror image across a symmetry plane) says since when: the model was then no longer the device, the physical reason it gives. {}\n\n",
-        match stent {
-            MeshStent::Straight => "crimped, cooled, released at 1.75 s, re-heated",
-            MeshStent::Curved =>
-                "straightened and compacted, cooled, released at 2.25 s, re-heated",
-        },
-        match stent {
-            MeshStent::Straight =>
-                "The paper's field's failures come and go with n, which a resolution limit would not do: its discrete configuration depends on the increments that led to it (docs/choices.md, *Rotation field*). Where the objective field fails the meshes are the coarsest; the release map (`--maps release`) shows one of them (p = 5, n = 14) folding in its own release path. Rod contact (`contact: {wires: true}`) does not rescue these coarse meshes (docs/speed.md, *Coarse stents and the rotation field*).",
-            MeshStent::Curved =>
-                "The paper's programme pushes a bridge lying in the symmetry plane across it while the stent is straightened (the crossing check warns of it on the design's own mesh too, README *Wires through each other are said*): a run with its wires through each other from the programming on is the paper's programme's, on any mesh.",
-        }
+        "\nThe stent (designs/{file}) runs its whole programme — {}, released at {} s, re-heated — at each degree and number of control points per patch, Newton alone (no stabilisation). A failure is the solver's: no convergence at the smallest step. A failure after the device's wires had passed through each other (the crossing check: a wire through another, or a wire through its own mirror image across a symmetry plane) says since when: the model was then no longer the device, the physical reason it gives. {}\n\n",
+        stent.programme(),
+        stent.release(),
+        stent.remark()
     );
     let header = format!(
         "the {}'s whole cycle (designs/{file}) at each degree p, control points per patch n and rotation field (objective_rotations: 1 for the objective field, 0 for the paper's)",
